@@ -1,0 +1,319 @@
+//! The graph model and its RON file format.
+//!
+//! A graph file is versioned and human-editable; nodes and edges keep the order they
+//! are written in, and params are kept sorted, so load → save → load is an identity and
+//! a saved file diffs cleanly. Saving writes a temporary file beside the target and
+//! renames it over, so a failed save never leaves a half-written graph.
+
+use std::collections::BTreeMap;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{ErrorKind, GraphError, Pos};
+use crate::types::ParamValue;
+
+/// The graph file version this build reads and writes.
+pub const VERSION: u32 = 1;
+
+/// A node: an instance of a node kind with its params.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Node {
+    /// Stable id, unique in the graph; edges name nodes by it.
+    pub id: String,
+    /// Name of the node kind in the registry.
+    pub kind: String,
+    /// Param values; params not listed take their defaults.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub params: BTreeMap<String, ParamValue>,
+    /// Position in the editor's canvas.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pos: Option<(f32, f32)>,
+}
+
+impl Node {
+    /// A node of `kind` with default params.
+    pub fn new(id: impl Into<String>, kind: impl Into<String>) -> Self {
+        Self {
+            id: id.into(),
+            kind: kind.into(),
+            params: BTreeMap::new(),
+            pos: None,
+        }
+    }
+
+    /// The same node with `param` set to `value`.
+    #[must_use]
+    pub fn with(mut self, param: &str, value: ParamValue) -> Self {
+        self.params.insert(param.to_owned(), value);
+        self
+    }
+}
+
+/// An edge from an output port to an input port, each written `"node.port"`.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Edge {
+    /// Output port, `"node.port"`.
+    pub from: String,
+    /// Input port, `"node.port"`.
+    pub to: String,
+}
+
+impl Edge {
+    /// An edge between two `"node.port"` references.
+    pub fn new(from: impl Into<String>, to: impl Into<String>) -> Self {
+        Self {
+            from: from.into(),
+            to: to.into(),
+        }
+    }
+}
+
+/// Splits `"node.port"` at its last dot.
+pub fn split_port_ref(r: &str) -> Option<(&str, &str)> {
+    let (node, port) = r.rsplit_once('.')?;
+    (!node.is_empty() && !port.is_empty()).then_some((node, port))
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GraphFile {
+    version: u32,
+    nodes: Vec<Node>,
+    #[serde(default)]
+    edges: Vec<Edge>,
+}
+
+#[derive(Deserialize)]
+struct VersionProbe {
+    version: u32,
+}
+
+/// Where a graph was loaded from, kept to point errors at lines.
+#[derive(Clone, Debug)]
+pub struct Origin {
+    /// The file.
+    pub path: PathBuf,
+    text: String,
+}
+
+impl Origin {
+    fn pos_of_offset(&self, offset: usize) -> Pos {
+        let before = &self.text[..offset];
+        let line = before.matches('\n').count() + 1;
+        let col = before.rfind('\n').map_or(offset, |nl| offset - nl - 1) + 1;
+        Pos { line, col }
+    }
+
+    fn node_offset(&self, id: &str) -> Option<usize> {
+        let needle = format!("\"{id}\"");
+        self.text.match_indices(&needle).map(|(i, _)| i).find(|&i| {
+            self.text[..i].trim_end().ends_with("id:")
+        })
+    }
+
+    /// Where node `id` is declared.
+    pub fn node_pos(&self, id: &str) -> Option<Pos> {
+        self.node_offset(id).map(|o| self.pos_of_offset(o))
+    }
+
+    /// Where param `param` of node `id` is set, or else where the node is declared.
+    pub fn param_pos(&self, id: &str, param: &str) -> Option<Pos> {
+        let start = self.node_offset(id)?;
+        let rest = &self.text[start..];
+        let end = rest[1..].find("id:").map_or(rest.len(), |e| e + 1);
+        let found = rest[..end].find(&format!("\"{param}\""));
+        Some(self.pos_of_offset(start + found.unwrap_or(0)))
+    }
+
+    /// Where the `index`-th edge is written.
+    pub fn edge_pos(&self, index: usize) -> Option<Pos> {
+        let edges = self.text.find("edges")?;
+        let (o, _) = self.text[edges..].match_indices("from").nth(index)?;
+        Some(self.pos_of_offset(edges + o))
+    }
+}
+
+/// A render graph: nodes and the edges between their ports.
+#[derive(Clone, Debug, Default)]
+pub struct Graph {
+    /// Nodes, in file order.
+    pub nodes: Vec<Node>,
+    /// Edges, in file order.
+    pub edges: Vec<Edge>,
+    /// The file the graph was loaded from.
+    pub origin: Option<Origin>,
+}
+
+impl PartialEq for Graph {
+    fn eq(&self, other: &Self) -> bool {
+        self.nodes == other.nodes && self.edges == other.edges
+    }
+}
+
+impl Graph {
+    /// An empty graph.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Loads a graph file.
+    ///
+    /// # Errors
+    /// When the file cannot be read or is not a valid graph file; the error names the file
+    /// and the line and column.
+    pub fn load(path: &Path) -> Result<Self, GraphError> {
+        let text = std::fs::read_to_string(path).map_err(|source| GraphError {
+            file: Some(path.to_owned()),
+            ..GraphError::new(ErrorKind::Io {
+                action: "cannot read graph file",
+                source,
+            })
+        })?;
+        let mut graph = Self::from_ron(&text).map_err(|mut e| {
+            e.file = Some(path.to_owned());
+            e
+        })?;
+        graph.origin = Some(Origin {
+            path: path.to_owned(),
+            text,
+        });
+        Ok(graph)
+    }
+
+    /// Parses a graph from RON text.
+    ///
+    /// # Errors
+    /// On a syntax error (with line and column) or an unsupported version.
+    pub fn from_ron(text: &str) -> Result<Self, GraphError> {
+        let syntax = |e: ron::error::SpannedError| GraphError {
+            pos: Some(Pos {
+                line: e.span.start.line,
+                col: e.span.start.col,
+            }),
+            ..GraphError::new(ErrorKind::Syntax(e.code.to_string()))
+        };
+        let probe: VersionProbe = ron::from_str(text).map_err(syntax)?;
+        if probe.version != VERSION {
+            return Err(GraphError::new(ErrorKind::Version {
+                found: probe.version,
+                supported: VERSION,
+            }));
+        }
+        let file: GraphFile = ron::from_str(text).map_err(syntax)?;
+        Ok(Self {
+            nodes: file.nodes,
+            edges: file.edges,
+            origin: None,
+        })
+    }
+
+    /// The graph as RON text, in the canonical layout `save` writes.
+    pub fn to_ron(&self) -> String {
+        let file = GraphFile {
+            version: VERSION,
+            nodes: self.nodes.clone(),
+            edges: self.edges.clone(),
+        };
+        let config = ron::ser::PrettyConfig::new()
+            .depth_limit(3)
+            .struct_names(false)
+            .indentor("    ");
+        let mut text = ron::ser::to_string_pretty(&file, config)
+            .expect("a graph always serializes: it holds only strings, numbers and maps");
+        text.push('\n');
+        text
+    }
+
+    /// Writes the graph to `path` atomically: a temporary file in the same folder,
+    /// renamed over the target, so the old file survives any failure.
+    ///
+    /// # Errors
+    /// When the folder cannot be written.
+    pub fn save(&self, path: &Path) -> Result<(), GraphError> {
+        write_atomic(path, self.to_ron().as_bytes()).map_err(|source| GraphError {
+            file: Some(path.to_owned()),
+            ..GraphError::new(ErrorKind::Io {
+                action: "cannot write graph file",
+                source,
+            })
+        })
+    }
+
+    /// The folder relative input paths are resolved against: the graph file's folder,
+    /// or the current folder for a graph not loaded from a file.
+    pub fn base_dir(&self) -> PathBuf {
+        self.origin
+            .as_ref()
+            .and_then(|o| o.path.parent().map(Path::to_path_buf))
+            .unwrap_or_default()
+    }
+
+    /// The node with id `id`.
+    pub fn node(&self, id: &str) -> Option<&Node> {
+        self.nodes.iter().find(|n| n.id == id)
+    }
+
+    /// The node with id `id`, mutably.
+    pub fn node_mut(&mut self, id: &str) -> Option<&mut Node> {
+        self.nodes.iter_mut().find(|n| n.id == id)
+    }
+
+    /// Sets a param from an override such as `tonemap.operator=agx` (the value in RON
+    /// syntax, or a bare word for a string). The value is checked when the graph is compiled.
+    ///
+    /// # Errors
+    /// When the override is malformed or names a missing node.
+    pub fn apply_override(&mut self, assignment: &str) -> Result<(), GraphError> {
+        let bad = |m: String| GraphError::new(ErrorKind::Source(m));
+        let (target, value) = assignment
+            .split_once('=')
+            .ok_or_else(|| bad(format!("override \"{assignment}\" is not node.param=value")))?;
+        let (node, param) = split_port_ref(target.trim())
+            .ok_or_else(|| bad(format!("override \"{assignment}\" is not node.param=value")))?;
+        let value = ParamValue::parse(value)
+            .map_err(|m| bad(format!("override \"{assignment}\": {m}")))?;
+        let n = self
+            .node_mut(node)
+            .ok_or_else(|| bad(format!("override \"{assignment}\": no node \"{node}\"")))?;
+        n.params.insert(param.to_owned(), value);
+        Ok(())
+    }
+
+    /// Fills in file, line and column for an error found in this graph.
+    pub fn locate(&self, mut e: GraphError, edge: Option<usize>, param: Option<&str>) -> GraphError {
+        if let Some(origin) = &self.origin {
+            e.file = Some(origin.path.clone());
+            e.pos = match (edge, &e.node, param) {
+                (Some(i), _, _) => origin.edge_pos(i),
+                (None, Some(node), Some(p)) => origin.param_pos(node, p),
+                (None, Some(node), None) => origin.node_pos(node),
+                _ => None,
+            };
+        }
+        e
+    }
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same folder and a rename,
+/// so readers see either the old file or the whole new one.
+///
+/// # Errors
+/// When the temporary file cannot be created, written or renamed.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".lumagraph-")
+        .suffix(".tmp")
+        .tempfile_in(dir)?;
+    tmp.write_all(bytes)?;
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}

@@ -1,0 +1,23 @@
+//! The lumagraph render graph, with no GPU in sight.
+//!
+//! - [`registry`]: the node kinds, their typed ports and params, with docs.
+//! - [`Graph`]: nodes and edges, loaded from and saved to versioned RON files.
+//! - [`compile`]: validation, topological order, pruning and texture assignment,
+//!   giving a [`Plan`] that the render crate executes.
+//!
+//! Everything here runs anywhere in microseconds, so it is tested without a GPU.
+
+mod compile;
+pub mod docs;
+mod error;
+mod graph;
+mod plan;
+pub mod registry;
+mod types;
+
+pub use compile::{CompileOptions, Params, compile, resolve_params};
+pub use error::{ErrorKind, GraphError, GraphErrors, Pos};
+pub use graph::{Edge, Graph, Node, Origin, VERSION, split_port_ref, write_atomic};
+pub use plan::{LeftOut, Pass, Plan, Slot, TextureDesc, TextureId};
+pub use registry::{Category, NodeKind, Registry};
+pub use types::{Extent, ParamType, ParamValue, PortType, TexFormat};

@@ -1,0 +1,268 @@
+//! The node kinds the graph knows: their ports, params and docs.
+//!
+//! The registry is data, not code: the compiler, the CLI's `nodes` listing, the generated
+//! docs and the editor's menus and inspector all read these declarations, so a kind is
+//! described in exactly one place. The GPU implementation of each kind lives in the
+//! render crate under the same name.
+
+use std::sync::LazyLock;
+
+use crate::types::{ParamType, PortType};
+
+/// Where a node kind sits in menus and docs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[non_exhaustive]
+pub enum Category {
+    /// Nodes that produce images from files or scenes.
+    Input,
+    /// Nodes that change colors of an image.
+    Color,
+    /// Nodes that write results out of the graph.
+    Output,
+}
+
+impl Category {
+    /// Display name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Input => "Input",
+            Self::Color => "Color",
+            Self::Output => "Output",
+        }
+    }
+}
+
+/// An input port of a node kind.
+#[derive(Clone, Debug)]
+pub struct InputDef {
+    /// Port name, unique among the kind's inputs.
+    pub name: &'static str,
+    /// The port types it accepts.
+    pub accepts: &'static [PortType],
+    /// One-line description.
+    pub doc: &'static str,
+}
+
+/// An output port of a node kind.
+#[derive(Clone, Debug)]
+pub struct OutputDef {
+    /// Port name, unique among the kind's outputs.
+    pub name: &'static str,
+    /// What it produces.
+    pub ty: PortType,
+    /// One-line description.
+    pub doc: &'static str,
+}
+
+/// A parameter of a node kind.
+#[derive(Clone, Debug)]
+pub struct ParamDef {
+    /// Parameter name, unique within the kind.
+    pub name: &'static str,
+    /// Type, default and range.
+    pub ty: ParamType,
+    /// One-line description.
+    pub doc: &'static str,
+}
+
+/// A kind of node: what it reads, writes and is configured with.
+#[derive(Clone, Debug)]
+pub struct NodeKind {
+    /// Name used in graph files (`kind: "Tonemap"`).
+    pub name: &'static str,
+    /// Menu and docs grouping.
+    pub category: Category,
+    /// One-paragraph description.
+    pub doc: &'static str,
+    /// Input ports; every one must be connected.
+    pub inputs: &'static [InputDef],
+    /// Output ports.
+    pub outputs: &'static [OutputDef],
+    /// Parameters.
+    pub params: Vec<ParamDef>,
+    /// Whether the node is a sink: it writes results out of the graph, and the nodes
+    /// that feed no sink are pruned.
+    pub sink: bool,
+}
+
+impl NodeKind {
+    /// The input port called `name`.
+    pub fn input(&self, name: &str) -> Option<&InputDef> {
+        self.inputs.iter().find(|p| p.name == name)
+    }
+
+    /// The output port called `name`.
+    pub fn output(&self, name: &str) -> Option<&OutputDef> {
+        self.outputs.iter().find(|p| p.name == name)
+    }
+
+    /// The parameter called `name`.
+    pub fn param(&self, name: &str) -> Option<&ParamDef> {
+        self.params.iter().find(|p| p.name == name)
+    }
+
+    /// Whether the node has no inputs and so sets the image size itself.
+    pub fn is_source(&self) -> bool {
+        self.inputs.is_empty()
+    }
+}
+
+/// A set of node kinds.
+#[derive(Debug)]
+pub struct Registry {
+    kinds: Vec<NodeKind>,
+}
+
+impl Registry {
+    /// The kinds built into lumagraph.
+    pub fn builtin() -> &'static Self {
+        static BUILTIN: LazyLock<Registry> = LazyLock::new(|| Registry {
+            kinds: builtin_kinds(),
+        });
+        &BUILTIN
+    }
+
+    /// The kind called `name`.
+    pub fn get(&self, name: &str) -> Option<&NodeKind> {
+        self.kinds.iter().find(|k| k.name == name)
+    }
+
+    /// Every kind, in registry order (grouped by category).
+    pub fn kinds(&self) -> &[NodeKind] {
+        &self.kinds
+    }
+}
+
+const COLOR_TYPES: &[PortType] = &[PortType::HdrColor];
+const ANY_IMAGE: &[PortType] = &[
+    PortType::HdrColor,
+    PortType::LdrColor,
+    PortType::Albedo,
+    PortType::Normal,
+    PortType::Depth,
+    PortType::Variance,
+];
+
+/// Tone-mapping operators, shared by the registry and the implementations.
+pub const TONEMAP_OPERATORS: &[(&str, &str)] = &[
+    ("clamp", "linear, clipped to [0, 1]"),
+    (
+        "reinhard",
+        "extended Reinhard on luminance, `white` maps to 1",
+    ),
+    ("aces", "ACES filmic curve (Hill's RRT+ODT fit)"),
+    ("agx", "AgX base (Sobotka), polynomial fit of the sigmoid"),
+    (
+        "pbr_neutral",
+        "Khronos PBR Neutral: keeps base colors, compresses highlights",
+    ),
+];
+
+fn builtin_kinds() -> Vec<NodeKind> {
+    vec![
+        NodeKind {
+            name: "ImageInput",
+            category: Category::Input,
+            doc: "Reads an image file. EXR and Radiance .hdr are taken as linear; PNG and JPEG are \
+                  decoded from sRGB to linear. The image sets the size of everything downstream.",
+            inputs: &[],
+            outputs: &[OutputDef {
+                name: "color",
+                ty: PortType::HdrColor,
+                doc: "the image, linear RGB",
+            }],
+            params: vec![ParamDef {
+                name: "path",
+                ty: ParamType::Path {
+                    default: "image.exr",
+                    extensions: &["exr", "hdr", "png", "jpg", "jpeg"],
+                },
+                doc: "image file, relative to the graph file's folder",
+            }],
+            sink: false,
+        },
+        NodeKind {
+            name: "Exposure",
+            category: Category::Color,
+            doc: "Scales linear color by 2^ev.",
+            inputs: &[InputDef {
+                name: "color",
+                accepts: COLOR_TYPES,
+                doc: "linear color",
+            }],
+            outputs: &[OutputDef {
+                name: "color",
+                ty: PortType::HdrColor,
+                doc: "color × 2^ev",
+            }],
+            params: vec![ParamDef {
+                name: "ev",
+                ty: ParamType::Float {
+                    default: 0.0,
+                    min: -20.0,
+                    max: 20.0,
+                },
+                doc: "exposure in stops; +1 doubles the brightness",
+            }],
+            sink: false,
+        },
+        NodeKind {
+            name: "Tonemap",
+            category: Category::Color,
+            doc: "Maps linear scene color to display color with a tone curve, then applies the \
+                  sRGB transfer function.",
+            inputs: &[InputDef {
+                name: "color",
+                accepts: COLOR_TYPES,
+                doc: "linear color",
+            }],
+            outputs: &[OutputDef {
+                name: "color",
+                ty: PortType::LdrColor,
+                doc: "display-encoded color",
+            }],
+            params: vec![
+                ParamDef {
+                    name: "operator",
+                    ty: ParamType::Enum {
+                        default: "aces",
+                        options: TONEMAP_OPERATORS,
+                    },
+                    doc: "tone curve",
+                },
+                ParamDef {
+                    name: "white",
+                    ty: ParamType::Float {
+                        default: 4.0,
+                        min: 1e-3,
+                        max: 1e6,
+                    },
+                    doc: "luminance mapped to white by `reinhard` (other operators ignore it)",
+                },
+            ],
+            sink: false,
+        },
+        NodeKind {
+            name: "Output",
+            category: Category::Output,
+            doc: "Writes its input to a file: PNG (8-bit sRGB) or EXR (32-bit float RGBA), chosen \
+                  by the extension. Linear input is sRGB-encoded (clipped) for PNG and written \
+                  as is to EXR; display-encoded input is written as is to both.",
+            inputs: &[InputDef {
+                name: "color",
+                accepts: ANY_IMAGE,
+                doc: "image to write",
+            }],
+            outputs: &[],
+            params: vec![ParamDef {
+                name: "path",
+                ty: ParamType::Path {
+                    default: "out.png",
+                    extensions: &["png", "exr"],
+                },
+                doc: "file to write, relative to the output folder (`--out`)",
+            }],
+            sink: true,
+        },
+    ]
+}

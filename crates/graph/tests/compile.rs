@@ -1,0 +1,323 @@
+//! Validation, pruning and texture assignment, and the RON round trip.
+
+use lumagraph_graph::{
+    CompileOptions, Edge, ErrorKind, Extent, Graph, GraphErrors, Node, ParamValue, Plan, Registry, compile,
+};
+
+fn extent(_: &Node, _: &lumagraph_graph::Params) -> Result<Extent, String> {
+    Ok(Extent::new(64, 32))
+}
+
+fn compile_graph(g: &Graph) -> Result<Plan, GraphErrors> {
+    compile(g, Registry::builtin(), &CompileOptions { source_extent: &extent, keep: &[] })
+}
+
+fn chain() -> Graph {
+    Graph {
+        nodes: vec![
+            Node::new("input", "ImageInput").with("path", ParamValue::Str("in.exr".into())),
+            Node::new("exposure", "Exposure").with("ev", ParamValue::Float(1.0)),
+            Node::new("tonemap", "Tonemap").with("operator", ParamValue::Str("agx".into())),
+            Node::new("out", "Output").with("path", ParamValue::Str("out.png".into())),
+        ],
+        edges: vec![
+            Edge::new("input.color", "exposure.color"),
+            Edge::new("exposure.color", "tonemap.color"),
+            Edge::new("tonemap.color", "out.color"),
+        ],
+        origin: None,
+    }
+}
+
+fn load_str(text: &str) -> Result<Graph, lumagraph_graph::GraphError> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("g.ron");
+    std::fs::write(&path, text).unwrap();
+    Graph::load(&path)
+}
+
+/// Loads `text` and compiles it, returning the one error message expected.
+fn single_error(text: &str) -> (ErrorKind, String) {
+    let g = load_str(text).unwrap();
+    let errors = compile_graph(&g).expect_err("graph should be rejected");
+    let message = errors.to_string();
+    assert_eq!(errors.0.len(), 1, "expected one error, got: {message}");
+    let e = errors.0.into_iter().next().unwrap();
+    assert!(e.file.is_some(), "error names no file: {message}");
+    (e.kind, message)
+}
+
+#[test]
+fn chain_compiles_in_order() {
+    let plan = compile_graph(&chain()).unwrap();
+    let order: Vec<_> = plan.passes.iter().map(|p| p.node.as_str()).collect();
+    assert_eq!(order, ["input", "exposure", "tonemap", "out"]);
+    assert!(plan.left_out.is_empty(), "{:?}", plan.left_out);
+    assert!((plan.pass("exposure").unwrap().params.float("ev") - 1.0).abs() < 1e-12);
+    // defaults filled in
+    assert!((plan.pass("tonemap").unwrap().params.float("white") - 4.0).abs() < 1e-12);
+}
+
+#[test]
+fn textures_share_memory_when_lifetimes_do_not_overlap() {
+    // input -> e1 -> e2 -> e3 -> out: input.color dies at pass 2, e2.color is written at 3.
+    let mut g = chain();
+    g.nodes = vec![
+        Node::new("input", "ImageInput"),
+        Node::new("e1", "Exposure"),
+        Node::new("e2", "Exposure"),
+        Node::new("e3", "Exposure"),
+        Node::new("out", "Output"),
+    ];
+    g.edges = vec![
+        Edge::new("input.color", "e1.color"),
+        Edge::new("e1.color", "e2.color"),
+        Edge::new("e2.color", "e3.color"),
+        Edge::new("e3.color", "out.color"),
+    ];
+    let plan = compile_graph(&g).unwrap();
+    assert_eq!(plan.textures.len(), 4);
+    assert_eq!(plan.slots.len(), 2, "{plan}");
+    // no two textures in one slot overlap in time
+    for slot in &plan.slots {
+        for w in slot.textures.windows(2) {
+            assert!(plan.textures[w[0].0].last < plan.textures[w[1].0].first, "{plan}");
+        }
+    }
+    assert_eq!(plan.texture_bytes() * 2, plan.unshared_texture_bytes());
+}
+
+#[test]
+fn dead_branch_is_left_out() {
+    let mut g = chain();
+    g.nodes.push(Node::new("debug", "Tonemap"));
+    g.edges.push(Edge::new("exposure.color", "debug.color"));
+    let plan = compile_graph(&g).unwrap();
+    assert!(plan.pass("debug").is_none());
+    assert!(plan.left_out.iter().any(|l| l.what.contains("\"debug\"") && l.reason.contains("no output")));
+    assert!(plan.to_string().contains("node \"debug\" (Tonemap): feeds no output"));
+}
+
+#[test]
+fn kept_port_stays_alive_to_the_end() {
+    let keep = ["exposure.color".to_owned()];
+    let plan = compile(&chain(), Registry::builtin(), &CompileOptions { source_extent: &extent, keep: &keep }).unwrap();
+    let t = plan.textures.iter().find(|t| t.name == "exposure.color").unwrap();
+    assert_eq!(t.last, plan.passes.len());
+}
+
+#[test]
+fn ron_round_trip_is_identical() {
+    let mut g = chain();
+    g.nodes[0].pos = Some((10.0, -20.5));
+    let text = g.to_ron();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("chain.ron");
+    g.save(&path).unwrap();
+    let loaded = Graph::load(&path).unwrap();
+    assert_eq!(loaded, g);
+    loaded.save(&path).unwrap();
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), text);
+    // no temporary files left behind
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+#[test]
+fn shipped_graphs_round_trip_and_compile() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs");
+    let mut n = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "ron") {
+            let g = Graph::load(&path).unwrap();
+            let again = Graph::from_ron(&g.to_ron()).unwrap();
+            assert_eq!(g, again, "{}", path.display());
+            compile_graph(&g).unwrap_or_else(|e| panic!("{e}"));
+            n += 1;
+        }
+    }
+    assert!(n > 0);
+}
+
+#[test]
+fn save_to_unwritable_place_keeps_old_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let err = chain().save(&dir.path().join("missing-dir/g.ron")).unwrap_err();
+    assert!(err.to_string().contains("cannot write graph file"), "{err}");
+}
+
+const HEAD: &str = "(\n    version: 1,\n    nodes: [\n";
+
+fn graph_text(nodes: &str, edges: &str) -> String {
+    format!("{HEAD}{nodes}    ],\n    edges: [\n{edges}    ],\n)\n")
+}
+
+const GOOD_NODES: &str = r#"        (id: "input", kind: "ImageInput", params: {"path": "in.exr"}),
+        (id: "tonemap", kind: "Tonemap"),
+        (id: "out", kind: "Output"),
+"#;
+const GOOD_EDGES: &str = r#"        (from: "input.color", to: "tonemap.color"),
+        (from: "tonemap.color", to: "out.color"),
+"#;
+
+#[test]
+fn good_text_compiles() {
+    compile_graph(&load_str(&graph_text(GOOD_NODES, GOOD_EDGES)).unwrap()).unwrap();
+}
+
+#[test]
+fn malformed_ron_names_line_and_column() {
+    let text = graph_text(GOOD_NODES, GOOD_EDGES).replace("(id: \"tonemap\", kind: \"Tonemap\"),", "(id: \"tonemap\" kind: \"Tonemap\"),");
+    let e = load_str(&text).unwrap_err();
+    assert!(matches!(e.kind, ErrorKind::Syntax(_)), "{e}");
+    let pos = e.pos.unwrap();
+    assert_eq!(pos.line, 5, "{e}");
+    assert!(e.to_string().contains("g.ron:5:"), "{e}");
+}
+
+#[test]
+fn unsupported_version() {
+    let e = load_str("(version: 7, nodes: [])").unwrap_err();
+    assert!(matches!(e.kind, ErrorKind::Version { found: 7, .. }), "{e}");
+}
+
+#[test]
+fn unknown_kind() {
+    let (k, m) = single_error(&graph_text(&GOOD_NODES.replace("\"Tonemap\"", "\"Tonemapp\""), GOOD_EDGES));
+    assert!(matches!(k, ErrorKind::UnknownKind { .. }), "{m}");
+    assert!(m.contains("g.ron:5:") && m.contains("node \"tonemap\"") && m.contains("Tonemapp"), "{m}");
+}
+
+#[test]
+fn unknown_param() {
+    let nodes = GOOD_NODES.replace("kind: \"Tonemap\")", "kind: \"Tonemap\", params: {\"whit\": 2.0})");
+    let (k, m) = single_error(&graph_text(&nodes, GOOD_EDGES));
+    assert!(matches!(k, ErrorKind::UnknownParam { .. }), "{m}");
+    assert!(m.contains("\"whit\"") && m.contains("operator, white") && m.contains("g.ron:5:"), "{m}");
+}
+
+#[test]
+fn param_of_wrong_type() {
+    let nodes = GOOD_NODES.replace("kind: \"Tonemap\")", "kind: \"Tonemap\", params: {\"white\": \"bright\"})");
+    let (k, m) = single_error(&graph_text(&nodes, GOOD_EDGES));
+    assert!(matches!(k, ErrorKind::BadParam { .. }), "{m}");
+    assert!(m.contains("expected float, found string"), "{m}");
+}
+
+#[test]
+fn param_out_of_range() {
+    let nodes = GOOD_NODES.replace("kind: \"Tonemap\")", "kind: \"Tonemap\", params: {\"white\": -1.0})");
+    let (_, m) = single_error(&graph_text(&nodes, GOOD_EDGES));
+    assert!(m.contains("out of range"), "{m}");
+}
+
+#[test]
+fn enum_value_not_an_option() {
+    let nodes = GOOD_NODES.replace("kind: \"Tonemap\")", "kind: \"Tonemap\", params: {\"operator\": \"filmic\"})");
+    let (_, m) = single_error(&graph_text(&nodes, GOOD_EDGES));
+    assert!(m.contains("\"filmic\" is not one of") && m.contains("\"agx\""), "{m}");
+}
+
+#[test]
+fn edge_to_missing_node() {
+    let edges = GOOD_EDGES.replace("to: \"out.color\"", "to: \"outt.color\"");
+    let (k, m) = single_error(&graph_text(GOOD_NODES, &edges));
+    assert!(matches!(k, ErrorKind::MissingNode { .. }), "{m}");
+    assert!(m.contains("g.ron:10:") && m.contains("no node \"outt\""), "{m}");
+}
+
+#[test]
+fn edge_to_missing_port() {
+    let edges = GOOD_EDGES.replace("to: \"out.color\"", "to: \"out.colour\"");
+    let (k, m) = single_error(&graph_text(GOOD_NODES, &edges));
+    assert!(matches!(k, ErrorKind::MissingPort { .. }), "{m}");
+    assert!(m.contains("no input port \"colour\"") && m.contains("its input ports: color"), "{m}");
+}
+
+#[test]
+fn edge_not_node_dot_port() {
+    let edges = GOOD_EDGES.replace("from: \"tonemap.color\"", "from: \"tonemap\"");
+    let (k, m) = single_error(&graph_text(GOOD_NODES, &edges));
+    assert!(matches!(k, ErrorKind::BadPortRef(_)), "{m}");
+}
+
+#[test]
+fn incompatible_port_types() {
+    // Tonemap makes LDR color; Exposure takes only HDR.
+    let nodes = format!("{GOOD_NODES}        (id: \"exp\", kind: \"Exposure\"),\n");
+    let edges = format!("{GOOD_EDGES}        (from: \"tonemap.color\", to: \"exp.color\"),\n");
+    let (k, m) = single_error(&graph_text(&nodes, &edges));
+    assert!(matches!(k, ErrorKind::IncompatibleTypes { .. }), "{m}");
+    assert!(m.contains("tonemap.color produces ldr_color, but exp.color accepts hdr_color"), "{m}");
+}
+
+#[test]
+fn cycle_is_refused() {
+    let nodes = r#"        (id: "input", kind: "ImageInput"),
+        (id: "a", kind: "Exposure"),
+        (id: "b", kind: "Exposure"),
+        (id: "out", kind: "Output"),
+"#;
+    let edges = r#"        (from: "a.color", to: "b.color"),
+        (from: "b.color", to: "a.color"),
+        (from: "b.color", to: "out.color"),
+"#;
+    let (k, m) = single_error(&graph_text(nodes, edges));
+    assert!(matches!(k, ErrorKind::Cycle(_)), "{m}");
+    assert!(m.contains("\"a\", \"b\""), "{m}");
+}
+
+#[test]
+fn duplicate_node_ids() {
+    let nodes = format!("{GOOD_NODES}        (id: \"tonemap\", kind: \"Exposure\"),\n");
+    let g = load_str(&graph_text(&nodes, GOOD_EDGES)).unwrap();
+    let errors = compile_graph(&g).unwrap_err();
+    assert!(errors.0.iter().any(|e| matches!(e.kind, ErrorKind::DuplicateId(_))), "{errors}");
+}
+
+#[test]
+fn graph_without_output() {
+    let nodes = r#"        (id: "input", kind: "ImageInput"),
+        (id: "tonemap", kind: "Tonemap"),
+"#;
+    let (k, m) = single_error(&graph_text(nodes, "        (from: \"input.color\", to: \"tonemap.color\"),\n"));
+    assert!(matches!(k, ErrorKind::NoOutput), "{m}");
+}
+
+#[test]
+fn two_edges_into_one_input() {
+    let nodes = format!("{GOOD_NODES}        (id: \"input2\", kind: \"ImageInput\"),\n");
+    let edges = format!("{GOOD_EDGES}        (from: \"input2.color\", to: \"tonemap.color\"),\n");
+    let (k, m) = single_error(&graph_text(&nodes, &edges));
+    assert!(matches!(k, ErrorKind::TwoEdgesIntoInput { .. }), "{m}");
+    assert!(m.contains("from input.color and input2.color"), "{m}");
+}
+
+#[test]
+fn unconnected_input_of_needed_node() {
+    let (k, m) = single_error(&graph_text(GOOD_NODES, "        (from: \"tonemap.color\", to: \"out.color\"),\n"));
+    assert!(matches!(k, ErrorKind::UnconnectedInput { .. }), "{m}");
+    assert!(m.contains("node \"tonemap\"") && m.contains("\"color\" is not connected"), "{m}");
+}
+
+#[test]
+fn source_that_cannot_tell_its_size() {
+    let g = load_str(&graph_text(GOOD_NODES, GOOD_EDGES)).unwrap();
+    let fail = |_: &Node, _: &lumagraph_graph::Params| Err("cannot open in.exr".to_owned());
+    let e = compile(&g, Registry::builtin(), &CompileOptions { source_extent: &fail, keep: &[] }).unwrap_err();
+    let m = e.to_string();
+    assert!(m.contains("node \"input\"") && m.contains("cannot open in.exr") && m.contains("g.ron:4:"), "{m}");
+}
+
+#[test]
+fn overrides_set_params() {
+    let mut g = chain();
+    g.apply_override("tonemap.operator=reinhard").unwrap();
+    g.apply_override("exposure.ev=-2").unwrap();
+    let plan = compile_graph(&g).unwrap();
+    assert_eq!(plan.pass("tonemap").unwrap().params.str("operator"), "reinhard");
+    assert!((plan.pass("exposure").unwrap().params.float("ev") + 2.0).abs() < 1e-12);
+    assert!(g.apply_override("nope.ev=1").is_err());
+    assert!(g.apply_override("exposure.ev").is_err());
+}
+
