@@ -1,1 +1,10 @@
-//! stub
+//! lumagraph: a modular node-graph renderer.
+//!
+//! This facade re-exports the workspace crates so a program can depend on one crate:
+//! - [`graph`]: node kinds, graph files, validation and compilation (no GPU);
+//! - [`render`]: the wgpu executor, node implementations and image files.
+//!
+//! The `lumagraph` binary is the command-line front end; see `lumagraph --help`.
+
+pub use lumagraph_graph as graph;
+pub use lumagraph_render as render;

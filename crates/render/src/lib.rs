@@ -1,1 +1,30 @@
-//! stub
+//! The lumagraph GPU executor, on wgpu.
+//!
+//! - [`GpuContext`]: headless adapter/device chosen from the environment, or a device
+//!   shared with the editor.
+//! - [`Kernel`]: a compute shader with declared bindings; passes are recorded through a
+//!   small builder that reads like their declaration.
+//! - [`TexturePool`]: the plan's texture slots as GPU textures, reused across plans.
+//! - [`GpuTimer`]: per-pass GPU time from timestamp queries.
+//! - [`Executor`]: runs a [`lumagraph_graph::Plan`] frame by frame.
+//! - [`image_io`] and [`cpu`]: image files, and plain-Rust references of every post node.
+
+pub mod cpu;
+mod context;
+mod error;
+mod executor;
+pub mod image_io;
+mod kernel;
+pub mod nodes;
+mod pool;
+pub mod readback;
+pub mod shader;
+mod timing;
+
+pub use context::{GPU_TIMEOUT, GpuContext};
+pub use error::{RenderError, Result};
+pub use executor::{Executor, FrameReport, compile, source_extent};
+pub use kernel::{Binding, Kernel, PassBuilder, uniform_buffer};
+pub use nodes::Paths;
+pub use pool::{PooledTexture, TexturePool, wgpu_format};
+pub use timing::GpuTimer;

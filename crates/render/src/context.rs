@@ -1,0 +1,143 @@
+//! The GPU context: instance, adapter, device and queue.
+//!
+//! The adapter is chosen from the environment the way wgpu's own tools do:
+//! `WGPU_BACKEND` (e.g. `vulkan`), `WGPU_ADAPTER_NAME` (a substring of the adapter name),
+//! `WGPU_POWER_PREF`. With none set, the system's default adapter is used. A context can
+//! also wrap a device created elsewhere (the editor shares eframe's).
+
+use std::time::Duration;
+
+use crate::error::{RenderError, Result};
+
+/// How long to wait for the GPU before giving up. lavapipe is slow, so this is generous.
+pub const GPU_TIMEOUT: Duration = Duration::from_secs(600);
+
+/// Instance, adapter, device and queue, plus what the device can do.
+#[derive(Clone, Debug)]
+pub struct GpuContext {
+    /// The adapter.
+    pub adapter: wgpu::Adapter,
+    /// The device.
+    pub device: wgpu::Device,
+    /// The queue.
+    pub queue: wgpu::Queue,
+    /// Adapter name, backend, driver.
+    pub info: wgpu::AdapterInfo,
+    /// Whether compute passes can be timed with timestamp queries.
+    pub timestamps: bool,
+}
+
+impl GpuContext {
+    /// Opens a headless context on the adapter the environment asks for.
+    ///
+    /// # Errors
+    /// When no adapter matches or the device cannot be opened.
+    pub fn headless() -> Result<Self> {
+        pollster::block_on(Self::headless_async())
+    }
+
+    async fn headless_async() -> Result<Self> {
+        let desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        let backends = desc.backends;
+        let instance = wgpu::Instance::new(desc);
+        let adapter = if let Ok(name) = std::env::var("WGPU_ADAPTER_NAME") {
+            let wanted = name.to_lowercase();
+            let adapters = instance.enumerate_adapters(backends).await;
+            let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
+            adapters
+                .into_iter()
+                .find(|a| a.get_info().name.to_lowercase().contains(&wanted))
+                .ok_or_else(|| {
+                    RenderError::NoAdapter(format!(
+                        " named like WGPU_ADAPTER_NAME={name:?} (adapters: {})",
+                        names.join(", ")
+                    ))
+                })?
+        } else {
+            instance
+                .request_adapter(&wgpu::RequestAdapterOptions {
+                    power_preference: wgpu::PowerPreference::from_env().unwrap_or_default(),
+                    ..Default::default()
+                })
+                .await
+                .map_err(|e| RenderError::NoAdapter(format!(": {e}")))?
+        };
+        Self::from_adapter(adapter).await
+    }
+
+    /// Opens a device on `adapter` with the features lumagraph uses where available.
+    ///
+    /// # Errors
+    /// When the device cannot be opened.
+    pub async fn from_adapter(adapter: wgpu::Adapter) -> Result<Self> {
+        let info = adapter.get_info();
+        let wanted = Self::optional_features();
+        let features = adapter.features() & wanted;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("lumagraph"),
+                required_features: features,
+                required_limits: Self::limits(&adapter),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| RenderError::Device {
+                adapter: info.name.clone(),
+                message: e.to_string(),
+            })?;
+        Ok(Self::from_parts(adapter, device, queue))
+    }
+
+    /// Features lumagraph enables when the adapter has them.
+    pub fn optional_features() -> wgpu::Features {
+        wgpu::Features::TIMESTAMP_QUERY
+    }
+
+    /// Limits lumagraph asks for: the adapter's own (large images, big scene buffers).
+    pub fn limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
+        adapter.limits()
+    }
+
+    /// Wraps a device created elsewhere.
+    pub fn from_parts(adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
+        let info = adapter.get_info();
+        let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        Self {
+            adapter,
+            device,
+            queue,
+            info,
+            timestamps,
+        }
+    }
+
+    /// One line naming the adapter, backend and driver.
+    pub fn describe(&self) -> String {
+        let i = &self.info;
+        let driver = if i.driver_info.is_empty() {
+            i.driver.clone()
+        } else {
+            format!("{} {}", i.driver, i.driver_info)
+        };
+        format!("{} ({:?}, {:?}, {driver})", i.name, i.backend, i.device_type)
+    }
+
+    /// Whether the adapter is a CPU implementation (lavapipe, llvmpipe, WARP).
+    pub fn is_cpu(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// Blocks until all submitted work is done.
+    ///
+    /// # Errors
+    /// When the GPU does not finish within [`GPU_TIMEOUT`] or the device is lost.
+    pub fn wait(&self) -> Result<()> {
+        self.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: None,
+                timeout: Some(GPU_TIMEOUT),
+            })
+            .map(|_| ())
+            .map_err(|e| RenderError::Gpu(e.to_string()))
+    }
+}

@@ -1,0 +1,167 @@
+//! Plain-Rust reference implementations of the GPU post nodes, written to mirror the
+//! WGSL line for line. Tests run both and compare.
+
+/// An image as linear RGBA `f32`, row-major, top row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width * height` RGBA pixels.
+    pub pixels: Vec<[f32; 4]>,
+}
+
+impl Image {
+    /// An image filled with one value.
+    pub fn filled(width: u32, height: u32, value: [f32; 4]) -> Self {
+        Self {
+            width,
+            height,
+            pixels: vec![value; width as usize * height as usize],
+        }
+    }
+
+    /// Applies `f` to every pixel.
+    #[must_use]
+    pub fn map(&self, f: impl Fn([f32; 4]) -> [f32; 4]) -> Self {
+        Self {
+            width: self.width,
+            height: self.height,
+            pixels: self.pixels.iter().map(|&p| f(p)).collect(),
+        }
+    }
+}
+
+type V3 = [f32; 3];
+
+fn rgb(p: [f32; 4]) -> V3 {
+    [p[0], p[1], p[2]]
+}
+
+fn map3(v: V3, f: impl Fn(f32) -> f32) -> V3 {
+    [f(v[0]), f(v[1]), f(v[2])]
+}
+
+/// Rec. 709 luminance.
+pub fn luminance(c: V3) -> f32 {
+    c[0] * 0.2126 + c[1] * 0.7152 + c[2] * 0.0722
+}
+
+/// Linear → sRGB transfer, clamped to \[0, 1\].
+pub fn srgb_encode(x: f32) -> f32 {
+    let c = x.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// sRGB → linear transfer.
+pub fn srgb_decode(x: f32) -> f32 {
+    let c = x.clamp(0.0, 1.0);
+    if c <= 0.040_45 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+/// Quantizes a value in \[0, 1\] to 8 bits, rounding to nearest.
+#[expect(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "clamped to [0, 255]")]
+pub fn to_u8(x: f32) -> u8 {
+    (x.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+/// Exposure: scales color by `scale` (= 2^ev), alpha unchanged.
+pub fn exposure(image: &Image, scale: f32) -> Image {
+    image.map(|p| [p[0] * scale, p[1] * scale, p[2] * scale, p[3]])
+}
+
+/// The scale an exposure of `ev` stops applies, in `f32` as the GPU receives it.
+#[expect(clippy::cast_possible_truncation, reason = "GPU math is f32")]
+pub fn exposure_scale(ev: f64) -> f32 {
+    ev.exp2() as f32
+}
+
+fn mul_rows(v: V3, rows: [V3; 3]) -> V3 {
+    // v * M in WGSL where M's columns are `rows`: out_i = dot(v, rows[i]).
+    [0, 1, 2].map(|i| v[0] * rows[i][0] + v[1] * rows[i][1] + v[2] * rows[i][2])
+}
+
+fn mul_cols(cols: [V3; 3], v: V3) -> V3 {
+    // M * v in WGSL where M's columns are `cols`.
+    [0, 1, 2].map(|i| cols[0][i] * v[0] + cols[1][i] * v[1] + cols[2][i] * v[2])
+}
+
+fn reinhard(c: V3, white: f32) -> V3 {
+    let l = luminance(c);
+    if l <= 0.0 {
+        return [0.0; 3];
+    }
+    let ld = l * (1.0 + l / (white * white)) / (1.0 + l);
+    map3(c, |x| x * (ld / l))
+}
+
+fn aces(c: V3) -> V3 {
+    let input = [[0.59719, 0.35458, 0.04823], [0.07600, 0.90834, 0.01566], [0.02840, 0.13383, 0.83777]];
+    let output = [[1.60475, -0.53108, -0.07367], [-0.10208, 1.10813, -0.00605], [-0.00327, -0.07276, 1.07602]];
+    let v = mul_rows(c, input);
+    let fit = map3(v, |v| (v * (v + 0.024_578_6) - 0.000_090_537) / (v * (0.983_729 * v + 0.432_951) + 0.238_081));
+    mul_rows(fit, output)
+}
+
+fn agx_contrast(x: f32) -> f32 {
+    let x2 = x * x;
+    let x4 = x2 * x2;
+    15.5 * x4 * x2 - 40.14 * x4 * x + 31.96 * x4 - 6.868 * x2 * x + 0.4298 * x2 + 0.1191 * x - 0.00232
+}
+
+fn agx(c: V3) -> V3 {
+    let inset = [
+        [0.842_479_1, 0.042_328_24, 0.042_375_655],
+        [0.078_433_6, 0.878_468_6, 0.078_433_6],
+        [0.079_223_745, 0.079_166_13, 0.879_142_97],
+    ];
+    let outset = [
+        [1.196_879, -0.052_896_85, -0.052_971_635],
+        [-0.098_020_88, 1.151_903_1, -0.098_043_45],
+        [-0.099_029_74, -0.098_961_18, 1.151_073_7],
+    ];
+    let (min_ev, max_ev) = (-12.473_93_f32, 4.026_069_f32);
+    let v = mul_cols(inset, map3(c, |x| x.max(1e-10)));
+    let v = map3(v, |x| (x.max(1e-10).log2().clamp(min_ev, max_ev) - min_ev) / (max_ev - min_ev));
+    let v = mul_cols(outset, map3(v, agx_contrast));
+    map3(v, |x| x.max(0.0).powf(2.2))
+}
+
+fn pbr_neutral(mut c: V3) -> V3 {
+    let start = 0.8 - 0.04;
+    let desaturation = 0.15;
+    let x = c[0].min(c[1].min(c[2]));
+    let offset = if x < 0.08 { x - 6.25 * x * x } else { 0.04 };
+    c = map3(c, |v| v - offset);
+    let peak = c[0].max(c[1].max(c[2]));
+    if peak < start {
+        return c;
+    }
+    let d = 1.0 - start;
+    let new_peak = 1.0 - d * d / (peak + d - start);
+    c = map3(c, |v| v * (new_peak / peak));
+    let g = 1.0 - 1.0 / (desaturation * (peak - new_peak) + 1.0);
+    map3(c, |v| v + (new_peak - v) * g)
+}
+
+/// Applies tone curve number `op` (the registry's operator order) to linear color, clamped.
+pub fn tonemap_curve(c: V3, op: u32, white: f32) -> V3 {
+    let c = map3(c, |x| x.max(0.0));
+    let out = match op {
+        1 => reinhard(c, white),
+        2 => aces(c),
+        3 => agx(c),
+        4 => pbr_neutral(c),
+        _ => c,
+    };
+    map3(out, |x| x.clamp(0.0, 1.0))
+}
+
+/// The Tonemap node: tone curve then sRGB encoding, as floats in \[0, 1\] (before 8-bit storage).
+pub fn tonemap(image: &Image, op: u32, white: f32) -> Image {
+    image.map(|p| {
+        let d = map3(tonemap_curve(rgb(p), op, white), srgb_encode);
+        [d[0], d[1], d[2], p[3].clamp(0.0, 1.0)]
+    })
+}

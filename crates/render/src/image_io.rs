@@ -1,0 +1,223 @@
+//! Image files: EXR, Radiance HDR, PNG and JPEG in; PNG (8-bit sRGB) and EXR (float RGBA)
+//! out. Every write goes to a temporary file that is renamed over the target, so a
+//! failed or interrupted write never leaves a truncated image.
+
+use std::io::Cursor;
+use std::path::Path;
+
+use exr::prelude::{self as exrp, ReadChannels as _, ReadLayers as _, WritableImage as _};
+use lumagraph_graph::{Extent, write_atomic};
+
+use crate::cpu::{Image, srgb_decode, srgb_encode, to_u8};
+use crate::error::{RenderError, Result};
+
+fn extension(path: &Path) -> String {
+    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+}
+
+fn check_exists(path: &Path) -> Result<()> {
+    std::fs::metadata(path)
+        .map(|_| ())
+        .map_err(|e| RenderError::image(path, format!("cannot open image: {e}")))
+}
+
+/// The size of an image file, read from its header only.
+///
+/// # Errors
+/// When the file is missing, unreadable or not an image of a known format.
+pub fn dimensions(path: &Path) -> Result<Extent> {
+    check_exists(path)?;
+    match extension(path).as_str() {
+        "exr" => {
+            let meta = exrp::MetaData::read_from_file(path, false)
+                .map_err(|e| RenderError::image(path, format!("not a readable EXR file: {e}")))?;
+            let header = meta
+                .headers
+                .first()
+                .ok_or_else(|| RenderError::image(path, "EXR file has no layers"))?;
+            let size = header.layer_size;
+            Ok(Extent::new(
+                u32::try_from(size.width()).unwrap_or(u32::MAX),
+                u32::try_from(size.height()).unwrap_or(u32::MAX),
+            ))
+        }
+        "hdr" | "png" | "jpg" | "jpeg" => image::image_dimensions(path)
+            .map(|(w, h)| Extent::new(w, h))
+            .map_err(|e| RenderError::image(path, format!("not a readable image: {e}"))),
+        other => Err(RenderError::image(
+            path,
+            format!("unsupported image extension \".{other}\" (use .exr, .hdr, .png, .jpg)"),
+        )),
+    }
+}
+
+/// Loads an image as linear RGBA floats: EXR and HDR as stored, 8- and 16-bit formats
+/// decoded from sRGB.
+///
+/// # Errors
+/// When the file is missing, unreadable, corrupt or of an unknown format.
+pub fn load(path: &Path) -> Result<Image> {
+    check_exists(path)?;
+    match extension(path).as_str() {
+        "exr" => load_exr(path),
+        "hdr" => {
+            let img = image::open(path).map_err(|e| RenderError::image(path, format!("not a readable image: {e}")))?;
+            let rgba = img.to_rgba32f();
+            Ok(Image {
+                width: rgba.width(),
+                height: rgba.height(),
+                pixels: rgba.pixels().map(|p| p.0).collect(),
+            })
+        }
+        "png" | "jpg" | "jpeg" => {
+            let img = image::open(path).map_err(|e| RenderError::image(path, format!("not a readable image: {e}")))?;
+            let rgba = img.to_rgba32f();
+            Ok(Image {
+                width: rgba.width(),
+                height: rgba.height(),
+                pixels: rgba
+                    .pixels()
+                    .map(|p| [srgb_decode(p.0[0]), srgb_decode(p.0[1]), srgb_decode(p.0[2]), p.0[3]])
+                    .collect(),
+            })
+        }
+        other => Err(RenderError::image(
+            path,
+            format!("unsupported image extension \".{other}\" (use .exr, .hdr, .png, .jpg)"),
+        )),
+    }
+}
+
+fn load_exr(path: &Path) -> Result<Image> {
+    let read = exrp::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |size, _| Image::filled(u32::try_from(size.width()).unwrap_or(0), u32::try_from(size.height()).unwrap_or(0), [0.0; 4]),
+            |img: &mut Image, pos, (r, g, b, a): (f32, f32, f32, f32)| {
+                let i = pos.y() * img.width as usize + pos.x();
+                img.pixels[i] = [r, g, b, a];
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| RenderError::image(path, format!("not a readable RGB(A) EXR file: {e}")))?;
+    Ok(read.layer_data.channel_data.pixels)
+}
+
+/// Encodes 8-bit RGBA rows as PNG bytes.
+///
+/// # Errors
+/// When encoding fails.
+pub fn encode_png(width: u32, height: u32, rgba8: &[u8]) -> Result<Vec<u8>> {
+    let mut out = Vec::new();
+    image::write_buffer_with_format(
+        &mut Cursor::new(&mut out),
+        rgba8,
+        width,
+        height,
+        image::ExtendedColorType::Rgba8,
+        image::ImageFormat::Png,
+    )
+    .map_err(|e| RenderError::image(Path::new("<png>"), e))?;
+    Ok(out)
+}
+
+/// Encodes an image as EXR bytes: 32-bit float RGBA, or half floats when `half` is set.
+///
+/// # Errors
+/// When encoding fails.
+pub fn encode_exr(image: &Image, half: bool) -> Result<Vec<u8>> {
+    let size = (image.width as usize, image.height as usize);
+    let w = image.width as usize;
+    let mut out = Vec::new();
+    let result = if half {
+        let channels = exrp::SpecificChannels::rgba(|exrp::Vec2(x, y): exrp::Vec2<usize>| {
+            let p = image.pixels[y * w + x];
+            (exrp::f16::from_f32(p[0]), exrp::f16::from_f32(p[1]), exrp::f16::from_f32(p[2]), exrp::f16::from_f32(p[3]))
+        });
+        exrp::Image::from_encoded_channels(size, exrp::Encoding::SMALL_LOSSLESS, channels)
+            .write()
+            .to_buffered(Cursor::new(&mut out))
+    } else {
+        let channels = exrp::SpecificChannels::rgba(|exrp::Vec2(x, y): exrp::Vec2<usize>| {
+            let p = image.pixels[y * w + x];
+            (p[0], p[1], p[2], p[3])
+        });
+        exrp::Image::from_encoded_channels(size, exrp::Encoding::SMALL_LOSSLESS, channels)
+            .write()
+            .to_buffered(Cursor::new(&mut out))
+    };
+    result.map_err(|e| RenderError::image(Path::new("<exr>"), e))?;
+    Ok(out)
+}
+
+fn write(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic(path, bytes).map_err(|e| RenderError::image(path, format!("cannot write: {e}")))
+}
+
+/// Writes 8-bit RGBA (already display-encoded) as a PNG file, atomically.
+///
+/// # Errors
+/// When the file cannot be written.
+pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<()> {
+    write(path, &encode_png(width, height, rgba8)?)
+}
+
+/// Writes an image to a file chosen by extension, atomically: `.exr` as 32-bit float RGBA
+/// as it is; `.png` as 8-bit, sRGB-encoding the values first when `linear` is set.
+///
+/// # Errors
+/// When the extension is unknown or the file cannot be written.
+pub fn save(path: &Path, image: &Image, linear: bool) -> Result<()> {
+    match extension(path).as_str() {
+        "exr" => write(path, &encode_exr(image, false)?),
+        "png" => {
+            let encode = |x: f32| if linear { srgb_encode(x) } else { x };
+            let bytes: Vec<u8> = image
+                .pixels
+                .iter()
+                .flat_map(|p| [to_u8(encode(p[0])), to_u8(encode(p[1])), to_u8(encode(p[2])), to_u8(p[3])])
+                .collect();
+            write_png(path, image.width, image.height, &bytes)
+        }
+        other => Err(RenderError::image(path, format!("unsupported output extension \".{other}\" (use .png or .exr)"))),
+    }
+}
+
+/// The HDR test chart shipped as `assets/test_chart.exr`, 512×256, generated so the
+/// project owns it:
+/// - rows 0–63: a neutral ramp from 2^-10 to 2^6, exponential in x;
+/// - rows 64–127: a fully saturated hue sweep at luminance-independent value 1;
+/// - rows 128–191: the same hue sweep fading from 2^-4 (left) to 2^4 (right);
+/// - rows 192–255: 17 patches, −8 to +8 EV around 0.18 grey.
+pub fn test_chart() -> Image {
+    let (w, h) = (512_u32, 256_u32);
+    let mut img = Image::filled(w, h, [0.0, 0.0, 0.0, 1.0]);
+    #[expect(clippy::cast_precision_loss, reason = "small integers")]
+    for y in 0..h {
+        for x in 0..w {
+            let u = (x as f32 + 0.5) / w as f32;
+            let rgb = match y / 64 {
+                0 => [(u * 16.0 - 10.0).exp2(); 3],
+                1 => hue(u),
+                2 => hue(u).map(|c| c * (u * 8.0 - 4.0).exp2()),
+                _ => {
+                    let patch = (u * 17.0).floor().min(16.0);
+                    [0.18 * (patch - 8.0).exp2(); 3]
+                }
+            };
+            img.pixels[(y * w + x) as usize] = [rgb[0], rgb[1], rgb[2], 1.0];
+        }
+    }
+    img
+}
+
+fn hue(u: f32) -> [f32; 3] {
+    let f = |n: f32| {
+        let k = (n + u * 6.0) % 6.0;
+        1.0 - (k.min(4.0 - k).clamp(0.0, 1.0))
+    };
+    [f(5.0), f(3.0), f(1.0)]
+}

@@ -1,0 +1,80 @@
+//! `ImageInput`: an image file, uploaded once, copied into the frame's texture each frame.
+
+use std::path::PathBuf;
+
+use lumagraph_graph::{Pass, TexFormat};
+
+use crate::context::GpuContext;
+use crate::error::Result;
+use crate::nodes::{FrameIo, NodeExec, Paths};
+use crate::pool::{PooledTexture, create};
+use crate::timing::GpuTimer;
+
+pub(crate) struct ImageInput {
+    paths: Paths,
+    loaded: Option<(PathBuf, PooledTexture)>,
+}
+
+impl ImageInput {
+    pub(crate) fn new(ctx: &GpuContext, pass: &Pass, paths: &Paths) -> Result<Self> {
+        let mut node = Self {
+            paths: paths.clone(),
+            loaded: None,
+        };
+        node.update(ctx, pass)?;
+        Ok(node)
+    }
+}
+
+/// Uploads an image into a new RGBA32F texture.
+pub(crate) fn upload(ctx: &GpuContext, label: &str, image: &crate::cpu::Image) -> PooledTexture {
+    let extent = lumagraph_graph::Extent::new(image.width, image.height);
+    let texture = create(ctx, label, TexFormat::Rgba32Float, extent);
+    ctx.queue.write_texture(
+        texture.texture.as_image_copy(),
+        bytemuck::cast_slice(&image.pixels),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(image.width * 16),
+            rows_per_image: Some(image.height),
+        },
+        texture.texture.size(),
+    );
+    texture
+}
+
+impl NodeExec for ImageInput {
+    fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
+        let path = self.paths.input(pass.params.str("path"));
+        if self.loaded.as_ref().is_some_and(|(p, _)| *p == path) {
+            return Ok(());
+        }
+        let image = crate::image_io::load(&path)?;
+        let texture = upload(ctx, &pass.node, &image);
+        self.loaded = Some((path, texture));
+        Ok(())
+    }
+
+    fn record(
+        &mut self,
+        _ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: &Pass,
+        io: &FrameIo<'_>,
+        _timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let (Some(out), Some((_, src))) = (pass.output("color"), &self.loaded) else {
+            return Ok(());
+        };
+        let dst = io.texture(out);
+        let size = src.texture.size();
+        if dst.texture.size() != size {
+            return Err(crate::error::RenderError::Gpu(format!(
+                "the image changed size since the graph was compiled ({}x{} now): recompile",
+                size.width, size.height
+            )));
+        }
+        encoder.copy_texture_to_texture(src.texture.as_image_copy(), dst.texture.as_image_copy(), size);
+        Ok(())
+    }
+}

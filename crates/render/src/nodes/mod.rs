@@ -1,0 +1,119 @@
+//! GPU implementations of the node kinds, one file per kind, each named as in the registry.
+
+mod exposure;
+mod image_input;
+mod output;
+mod tonemap;
+
+use std::path::{Path, PathBuf};
+
+use lumagraph_graph::{Pass, Plan, TextureId};
+
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+use crate::pool::PooledTexture;
+use crate::timing::GpuTimer;
+
+/// Where a node's relative paths point.
+#[derive(Clone, Debug, Default)]
+pub struct Paths {
+    /// Folder input paths are relative to (the graph file's folder).
+    pub base_dir: PathBuf,
+    /// Folder output paths are relative to.
+    pub out_dir: PathBuf,
+}
+
+impl Paths {
+    /// An input path resolved against the base folder.
+    pub fn input(&self, p: &str) -> PathBuf {
+        self.base_dir.join(p)
+    }
+
+    /// An output path resolved against the output folder.
+    pub fn output(&self, p: &str) -> PathBuf {
+        self.out_dir.join(p)
+    }
+}
+
+/// What a node sees of the frame: the plan and the textures its ports are bound to.
+#[derive(Debug)]
+pub struct FrameIo<'a> {
+    /// The plan being executed.
+    pub plan: &'a Plan,
+    /// One texture per plan slot.
+    pub slots: &'a [PooledTexture],
+}
+
+impl FrameIo<'_> {
+    /// The texture holding logical texture `id`.
+    pub fn texture(&self, id: TextureId) -> &PooledTexture {
+        &self.slots[self.plan.textures[id.0].slot]
+    }
+
+    /// The texture bound to input `port` of `pass`.
+    ///
+    /// # Errors
+    /// When the port is not bound (a plan/implementation mismatch).
+    pub fn input(&self, pass: &Pass, port: &str) -> Result<&PooledTexture> {
+        pass.input(port)
+            .map(|t| self.texture(t))
+            .ok_or_else(|| RenderError::Gpu(format!("input \"{port}\" is not bound")))
+    }
+}
+
+/// A node's GPU side.
+pub trait NodeExec {
+    /// Takes new param values (the kind and ports are unchanged).
+    ///
+    /// # Errors
+    /// When a param cannot be applied (e.g. an input file fails to load).
+    fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()>;
+
+    /// Records this frame's GPU work.
+    ///
+    /// # Errors
+    /// When recording fails.
+    fn record(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: &Pass,
+        io: &FrameIo<'_>,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()>;
+
+    /// Runs after the frame's GPU work finished; returns files written.
+    ///
+    /// # Errors
+    /// When writing results fails.
+    fn finish(&mut self, _ctx: &GpuContext, _pass: &Pass) -> Result<Vec<PathBuf>> {
+        Ok(Vec::new())
+    }
+}
+
+/// Creates the GPU side of the node a pass runs.
+///
+/// # Errors
+/// When the kind has no implementation or its setup fails; the error names the node.
+pub fn create(ctx: &GpuContext, pass: &Pass, paths: &Paths) -> Result<Box<dyn NodeExec>> {
+    let node: Result<Box<dyn NodeExec>> = match pass.kind {
+        "ImageInput" => image_input::ImageInput::new(ctx, pass, paths).map(|n| Box::new(n) as _),
+        "Exposure" => exposure::Exposure::new(ctx, pass).map(|n| Box::new(n) as _),
+        "Tonemap" => tonemap::Tonemap::new(ctx, pass).map(|n| Box::new(n) as _),
+        "Output" => output::Output::new(ctx, pass, paths).map(|n| Box::new(n) as _),
+        other => Err(RenderError::Unimplemented(other.to_owned())),
+    };
+    node.map_err(|e| e.in_node(&pass.node))
+}
+
+/// Checks that `path` can be written, by creating and removing a temporary file beside it
+/// (creating missing folders first), so a long render does not fail at the very end.
+///
+/// # Errors
+/// When the folder cannot be created or written.
+pub fn check_writable(path: &Path) -> Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir)
+        .and_then(|()| tempfile::Builder::new().prefix(".lumagraph-check").tempfile_in(dir).map(|_| ()))
+        .map_err(|e| RenderError::image(path, format!("cannot write output: {e}")))
+}

@@ -1,0 +1,107 @@
+//! Output: copies its input to a readback buffer in the frame, then writes the file.
+
+use std::path::PathBuf;
+
+use lumagraph_graph::{Extent, Pass, PortType, TexFormat};
+
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+use crate::nodes::{FrameIo, NodeExec, Paths, check_writable};
+use crate::timing::GpuTimer;
+
+pub(crate) struct Output {
+    paths: Paths,
+    staged: Option<Staged>,
+}
+
+struct Staged {
+    buffer: wgpu::Buffer,
+    padded_row: u32,
+    format: TexFormat,
+    ty: PortType,
+    extent: Extent,
+}
+
+impl Output {
+    pub(crate) fn new(ctx: &GpuContext, pass: &Pass, paths: &Paths) -> Result<Self> {
+        let mut node = Self {
+            paths: paths.clone(),
+            staged: None,
+        };
+        node.update(ctx, pass)?;
+        Ok(node)
+    }
+
+    fn path(&self, pass: &Pass) -> PathBuf {
+        self.paths.output(pass.params.str("path"))
+    }
+}
+
+impl NodeExec for Output {
+    fn update(&mut self, _ctx: &GpuContext, pass: &Pass) -> Result<()> {
+        check_writable(&self.path(pass))
+    }
+
+    fn record(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: &Pass,
+        io: &FrameIo<'_>,
+        _timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let id = pass.input("color").ok_or_else(|| RenderError::Gpu("input \"color\" is not bound".into()))?;
+        let desc = &io.plan.textures[id.0];
+        let texture = io.texture(id);
+        let bpp = u32::try_from(desc.format.bytes_per_pixel()).unwrap_or(16);
+        let padded_row = (desc.extent.width * bpp).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let size = u64::from(padded_row) * u64::from(desc.extent.height);
+        let buffer = match self.staged.take() {
+            Some(s) if s.buffer.size() == size => s.buffer,
+            _ => ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(&pass.node),
+                size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+        };
+        encoder.copy_texture_to_buffer(
+            texture.texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row),
+                    rows_per_image: Some(desc.extent.height),
+                },
+            },
+            texture.texture.size(),
+        );
+        self.staged = Some(Staged {
+            buffer,
+            padded_row,
+            format: desc.format,
+            ty: desc.ty,
+            extent: desc.extent,
+        });
+        Ok(())
+    }
+
+    fn finish(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<Vec<PathBuf>> {
+        let Some(s) = &self.staged else { return Ok(Vec::new()) };
+        let row = s.extent.width as usize * s.format.bytes_per_pixel() as usize;
+        let size = s.buffer.size();
+        let bytes = crate::readback::map_read(ctx, &s.buffer, size, |b| {
+            b.chunks_exact(s.padded_row as usize).flat_map(|r| r[..row].to_vec()).collect::<Vec<u8>>()
+        })?;
+        let path = self.path(pass);
+        let is_png = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if is_png && s.format == TexFormat::Rgba8Unorm {
+            crate::image_io::write_png(&path, s.extent.width, s.extent.height, &bytes)?;
+        } else {
+            let image = crate::readback::to_image(&bytes, s.format, s.extent);
+            crate::image_io::save(&path, &image, s.ty != PortType::LdrColor)?;
+        }
+        Ok(vec![path])
+    }
+}

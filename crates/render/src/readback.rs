@@ -1,0 +1,96 @@
+//! Copying textures and buffers back to the CPU.
+
+use std::sync::mpsc;
+
+use lumagraph_graph::{Extent, TexFormat};
+
+use crate::context::GpuContext;
+use crate::cpu::Image;
+use crate::error::{RenderError, Result};
+
+/// Maps the first `size` bytes of a `MAP_READ` buffer, waits, and passes them to `f`.
+///
+/// # Errors
+/// When mapping fails or the GPU does not finish.
+pub fn map_read<T>(ctx: &GpuContext, buffer: &wgpu::Buffer, size: u64, f: impl FnOnce(&[u8]) -> T) -> Result<T> {
+    let slice = buffer.slice(..size);
+    let (tx, rx) = mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    ctx.wait()?;
+    rx.recv().map_err(|_| RenderError::Gpu("buffer map callback was dropped".into()))??;
+    let out = {
+        let view = slice.get_mapped_range().map_err(|e| RenderError::Gpu(e.to_string()))?;
+        f(&view)
+    };
+    buffer.unmap();
+    Ok(out)
+}
+
+/// Reads a whole texture back as tightly packed rows of texels.
+///
+/// # Errors
+/// When the GPU does not finish.
+pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture, format: TexFormat, extent: Extent) -> Result<Vec<u8>> {
+    let bpp = u32::try_from(format.bytes_per_pixel()).unwrap_or(16);
+    let row = extent.width * bpp;
+    let padded = row.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let size = u64::from(padded) * u64::from(extent.height);
+    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(extent.height),
+            },
+        },
+        wgpu::Extent3d {
+            width: extent.width,
+            height: extent.height,
+            depth_or_array_layers: 1,
+        },
+    );
+    ctx.queue.submit([encoder.finish()]);
+    map_read(ctx, &buffer, size, |bytes| {
+        let mut out = Vec::with_capacity(row as usize * extent.height as usize);
+        for r in bytes.chunks_exact(padded as usize) {
+            out.extend_from_slice(&r[..row as usize]);
+        }
+        out
+    })
+}
+
+/// Turns packed texels into an RGBA float image (8-bit values become \[0, 1\];
+/// one-channel images are repeated into RGB with alpha 1).
+pub fn to_image(bytes: &[u8], format: TexFormat, extent: Extent) -> Image {
+    let pixels = match format {
+        TexFormat::Rgba32Float => bytemuck::pod_collect_to_vec::<u8, f32>(bytes)
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect(),
+        TexFormat::Rgba8Unorm => bytes
+            .chunks_exact(4)
+            .map(|c| c.iter().map(|&b| f32::from(b) / 255.0).collect::<Vec<_>>())
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect(),
+        TexFormat::R32Float => bytemuck::pod_collect_to_vec::<u8, f32>(bytes)
+            .into_iter()
+            .map(|v| [v, v, v, 1.0])
+            .collect(),
+    };
+    Image {
+        width: extent.width,
+        height: extent.height,
+        pixels,
+    }
+}

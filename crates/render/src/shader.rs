@@ -1,0 +1,91 @@
+//! WGSL sources and the `#import` resolver.
+//!
+//! Shaders live in `shaders/` by topic; a line `#import "common/color.wgsl"` is replaced by
+//! that file's text (each file at most once, recursively), so shared code is written once.
+//! Release builds use copies embedded at build time; debug builds read the folder on disk
+//! when it is there, so an edited shader is picked up by the next pipeline created. The
+//! same resolver is used by the naga validation test, so every shader the program can
+//! load is checked without a GPU.
+
+use std::collections::HashSet;
+use std::path::PathBuf;
+
+use crate::error::{RenderError, Result};
+
+mod embedded {
+    include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+}
+
+/// Names of every shader file, relative to `shaders/`.
+pub fn all_names() -> impl Iterator<Item = &'static str> {
+    embedded::EMBEDDED.iter().map(|(name, _)| *name)
+}
+
+fn disk_dir() -> Option<PathBuf> {
+    if cfg!(debug_assertions) {
+        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shaders");
+        dir.is_dir().then_some(dir)
+    } else {
+        None
+    }
+}
+
+/// The raw text of one shader file.
+///
+/// # Errors
+/// When there is no such file.
+pub fn raw(name: &str) -> Result<String> {
+    if let Some(dir) = disk_dir()
+        && let Ok(text) = std::fs::read_to_string(dir.join(name))
+    {
+        return Ok(text);
+    }
+    embedded::EMBEDDED
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, text)| (*text).to_owned())
+        .ok_or_else(|| RenderError::Shader {
+            name: name.to_owned(),
+            message: "no such shader file".to_owned(),
+        })
+}
+
+/// A shader's text with its `#import` lines resolved.
+///
+/// # Errors
+/// When the file or one it imports is missing, or an import line is malformed.
+pub fn resolve(name: &str) -> Result<String> {
+    let mut seen = HashSet::new();
+    let mut out = String::new();
+    resolve_into(name, &mut seen, &mut out)?;
+    Ok(out)
+}
+
+fn resolve_into(name: &str, seen: &mut HashSet<String>, out: &mut String) -> Result<()> {
+    if !seen.insert(name.to_owned()) {
+        return Ok(());
+    }
+    let text = raw(name)?;
+    for (i, line) in text.lines().enumerate() {
+        if let Some(rest) = line.trim_start().strip_prefix("#import") {
+            let target = rest.trim().trim_matches('"');
+            if target.is_empty() || !rest.trim().starts_with('"') {
+                return Err(RenderError::Shader {
+                    name: name.to_owned(),
+                    message: format!("line {}: expected #import \"path.wgsl\"", i + 1),
+                });
+            }
+            resolve_into(target, seen, out).map_err(|e| match e {
+                RenderError::Shader { name: n, message } if n == target => RenderError::Shader {
+                    name: name.to_owned(),
+                    message: format!("line {}: cannot import {target}: {message}", i + 1),
+                },
+                e => e,
+            })?;
+        } else {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    Ok(())
+}
