@@ -27,7 +27,9 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Render a graph: run it once on the GPU and write every Output node's file.
-    #[command(after_help = "Example:\n  lumagraph render graphs/post_tonemap.ron --out out --set exposure.ev=-1")]
+    #[command(
+        after_help = "Example:\n  lumagraph render graphs/post_tonemap.ron --out out --set exposure.ev=-1"
+    )]
     Render {
         /// The graph file (RON).
         graph: PathBuf,
@@ -66,7 +68,7 @@ enum Command {
         #[arg(long)]
         markdown: bool,
     },
-    /// Write the generated HDR test chart (the source of assets/test_chart.exr).
+    /// Write the generated HDR test chart (the source of `assets/test_chart.exr`).
     #[command(hide = true)]
     TestChart {
         /// EXR file to write.
@@ -84,8 +86,12 @@ fn load(path: &Path, overrides: &[String]) -> Result<Graph> {
 
 fn note_scene(scene: Option<&Path>) -> Result<()> {
     if let Some(scene) = scene {
-        std::fs::metadata(scene).with_context(|| format!("cannot open scene {}", scene.display()))?;
-        println!("scene {}: not used (no node of this graph renders a scene)", scene.display());
+        std::fs::metadata(scene)
+            .with_context(|| format!("cannot open scene {}", scene.display()))?;
+        println!(
+            "scene {}: not used (no node of this graph renders a scene)",
+            scene.display()
+        );
     }
     Ok(())
 }
@@ -160,13 +166,21 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Nodes { markdown } => {
             let r = Registry::builtin();
-            print!("{}", if markdown { docs::markdown(r) } else { docs::text(r) });
+            print!(
+                "{}",
+                if markdown {
+                    docs::markdown(r)
+                } else {
+                    docs::text(r)
+                }
+            );
             Ok(())
         }
         Command::TestChart { out } => {
             let chart = image_io::test_chart();
             let bytes = image_io::encode_exr(&chart, true)?;
-            lumagraph::graph::write_atomic(&out, &bytes).with_context(|| format!("cannot write {}", out.display()))?;
+            lumagraph::graph::write_atomic(&out, &bytes)
+                .with_context(|| format!("cannot write {}", out.display()))?;
             println!("wrote {}", out.display());
             Ok(())
         }
@@ -204,4 +218,3 @@ mod tests {
         super::Cli::command().debug_assert();
     }
 }
-

@@ -72,7 +72,11 @@ pub fn resolve_params(node: &Node, kind: &NodeKind) -> Result<Params, Vec<(Strin
                 ErrorKind::UnknownParam {
                     param: name.clone(),
                     kind: kind.name.to_owned(),
-                    known: if known.is_empty() { "none".into() } else { known.join(", ") },
+                    known: if known.is_empty() {
+                        "none".into()
+                    } else {
+                        known.join(", ")
+                    },
                 },
             ));
         }
@@ -97,7 +101,11 @@ pub fn resolve_params(node: &Node, kind: &NodeKind) -> Result<Params, Vec<(Strin
         };
         params.insert(def.name.to_owned(), value);
     }
-    if errors.is_empty() { Ok(Params(params)) } else { Err(errors) }
+    if errors.is_empty() {
+        Ok(Params(params))
+    } else {
+        Err(errors)
+    }
 }
 
 /// What the compiler needs from outside the graph.
@@ -110,7 +118,9 @@ pub struct CompileOptions<'a> {
 
 impl std::fmt::Debug for CompileOptions<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("CompileOptions").field("keep", &self.keep).finish_non_exhaustive()
+        f.debug_struct("CompileOptions")
+            .field("keep", &self.keep)
+            .finish_non_exhaustive()
     }
 }
 
@@ -148,8 +158,12 @@ pub fn compile(
             if cyclic {
                 let mut ids: Vec<usize> = scc.iter().map(|&i| dag[i]).collect();
                 ids.sort_unstable();
-                let names: Vec<_> = ids.iter().map(|&i| format!("\"{}\"", graph.nodes[i].id)).collect();
-                let e = GraphError::new(ErrorKind::Cycle(names.join(", "))).at_node(&graph.nodes[ids[0]].id);
+                let names: Vec<_> = ids
+                    .iter()
+                    .map(|&i| format!("\"{}\"", graph.nodes[i].id))
+                    .collect();
+                let e = GraphError::new(ErrorKind::Cycle(names.join(", ")))
+                    .at_node(&graph.nodes[ids[0]].id);
                 errors.push(graph.locate(e, None, None));
             }
         }
@@ -159,7 +173,9 @@ pub fn compile(
     // Liveness: everything that reaches a sink or a kept port.
     let mut keep_nodes = HashSet::new();
     for k in options.keep {
-        if let Some(i) = split_port_ref(k).and_then(|(node, _)| graph.nodes.iter().position(|n| n.id == node)) {
+        if let Some(i) =
+            split_port_ref(k).and_then(|(node, _)| graph.nodes.iter().position(|n| n.id == node))
+        {
             keep_nodes.insert(i);
         }
     }
@@ -177,20 +193,31 @@ pub fn compile(
         if std::mem::replace(&mut live[i], true) {
             continue;
         }
-        stack.extend(checked.inputs.iter().filter(|((to, _), _)| *to == i).map(|(_, (from, _))| *from));
+        stack.extend(
+            checked
+                .inputs
+                .iter()
+                .filter(|((to, _), _)| *to == i)
+                .map(|(_, (from, _))| *from),
+        );
     }
 
     // Live nodes need every input connected (reported only when the edges themselves
     // were fine, so one mistake does not give two errors).
     let edges_ok = errors.is_empty();
     for (i, node) in graph.nodes.iter().enumerate() {
-        let Some(kind) = checked.kinds[i] else { continue };
+        let Some(kind) = checked.kinds[i] else {
+            continue;
+        };
         if !live[i] || !edges_ok {
             continue;
         }
         for input in kind.inputs {
             if !checked.inputs.contains_key(&(i, input.name)) {
-                let e = GraphError::new(ErrorKind::UnconnectedInput { port: input.name.to_owned() }).at_node(&node.id);
+                let e = GraphError::new(ErrorKind::UnconnectedInput {
+                    port: input.name.to_owned(),
+                })
+                .at_node(&node.id);
                 errors.push(graph.locate(e, None, None));
             }
         }
@@ -201,16 +228,31 @@ pub fn compile(
 
     let order: Vec<usize> = order.into_iter().filter(|&i| live[i]).collect();
     let plan = build_plan(graph, &checked, &order, options, &mut errors);
-    if errors.is_empty() { Ok(plan) } else { Err(GraphErrors(errors)) }
+    if errors.is_empty() {
+        Ok(plan)
+    } else {
+        Err(GraphErrors(errors))
+    }
 }
 
-fn check<'g>(graph: &'g Graph, registry: &'g Registry, errors: &mut Vec<GraphError>) -> Checked<'g> {
+fn check<'g>(
+    graph: &'g Graph,
+    registry: &'g Registry,
+    errors: &mut Vec<GraphError>,
+) -> Checked<'g> {
     let mut seen = HashSet::new();
     let mut kinds = Vec::with_capacity(graph.nodes.len());
     let mut params = Vec::with_capacity(graph.nodes.len());
     for node in &graph.nodes {
-        let err = |kind: ErrorKind, param: Option<&str>| graph.locate(GraphError::new(kind).at_node(&node.id), None, param);
-        if node.id.is_empty() || !node.id.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+        let err = |kind: ErrorKind, param: Option<&str>| {
+            graph.locate(GraphError::new(kind).at_node(&node.id), None, param)
+        };
+        if node.id.is_empty()
+            || !node
+                .id
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+        {
             errors.push(err(ErrorKind::InvalidId(node.id.clone()), None));
         }
         if !seen.insert(node.id.as_str()) {
@@ -221,7 +263,10 @@ fn check<'g>(graph: &'g Graph, registry: &'g Registry, errors: &mut Vec<GraphErr
             None => {
                 let known: Vec<_> = registry.kinds().iter().map(|k| k.name).collect();
                 errors.push(err(
-                    ErrorKind::UnknownKind { kind: node.kind.clone(), known: known.join(", ") },
+                    ErrorKind::UnknownKind {
+                        kind: node.kind.clone(),
+                        known: known.join(", "),
+                    },
                     None,
                 ));
                 params.push(Params::default());
@@ -237,7 +282,12 @@ fn check<'g>(graph: &'g Graph, registry: &'g Registry, errors: &mut Vec<GraphErr
         kinds.push(kind);
     }
 
-    let index: HashMap<&str, usize> = graph.nodes.iter().enumerate().map(|(i, n)| (n.id.as_str(), i)).collect();
+    let index: HashMap<&str, usize> = graph
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (n.id.as_str(), i))
+        .collect();
     let mut inputs: HashMap<(usize, &str), (usize, &str)> = HashMap::new();
     for (e_i, edge) in graph.edges.iter().enumerate() {
         let mut fail = |kind: ErrorKind, node: Option<&str>| {
@@ -245,8 +295,14 @@ fn check<'g>(graph: &'g Graph, registry: &'g Registry, errors: &mut Vec<GraphErr
             e.node = node.map(str::to_owned);
             errors.push(graph.locate(e, Some(e_i), None));
         };
-        let (Some((from_node, from_port)), Some((to_node, to_port))) = (split_port_ref(&edge.from), split_port_ref(&edge.to)) else {
-            let bad = if split_port_ref(&edge.from).is_none() { &edge.from } else { &edge.to };
+        let (Some((from_node, from_port)), Some((to_node, to_port))) =
+            (split_port_ref(&edge.from), split_port_ref(&edge.to))
+        else {
+            let bad = if split_port_ref(&edge.from).is_none() {
+                &edge.from
+            } else {
+                &edge.to
+            };
             fail(ErrorKind::BadPortRef(bad.clone()), None);
             continue;
         };
@@ -254,12 +310,23 @@ fn check<'g>(graph: &'g Graph, registry: &'g Registry, errors: &mut Vec<GraphErr
         let mut resolved = [None, None];
         for (slot, (node, direction)) in ends.into_iter().enumerate() {
             let Some(&i) = index.get(node) else {
-                fail(ErrorKind::MissingNode { from: edge.from.clone(), to: edge.to.clone(), node: node.to_owned() }, None);
+                fail(
+                    ErrorKind::MissingNode {
+                        from: edge.from.clone(),
+                        to: edge.to.clone(),
+                        node: node.to_owned(),
+                    },
+                    None,
+                );
                 continue;
             };
             let Some(kind) = kinds[i] else { continue }; // already reported as unknown kind
             let port = if slot == 0 { from_port } else { to_port };
-            let has = if slot == 0 { kind.output(port).is_some() } else { kind.input(port).is_some() };
+            let has = if slot == 0 {
+                kind.output(port).is_some()
+            } else {
+                kind.input(port).is_some()
+            };
             if !has {
                 let known: Vec<&str> = if slot == 0 {
                     kind.outputs.iter().map(|p| p.name).collect()
@@ -273,7 +340,11 @@ fn check<'g>(graph: &'g Graph, registry: &'g Registry, errors: &mut Vec<GraphErr
                         kind: kind.name.to_owned(),
                         direction,
                         port: port.to_owned(),
-                        known: if known.is_empty() { "none".into() } else { known.join(", ") },
+                        known: if known.is_empty() {
+                            "none".into()
+                        } else {
+                            known.join(", ")
+                        },
                     },
                     Some(node),
                 );
@@ -281,8 +352,12 @@ fn check<'g>(graph: &'g Graph, registry: &'g Registry, errors: &mut Vec<GraphErr
             }
             resolved[slot] = Some((i, kind));
         }
-        let [Some((fi, fk)), Some((ti, tk))] = resolved else { continue };
-        let (Some(out), Some(inp)) = (fk.output(from_port), tk.input(to_port)) else { continue };
+        let [Some((fi, fk)), Some((ti, tk))] = resolved else {
+            continue;
+        };
+        let (Some(out), Some(inp)) = (fk.output(from_port), tk.input(to_port)) else {
+            continue;
+        };
         if !inp.accepts.contains(&out.ty) {
             let accepted: Vec<_> = inp.accepts.iter().map(|t| t.name()).collect();
             fail(
@@ -309,7 +384,11 @@ fn check<'g>(graph: &'g Graph, registry: &'g Registry, errors: &mut Vec<GraphErr
         }
         inputs.insert((ti, inp.name), (fi, out.name));
     }
-    Checked { kinds, params, inputs }
+    Checked {
+        kinds,
+        params,
+        inputs,
+    }
 }
 
 fn build_plan(
@@ -338,15 +417,17 @@ fn build_plan(
             let e = textures[t.0].extent;
             match extent {
                 None => extent = Some(e),
-                Some(prev) if prev != e => errors.push(graph.locate(
-                    GraphError::new(ErrorKind::Source(format!(
-                        "inputs differ in size: {prev} and {e} (input \"{}\")",
-                        input.name
-                    )))
-                    .at_node(&node.id),
-                    None,
-                    None,
-                )),
+                Some(prev) if prev != e => errors.push(
+                    graph.locate(
+                        GraphError::new(ErrorKind::Source(format!(
+                            "inputs differ in size: {prev} and {e} (input \"{}\")",
+                            input.name
+                        )))
+                        .at_node(&node.id),
+                        None,
+                        None,
+                    ),
+                ),
                 Some(_) => {}
             }
             textures[t.0].last = textures[t.0].last.max(p);
@@ -357,7 +438,11 @@ fn build_plan(
             None => match (options.source_extent)(node, &params) {
                 Ok(e) => e,
                 Err(m) => {
-                    errors.push(graph.locate(GraphError::new(ErrorKind::Source(m)).at_node(&node.id), None, Some("path")));
+                    errors.push(graph.locate(
+                        GraphError::new(ErrorKind::Source(m)).at_node(&node.id),
+                        None,
+                        Some("path"),
+                    ));
                     Extent::new(1, 1)
                 }
             },
@@ -367,13 +452,15 @@ fn build_plan(
         let mut outputs = Vec::new();
         for output in kind.outputs {
             let name = format!("{}.{}", node.id, output.name);
-            let consumed = checked
-                .inputs
-                .iter()
-                .any(|((to, _), (from, port))| *from == i && *port == output.name && position.contains_key(to));
+            let consumed = checked.inputs.iter().any(|((to, _), (from, port))| {
+                *from == i && *port == output.name && position.contains_key(to)
+            });
             let kept = options.keep.contains(&name);
             if !consumed && !kept {
-                left_out.push(LeftOut { what: format!("texture {name}"), reason: "nothing reads it".into() });
+                left_out.push(LeftOut {
+                    what: format!("texture {name}"),
+                    reason: "nothing reads it".into(),
+                });
                 continue;
             }
             let id = TextureId(textures.len());
@@ -390,7 +477,14 @@ fn build_plan(
             texture_of.insert((i, output.name), id);
             outputs.push((output.name, id));
         }
-        passes.push(Pass { node: node.id.clone(), kind: kind.name, params, inputs, outputs, extent });
+        passes.push(Pass {
+            node: node.id.clone(),
+            kind: kind.name,
+            params,
+            inputs,
+            outputs,
+            extent,
+        });
     }
 
     for (i, node) in graph.nodes.iter().enumerate() {
@@ -405,7 +499,12 @@ fn build_plan(
     }
 
     let slots = assign_slots(&mut textures);
-    Plan { passes, textures, slots, left_out }
+    Plan {
+        passes,
+        textures,
+        slots,
+        left_out,
+    }
 }
 
 /// Greedy interval assignment: each texture, in order of first use, takes the first slot of
@@ -414,12 +513,15 @@ fn assign_slots(textures: &mut [TextureDesc]) -> Vec<Slot> {
     let mut slots: Vec<Slot> = Vec::new();
     let mut busy_until: Vec<usize> = Vec::new();
     for t in textures.iter_mut() {
-        let free = slots
-            .iter()
-            .zip(&busy_until)
-            .position(|(s, &until)| s.format == t.format && s.extent == t.extent && until < t.first);
+        let free = slots.iter().zip(&busy_until).position(|(s, &until)| {
+            s.format == t.format && s.extent == t.extent && until < t.first
+        });
         let s = free.unwrap_or_else(|| {
-            slots.push(Slot { format: t.format, extent: t.extent, textures: Vec::new() });
+            slots.push(Slot {
+                format: t.format,
+                extent: t.extent,
+                textures: Vec::new(),
+            });
             busy_until.push(0);
             slots.len() - 1
         });

@@ -11,17 +11,25 @@ fn param_range(ty: &ParamType) -> String {
         ParamType::Float { min, max, .. } => format!("[{min}, {max}]"),
         ParamType::Int { min, max, .. } => format!("[{min}, {max}]"),
         ParamType::Bool { .. } => "true / false".to_owned(),
-        ParamType::Enum { options, .. } => {
-            options.iter().map(|(n, _)| format!("\"{n}\"")).collect::<Vec<_>>().join(", ")
-        }
-        ParamType::Path { extensions, .. } => {
-            extensions.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(" ")
-        }
+        ParamType::Enum { options, .. } => options
+            .iter()
+            .map(|(n, _)| format!("\"{n}\""))
+            .collect::<Vec<_>>()
+            .join(", "),
+        ParamType::Path { extensions, .. } => extensions
+            .iter()
+            .map(|e| format!(".{e}"))
+            .collect::<Vec<_>>()
+            .join(" "),
     }
 }
 
 fn accepts(types: &[PortType]) -> String {
-    types.iter().map(|t| t.name()).collect::<Vec<_>>().join(" | ")
+    types
+        .iter()
+        .map(|t| t.name())
+        .collect::<Vec<_>>()
+        .join(" | ")
 }
 
 /// A plain-text listing of every kind, for the terminal.
@@ -31,7 +39,13 @@ pub fn text(registry: &Registry) -> String {
         let _ = writeln!(s, "{} [{}]", kind.name, kind.category.name());
         let _ = writeln!(s, "    {}", kind.doc);
         for p in kind.inputs {
-            let _ = writeln!(s, "    in   {:<10} {:<24} {}", p.name, accepts(p.accepts), p.doc);
+            let _ = writeln!(
+                s,
+                "    in   {:<10} {:<24} {}",
+                p.name,
+                accepts(p.accepts),
+                p.doc
+            );
         }
         for p in kind.outputs {
             let _ = writeln!(s, "    out  {:<10} {:<24} {}", p.name, p.ty.name(), p.doc);
@@ -55,9 +69,18 @@ pub fn text(registry: &Registry) -> String {
 fn kind_markdown(s: &mut String, kind: &NodeKind) {
     let _ = writeln!(s, "### {}\n\n{}\n", kind.name, kind.doc);
     if !kind.inputs.is_empty() || !kind.outputs.is_empty() {
-        let _ = writeln!(s, "| port | direction | type | description |\n|---|---|---|---|");
+        let _ = writeln!(
+            s,
+            "| port | direction | type | description |\n|---|---|---|---|"
+        );
         for p in kind.inputs {
-            let _ = writeln!(s, "| `{}` | in | {} | {} |", p.name, accepts(p.accepts), p.doc);
+            let _ = writeln!(
+                s,
+                "| `{}` | in | {} | {} |",
+                p.name,
+                accepts(p.accepts),
+                p.doc
+            );
         }
         for p in kind.outputs {
             let _ = writeln!(s, "| `{}` | out | {} | {} |", p.name, p.ty.name(), p.doc);
@@ -65,7 +88,10 @@ fn kind_markdown(s: &mut String, kind: &NodeKind) {
         s.push('\n');
     }
     if !kind.params.is_empty() {
-        let _ = writeln!(s, "| param | type | default | range | description |\n|---|---|---|---|---|");
+        let _ = writeln!(
+            s,
+            "| param | type | default | range | description |\n|---|---|---|---|---|"
+        );
         for p in &kind.params {
             let _ = writeln!(
                 s,

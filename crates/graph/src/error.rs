@@ -83,7 +83,9 @@ pub enum ErrorKind {
         node: String,
     },
     /// An edge names a port its node does not have.
-    #[error("edge {from} -> {to}: {kind} has no {direction} port \"{port}\" (its {direction} ports: {known})")]
+    #[error(
+        "edge {from} -> {to}: {kind} has no {direction} port \"{port}\" (its {direction} ports: {known})"
+    )]
     MissingPort {
         /// Edge start.
         from: String,
@@ -147,7 +149,7 @@ pub struct GraphError {
     /// The node concerned, when there is one.
     pub node: Option<String>,
     /// What went wrong.
-    pub kind: ErrorKind,
+    pub kind: Box<ErrorKind>,
 }
 
 impl GraphError {
@@ -157,7 +159,7 @@ impl GraphError {
             file: None,
             pos: None,
             node: None,
-            kind,
+            kind: Box::new(kind),
         }
     }
 
@@ -187,7 +189,7 @@ impl fmt::Display for GraphError {
 
 impl std::error::Error for GraphError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        std::error::Error::source(&self.kind)
+        std::error::Error::source(&*self.kind)
     }
 }
 
@@ -198,7 +200,9 @@ pub struct GraphErrors(pub Vec<GraphError>);
 impl GraphErrors {
     /// The errors that concern `node`.
     pub fn for_node<'a>(&'a self, node: &'a str) -> impl Iterator<Item = &'a GraphError> + 'a {
-        self.0.iter().filter(move |e| e.node.as_deref() == Some(node))
+        self.0
+            .iter()
+            .filter(move |e| e.node.as_deref() == Some(node))
     }
 }
 

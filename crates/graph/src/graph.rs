@@ -110,9 +110,10 @@ impl Origin {
 
     fn node_offset(&self, id: &str) -> Option<usize> {
         let needle = format!("\"{id}\"");
-        self.text.match_indices(&needle).map(|(i, _)| i).find(|&i| {
-            self.text[..i].trim_end().ends_with("id:")
-        })
+        self.text
+            .match_indices(&needle)
+            .map(|(i, _)| i)
+            .find(|&i| self.text[..i].trim_end().ends_with("id:"))
     }
 
     /// Where node `id` is declared.
@@ -274,8 +275,8 @@ impl Graph {
             .ok_or_else(|| bad(format!("override \"{assignment}\" is not node.param=value")))?;
         let (node, param) = split_port_ref(target.trim())
             .ok_or_else(|| bad(format!("override \"{assignment}\" is not node.param=value")))?;
-        let value = ParamValue::parse(value)
-            .map_err(|m| bad(format!("override \"{assignment}\": {m}")))?;
+        let value =
+            ParamValue::parse(value).map_err(|m| bad(format!("override \"{assignment}\": {m}")))?;
         let n = self
             .node_mut(node)
             .ok_or_else(|| bad(format!("override \"{assignment}\": no node \"{node}\"")))?;
@@ -284,7 +285,12 @@ impl Graph {
     }
 
     /// Fills in file, line and column for an error found in this graph.
-    pub fn locate(&self, mut e: GraphError, edge: Option<usize>, param: Option<&str>) -> GraphError {
+    pub fn locate(
+        &self,
+        mut e: GraphError,
+        edge: Option<usize>,
+        param: Option<&str>,
+    ) -> GraphError {
         if let Some(origin) = &self.origin {
             e.file = Some(origin.path.clone());
             e.pos = match (edge, &e.node, param) {
@@ -308,10 +314,21 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".lumagraph-")
-        .suffix(".tmp")
-        .tempfile_in(dir)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".lumagraph-").suffix(".tmp");
+    // Keep the permissions of the file being replaced; a new file gets the usual rw-r--r--
+    // rather than the temporary file's private rw-------.
+    let permissions = match std::fs::metadata(path) {
+        Ok(m) => Some(m.permissions()),
+        #[cfg(unix)]
+        Err(_) => Some(std::os::unix::fs::PermissionsExt::from_mode(0o644)),
+        #[cfg(not(unix))]
+        Err(_) => None,
+    };
+    if let Some(p) = permissions {
+        builder.permissions(p);
+    }
+    let mut tmp = builder.tempfile_in(dir)?;
     tmp.write_all(bytes)?;
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;

@@ -30,12 +30,18 @@ pub struct Pass {
 impl Pass {
     /// The texture bound to input `port`.
     pub fn input(&self, port: &str) -> Option<TextureId> {
-        self.inputs.iter().find(|(p, _)| *p == port).map(|(_, t)| *t)
+        self.inputs
+            .iter()
+            .find(|(p, _)| *p == port)
+            .map(|(_, t)| *t)
     }
 
     /// The texture bound to output `port`, if anything reads it.
     pub fn output(&self, port: &str) -> Option<TextureId> {
-        self.outputs.iter().find(|(p, _)| *p == port).map(|(_, t)| *t)
+        self.outputs
+            .iter()
+            .find(|(p, _)| *p == port)
+            .map(|(_, t)| *t)
     }
 }
 
@@ -113,7 +119,10 @@ impl Plan {
 
     /// Bytes transient textures would take without sharing.
     pub fn unshared_texture_bytes(&self) -> u64 {
-        self.textures.iter().map(|t| t.extent.pixels() * t.format.bytes_per_pixel()).sum()
+        self.textures
+            .iter()
+            .map(|t| t.extent.pixels() * t.format.bytes_per_pixel())
+            .sum()
     }
 }
 
@@ -127,9 +136,24 @@ impl fmt::Display for Plan {
         writeln!(f, "passes ({}), in order:", self.passes.len())?;
         let w = self.passes.iter().map(|p| p.node.len()).max().unwrap_or(0);
         for (i, p) in self.passes.iter().enumerate() {
-            let reads: Vec<_> = p.inputs.iter().map(|(_, t)| self.textures[t.0].name.as_str()).collect();
-            let writes: Vec<_> = p.outputs.iter().map(|(_, t)| self.textures[t.0].name.as_str()).collect();
-            write!(f, "  {:>2}. {:<w$}  {:<12} {:>9}", i + 1, p.node, p.kind, p.extent.to_string())?;
+            let reads: Vec<_> = p
+                .inputs
+                .iter()
+                .map(|(_, t)| self.textures[t.0].name.as_str())
+                .collect();
+            let writes: Vec<_> = p
+                .outputs
+                .iter()
+                .map(|(_, t)| self.textures[t.0].name.as_str())
+                .collect();
+            write!(
+                f,
+                "  {:>2}. {:<w$}  {:<12} {:>9}",
+                i + 1,
+                p.node,
+                p.kind,
+                p.extent.to_string()
+            )?;
             if !reads.is_empty() {
                 write!(f, "  reads {}", reads.join(", "))?;
             }
@@ -152,11 +176,19 @@ impl fmt::Display for Plan {
                 .iter()
                 .map(|t| {
                     let t = &self.textures[t.0];
-                    let last = if t.last >= self.passes.len() { "end".to_owned() } else { (t.last + 1).to_string() };
+                    let last = if t.last >= self.passes.len() {
+                        "end".to_owned()
+                    } else {
+                        (t.last + 1).to_string()
+                    };
                     format!("{} (passes {}-{last})", t.name, t.first + 1)
                 })
                 .collect();
-            let shared = if slot.textures.len() > 1 { "  shared by" } else { "" };
+            let shared = if slot.textures.len() > 1 {
+                "  shared by"
+            } else {
+                ""
+            };
             writeln!(
                 f,
                 "  #{s} {} {} {}{shared}: {}",

@@ -239,7 +239,11 @@ impl ParamType {
                     Ok(value.clone())
                 }
             }
-            _ => Err(format!("expected {}, found {}", self.name(), value.type_name())),
+            _ => Err(format!(
+                "expected {}, found {}",
+                self.name(),
+                value.type_name()
+            )),
         }
     }
 }

@@ -1,7 +1,8 @@
 //! Validation, pruning and texture assignment, and the RON round trip.
 
 use lumagraph_graph::{
-    CompileOptions, Edge, ErrorKind, Extent, Graph, GraphErrors, Node, ParamValue, Plan, Registry, compile,
+    CompileOptions, Edge, ErrorKind, Extent, Graph, GraphErrors, Node, ParamValue, Plan, Registry,
+    compile,
 };
 
 fn extent(_: &Node, _: &lumagraph_graph::Params) -> Result<Extent, String> {
@@ -9,7 +10,14 @@ fn extent(_: &Node, _: &lumagraph_graph::Params) -> Result<Extent, String> {
 }
 
 fn compile_graph(g: &Graph) -> Result<Plan, GraphErrors> {
-    compile(g, Registry::builtin(), &CompileOptions { source_extent: &extent, keep: &[] })
+    compile(
+        g,
+        Registry::builtin(),
+        &CompileOptions {
+            source_extent: &extent,
+            keep: &[],
+        },
+    )
 }
 
 fn chain() -> Graph {
@@ -44,7 +52,7 @@ fn single_error(text: &str) -> (ErrorKind, String) {
     assert_eq!(errors.0.len(), 1, "expected one error, got: {message}");
     let e = errors.0.into_iter().next().unwrap();
     assert!(e.file.is_some(), "error names no file: {message}");
-    (e.kind, message)
+    (*e.kind, message)
 }
 
 #[test]
@@ -81,7 +89,10 @@ fn textures_share_memory_when_lifetimes_do_not_overlap() {
     // no two textures in one slot overlap in time
     for slot in &plan.slots {
         for w in slot.textures.windows(2) {
-            assert!(plan.textures[w[0].0].last < plan.textures[w[1].0].first, "{plan}");
+            assert!(
+                plan.textures[w[0].0].last < plan.textures[w[1].0].first,
+                "{plan}"
+            );
         }
     }
     assert_eq!(plan.texture_bytes() * 2, plan.unshared_texture_bytes());
@@ -94,15 +105,34 @@ fn dead_branch_is_left_out() {
     g.edges.push(Edge::new("exposure.color", "debug.color"));
     let plan = compile_graph(&g).unwrap();
     assert!(plan.pass("debug").is_none());
-    assert!(plan.left_out.iter().any(|l| l.what.contains("\"debug\"") && l.reason.contains("no output")));
-    assert!(plan.to_string().contains("node \"debug\" (Tonemap): feeds no output"));
+    assert!(
+        plan.left_out
+            .iter()
+            .any(|l| l.what.contains("\"debug\"") && l.reason.contains("no output"))
+    );
+    assert!(
+        plan.to_string()
+            .contains("node \"debug\" (Tonemap): feeds no output")
+    );
 }
 
 #[test]
 fn kept_port_stays_alive_to_the_end() {
     let keep = ["exposure.color".to_owned()];
-    let plan = compile(&chain(), Registry::builtin(), &CompileOptions { source_extent: &extent, keep: &keep }).unwrap();
-    let t = plan.textures.iter().find(|t| t.name == "exposure.color").unwrap();
+    let plan = compile(
+        &chain(),
+        Registry::builtin(),
+        &CompileOptions {
+            source_extent: &extent,
+            keep: &keep,
+        },
+    )
+    .unwrap();
+    let t = plan
+        .textures
+        .iter()
+        .find(|t| t.name == "exposure.color")
+        .unwrap();
     assert_eq!(t.last, plan.passes.len());
 }
 
@@ -142,7 +172,9 @@ fn shipped_graphs_round_trip_and_compile() {
 #[test]
 fn save_to_unwritable_place_keeps_old_file() {
     let dir = tempfile::tempdir().unwrap();
-    let err = chain().save(&dir.path().join("missing-dir/g.ron")).unwrap_err();
+    let err = chain()
+        .save(&dir.path().join("missing-dir/g.ron"))
+        .unwrap_err();
     assert!(err.to_string().contains("cannot write graph file"), "{err}");
 }
 
@@ -167,9 +199,12 @@ fn good_text_compiles() {
 
 #[test]
 fn malformed_ron_names_line_and_column() {
-    let text = graph_text(GOOD_NODES, GOOD_EDGES).replace("(id: \"tonemap\", kind: \"Tonemap\"),", "(id: \"tonemap\" kind: \"Tonemap\"),");
+    let text = graph_text(GOOD_NODES, GOOD_EDGES).replace(
+        "(id: \"tonemap\", kind: \"Tonemap\"),",
+        "(id: \"tonemap\" kind: \"Tonemap\"),",
+    );
     let e = load_str(&text).unwrap_err();
-    assert!(matches!(e.kind, ErrorKind::Syntax(_)), "{e}");
+    assert!(matches!(*e.kind, ErrorKind::Syntax(_)), "{e}");
     let pos = e.pos.unwrap();
     assert_eq!(pos.line, 5, "{e}");
     assert!(e.to_string().contains("g.ron:5:"), "{e}");
@@ -178,27 +213,45 @@ fn malformed_ron_names_line_and_column() {
 #[test]
 fn unsupported_version() {
     let e = load_str("(version: 7, nodes: [])").unwrap_err();
-    assert!(matches!(e.kind, ErrorKind::Version { found: 7, .. }), "{e}");
+    assert!(
+        matches!(*e.kind, ErrorKind::Version { found: 7, .. }),
+        "{e}"
+    );
 }
 
 #[test]
 fn unknown_kind() {
-    let (k, m) = single_error(&graph_text(&GOOD_NODES.replace("\"Tonemap\"", "\"Tonemapp\""), GOOD_EDGES));
+    let (k, m) = single_error(&graph_text(
+        &GOOD_NODES.replace("\"Tonemap\"", "\"Tonemapp\""),
+        GOOD_EDGES,
+    ));
     assert!(matches!(k, ErrorKind::UnknownKind { .. }), "{m}");
-    assert!(m.contains("g.ron:5:") && m.contains("node \"tonemap\"") && m.contains("Tonemapp"), "{m}");
+    assert!(
+        m.contains("g.ron:5:") && m.contains("node \"tonemap\"") && m.contains("Tonemapp"),
+        "{m}"
+    );
 }
 
 #[test]
 fn unknown_param() {
-    let nodes = GOOD_NODES.replace("kind: \"Tonemap\")", "kind: \"Tonemap\", params: {\"whit\": 2.0})");
+    let nodes = GOOD_NODES.replace(
+        "kind: \"Tonemap\")",
+        "kind: \"Tonemap\", params: {\"whit\": 2.0})",
+    );
     let (k, m) = single_error(&graph_text(&nodes, GOOD_EDGES));
     assert!(matches!(k, ErrorKind::UnknownParam { .. }), "{m}");
-    assert!(m.contains("\"whit\"") && m.contains("operator, white") && m.contains("g.ron:5:"), "{m}");
+    assert!(
+        m.contains("\"whit\"") && m.contains("operator, white") && m.contains("g.ron:5:"),
+        "{m}"
+    );
 }
 
 #[test]
 fn param_of_wrong_type() {
-    let nodes = GOOD_NODES.replace("kind: \"Tonemap\")", "kind: \"Tonemap\", params: {\"white\": \"bright\"})");
+    let nodes = GOOD_NODES.replace(
+        "kind: \"Tonemap\")",
+        "kind: \"Tonemap\", params: {\"white\": \"bright\"})",
+    );
     let (k, m) = single_error(&graph_text(&nodes, GOOD_EDGES));
     assert!(matches!(k, ErrorKind::BadParam { .. }), "{m}");
     assert!(m.contains("expected float, found string"), "{m}");
@@ -206,16 +259,25 @@ fn param_of_wrong_type() {
 
 #[test]
 fn param_out_of_range() {
-    let nodes = GOOD_NODES.replace("kind: \"Tonemap\")", "kind: \"Tonemap\", params: {\"white\": -1.0})");
+    let nodes = GOOD_NODES.replace(
+        "kind: \"Tonemap\")",
+        "kind: \"Tonemap\", params: {\"white\": -1.0})",
+    );
     let (_, m) = single_error(&graph_text(&nodes, GOOD_EDGES));
     assert!(m.contains("out of range"), "{m}");
 }
 
 #[test]
 fn enum_value_not_an_option() {
-    let nodes = GOOD_NODES.replace("kind: \"Tonemap\")", "kind: \"Tonemap\", params: {\"operator\": \"filmic\"})");
+    let nodes = GOOD_NODES.replace(
+        "kind: \"Tonemap\")",
+        "kind: \"Tonemap\", params: {\"operator\": \"filmic\"})",
+    );
     let (_, m) = single_error(&graph_text(&nodes, GOOD_EDGES));
-    assert!(m.contains("\"filmic\" is not one of") && m.contains("\"agx\""), "{m}");
+    assert!(
+        m.contains("\"filmic\" is not one of") && m.contains("\"agx\""),
+        "{m}"
+    );
 }
 
 #[test]
@@ -223,7 +285,10 @@ fn edge_to_missing_node() {
     let edges = GOOD_EDGES.replace("to: \"out.color\"", "to: \"outt.color\"");
     let (k, m) = single_error(&graph_text(GOOD_NODES, &edges));
     assert!(matches!(k, ErrorKind::MissingNode { .. }), "{m}");
-    assert!(m.contains("g.ron:10:") && m.contains("no node \"outt\""), "{m}");
+    assert!(
+        m.contains("g.ron:10:") && m.contains("no node \"outt\""),
+        "{m}"
+    );
 }
 
 #[test]
@@ -231,7 +296,10 @@ fn edge_to_missing_port() {
     let edges = GOOD_EDGES.replace("to: \"out.color\"", "to: \"out.colour\"");
     let (k, m) = single_error(&graph_text(GOOD_NODES, &edges));
     assert!(matches!(k, ErrorKind::MissingPort { .. }), "{m}");
-    assert!(m.contains("no input port \"colour\"") && m.contains("its input ports: color"), "{m}");
+    assert!(
+        m.contains("no input port \"colour\"") && m.contains("its input ports: color"),
+        "{m}"
+    );
 }
 
 #[test]
@@ -248,7 +316,10 @@ fn incompatible_port_types() {
     let edges = format!("{GOOD_EDGES}        (from: \"tonemap.color\", to: \"exp.color\"),\n");
     let (k, m) = single_error(&graph_text(&nodes, &edges));
     assert!(matches!(k, ErrorKind::IncompatibleTypes { .. }), "{m}");
-    assert!(m.contains("tonemap.color produces ldr_color, but exp.color accepts hdr_color"), "{m}");
+    assert!(
+        m.contains("tonemap.color produces ldr_color, but exp.color accepts hdr_color"),
+        "{m}"
+    );
 }
 
 #[test]
@@ -272,7 +343,13 @@ fn duplicate_node_ids() {
     let nodes = format!("{GOOD_NODES}        (id: \"tonemap\", kind: \"Exposure\"),\n");
     let g = load_str(&graph_text(&nodes, GOOD_EDGES)).unwrap();
     let errors = compile_graph(&g).unwrap_err();
-    assert!(errors.0.iter().any(|e| matches!(e.kind, ErrorKind::DuplicateId(_))), "{errors}");
+    assert!(
+        errors
+            .0
+            .iter()
+            .any(|e| matches!(*e.kind, ErrorKind::DuplicateId(_))),
+        "{errors}"
+    );
 }
 
 #[test]
@@ -280,7 +357,10 @@ fn graph_without_output() {
     let nodes = r#"        (id: "input", kind: "ImageInput"),
         (id: "tonemap", kind: "Tonemap"),
 "#;
-    let (k, m) = single_error(&graph_text(nodes, "        (from: \"input.color\", to: \"tonemap.color\"),\n"));
+    let (k, m) = single_error(&graph_text(
+        nodes,
+        "        (from: \"input.color\", to: \"tonemap.color\"),\n",
+    ));
     assert!(matches!(k, ErrorKind::NoOutput), "{m}");
 }
 
@@ -295,18 +375,35 @@ fn two_edges_into_one_input() {
 
 #[test]
 fn unconnected_input_of_needed_node() {
-    let (k, m) = single_error(&graph_text(GOOD_NODES, "        (from: \"tonemap.color\", to: \"out.color\"),\n"));
+    let (k, m) = single_error(&graph_text(
+        GOOD_NODES,
+        "        (from: \"tonemap.color\", to: \"out.color\"),\n",
+    ));
     assert!(matches!(k, ErrorKind::UnconnectedInput { .. }), "{m}");
-    assert!(m.contains("node \"tonemap\"") && m.contains("\"color\" is not connected"), "{m}");
+    assert!(
+        m.contains("node \"tonemap\"") && m.contains("\"color\" is not connected"),
+        "{m}"
+    );
 }
 
 #[test]
 fn source_that_cannot_tell_its_size() {
     let g = load_str(&graph_text(GOOD_NODES, GOOD_EDGES)).unwrap();
     let fail = |_: &Node, _: &lumagraph_graph::Params| Err("cannot open in.exr".to_owned());
-    let e = compile(&g, Registry::builtin(), &CompileOptions { source_extent: &fail, keep: &[] }).unwrap_err();
+    let e = compile(
+        &g,
+        Registry::builtin(),
+        &CompileOptions {
+            source_extent: &fail,
+            keep: &[],
+        },
+    )
+    .unwrap_err();
     let m = e.to_string();
-    assert!(m.contains("node \"input\"") && m.contains("cannot open in.exr") && m.contains("g.ron:4:"), "{m}");
+    assert!(
+        m.contains("node \"input\"") && m.contains("cannot open in.exr") && m.contains("g.ron:4:"),
+        "{m}"
+    );
 }
 
 #[test]
@@ -315,9 +412,30 @@ fn overrides_set_params() {
     g.apply_override("tonemap.operator=reinhard").unwrap();
     g.apply_override("exposure.ev=-2").unwrap();
     let plan = compile_graph(&g).unwrap();
-    assert_eq!(plan.pass("tonemap").unwrap().params.str("operator"), "reinhard");
+    assert_eq!(
+        plan.pass("tonemap").unwrap().params.str("operator"),
+        "reinhard"
+    );
     assert!((plan.pass("exposure").unwrap().params.float("ev") + 2.0).abs() < 1e-12);
     assert!(g.apply_override("nope.ev=1").is_err());
     assert!(g.apply_override("exposure.ev").is_err());
 }
 
+#[cfg(unix)]
+#[test]
+fn saved_files_are_readable_by_others_and_keep_permissions() {
+    use std::os::unix::fs::PermissionsExt as _;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("g.ron");
+    chain().save(&path).unwrap();
+    assert_eq!(
+        std::fs::metadata(&path).unwrap().permissions().mode() & 0o777,
+        0o644
+    );
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o600)).unwrap();
+    chain().save(&path).unwrap();
+    assert_eq!(
+        std::fs::metadata(&path).unwrap().permissions().mode() & 0o777,
+        0o600
+    );
+}

@@ -33,10 +33,20 @@ impl GpuContext {
     /// # Errors
     /// When no adapter matches or the device cannot be opened.
     pub fn headless() -> Result<Self> {
-        pollster::block_on(Self::headless_async())
+        pollster::block_on(Self::headless_async(false))
     }
 
-    async fn headless_async() -> Result<Self> {
+    /// Like [`Self::headless`], but when the environment names no adapter, a CPU adapter
+    /// (lavapipe) is taken if there is one, so tests compare against references made on
+    /// the same kind of device wherever they run.
+    ///
+    /// # Errors
+    /// When no adapter matches or the device cannot be opened.
+    pub fn headless_prefer_cpu() -> Result<Self> {
+        pollster::block_on(Self::headless_async(true))
+    }
+
+    async fn headless_async(prefer_cpu: bool) -> Result<Self> {
         let desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
         let backends = desc.backends;
         let instance = wgpu::Instance::new(desc);
@@ -53,6 +63,16 @@ impl GpuContext {
                         names.join(", ")
                     ))
                 })?
+        } else if let Some(cpu) = if prefer_cpu {
+            instance
+                .enumerate_adapters(backends)
+                .await
+                .into_iter()
+                .find(|a| a.get_info().device_type == wgpu::DeviceType::Cpu)
+        } else {
+            None
+        } {
+            cpu
         } else {
             instance
                 .request_adapter(&wgpu::RequestAdapterOptions {
@@ -119,7 +139,10 @@ impl GpuContext {
         } else {
             format!("{} {}", i.driver, i.driver_info)
         };
-        format!("{} ({:?}, {:?}, {driver})", i.name, i.backend, i.device_type)
+        format!(
+            "{} ({:?}, {:?}, {driver})",
+            i.name, i.backend, i.device_type
+        )
     }
 
     /// Whether the adapter is a CPU implementation (lavapipe, llvmpipe, WARP).

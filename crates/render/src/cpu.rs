@@ -51,17 +51,29 @@ pub fn luminance(c: V3) -> f32 {
 /// Linear → sRGB transfer, clamped to \[0, 1\].
 pub fn srgb_encode(x: f32) -> f32 {
     let c = x.clamp(0.0, 1.0);
-    if c <= 0.003_130_8 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+    if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
 }
 
 /// sRGB → linear transfer.
 pub fn srgb_decode(x: f32) -> f32 {
     let c = x.clamp(0.0, 1.0);
-    if c <= 0.040_45 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    if c <= 0.040_45 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 /// Quantizes a value in \[0, 1\] to 8 bits, rounding to nearest.
-#[expect(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "clamped to [0, 255]")]
+#[expect(
+    clippy::cast_possible_truncation,
+    clippy::cast_sign_loss,
+    reason = "clamped to [0, 255]"
+)]
 pub fn to_u8(x: f32) -> u8 {
     (x.clamp(0.0, 1.0) * 255.0).round() as u8
 }
@@ -97,24 +109,35 @@ fn reinhard(c: V3, white: f32) -> V3 {
 }
 
 fn aces(c: V3) -> V3 {
-    let input = [[0.59719, 0.35458, 0.04823], [0.07600, 0.90834, 0.01566], [0.02840, 0.13383, 0.83777]];
-    let output = [[1.60475, -0.53108, -0.07367], [-0.10208, 1.10813, -0.00605], [-0.00327, -0.07276, 1.07602]];
+    let input = [
+        [0.59719, 0.35458, 0.04823],
+        [0.07600, 0.90834, 0.01566],
+        [0.02840, 0.13383, 0.83777],
+    ];
+    let output = [
+        [1.60475, -0.53108, -0.07367],
+        [-0.10208, 1.10813, -0.00605],
+        [-0.00327, -0.07276, 1.07602],
+    ];
     let v = mul_rows(c, input);
-    let fit = map3(v, |v| (v * (v + 0.024_578_6) - 0.000_090_537) / (v * (0.983_729 * v + 0.432_951) + 0.238_081));
+    let fit = map3(v, |v| {
+        (v * (v + 0.024_578_6) - 0.000_090_537) / (v * (0.983_729 * v + 0.432_951) + 0.238_081)
+    });
     mul_rows(fit, output)
 }
 
 fn agx_contrast(x: f32) -> f32 {
     let x2 = x * x;
     let x4 = x2 * x2;
-    15.5 * x4 * x2 - 40.14 * x4 * x + 31.96 * x4 - 6.868 * x2 * x + 0.4298 * x2 + 0.1191 * x - 0.00232
+    15.5 * x4 * x2 - 40.14 * x4 * x + 31.96 * x4 - 6.868 * x2 * x + 0.4298 * x2 + 0.1191 * x
+        - 0.00232
 }
 
 fn agx(c: V3) -> V3 {
     let inset = [
         [0.842_479_1, 0.042_328_24, 0.042_375_655],
         [0.078_433_6, 0.878_468_6, 0.078_433_6],
-        [0.079_223_745, 0.079_166_13, 0.879_142_97],
+        [0.079_223_745, 0.079_166_13, 0.879_143],
     ];
     let outset = [
         [1.196_879, -0.052_896_85, -0.052_971_635],
@@ -123,7 +146,9 @@ fn agx(c: V3) -> V3 {
     ];
     let (min_ev, max_ev) = (-12.473_93_f32, 4.026_069_f32);
     let v = mul_cols(inset, map3(c, |x| x.max(1e-10)));
-    let v = map3(v, |x| (x.max(1e-10).log2().clamp(min_ev, max_ev) - min_ev) / (max_ev - min_ev));
+    let v = map3(v, |x| {
+        (x.max(1e-10).log2().clamp(min_ev, max_ev) - min_ev) / (max_ev - min_ev)
+    });
     let v = mul_cols(outset, map3(v, agx_contrast));
     map3(v, |x| x.max(0.0).powf(2.2))
 }

@@ -4,7 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use lumagraph_graph::{CompileOptions, Extent, Graph, GraphErrors, Node, Params, Plan, Registry, TextureId};
+use lumagraph_graph::{
+    CompileOptions, Extent, Graph, GraphErrors, Node, Params, Plan, Registry, TextureId,
+};
 
 use crate::context::GpuContext;
 use crate::cpu::Image;
@@ -17,9 +19,14 @@ use crate::timing::GpuTimer;
 ///
 /// # Errors
 /// A message naming the file when a source cannot tell its size.
-pub fn source_extent(base_dir: &Path, node: &Node, params: &Params) -> std::result::Result<Extent, String> {
+pub fn source_extent(
+    base_dir: &Path,
+    node: &Node,
+    params: &Params,
+) -> std::result::Result<Extent, String> {
     match node.kind.as_str() {
-        "ImageInput" => crate::image_io::dimensions(&base_dir.join(params.str("path"))).map_err(|e| e.to_string()),
+        "ImageInput" => crate::image_io::dimensions(&base_dir.join(params.str("path")))
+            .map_err(|e| e.to_string()),
         other => Err(format!("{other} is not a source")),
     }
 }
@@ -50,6 +57,8 @@ pub struct FrameReport {
     pub wall: Duration,
     /// Files written by sinks.
     pub written: Vec<PathBuf>,
+    /// Nodes whose passes were recorded, in order.
+    pub executed: Vec<String>,
 }
 
 /// A plan bound to GPU resources, ready to run frames.
@@ -87,7 +96,9 @@ impl Executor {
         let mut pool = TexturePool::new();
         let slots = pool.acquire(ctx, &plan);
         // Two timestamps per pass; nodes with several passes get room too.
-        let capacity = u32::try_from(plan.passes.len() * 8).unwrap_or(u32::MAX).max(8);
+        let capacity = u32::try_from(plan.passes.len() * 8)
+            .unwrap_or(u32::MAX)
+            .max(8);
         let timer = GpuTimer::new(ctx, capacity);
         Ok(Self {
             ctx: ctx.clone(),
@@ -124,7 +135,9 @@ impl Executor {
         let mut encoder = self
             .ctx
             .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("frame"),
+            });
         if let Some(t) = &mut self.timer {
             t.begin_frame();
         }
@@ -132,14 +145,19 @@ impl Executor {
             plan: &self.plan,
             slots: &self.slots,
         };
+        let mut executed = Vec::with_capacity(self.plan.passes.len());
         for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
             node.record(&self.ctx, &mut encoder, pass, &io, self.timer.as_mut())
                 .map_err(|e| e.in_node(&pass.node))?;
+            executed.push(pass.node.clone());
         }
         if let Some(t) = &self.timer {
             t.resolve(&mut encoder);
         }
-        let scope = self.ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = self
+            .ctx
+            .device
+            .push_error_scope(wgpu::ErrorFilter::Validation);
         self.ctx.queue.submit([encoder.finish()]);
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Gpu(e.to_string()));
@@ -147,7 +165,10 @@ impl Executor {
         self.ctx.wait()?;
         let mut written = Vec::new();
         for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
-            written.extend(node.finish(&self.ctx, pass).map_err(|e| e.in_node(&pass.node))?);
+            written.extend(
+                node.finish(&self.ctx, pass)
+                    .map_err(|e| e.in_node(&pass.node))?,
+            );
         }
         let pass_ms = match &self.timer {
             Some(t) => Some(t.read(&self.ctx)?),
@@ -158,6 +179,7 @@ impl Executor {
             pass_ms,
             wall: start.elapsed(),
             written,
+            executed,
         })
     }
 
@@ -168,7 +190,8 @@ impl Executor {
     pub fn read(&self, id: TextureId) -> Result<Image> {
         let desc = &self.plan.textures[id.0];
         let texture = &self.slots[desc.slot];
-        let bytes = crate::readback::read_texture(&self.ctx, &texture.texture, desc.format, desc.extent)?;
+        let bytes =
+            crate::readback::read_texture(&self.ctx, &texture.texture, desc.format, desc.extent)?;
         Ok(crate::readback::to_image(&bytes, desc.format, desc.extent))
     }
 

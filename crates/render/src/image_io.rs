@@ -12,7 +12,10 @@ use crate::cpu::{Image, srgb_decode, srgb_encode, to_u8};
 use crate::error::{RenderError, Result};
 
 fn extension(path: &Path) -> String {
-    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+    path.extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase()
 }
 
 fn check_exists(path: &Path) -> Result<()> {
@@ -61,7 +64,8 @@ pub fn load(path: &Path) -> Result<Image> {
     match extension(path).as_str() {
         "exr" => load_exr(path),
         "hdr" => {
-            let img = image::open(path).map_err(|e| RenderError::image(path, format!("not a readable image: {e}")))?;
+            let img = image::open(path)
+                .map_err(|e| RenderError::image(path, format!("not a readable image: {e}")))?;
             let rgba = img.to_rgba32f();
             Ok(Image {
                 width: rgba.width(),
@@ -70,14 +74,22 @@ pub fn load(path: &Path) -> Result<Image> {
             })
         }
         "png" | "jpg" | "jpeg" => {
-            let img = image::open(path).map_err(|e| RenderError::image(path, format!("not a readable image: {e}")))?;
+            let img = image::open(path)
+                .map_err(|e| RenderError::image(path, format!("not a readable image: {e}")))?;
             let rgba = img.to_rgba32f();
             Ok(Image {
                 width: rgba.width(),
                 height: rgba.height(),
                 pixels: rgba
                     .pixels()
-                    .map(|p| [srgb_decode(p.0[0]), srgb_decode(p.0[1]), srgb_decode(p.0[2]), p.0[3]])
+                    .map(|p| {
+                        [
+                            srgb_decode(p.0[0]),
+                            srgb_decode(p.0[1]),
+                            srgb_decode(p.0[2]),
+                            p.0[3],
+                        ]
+                    })
                     .collect(),
             })
         }
@@ -93,7 +105,13 @@ fn load_exr(path: &Path) -> Result<Image> {
         .no_deep_data()
         .largest_resolution_level()
         .rgba_channels(
-            |size, _| Image::filled(u32::try_from(size.width()).unwrap_or(0), u32::try_from(size.height()).unwrap_or(0), [0.0; 4]),
+            |size, _| {
+                Image::filled(
+                    u32::try_from(size.width()).unwrap_or(0),
+                    u32::try_from(size.height()).unwrap_or(0),
+                    [0.0; 4],
+                )
+            },
             |img: &mut Image, pos, (r, g, b, a): (f32, f32, f32, f32)| {
                 let i = pos.y() * img.width as usize + pos.x();
                 img.pixels[i] = [r, g, b, a];
@@ -135,7 +153,12 @@ pub fn encode_exr(image: &Image, half: bool) -> Result<Vec<u8>> {
     let result = if half {
         let channels = exrp::SpecificChannels::rgba(|exrp::Vec2(x, y): exrp::Vec2<usize>| {
             let p = image.pixels[y * w + x];
-            (exrp::f16::from_f32(p[0]), exrp::f16::from_f32(p[1]), exrp::f16::from_f32(p[2]), exrp::f16::from_f32(p[3]))
+            (
+                exrp::f16::from_f32(p[0]),
+                exrp::f16::from_f32(p[1]),
+                exrp::f16::from_f32(p[2]),
+                exrp::f16::from_f32(p[3]),
+            )
         });
         exrp::Image::from_encoded_channels(size, exrp::Encoding::SMALL_LOSSLESS, channels)
             .write()
@@ -178,11 +201,21 @@ pub fn save(path: &Path, image: &Image, linear: bool) -> Result<()> {
             let bytes: Vec<u8> = image
                 .pixels
                 .iter()
-                .flat_map(|p| [to_u8(encode(p[0])), to_u8(encode(p[1])), to_u8(encode(p[2])), to_u8(p[3])])
+                .flat_map(|p| {
+                    [
+                        to_u8(encode(p[0])),
+                        to_u8(encode(p[1])),
+                        to_u8(encode(p[2])),
+                        to_u8(p[3]),
+                    ]
+                })
                 .collect();
             write_png(path, image.width, image.height, &bytes)
         }
-        other => Err(RenderError::image(path, format!("unsupported output extension \".{other}\" (use .png or .exr)"))),
+        other => Err(RenderError::image(
+            path,
+            format!("unsupported output extension \".{other}\" (use .png or .exr)"),
+        )),
     }
 }
 

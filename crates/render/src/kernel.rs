@@ -90,7 +90,12 @@ impl Kernel {
     ///
     /// # Errors
     /// When the shader does not compile or does not match `bindings`.
-    pub fn from_source(ctx: &GpuContext, label: &str, source: &str, bindings: &[Binding]) -> Result<Self> {
+    pub fn from_source(
+        ctx: &GpuContext,
+        label: &str,
+        source: &str,
+        bindings: &[Binding],
+    ) -> Result<Self> {
         let device = &ctx.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -163,7 +168,8 @@ impl<'a> PassBuilder<'a> {
     /// A texture the pass reads.
     #[must_use]
     pub fn read(mut self, view: &'a wgpu::TextureView) -> Self {
-        self.resources.push(wgpu::BindingResource::TextureView(view));
+        self.resources
+            .push(wgpu::BindingResource::TextureView(view));
         self.kinds.push(true);
         self
     }
@@ -217,7 +223,10 @@ impl<'a> PassBuilder<'a> {
     ) -> Result<()> {
         let declared = &self.kernel.bindings;
         let matches = declared.len() == self.kinds.len()
-            && declared.iter().zip(&self.kinds).all(|(b, &is_tex)| b.is_texture() == is_tex);
+            && declared
+                .iter()
+                .zip(&self.kinds)
+                .all(|(b, &is_tex)| b.is_texture() == is_tex);
         if !matches {
             return Err(RenderError::Shader {
                 name: self.kernel.label.clone(),

@@ -9,8 +9,8 @@
 //! - [`Executor`]: runs a [`lumagraph_graph::Plan`] frame by frame.
 //! - [`image_io`] and [`cpu`]: image files, and plain-Rust references of every post node.
 
-pub mod cpu;
 mod context;
+pub mod cpu;
 mod error;
 mod executor;
 pub mod image_io;

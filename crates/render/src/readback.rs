@@ -12,16 +12,24 @@ use crate::error::{RenderError, Result};
 ///
 /// # Errors
 /// When mapping fails or the GPU does not finish.
-pub fn map_read<T>(ctx: &GpuContext, buffer: &wgpu::Buffer, size: u64, f: impl FnOnce(&[u8]) -> T) -> Result<T> {
+pub fn map_read<T>(
+    ctx: &GpuContext,
+    buffer: &wgpu::Buffer,
+    size: u64,
+    f: impl FnOnce(&[u8]) -> T,
+) -> Result<T> {
     let slice = buffer.slice(..size);
     let (tx, rx) = mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
     ctx.wait()?;
-    rx.recv().map_err(|_| RenderError::Gpu("buffer map callback was dropped".into()))??;
+    rx.recv()
+        .map_err(|_| RenderError::Gpu("buffer map callback was dropped".into()))??;
     let out = {
-        let view = slice.get_mapped_range().map_err(|e| RenderError::Gpu(e.to_string()))?;
+        let view = slice
+            .get_mapped_range()
+            .map_err(|e| RenderError::Gpu(e.to_string()))?;
         f(&view)
     };
     buffer.unmap();
@@ -32,7 +40,12 @@ pub fn map_read<T>(ctx: &GpuContext, buffer: &wgpu::Buffer, size: u64, f: impl F
 ///
 /// # Errors
 /// When the GPU does not finish.
-pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture, format: TexFormat, extent: Extent) -> Result<Vec<u8>> {
+pub fn read_texture(
+    ctx: &GpuContext,
+    texture: &wgpu::Texture,
+    format: TexFormat,
+    extent: Extent,
+) -> Result<Vec<u8>> {
     let bpp = u32::try_from(format.bytes_per_pixel()).unwrap_or(16);
     let row = extent.width * bpp;
     let padded = row.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
@@ -43,7 +56,11 @@ pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture, format: TexFormat
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+    let mut encoder = ctx
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("readback"),
+        });
     encoder.copy_texture_to_buffer(
         texture.as_image_copy(),
         wgpu::TexelCopyBufferInfo {

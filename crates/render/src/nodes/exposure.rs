@@ -19,7 +19,11 @@ impl Exposure {
         let kernel = Kernel::new(
             ctx,
             "post/exposure.wgsl",
-            &[Binding::Texture, Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float), Binding::Uniform],
+            &[
+                Binding::Texture,
+                Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
+                Binding::Uniform,
+            ],
         )?;
         let params = uniform_buffer(ctx, "exposure params", &[0; 16]);
         let mut node = Self { kernel, params };
@@ -31,7 +35,8 @@ impl Exposure {
 impl NodeExec for Exposure {
     fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
         let scale = exposure_scale(pass.params.float("ev"));
-        ctx.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&[scale, 0.0, 0.0, 0.0]));
+        ctx.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&[scale, 0.0, 0.0, 0.0]));
         Ok(())
     }
 
@@ -44,7 +49,9 @@ impl NodeExec for Exposure {
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let input = io.input(pass, "color")?;
-        let Some(out) = pass.output("color") else { return Ok(()) };
+        let Some(out) = pass.output("color") else {
+            return Ok(());
+        };
         self.kernel
             .pass(&pass.node)
             .read(&input.view)

@@ -74,7 +74,11 @@ impl NodeExec for ImageInput {
                 size.width, size.height
             )));
         }
-        encoder.copy_texture_to_texture(src.texture.as_image_copy(), dst.texture.as_image_copy(), size);
+        encoder.copy_texture_to_texture(
+            src.texture.as_image_copy(),
+            dst.texture.as_image_copy(),
+            size,
+        );
         Ok(())
     }
 }

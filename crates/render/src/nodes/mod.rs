@@ -112,8 +112,16 @@ pub fn create(ctx: &GpuContext, pass: &Pass, paths: &Paths) -> Result<Box<dyn No
 /// # Errors
 /// When the folder cannot be created or written.
 pub fn check_writable(path: &Path) -> Result<()> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir)
-        .and_then(|()| tempfile::Builder::new().prefix(".lumagraph-check").tempfile_in(dir).map(|_| ()))
+        .and_then(|()| {
+            tempfile::Builder::new()
+                .prefix(".lumagraph-check")
+                .tempfile_in(dir)
+                .map(|_| ())
+        })
         .map_err(|e| RenderError::image(path, format!("cannot write output: {e}")))
 }

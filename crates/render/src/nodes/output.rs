@@ -50,11 +50,14 @@ impl NodeExec for Output {
         io: &FrameIo<'_>,
         _timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let id = pass.input("color").ok_or_else(|| RenderError::Gpu("input \"color\" is not bound".into()))?;
+        let id = pass
+            .input("color")
+            .ok_or_else(|| RenderError::Gpu("input \"color\" is not bound".into()))?;
         let desc = &io.plan.textures[id.0];
         let texture = io.texture(id);
         let bpp = u32::try_from(desc.format.bytes_per_pixel()).unwrap_or(16);
-        let padded_row = (desc.extent.width * bpp).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let padded_row =
+            (desc.extent.width * bpp).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
         let size = u64::from(padded_row) * u64::from(desc.extent.height);
         let buffer = match self.staged.take() {
             Some(s) if s.buffer.size() == size => s.buffer,
@@ -88,14 +91,20 @@ impl NodeExec for Output {
     }
 
     fn finish(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<Vec<PathBuf>> {
-        let Some(s) = &self.staged else { return Ok(Vec::new()) };
+        let Some(s) = &self.staged else {
+            return Ok(Vec::new());
+        };
         let row = s.extent.width as usize * s.format.bytes_per_pixel() as usize;
         let size = s.buffer.size();
         let bytes = crate::readback::map_read(ctx, &s.buffer, size, |b| {
-            b.chunks_exact(s.padded_row as usize).flat_map(|r| r[..row].to_vec()).collect::<Vec<u8>>()
+            b.chunks_exact(s.padded_row as usize)
+                .flat_map(|r| r[..row].to_vec())
+                .collect::<Vec<u8>>()
         })?;
         let path = self.path(pass);
-        let is_png = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        let is_png = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
         if is_png && s.format == TexFormat::Rgba8Unorm {
             crate::image_io::write_png(&path, s.extent.width, s.extent.height, &bytes)?;
         } else {

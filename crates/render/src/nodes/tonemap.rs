@@ -28,7 +28,11 @@ impl Tonemap {
         let kernel = Kernel::new(
             ctx,
             "post/tonemap.wgsl",
-            &[Binding::Texture, Binding::StorageTexture(wgpu::TextureFormat::Rgba8Unorm), Binding::Uniform],
+            &[
+                Binding::Texture,
+                Binding::StorageTexture(wgpu::TextureFormat::Rgba8Unorm),
+                Binding::Uniform,
+            ],
         )?;
         let params = uniform_buffer(ctx, "tonemap params", &[0; 16]);
         let mut node = Self { kernel, params };
@@ -58,7 +62,9 @@ impl NodeExec for Tonemap {
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let input = io.input(pass, "color")?;
-        let Some(out) = pass.output("color") else { return Ok(()) };
+        let Some(out) = pass.output("color") else {
+            return Ok(());
+        };
         self.kernel
             .pass(&pass.node)
             .read(&input.view)
