@@ -15,6 +15,8 @@ use crate::types::{ParamType, PortType};
 pub enum Category {
     /// Nodes that produce images from files or scenes.
     Input,
+    /// Nodes that render or accumulate samples over frames.
+    Render,
     /// Nodes that change colors of an image.
     Color,
     /// Nodes that write results out of the graph.
@@ -26,6 +28,7 @@ impl Category {
     pub fn name(self) -> &'static str {
         match self {
             Self::Input => "Input",
+            Self::Render => "Render",
             Self::Color => "Color",
             Self::Output => "Output",
         }
@@ -83,6 +86,9 @@ pub struct NodeKind {
     /// Whether the node is a sink: it writes results out of the graph, and the nodes
     /// that feed no sink are pruned.
     pub sink: bool,
+    /// Whether the node keeps history across frames (progressive accumulation): it and
+    /// everything upstream of it run every frame; nodes downstream only need the last one.
+    pub history: bool,
 }
 
 impl NodeKind {
@@ -180,6 +186,27 @@ fn builtin_kinds() -> Vec<NodeKind> {
                 doc: "image file, relative to the graph file's folder",
             }],
             sink: false,
+            history: false,
+        },
+        NodeKind {
+            name: "Accumulate",
+            category: Category::Render,
+            doc: "Running mean of its input over frames (progressive rendering). Sums are kept in \
+                  f32 with Kahan compensation, so millions of frames do not drift. Restarts when \
+                  the scene, the camera or anything upstream changes.",
+            inputs: &[InputDef {
+                name: "color",
+                accepts: COLOR_TYPES,
+                doc: "this frame's estimate",
+            }],
+            outputs: &[OutputDef {
+                name: "color",
+                ty: PortType::HdrColor,
+                doc: "mean of all frames so far",
+            }],
+            params: vec![],
+            sink: false,
+            history: true,
         },
         NodeKind {
             name: "Exposure",
@@ -205,6 +232,7 @@ fn builtin_kinds() -> Vec<NodeKind> {
                 doc: "exposure in stops; +1 doubles the brightness",
             }],
             sink: false,
+            history: false,
         },
         NodeKind {
             name: "Tonemap",
@@ -241,6 +269,7 @@ fn builtin_kinds() -> Vec<NodeKind> {
                 },
             ],
             sink: false,
+            history: false,
         },
         NodeKind {
             name: "Output",
@@ -263,6 +292,7 @@ fn builtin_kinds() -> Vec<NodeKind> {
                 doc: "file to write, relative to the output folder (`--out`)",
             }],
             sink: true,
+            history: false,
         },
     ]
 }

@@ -190,3 +190,29 @@ pub fn tonemap(image: &Image, op: u32, white: f32) -> Image {
         [d[0], d[1], d[2], p[3].clamp(0.0, 1.0)]
     })
 }
+
+/// Kahan-compensated running mean, per channel, exactly as `post/accumulate.wgsl` does it.
+#[derive(Clone, Debug, Default)]
+pub struct KahanMean {
+    sum: [f32; 3],
+    comp: [f32; 3],
+    frames: f32,
+}
+
+impl KahanMean {
+    /// Adds one frame's value.
+    pub fn add(&mut self, x: [f32; 3]) {
+        for ((s, c), x) in self.sum.iter_mut().zip(&mut self.comp).zip(x) {
+            let y = x - *c;
+            let t = *s + y;
+            *c = (t - *s) - y;
+            *s = t;
+        }
+        self.frames += 1.0;
+    }
+
+    /// The mean so far.
+    pub fn mean(&self) -> [f32; 3] {
+        self.sum.map(|s| s / self.frames)
+    }
+}

@@ -70,6 +70,8 @@ pub struct Executor {
     pool: TexturePool,
     timer: Option<GpuTimer>,
     frames: u64,
+    /// Per pass: whether it feeds (or is) a node with history, and so runs every frame.
+    every_frame: Vec<bool>,
 }
 
 impl std::fmt::Debug for Executor {
@@ -100,6 +102,7 @@ impl Executor {
             .unwrap_or(u32::MAX)
             .max(8);
         let timer = GpuTimer::new(ctx, capacity);
+        let every_frame = every_frame(&plan);
         Ok(Self {
             ctx: ctx.clone(),
             plan,
@@ -108,7 +111,13 @@ impl Executor {
             pool,
             timer,
             frames: 0,
+            every_frame,
         })
+    }
+
+    /// Frames run so far.
+    pub fn frames(&self) -> u64 {
+        self.frames
     }
 
     /// The plan being executed.
@@ -126,11 +135,27 @@ impl Executor {
         &self.pool
     }
 
+    /// Restarts progressive accumulation in every node that keeps history.
+    pub fn reset_history(&mut self) {
+        for node in &mut self.nodes {
+            node.reset();
+        }
+    }
+
     /// Records, submits and finishes one frame.
     ///
     /// # Errors
     /// When a node fails; the error names the node.
     pub fn run_frame(&mut self) -> Result<FrameReport> {
+        self.run_frames(1)
+    }
+
+    /// Runs `n` frames in one submission: passes that feed a node with history (and that
+    /// node) run every frame; the rest run once, in the last frame, which is the one timed.
+    ///
+    /// # Errors
+    /// When a node fails; the error names the node.
+    pub fn run_frames(&mut self, n: u32) -> Result<FrameReport> {
         let start = Instant::now();
         let mut encoder = self
             .ctx
@@ -146,10 +171,20 @@ impl Executor {
             slots: &self.slots,
         };
         let mut executed = Vec::with_capacity(self.plan.passes.len());
-        for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
-            node.record(&self.ctx, &mut encoder, pass, &io, self.timer.as_mut())
-                .map_err(|e| e.in_node(&pass.node))?;
-            executed.push(pass.node.clone());
+        let n = n.max(1);
+        for frame in 0..n {
+            let last = frame + 1 == n;
+            for (p, (pass, node)) in self.plan.passes.iter().zip(&mut self.nodes).enumerate() {
+                if !last && !self.every_frame[p] {
+                    continue;
+                }
+                let timer = if last { self.timer.as_mut() } else { None };
+                node.record(&self.ctx, &mut encoder, pass, &io, timer)
+                    .map_err(|e| e.in_node(&pass.node))?;
+                if last {
+                    executed.push(pass.node.clone());
+                }
+            }
         }
         if let Some(t) = &self.timer {
             t.resolve(&mut encoder);
@@ -174,7 +209,7 @@ impl Executor {
             Some(t) => Some(t.read(&self.ctx)?),
             None => None,
         };
-        self.frames += 1;
+        self.frames += u64::from(n);
         Ok(FrameReport {
             pass_ms,
             wall: start.elapsed(),
@@ -209,4 +244,23 @@ impl Executor {
             .ok_or_else(|| RenderError::Gpu(format!("no planned texture for {port}")))?;
         self.read(t.id)
     }
+}
+
+/// For each pass, whether it is a node with history or feeds one.
+fn every_frame(plan: &Plan) -> Vec<bool> {
+    let mut flags: Vec<bool> = plan
+        .passes
+        .iter()
+        .map(|p| Registry::builtin().get(p.kind).is_some_and(|k| k.history))
+        .collect();
+    // Walk backwards: a pass runs every frame if a later pass that does reads its output.
+    for i in (0..plan.passes.len()).rev() {
+        if !flags[i] {
+            continue;
+        }
+        for (_, t) in &plan.passes[i].inputs {
+            flags[plan.textures[t.0].first] = true;
+        }
+    }
+    flags
 }

@@ -129,6 +129,15 @@ fn load_exr(path: &Path) -> Result<Image> {
 /// # Errors
 /// When encoding fails.
 pub fn encode_png(width: u32, height: u32, rgba8: &[u8]) -> Result<Vec<u8>> {
+    if rgba8.len() as u64 != u64::from(width) * u64::from(height) * 4 {
+        return Err(RenderError::image(
+            Path::new("<png>"),
+            format!(
+                "{} bytes do not make a {width}x{height} RGBA image",
+                rgba8.len()
+            ),
+        ));
+    }
     let mut out = Vec::new();
     image::write_buffer_with_format(
         &mut Cursor::new(&mut out),
@@ -147,6 +156,17 @@ pub fn encode_png(width: u32, height: u32, rgba8: &[u8]) -> Result<Vec<u8>> {
 /// # Errors
 /// When encoding fails.
 pub fn encode_exr(image: &Image, half: bool) -> Result<Vec<u8>> {
+    if image.pixels.len() as u64 != u64::from(image.width) * u64::from(image.height) {
+        return Err(RenderError::image(
+            Path::new("<exr>"),
+            format!(
+                "{} pixels do not make a {}x{} image",
+                image.pixels.len(),
+                image.width,
+                image.height
+            ),
+        ));
+    }
     let size = (image.width as usize, image.height as usize);
     let w = image.width as usize;
     let mut out = Vec::new();

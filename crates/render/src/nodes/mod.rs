@@ -1,5 +1,6 @@
 //! GPU implementations of the node kinds, one file per kind, each named as in the registry.
 
+mod accumulate;
 mod exposure;
 mod image_input;
 mod output;
@@ -69,6 +70,9 @@ pub trait NodeExec {
     /// When a param cannot be applied (e.g. an input file fails to load).
     fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()>;
 
+    /// Forgets history kept across frames (progressive accumulation restarts).
+    fn reset(&mut self) {}
+
     /// Records this frame's GPU work.
     ///
     /// # Errors
@@ -98,6 +102,7 @@ pub trait NodeExec {
 pub fn create(ctx: &GpuContext, pass: &Pass, paths: &Paths) -> Result<Box<dyn NodeExec>> {
     let node: Result<Box<dyn NodeExec>> = match pass.kind {
         "ImageInput" => image_input::ImageInput::new(ctx, pass, paths).map(|n| Box::new(n) as _),
+        "Accumulate" => accumulate::Accumulate::new(ctx).map(|n| Box::new(n) as _),
         "Exposure" => exposure::Exposure::new(ctx, pass).map(|n| Box::new(n) as _),
         "Tonemap" => tonemap::Tonemap::new(ctx, pass).map(|n| Box::new(n) as _),
         "Output" => output::Output::new(ctx, pass, paths).map(|n| Box::new(n) as _),
