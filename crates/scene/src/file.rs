@@ -8,15 +8,16 @@
 //!     shapes: [
 //!         Sphere(center: (0, 0, 0), radius: 1, material: "white"),
 //!         Quad(corners: [(-1, 1, 0), (1, 1, 0), (1, 1, 1), (-1, 1, 1)], material: "white",
-//!              emission: Some((10, 10, 10))),
-//!         Mesh(path: "CornellBox/CornellBox.gltf", transform: (scale: Some((2, 2, 2)))),
+//!              emission: (10, 10, 10)),
+//!         Mesh(name: "box", path: "CornellBox/CornellBox.gltf", transform: (scale: (2, 2, 2))),
 //!     ],
 //!     environment: Constant((1, 1, 1)),
 //!     render: (width: 256, height: 256, spp: 16),
 //! )
 //! ```
 //!
-//! Every struct refuses unknown fields. Vectors are tuples `(x, y, z)`. Angles are in
+//! Optional fields are written without `Some(…)` (ron's `implicit_some` is on). Every
+//! struct refuses unknown fields. Vectors are tuples `(x, y, z)`. Angles are in
 //! degrees. Paths are relative to the scene file. Shapes follow Mitsuba's conventions:
 //! a `Rectangle` is the square [-1,1]² in the plane z=0 with its front normal +z, a `Box`
 //! is the cube [-1,1]³ with outward normals, both placed by their `transform`; a `Quad`
@@ -149,8 +150,9 @@ pub struct TransformDesc {
     pub rotate: Vec<Rotation>,
     /// Per-axis scale, applied first.
     pub scale: Option<V3>,
-    /// A full matrix, rows first; excludes the other fields.
-    pub matrix: Option<[[f32; 4]; 4]>,
+    /// A full matrix, 4 rows of 4 written as lists `[[..], [..], [..], [..]]`; excludes
+    /// the other fields.
+    pub matrix: Option<Vec<Vec<f32>>>,
 }
 
 /// A rotation about an axis through the origin.
@@ -246,8 +248,8 @@ pub enum ShapeDesc {
         /// Name for messages.
         #[serde(default)]
         name: Option<String>,
-        /// Corners, world space.
-        corners: [V3; 4],
+        /// The 4 corners, world space, as a list `[(x, y, z), …]`.
+        corners: Vec<V3>,
         /// Material name.
         material: String,
         /// Emitted radiance, replacing the material's own.

@@ -6,6 +6,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
+use ron::extensions::Extensions;
 use serde::Deserialize;
 
 use crate::error::{ErrorKind, Pos, SceneError};
@@ -131,14 +132,21 @@ fn unit_range(field: &'static str, x: f32) -> Result<f32, SceneError> {
 /// When `matrix` is given with other fields, a rotation axis is zero, or the result is
 /// singular or not finite.
 pub fn transform_matrix(t: &TransformDesc) -> Result<Mat4, SceneError> {
-    let m = if let Some(rows) = t.matrix {
+    let m = if let Some(rows) = &t.matrix {
         if t.translate.is_some() || t.scale.is_some() || !t.rotate.is_empty() {
             return Err(bad(
                 "transform",
                 "give either `matrix` or translate/rotate/scale, not both",
             ));
         }
-        Mat4::from_cols_array_2d(&rows).transpose()
+        if rows.len() != 4 || rows.iter().any(|r| r.len() != 4) {
+            return Err(bad("matrix", "give 4 rows of 4 numbers"));
+        }
+        let mut a = [[0.0; 4]; 4];
+        for (dst, src) in a.iter_mut().zip(rows) {
+            dst.copy_from_slice(src);
+        }
+        Mat4::from_cols_array_2d(&a).transpose()
     } else {
         let mut m = Mat4::from_scale(t.scale.map_or(Vec3::ONE, Vec3::from));
         for r in &t.rotate {
@@ -212,7 +220,8 @@ impl Scene {
                 col: e.span.start.col,
             }))
         };
-        let probe: VersionProbe = ron::from_str(text).map_err(syntax)?;
+        let options = ron::Options::default().with_default_extension(Extensions::IMPLICIT_SOME);
+        let probe: VersionProbe = options.from_str(text).map_err(syntax)?;
         if probe.version != VERSION {
             let loc = Locator::new(text);
             return Err(SceneError::new(ErrorKind::Version {
@@ -221,7 +230,7 @@ impl Scene {
             })
             .at(loc.find("version")));
         }
-        let file: SceneFile = ron::from_str(text).map_err(syntax)?;
+        let file: SceneFile = options.from_str(text).map_err(syntax)?;
         Builder::new(text, base_dir).build(&file)
     }
 }
@@ -364,11 +373,17 @@ impl<'a> Builder<'a> {
             ShapeDesc::Quad {
                 corners, material, ..
             } => {
+                let [a, b, c, d] = corners.as_slice() else {
+                    return Err(bad(
+                        "corners",
+                        format!("give 4 corners, not {}", corners.len()),
+                    ));
+                };
                 let c = [
-                    finite3("corners", corners[0])?,
-                    finite3("corners", corners[1])?,
-                    finite3("corners", corners[2])?,
-                    finite3("corners", corners[3])?,
+                    finite3("corners", *a)?,
+                    finite3("corners", *b)?,
+                    finite3("corners", *c)?,
+                    finite3("corners", *d)?,
                 ];
                 let m = self.lookup(material)?;
                 let m = self.emissive(m, emission, two_sided)?;

@@ -119,10 +119,12 @@ pub fn intersect_sphere(
         return None;
     }
     let c = f.dot(f) - radius * radius;
-    let q = b + disc.sqrt().copysign(b);
+    let root = disc.sqrt();
+    let q = b + if b < 0.0 { -root } else { root };
     let t0 = c / q;
     let t1 = q / a;
-    let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
+    let near = t0.min(t1);
+    let far = t0.max(t1);
     if near > 0.0 && near < t_max {
         Some(near)
     } else if far > 0.0 && far < t_max {
