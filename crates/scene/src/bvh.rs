@@ -1,0 +1,207 @@
+//! The BVH: built by [`obvhs`] (PLOC + reinsertion + leaf collapse) over the boxes of
+//! triangles and spheres together, then flattened into [`GpuBvhNode`]s for the GPU.
+//!
+//! # Layout (32 bytes a node, two 16-byte loads)
+//! Nodes are in depth-first order: the root is node 0 and an inner node's **first child is
+//! the next node** (`i + 1`); only the second child's index is stored. Inner node
+//! children are ordered so the first one has the lower centroid along the node's `axis`;
+//! a ray with a negative direction component on that axis visits the second child first.
+//!
+//! | field | inner node | leaf |
+//! |---|---|---|
+//! | `aabb_min`, `aabb_max` | bounds of the subtree | bounds of its primitives |
+//! | `index` | second child's node index | first primitive, in its kind's array |
+//! | `meta` bits 0–1 | split axis (0 x, 1 y, 2 z) | 0 |
+//! | `meta` bit 2 | 0 | kind: 0 triangles (`tri_positions`), 1 spheres (`spheres`) |
+//! | `meta` bits 3–31 | 0 (this is what makes it inner) | primitive count ≥ 1 |
+//!
+//! A leaf holds one kind only: when obvhs puts triangles and spheres in one leaf, it is
+//! split into an inner node over two leaves. Triangles and spheres are **reordered** so
+//! that every leaf's primitives are contiguous in their array: no index indirection, one
+//! load fewer per primitive. [`crate::GpuScene::tri_source`] maps back to the scene order.
+//!
+//! The traversal keeps a stack of second children; its depth never exceeds the tree depth,
+//! which is checked against [`BVH_STACK_SIZE`] here.
+
+use std::time::Duration;
+
+use glam::{Vec3, Vec3A};
+use obvhs::BvhBuildParams;
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::Bvh2;
+
+use crate::error::{ErrorKind, SceneError};
+use crate::gpu::GpuBvhNode;
+
+/// Entries in the traversal stack of the CPU and WGSL traversal (`BVH_STACK_SIZE` in
+/// `bvh.wgsl`); trees deeper than this are refused.
+pub const BVH_STACK_SIZE: usize = 64;
+
+/// `meta` bit: the leaf holds spheres.
+pub const NODE_SPHERES: u32 = 4;
+/// `meta` shift of the primitive count.
+pub const NODE_COUNT_SHIFT: u32 = 3;
+
+/// BVH build settings.
+#[derive(Clone, Copy, Debug)]
+pub struct BvhOptions {
+    /// Most primitives in one leaf (1..=255); obvhs's collapse picks fewer where cheaper.
+    pub max_leaf_size: u32,
+    /// Relative cost of a node visit against a primitive test, for the leaf collapse.
+    /// Higher gives bigger leaves.
+    pub traversal_cost: f32,
+}
+
+impl Default for BvhOptions {
+    fn default() -> Self {
+        Self {
+            max_leaf_size: 4,
+            traversal_cost: 1.0,
+        }
+    }
+}
+
+/// The flattened tree and the primitive orders it implies.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct FlatBvh {
+    pub nodes: Vec<GpuBvhNode>,
+    /// New triangle order: `tri_order[i]` is the input triangle stored at `i`.
+    pub tri_order: Vec<u32>,
+    /// New sphere order, likewise.
+    pub sphere_order: Vec<u32>,
+    /// Most inner nodes above a leaf.
+    pub depth: usize,
+}
+
+/// Builds and flattens the BVH over `tri_boxes` (primitives `0..n`) and `sphere_boxes`
+/// (primitives `n..`).
+pub(crate) fn build(
+    tri_boxes: &[Aabb],
+    sphere_boxes: &[Aabb],
+    options: &BvhOptions,
+) -> Result<FlatBvh, SceneError> {
+    let n_tris = tri_boxes.len() as u32;
+    let boxes: Vec<Aabb> = tri_boxes.iter().chain(sphere_boxes).copied().collect();
+    let mut flat = FlatBvh::default();
+    if boxes.is_empty() {
+        return Ok(flat);
+    }
+    let params = BvhBuildParams {
+        max_prims_per_leaf: options.max_leaf_size.clamp(1, 255),
+        collapse_traversal_cost: options.traversal_cost,
+        ..BvhBuildParams::medium_build()
+    };
+    let bvh = obvhs::bvh2::builder::build_bvh2(&boxes, params, &mut Duration::default());
+    let mut f = Flattener {
+        bvh: &bvh,
+        boxes: &boxes,
+        n_tris,
+        out: &mut flat,
+    };
+    f.node(0, 0)?;
+    Ok(flat)
+}
+
+struct Flattener<'a> {
+    bvh: &'a Bvh2,
+    boxes: &'a [Aabb],
+    n_tris: u32,
+    out: &'a mut FlatBvh,
+}
+
+fn to3(v: Vec3A) -> [f32; 3] {
+    Vec3::from(v).to_array()
+}
+
+impl Flattener<'_> {
+    fn too_deep(depth: usize) -> Result<(), SceneError> {
+        if depth > BVH_STACK_SIZE {
+            return Err(SceneError::new(ErrorKind::BvhTooDeep {
+                depth,
+                max: BVH_STACK_SIZE,
+            }));
+        }
+        Ok(())
+    }
+
+    /// Emits source node `src` and its subtree at `depth`; returns its output index.
+    fn node(&mut self, src: usize, depth: usize) -> Result<u32, SceneError> {
+        Self::too_deep(depth)?;
+        self.out.depth = self.out.depth.max(depth);
+        let n = &self.bvh.nodes[src];
+        let at = self.out.nodes.len();
+        self.out.nodes.push(GpuBvhNode::default());
+        if n.is_leaf() {
+            let first = n.first_index as usize;
+            let prims = &self.bvh.primitive_indices[first..first + n.prim_count as usize];
+            let (tris, spheres): (Vec<u32>, Vec<u32>) =
+                prims.iter().partition(|&&p| p < self.n_tris);
+            if tris.is_empty() || spheres.is_empty() {
+                self.out.nodes[at] = self.leaf(&tris, &spheres);
+            } else {
+                Self::too_deep(depth + 1)?;
+                self.out.depth = self.out.depth.max(depth + 1);
+                let left = self.leaf(&tris, &[]);
+                self.out.nodes.push(left);
+                let right_at = self.out.nodes.len() as u32;
+                let right = self.leaf(&[], &spheres);
+                self.out.nodes.push(right);
+                self.out.nodes[at] = GpuBvhNode {
+                    aabb_min: to3(n.aabb().min),
+                    index: right_at,
+                    aabb_max: to3(n.aabb().max),
+                    meta: 0,
+                };
+            }
+            return Ok(at as u32);
+        }
+        let (mut a, mut b) = (n.first_index as usize, n.first_index as usize + 1);
+        let ca = self.bvh.nodes[a].aabb().center();
+        let cb = self.bvh.nodes[b].aabb().center();
+        let d = (cb - ca).abs();
+        let axis = if d.x >= d.y && d.x >= d.z {
+            0
+        } else if d.y >= d.z {
+            1
+        } else {
+            2
+        };
+        if ca[axis] > cb[axis] {
+            std::mem::swap(&mut a, &mut b);
+        }
+        self.node(a, depth + 1)?;
+        let right = self.node(b, depth + 1)?;
+        self.out.nodes[at] = GpuBvhNode {
+            aabb_min: to3(n.aabb().min),
+            index: right,
+            aabb_max: to3(n.aabb().max),
+            meta: axis as u32,
+        };
+        Ok(at as u32)
+    }
+
+    /// A leaf over `tris` or `spheres` (one of them empty), appending them to the orders.
+    fn leaf(&mut self, tris: &[u32], spheres: &[u32]) -> GpuBvhNode {
+        let mut aabb = Aabb::empty();
+        for &p in tris.iter().chain(spheres) {
+            aabb = aabb.union(&self.boxes[p as usize]);
+        }
+        let (index, count, kind) = if spheres.is_empty() {
+            let first = self.out.tri_order.len() as u32;
+            self.out.tri_order.extend_from_slice(tris);
+            (first, tris.len() as u32, 0)
+        } else {
+            let first = self.out.sphere_order.len() as u32;
+            self.out
+                .sphere_order
+                .extend(spheres.iter().map(|&p| p - self.n_tris));
+            (first, spheres.len() as u32, NODE_SPHERES)
+        };
+        GpuBvhNode {
+            aabb_min: to3(aabb.min),
+            index,
+            aabb_max: to3(aabb.max),
+            meta: (count << NODE_COUNT_SHIFT) | kind,
+        }
+    }
+}

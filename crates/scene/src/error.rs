@@ -1,0 +1,159 @@
+//! Scene errors: each names the file, the line and column when known, and the shape or
+//! material it concerns.
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// A line and column in a scene file, both starting at 1.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Pos {
+    /// Line, from 1.
+    pub line: usize,
+    /// Column, from 1.
+    pub col: usize,
+}
+
+/// What went wrong.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ErrorKind {
+    /// A file could not be read.
+    #[error("cannot read {what}: {source}")]
+    Io {
+        /// What was being read ("scene file", "OBJ file").
+        what: &'static str,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file is not valid RON for a scene.
+    #[error("syntax error: {0}")]
+    Syntax(String),
+    /// The file's version is not one this build reads.
+    #[error("unsupported scene version {found} (this build reads version {supported})")]
+    Version {
+        /// Version in the file.
+        found: u32,
+        /// Version this build reads.
+        supported: u32,
+    },
+    /// A shape names a material that is not defined.
+    #[error("unknown material \"{material}\" (defined materials: {known})")]
+    UnknownMaterial {
+        /// The name used.
+        material: String,
+        /// The names defined, comma-separated.
+        known: String,
+    },
+    /// A value is out of its range or not finite.
+    #[error("{field}: {message}")]
+    BadValue {
+        /// The field ("radius", "fov_y").
+        field: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// The camera asks for a glTF camera that cannot be found.
+    #[error("{0}")]
+    Camera(String),
+    /// A glTF file could not be loaded.
+    #[error("glTF: {0}")]
+    Gltf(#[from] gltf::Error),
+    /// An OBJ or MTL file could not be loaded.
+    #[error("OBJ: {0}")]
+    Obj(#[from] tobj::LoadError),
+    /// A mesh file has an extension this build does not import.
+    #[error("unsupported mesh file type \"{0}\" (use .gltf, .glb or .obj)")]
+    MeshType(String),
+    /// The BVH is deeper than the traversal stack.
+    #[error("BVH depth {depth} exceeds the traversal stack size {max}")]
+    BvhTooDeep {
+        /// Depth of the built tree.
+        depth: usize,
+        /// The stack size the traversal code uses.
+        max: usize,
+    },
+    /// More primitives than the GPU layout can index.
+    #[error("too many primitives ({0}); the GPU layout indexes at most 2^28")]
+    TooManyPrimitives(usize),
+}
+
+/// One scene error with its location.
+#[derive(Debug)]
+pub struct SceneError {
+    /// The file concerned (the scene file, or the mesh file it references).
+    pub file: Option<PathBuf>,
+    /// Line and column in the file, when known.
+    pub pos: Option<Pos>,
+    /// The shape or material concerned, e.g. `shape "floor"` or `material "white"`.
+    pub item: Option<String>,
+    /// What went wrong.
+    pub kind: ErrorKind,
+}
+
+impl SceneError {
+    /// An error with no location yet.
+    pub fn new(kind: ErrorKind) -> Self {
+        Self {
+            file: None,
+            pos: None,
+            item: None,
+            kind,
+        }
+    }
+
+    /// The same error, in `file`, unless it already names one.
+    #[must_use]
+    pub fn in_file(mut self, file: impl Into<PathBuf>) -> Self {
+        if self.file.is_none() {
+            self.file = Some(file.into());
+        }
+        self
+    }
+
+    /// The same error, at `pos`, unless it already has a position.
+    #[must_use]
+    pub fn at(mut self, pos: Option<Pos>) -> Self {
+        if self.pos.is_none() {
+            self.pos = pos;
+        }
+        self
+    }
+
+    /// The same error, about `item` (e.g. `shape "floor"`), unless it already names one.
+    #[must_use]
+    pub fn about(mut self, item: impl Into<String>) -> Self {
+        if self.item.is_none() {
+            self.item = Some(item.into());
+        }
+        self
+    }
+}
+
+impl<E: Into<ErrorKind>> From<E> for SceneError {
+    fn from(e: E) -> Self {
+        Self::new(e.into())
+    }
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if let Some(file) = &self.file {
+            write!(f, "{}", file.display())?;
+            if let Some(pos) = self.pos {
+                write!(f, ":{}:{}", pos.line, pos.col)?;
+            }
+            f.write_str(": ")?;
+        }
+        if let Some(item) = &self.item {
+            write!(f, "{item}: ")?;
+        }
+        write!(f, "{}", self.kind)
+    }
+}
+
+impl std::error::Error for SceneError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        std::error::Error::source(&self.kind)
+    }
+}

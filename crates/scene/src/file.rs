@@ -1,0 +1,356 @@
+//! The scene file format (RON, `version: 1`), as written by hand.
+//!
+//! ```ron
+//! (
+//!     version: 1,
+//!     camera: Perspective(position: (0, 0, 3.9), target: (0, 0, 0), up: (0, 1, 0), fov_y: 39.3077),
+//!     materials: { "white": (base_color: (0.8, 0.8, 0.8)) },
+//!     shapes: [
+//!         Sphere(center: (0, 0, 0), radius: 1, material: "white"),
+//!         Quad(corners: [(-1, 1, 0), (1, 1, 0), (1, 1, 1), (-1, 1, 1)], material: "white",
+//!              emission: (10, 10, 10)),
+//!         Mesh(name: "box", path: "CornellBox/CornellBox.gltf", transform: (scale: (2, 2, 2))),
+//!     ],
+//!     environment: Constant((1, 1, 1)),
+//!     render: (width: 256, height: 256, spp: 16),
+//! )
+//! ```
+//!
+//! Optional fields are written without `Some(…)` (ron's `implicit_some` is on). Every
+//! struct refuses unknown fields. Vectors are tuples `(x, y, z)`. Angles are in
+//! degrees. Paths are relative to the scene file. Shapes follow Mitsuba's conventions:
+//! a `Rectangle` is the square [-1,1]² in the plane z=0 with its front normal +z, a `Box`
+//! is the cube [-1,1]³ with outward normals, both placed by their `transform`; a `Quad`
+//! is given by 4 world corners, counter-clockwise seen from its front. Emitters are
+//! one-sided (radiance from the front only) unless `two_sided: true`.
+
+use std::collections::BTreeMap;
+
+use serde::Deserialize;
+
+/// The scene file version this build reads and writes.
+pub const VERSION: u32 = 1;
+
+/// A 3-vector written `(x, y, z)`.
+pub type V3 = [f32; 3];
+
+/// The whole file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Always [`VERSION`].
+    pub version: u32,
+    /// The camera.
+    pub camera: CameraDesc,
+    /// Named materials.
+    #[serde(default)]
+    pub materials: BTreeMap<String, MaterialDesc>,
+    /// The shapes, each triangulated or kept as an analytic sphere.
+    pub shapes: Vec<ShapeDesc>,
+    /// What rays that leave the scene see.
+    #[serde(default)]
+    pub environment: Environment,
+    /// Image size and sampling.
+    pub render: RenderSettings,
+}
+
+/// Where the camera comes from.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[non_exhaustive]
+pub enum CameraDesc {
+    /// A pinhole or thin-lens camera given by position, target and up.
+    Perspective {
+        /// Eye position.
+        position: V3,
+        /// A point the camera looks at.
+        target: V3,
+        /// Up direction (need not be orthogonal to the view direction).
+        #[serde(default = "default_up")]
+        up: V3,
+        /// Full vertical field of view, degrees.
+        fov_y: f32,
+        /// Lens radius; 0 is a pinhole.
+        #[serde(default)]
+        aperture_radius: f32,
+        /// Distance to the plane in focus; the distance to `target` when absent.
+        #[serde(default)]
+        focus_distance: Option<f32>,
+    },
+    /// A camera of a glTF file loaded by a `Mesh` shape, placed by its node (and the
+    /// shape's transform).
+    Gltf {
+        /// The `name` of the `Mesh` shape whose file holds the camera.
+        shape: String,
+        /// Which camera of the file, in node order.
+        #[serde(default)]
+        index: usize,
+        /// Lens radius; 0 is a pinhole.
+        #[serde(default)]
+        aperture_radius: f32,
+        /// Distance to the plane in focus; 1 when absent.
+        #[serde(default)]
+        focus_distance: Option<f32>,
+    },
+}
+
+fn default_up() -> V3 {
+    [0.0, 1.0, 0.0]
+}
+
+/// A material; every field has a default, so a diffuse material is just `base_color`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MaterialDesc {
+    /// Diffuse albedo, or metal reflectance (linear RGB). Default 0.8 grey.
+    pub base_color: V3,
+    /// Emitted radiance (linear RGB). Default black.
+    pub emission: V3,
+    /// Perceptual roughness in [0, 1] (α = roughness²). Default 0.5.
+    pub roughness: f32,
+    /// 0 dielectric, 1 metal. Default 0.
+    pub metallic: f32,
+    /// Dielectric specular strength; 0.5 means F0 = 0.04. Default 0.5. Use 0 for a pure
+    /// Lambertian surface.
+    pub specular: f32,
+    /// Tints the dielectric specular towards the base color, in [0, 1]. Default 0.
+    pub specular_tint: f32,
+    /// Fraction of the dielectric lobe that is transmitted (glass), in [0, 1]. Default 0.
+    pub transmission: f32,
+    /// Index of refraction. Default 1.5.
+    pub ior: f32,
+    /// Emission leaves both sides. Default false (front only).
+    pub two_sided: bool,
+}
+
+impl Default for MaterialDesc {
+    fn default() -> Self {
+        Self {
+            base_color: [0.8, 0.8, 0.8],
+            emission: [0.0; 3],
+            roughness: 0.5,
+            metallic: 0.0,
+            specular: 0.5,
+            specular_tint: 0.0,
+            transmission: 0.0,
+            ior: 1.5,
+            two_sided: false,
+        }
+    }
+}
+
+/// A placement: either scale, then rotations in the order listed, then translation; or a
+/// full row-major 4×4 `matrix` acting on column vectors (Mitsuba's `to_world`).
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TransformDesc {
+    /// Translation, applied last.
+    pub translate: Option<V3>,
+    /// Rotations, applied in the order listed, after the scale.
+    pub rotate: Vec<Rotation>,
+    /// Per-axis scale, applied first.
+    pub scale: Option<V3>,
+    /// A full matrix, 4 rows of 4 written as lists `[[..], [..], [..], [..]]`; excludes
+    /// the other fields.
+    pub matrix: Option<Vec<Vec<f32>>>,
+}
+
+/// A rotation about an axis through the origin.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Rotation {
+    /// The axis (normalized on load).
+    pub axis: V3,
+    /// Angle in degrees, counter-clockwise looking down the axis.
+    pub degrees: f32,
+}
+
+/// One shape of the scene.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[non_exhaustive]
+pub enum ShapeDesc {
+    /// Triangles from a glTF (`.gltf`, `.glb`) or OBJ (`.obj`) file.
+    Mesh {
+        /// Name for messages and for `CameraDesc::Gltf`.
+        #[serde(default)]
+        name: Option<String>,
+        /// The file, relative to the scene file.
+        path: String,
+        /// Placement of the whole file.
+        #[serde(default)]
+        transform: TransformDesc,
+        /// A scene material that replaces every material of the file.
+        #[serde(default)]
+        material: Option<String>,
+        /// Emitted radiance, replacing the materials' own.
+        #[serde(default)]
+        emission: Option<V3>,
+        /// Emission leaves both sides.
+        #[serde(default)]
+        two_sided: bool,
+    },
+    /// An analytic sphere.
+    Sphere {
+        /// Name for messages.
+        #[serde(default)]
+        name: Option<String>,
+        /// Center, world space.
+        center: V3,
+        /// Radius, > 0.
+        radius: f32,
+        /// Material name.
+        material: String,
+        /// Emitted radiance, replacing the material's own.
+        #[serde(default)]
+        emission: Option<V3>,
+        /// Emission leaves both sides.
+        #[serde(default)]
+        two_sided: bool,
+    },
+    /// The square [-1,1]² in z=0, front normal +z, then `transform`: 2 triangles.
+    Rectangle {
+        /// Name for messages.
+        #[serde(default)]
+        name: Option<String>,
+        /// Placement.
+        #[serde(default)]
+        transform: TransformDesc,
+        /// Material name.
+        material: String,
+        /// Emitted radiance, replacing the material's own.
+        #[serde(default)]
+        emission: Option<V3>,
+        /// Emission leaves both sides.
+        #[serde(default)]
+        two_sided: bool,
+    },
+    /// The cube [-1,1]³ with outward normals, then `transform`: 12 triangles.
+    Box {
+        /// Name for messages.
+        #[serde(default)]
+        name: Option<String>,
+        /// Placement.
+        #[serde(default)]
+        transform: TransformDesc,
+        /// Material name.
+        material: String,
+        /// Emitted radiance, replacing the material's own.
+        #[serde(default)]
+        emission: Option<V3>,
+        /// Emission leaves both sides.
+        #[serde(default)]
+        two_sided: bool,
+    },
+    /// A planar quad by 4 world corners, counter-clockwise seen from the front:
+    /// triangles (0, 1, 2) and (0, 2, 3).
+    Quad {
+        /// Name for messages.
+        #[serde(default)]
+        name: Option<String>,
+        /// The 4 corners, world space, as a list `[(x, y, z), …]`.
+        corners: Vec<V3>,
+        /// Material name.
+        material: String,
+        /// Emitted radiance, replacing the material's own.
+        #[serde(default)]
+        emission: Option<V3>,
+        /// Emission leaves both sides.
+        #[serde(default)]
+        two_sided: bool,
+    },
+}
+
+impl ShapeDesc {
+    /// The shape's name, if it has one.
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            Self::Mesh { name, .. }
+            | Self::Sphere { name, .. }
+            | Self::Rectangle { name, .. }
+            | Self::Box { name, .. }
+            | Self::Quad { name, .. } => name.as_deref(),
+        }
+    }
+
+    /// The kind, as written in the file.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Mesh { .. } => "Mesh",
+            Self::Sphere { .. } => "Sphere",
+            Self::Rectangle { .. } => "Rectangle",
+            Self::Box { .. } => "Box",
+            Self::Quad { .. } => "Quad",
+        }
+    }
+
+    /// Emission override and two-sided flag.
+    pub fn emitter(&self) -> (Option<V3>, bool) {
+        match self {
+            Self::Mesh {
+                emission,
+                two_sided,
+                ..
+            }
+            | Self::Sphere {
+                emission,
+                two_sided,
+                ..
+            }
+            | Self::Rectangle {
+                emission,
+                two_sided,
+                ..
+            }
+            | Self::Box {
+                emission,
+                two_sided,
+                ..
+            }
+            | Self::Quad {
+                emission,
+                two_sided,
+                ..
+            } => (*emission, *two_sided),
+        }
+    }
+}
+
+/// What rays that leave the scene see. More kinds (an equirectangular map with its
+/// sampling tables) will be added; match with a wildcard arm.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Deserialize)]
+#[non_exhaustive]
+pub enum Environment {
+    /// Black.
+    #[default]
+    None,
+    /// The same radiance (linear RGB) from every direction.
+    Constant(V3),
+}
+
+/// Image size and sampling.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderSettings {
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// Most scattering events per path (Mitsuba `max_depth` = this + 1). Default 20.
+    #[serde(default = "default_max_bounces")]
+    pub max_bounces: u32,
+    /// Samples per pixel. Default 1.
+    #[serde(default = "default_spp")]
+    pub spp: u32,
+    /// Random seed. Default 0.
+    #[serde(default)]
+    pub seed: u32,
+}
+
+fn default_max_bounces() -> u32 {
+    20
+}
+
+fn default_spp() -> u32 {
+    1
+}

@@ -1,0 +1,304 @@
+//! Flattening a [`Scene`] into a [`GpuScene`]: BVH, reordered primitives, materials,
+//! lights with a power-proportional alias table, camera and settings.
+
+use glam::{Vec3, Vec3A};
+use obvhs::aabb::Aabb;
+
+use crate::bvh::{self, BvhOptions};
+use crate::error::{ErrorKind, SceneError};
+use crate::file::Environment;
+use crate::gpu::{
+    ENV_CONSTANT, ENV_NONE, FEATURE_ENVIRONMENT, FEATURE_LIGHTS, FEATURE_METAL, FEATURE_SPHERES,
+    FEATURE_TEXTURES, FEATURE_TRANSMISSION, GpuAliasEntry, GpuBvhNode, GpuCamera, GpuHeader,
+    GpuLight, GpuMaterial, GpuSettings, GpuSphere, GpuTriShading, GpuTriangle, LIGHT_SPHERE,
+    LIGHT_TWO_SIDED, MATERIAL_TWO_SIDED, NO_LIGHT, TRI_VERTEX_NORMALS,
+};
+use crate::scene::{Material, NO_TEXTURE, Scene};
+
+/// Everything the render crate uploads: one `Vec` per storage buffer, plus small blocks.
+/// Arrays may be empty (no spheres, no lights); the uploader pads empty buffers.
+#[derive(Clone, Debug, Default)]
+pub struct GpuScene {
+    /// Counts and scene-wide values.
+    pub header: GpuHeader,
+    /// The camera.
+    pub camera: GpuCamera,
+    /// Image size, sampling, environment.
+    pub settings: GpuSettings,
+    /// BVH nodes, root first (buffer `bvh_nodes`).
+    pub bvh_nodes: Vec<GpuBvhNode>,
+    /// Triangle intersection data in BVH order (buffer `tri_positions`).
+    pub tri_positions: Vec<GpuTriangle>,
+    /// Triangle shading data, same order (buffer `tri_shading`).
+    pub tri_shading: Vec<GpuTriShading>,
+    /// Spheres in BVH order (buffer `spheres`).
+    pub spheres: Vec<GpuSphere>,
+    /// Materials, as in [`Scene::materials`] (buffer `materials`).
+    pub materials: Vec<GpuMaterial>,
+    /// Emissive triangles and spheres (buffer `lights`).
+    pub lights: Vec<GpuLight>,
+    /// Alias table over `lights`, by power (buffer `light_alias`).
+    pub light_alias: Vec<GpuAliasEntry>,
+    /// For each GPU triangle, its index in [`Scene::triangles`] (CPU side only).
+    pub tri_source: Vec<u32>,
+    /// For each GPU sphere, its index in [`Scene::spheres`] (CPU side only).
+    pub sphere_source: Vec<u32>,
+}
+
+/// Rec. 709 luminance of linear RGB.
+pub fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+fn tex16(t: u32) -> u32 {
+    if t == NO_TEXTURE || t >= 0xFFFF {
+        0xFFFF
+    } else {
+        t
+    }
+}
+
+fn gpu_material(m: &Material) -> GpuMaterial {
+    GpuMaterial {
+        base_color: m.base_color.to_array(),
+        roughness: m.roughness,
+        emission: m.emission.to_array(),
+        metallic: m.metallic,
+        specular: m.specular,
+        specular_tint: m.specular_tint,
+        transmission: m.transmission,
+        ior: m.ior,
+        tex_base_mr: tex16(m.textures.base_color) | (tex16(m.textures.metallic_roughness) << 16),
+        tex_emissive_normal: tex16(m.textures.emissive) | (tex16(m.textures.normal) << 16),
+        flags: if m.two_sided { MATERIAL_TWO_SIDED } else { 0 },
+        pad0: 0,
+    }
+}
+
+/// Vose's alias table for the weights `w` (all ≥ 0, sum > 0).
+pub fn alias_table(w: &[f32]) -> Vec<GpuAliasEntry> {
+    let n = w.len();
+    let total: f64 = w.iter().map(|&x| f64::from(x)).sum();
+    if n == 0 || !(total > 0.0) {
+        return vec![
+            GpuAliasEntry {
+                prob: 1.0,
+                alias: 0
+            };
+            n
+        ];
+    }
+    let mut scaled: Vec<f64> = w.iter().map(|&x| f64::from(x) * n as f64 / total).collect();
+    let mut table: Vec<GpuAliasEntry> = (0..n as u32)
+        .map(|i| GpuAliasEntry {
+            prob: 1.0,
+            alias: i,
+        })
+        .collect();
+    let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
+    while let (Some(s), Some(&l)) = (small.pop(), large.last()) {
+        table[s] = GpuAliasEntry {
+            prob: scaled[s] as f32,
+            alias: l as u32,
+        };
+        scaled[l] -= 1.0 - scaled[s];
+        if scaled[l] < 1.0 {
+            large.pop();
+            small.push(l);
+        }
+    }
+    table
+}
+
+impl GpuScene {
+    /// Flattens `scene` with the default BVH options.
+    ///
+    /// # Errors
+    /// When the scene has no primitive, more than 2^28 of them, or the BVH is too deep.
+    pub fn build(scene: &Scene) -> Result<Self, SceneError> {
+        Self::build_with(scene, &BvhOptions::default())
+    }
+
+    /// Flattens `scene`.
+    ///
+    /// # Errors
+    /// As [`GpuScene::build`].
+    pub fn build_with(scene: &Scene, options: &BvhOptions) -> Result<Self, SceneError> {
+        let total = scene.triangles.len() + scene.spheres.len();
+        if total >= 1 << 28 {
+            return Err(SceneError::new(ErrorKind::TooManyPrimitives(total)));
+        }
+        if total == 0 {
+            return Err(SceneError::new(ErrorKind::BadValue {
+                field: "shapes",
+                message: "the scene has no triangle or sphere".to_owned(),
+            }));
+        }
+        let tri_boxes: Vec<Aabb> = scene
+            .triangles
+            .iter()
+            .map(|t| Aabb::from_points(&t.positions.map(Vec3A::from)))
+            .collect();
+        let sphere_boxes: Vec<Aabb> = scene
+            .spheres
+            .iter()
+            .map(|s| {
+                let c = Vec3A::from(s.center);
+                Aabb::new(c - s.radius, c + s.radius)
+            })
+            .collect();
+        let flat = bvh::build(&tri_boxes, &sphere_boxes, options)?;
+
+        let mut out = Self {
+            materials: scene.materials.iter().map(gpu_material).collect(),
+            bvh_nodes: flat.nodes,
+            tri_source: flat.tri_order,
+            sphere_source: flat.sphere_order,
+            ..Self::default()
+        };
+        let mut weights = Vec::new();
+        for (i, &src) in out.tri_source.iter().enumerate() {
+            let t = &scene.triangles[src as usize];
+            let [p0, p1, p2] = t.positions;
+            let (e1, e2) = (p1 - p0, p2 - p0);
+            out.tri_positions.push(GpuTriangle {
+                v0: p0.to_array(),
+                e1: e1.to_array(),
+                e2: e2.to_array(),
+                ..GpuTriangle::default()
+            });
+            let flat_n = e1.cross(e2).normalize();
+            let ns = t.normals.unwrap_or([flat_n; 3]);
+            let m = &scene.materials[t.material as usize];
+            let mut light = NO_LIGHT;
+            if m.is_emissive() {
+                light = out.lights.len() as u32;
+                let area = t.area();
+                let sides = if m.two_sided { 2.0 } else { 1.0 };
+                let power = luminance(m.emission) * area * std::f32::consts::PI * sides;
+                weights.push(power);
+                out.lights.push(GpuLight {
+                    p0: p0.to_array(),
+                    flags: if m.two_sided { LIGHT_TWO_SIDED } else { 0 },
+                    e1: e1.to_array(),
+                    prim: i as u32,
+                    e2: e2.to_array(),
+                    area,
+                    emission: m.emission.to_array(),
+                    power,
+                });
+            }
+            out.tri_shading.push(GpuTriShading {
+                n0: ns[0].to_array(),
+                material: t.material,
+                n1: ns[1].to_array(),
+                light,
+                n2: ns[2].to_array(),
+                flags: if t.normals.is_some() {
+                    TRI_VERTEX_NORMALS
+                } else {
+                    0
+                },
+            });
+        }
+        for (i, &src) in out.sphere_source.iter().enumerate() {
+            let s = &scene.spheres[src as usize];
+            let m = &scene.materials[s.material as usize];
+            let mut light = NO_LIGHT;
+            if m.is_emissive() {
+                light = out.lights.len() as u32;
+                let area = 4.0 * std::f32::consts::PI * s.radius * s.radius;
+                let power = luminance(m.emission) * area * std::f32::consts::PI;
+                weights.push(power);
+                out.lights.push(GpuLight {
+                    p0: s.center.to_array(),
+                    flags: LIGHT_SPHERE,
+                    e1: [s.radius, 0.0, 0.0],
+                    prim: i as u32,
+                    e2: [0.0; 3],
+                    area,
+                    emission: m.emission.to_array(),
+                    power,
+                });
+            }
+            out.spheres.push(GpuSphere {
+                center: s.center.to_array(),
+                radius: s.radius,
+                material: s.material,
+                light,
+                ..GpuSphere::default()
+            });
+        }
+        out.light_alias = alias_table(&weights);
+        out.header = header(scene, &out, flat.depth, weights.iter().sum());
+        out.camera = camera(scene);
+        out.settings = settings(scene);
+        Ok(out)
+    }
+}
+
+fn header(scene: &Scene, g: &GpuScene, depth: usize, total_power: f32) -> GpuHeader {
+    let mut features = 0;
+    if !g.spheres.is_empty() {
+        features |= FEATURE_SPHERES;
+    }
+    if !g.lights.is_empty() {
+        features |= FEATURE_LIGHTS;
+    }
+    if scene.materials.iter().any(|m| m.transmission > 0.0) {
+        features |= FEATURE_TRANSMISSION;
+    }
+    if scene.materials.iter().any(|m| m.metallic > 0.0) {
+        features |= FEATURE_METAL;
+    }
+    if scene.materials.iter().any(|m| m.textures.any()) {
+        features |= FEATURE_TEXTURES;
+    }
+    if matches!(scene.environment, Environment::Constant(c) if c.iter().any(|&x| x > 0.0)) {
+        features |= FEATURE_ENVIRONMENT;
+    }
+    GpuHeader {
+        num_nodes: g.bvh_nodes.len() as u32,
+        num_triangles: g.tri_positions.len() as u32,
+        num_spheres: g.spheres.len() as u32,
+        num_materials: g.materials.len() as u32,
+        num_lights: g.lights.len() as u32,
+        bvh_depth: depth as u32,
+        features,
+        total_light_power: total_power,
+    }
+}
+
+fn camera(scene: &Scene) -> GpuCamera {
+    let c = &scene.camera;
+    let (right, up, forward) = c.basis();
+    let s = scene.settings;
+    GpuCamera {
+        position: c.position.to_array(),
+        tan_half_fov: (c.fov_y_deg.to_radians() * 0.5).tan(),
+        right: right.to_array(),
+        aspect: s.width as f32 / s.height as f32,
+        up: up.to_array(),
+        aperture_radius: c.aperture_radius,
+        forward: forward.to_array(),
+        focus_distance: c.focus_distance,
+    }
+}
+
+fn settings(scene: &Scene) -> GpuSettings {
+    let s = scene.settings;
+    let (env_kind, env_radiance) = match scene.environment {
+        Environment::Constant(c) => (ENV_CONSTANT, c),
+        Environment::None => (ENV_NONE, [0.0; 3]),
+    };
+    GpuSettings {
+        width: s.width,
+        height: s.height,
+        max_bounces: s.max_bounces,
+        spp: s.spp,
+        seed: s.seed,
+        env_kind,
+        env_radiance,
+        ..GpuSettings::default()
+    }
+}

@@ -1,0 +1,259 @@
+//! The flat, GPU-ready scene: `#[repr(C)]` + [`bytemuck::Pod`] structs laid out exactly as
+//! WGSL lays out the structs of `shaders/pathtrace/scene_types.wgsl` in storage buffers
+//! (std430-compatible: every `vec3<f32>` starts at a multiple of 16 bytes and is followed
+//! by a 4-byte scalar; every struct's size is a multiple of 16 or of 8 for [`GpuAliasEntry`]).
+//! A test checks each offset and size against naga's layouter.
+//!
+//! Intersection data is kept apart from shading data so the traversal loop loads little:
+//! [`GpuBvhNode`] (32 B) and [`GpuTriangle`] (48 B: a corner and two edges) or the first
+//! 16 bytes of [`GpuSphere`]; normals and material ids live in [`GpuTriShading`], read once
+//! per hit.
+//!
+//! Primitive ids: triangles and spheres are stored in BVH leaf order (see [`crate::bvh`]).
+//! A hit's `prim` is the triangle index, or the sphere index with [`PRIM_SPHERE`] set.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Set in a hit's `prim` when it is a sphere; the low bits are then the sphere index.
+pub const PRIM_SPHERE: u32 = 0x8000_0000;
+/// A hit's `prim` when nothing was hit.
+pub const NO_HIT: u32 = u32::MAX;
+/// No light: the value of `light` in [`GpuTriShading`] and [`GpuSphere`] for a
+/// non-emissive primitive.
+pub const NO_LIGHT: u32 = u32::MAX;
+
+/// [`GpuTriShading::flags`]: the normals are interpolated vertex normals (else flat).
+pub const TRI_VERTEX_NORMALS: u32 = 1;
+/// [`GpuMaterial::flags`]: emission leaves both sides.
+pub const MATERIAL_TWO_SIDED: u32 = 1;
+/// [`GpuLight::flags`]: the light is a sphere (else a triangle).
+pub const LIGHT_SPHERE: u32 = 1;
+/// [`GpuLight::flags`]: emission leaves both sides of the triangle.
+pub const LIGHT_TWO_SIDED: u32 = 2;
+
+/// [`GpuSettings::env_kind`]: black environment.
+pub const ENV_NONE: u32 = 0;
+/// [`GpuSettings::env_kind`]: constant radiance `env_radiance`.
+pub const ENV_CONSTANT: u32 = 1;
+
+/// [`GpuHeader::features`]: the scene has spheres.
+pub const FEATURE_SPHERES: u32 = 1;
+/// [`GpuHeader::features`]: some material transmits (glass lobe needed).
+pub const FEATURE_TRANSMISSION: u32 = 2;
+/// [`GpuHeader::features`]: some material has a texture.
+pub const FEATURE_TEXTURES: u32 = 4;
+/// [`GpuHeader::features`]: the environment is not black.
+pub const FEATURE_ENVIRONMENT: u32 = 8;
+/// [`GpuHeader::features`]: there are emissive primitives (NEE needed).
+pub const FEATURE_LIGHTS: u32 = 16;
+/// [`GpuHeader::features`]: some material is metallic.
+pub const FEATURE_METAL: u32 = 32;
+
+/// A BVH node, 32 bytes. See [`crate::bvh`] for the encoding.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuBvhNode {
+    /// Box minimum corner (offset 0).
+    pub aabb_min: [f32; 3],
+    /// Inner: second child's node index. Leaf: first primitive in its kind's array
+    /// (offset 12).
+    pub index: u32,
+    /// Box maximum corner (offset 16).
+    pub aabb_max: [f32; 3],
+    /// Bits 0–1 split axis (inner), bit 2 leaf kind (1 = spheres), bits 3–31 primitive
+    /// count (0 = inner node) (offset 28).
+    pub meta: u32,
+}
+
+/// A triangle's intersection data, 48 bytes: corner 0 and the two edges from it, as
+/// Möller–Trumbore uses them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuTriangle {
+    /// Corner 0 (offset 0).
+    pub v0: [f32; 3],
+    /// Padding (offset 12).
+    pub pad0: u32,
+    /// Corner 1 − corner 0 (offset 16).
+    pub e1: [f32; 3],
+    /// Padding (offset 28).
+    pub pad1: u32,
+    /// Corner 2 − corner 0 (offset 32). The front normal is `e1 × e2`.
+    pub e2: [f32; 3],
+    /// Padding (offset 44).
+    pub pad2: u32,
+}
+
+/// A triangle's shading data, 48 bytes, same index as its [`GpuTriangle`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuTriShading {
+    /// Unit shading normal at corner 0 (offset 0); the flat normal without vertex normals.
+    pub n0: [f32; 3],
+    /// Material index (offset 12).
+    pub material: u32,
+    /// Unit shading normal at corner 1 (offset 16).
+    pub n1: [f32; 3],
+    /// Index into the lights, or [`NO_LIGHT`] (offset 28): for MIS when a ray hits it.
+    pub light: u32,
+    /// Unit shading normal at corner 2 (offset 32).
+    pub n2: [f32; 3],
+    /// [`TRI_VERTEX_NORMALS`] (offset 44).
+    pub flags: u32,
+}
+
+/// An analytic sphere, 32 bytes; the traversal reads only the first 16.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuSphere {
+    /// Center (offset 0).
+    pub center: [f32; 3],
+    /// Radius (offset 12).
+    pub radius: f32,
+    /// Material index (offset 16).
+    pub material: u32,
+    /// Index into the lights, or [`NO_LIGHT`] (offset 20).
+    pub light: u32,
+    /// Padding (offset 24).
+    pub pad0: u32,
+    /// Padding (offset 28).
+    pub pad1: u32,
+}
+
+/// A material, 64 bytes (four vec4s).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuMaterial {
+    /// Diffuse albedo or metal reflectance, linear RGB (offset 0).
+    pub base_color: [f32; 3],
+    /// Perceptual roughness in [0, 1] (offset 12).
+    pub roughness: f32,
+    /// Emitted radiance, linear RGB (offset 16).
+    pub emission: [f32; 3],
+    /// 0 dielectric, 1 metal (offset 28).
+    pub metallic: f32,
+    /// Dielectric specular strength, 0.5 ⇒ F0 = 0.04 (offset 32).
+    pub specular: f32,
+    /// Specular tint towards the base color (offset 36).
+    pub specular_tint: f32,
+    /// Transmitted fraction of the dielectric lobe (offset 40).
+    pub transmission: f32,
+    /// Index of refraction (offset 44).
+    pub ior: f32,
+    /// Base color texture (low 16 bits) and metallic-roughness texture (high 16 bits);
+    /// 0xFFFF = none (offset 48).
+    pub tex_base_mr: u32,
+    /// Emissive texture (low 16 bits) and normal texture (high 16 bits); 0xFFFF = none
+    /// (offset 52).
+    pub tex_emissive_normal: u32,
+    /// [`MATERIAL_TWO_SIDED`] (offset 56).
+    pub flags: u32,
+    /// Padding (offset 60).
+    pub pad0: u32,
+}
+
+/// An emitter, 64 bytes: an emissive triangle or sphere.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuLight {
+    /// Triangle corner 0, or sphere center (offset 0).
+    pub p0: [f32; 3],
+    /// [`LIGHT_SPHERE`], [`LIGHT_TWO_SIDED`] (offset 12).
+    pub flags: u32,
+    /// Triangle edge 1, or `(radius, 0, 0)` (offset 16).
+    pub e1: [f32; 3],
+    /// The primitive: triangle index, or sphere index (offset 28).
+    pub prim: u32,
+    /// Triangle edge 2, or zero (offset 32).
+    pub e2: [f32; 3],
+    /// Emitting area (offset 44).
+    pub area: f32,
+    /// Emitted radiance, linear RGB (offset 48).
+    pub emission: [f32; 3],
+    /// Power used for selection: luminance(emission) × area × π (× 2 if two-sided)
+    /// (offset 60). Selection probability = power / `GpuHeader::total_light_power`.
+    pub power: f32,
+}
+
+/// One entry of the light alias table (Vose), 8 bytes: pick `i` uniformly, keep it with
+/// probability `prob`, else take `alias`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuAliasEntry {
+    /// Probability of keeping this entry (offset 0).
+    pub prob: f32,
+    /// The other light of this bucket (offset 4).
+    pub alias: u32,
+}
+
+/// The camera, 64 bytes. A pixel's ray direction, for image coordinates `(x, y)` in
+/// [0, 1]² (y down): `forward + (2x − 1)·tan_half_fov·aspect·right − (2y − 1)·tan_half_fov·up`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuCamera {
+    /// Eye position (offset 0).
+    pub position: [f32; 3],
+    /// tan(vertical fov / 2) (offset 12).
+    pub tan_half_fov: f32,
+    /// Unit right vector: image x grows along it (offset 16).
+    pub right: [f32; 3],
+    /// Width / height (offset 28).
+    pub aspect: f32,
+    /// Unit up vector: image y grows along its opposite (offset 32).
+    pub up: [f32; 3],
+    /// Lens radius, 0 for a pinhole (offset 44).
+    pub aperture_radius: f32,
+    /// Unit view direction (offset 48).
+    pub forward: [f32; 3],
+    /// Distance to the plane in focus, along `forward` (offset 60).
+    pub focus_distance: f32,
+}
+
+/// Render settings and environment, 48 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuSettings {
+    /// Image width (offset 0).
+    pub width: u32,
+    /// Image height (offset 4).
+    pub height: u32,
+    /// Most scattering events per path (offset 8).
+    pub max_bounces: u32,
+    /// Samples per pixel (offset 12).
+    pub spp: u32,
+    /// Random seed (offset 16).
+    pub seed: u32,
+    /// [`ENV_NONE`] or [`ENV_CONSTANT`] (offset 20).
+    pub env_kind: u32,
+    /// Padding (offset 24).
+    pub pad0: u32,
+    /// Padding (offset 28).
+    pub pad1: u32,
+    /// Constant environment radiance, linear RGB (offset 32).
+    pub env_radiance: [f32; 3],
+    /// Padding (offset 44).
+    pub pad2: u32,
+}
+
+/// Counts and scene-wide values, 32 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuHeader {
+    /// BVH nodes (offset 0).
+    pub num_nodes: u32,
+    /// Triangles (offset 4).
+    pub num_triangles: u32,
+    /// Spheres (offset 8).
+    pub num_spheres: u32,
+    /// Materials (offset 12).
+    pub num_materials: u32,
+    /// Lights, and alias table entries (offset 16).
+    pub num_lights: u32,
+    /// Most inner nodes above a leaf; the traversal stack needs this many entries
+    /// (offset 20).
+    pub bvh_depth: u32,
+    /// `FEATURE_*` bits: what the shader can leave out (offset 24).
+    pub features: u32,
+    /// Sum of the lights' `power` (offset 28).
+    pub total_light_power: f32,
+}

@@ -1,0 +1,48 @@
+//! Mesh import: glTF 2.0 ([`gltf`]) and OBJ + MTL ([`obj`]).
+//!
+//! An importer returns world-space triangles (the file's node hierarchy and the caller's
+//! transform applied), its materials with indices local to the file, and its cameras.
+//! Broken triangles (NaN or infinite corners, zero area) are dropped and counted in the
+//! [`LoadReport`], never a panic.
+
+pub mod gltf;
+pub mod obj;
+
+use std::path::Path;
+
+use glam::Mat4;
+
+use crate::error::{ErrorKind, SceneError};
+use crate::scene::{Camera, LoadReport, Material, Triangle};
+
+/// What a mesh file holds, placed in the world.
+#[derive(Clone, Debug, Default)]
+pub struct ImportedMesh {
+    /// Triangles; `material` indexes [`ImportedMesh::materials`].
+    pub triangles: Vec<Triangle>,
+    /// The file's materials (plus a default one when some triangles had none).
+    pub materials: Vec<Material>,
+    /// The file's cameras, in node order (glTF only).
+    pub cameras: Vec<Camera>,
+    /// What was dropped or changed.
+    pub report: LoadReport,
+}
+
+/// Imports a `.gltf`, `.glb` or `.obj` file, placed by `transform`.
+///
+/// # Errors
+/// When the file cannot be read or parsed, or its extension is not one of these; the
+/// error names the file.
+pub fn import_mesh(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let result = match ext.as_str() {
+        "gltf" | "glb" => gltf::import_gltf(path, transform),
+        "obj" => obj::import_obj(path, transform),
+        _ => Err(SceneError::new(ErrorKind::MeshType(ext))),
+    };
+    result.map_err(|e| e.in_file(path))
+}

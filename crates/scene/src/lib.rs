@@ -1,0 +1,36 @@
+//! lumagraph scenes, with no GPU in sight.
+//!
+//! - [`file`]: the RON scene format (`version: 1`): camera, named materials, shapes
+//!   (meshes, spheres, Mitsuba-style rectangles and boxes, quads), environment, render
+//!   settings. [`Scene::load`] reads it into a [`Scene`] with world-space triangles.
+//! - [`import`]: glTF 2.0 and OBJ + MTL meshes, cameras and materials.
+//! - [`GpuScene`]: the scene flattened into `#[repr(C)]` arrays laid out as WGSL lays out
+//!   storage buffers ([`gpu`]), with a BVH built by obvhs ([`bvh`]), lights and an alias
+//!   table for picking them by power.
+//! - [`traverse`]: CPU ray queries over exactly that layout, mirrored by
+//!   `shaders/pathtrace/bvh.wgsl`.
+//!
+//! Broken input never panics: syntax and semantic errors name the file, line:column and
+//! the shape or material; broken triangles are dropped and counted in a [`LoadReport`].
+
+pub mod bvh;
+mod error;
+pub mod file;
+mod flatten;
+pub mod gpu;
+pub mod import;
+mod load;
+mod scene;
+pub mod traverse;
+
+pub use bvh::{BVH_STACK_SIZE, BvhOptions};
+pub use error::{ErrorKind, Pos, SceneError};
+pub use file::{Environment, RenderSettings, VERSION};
+pub use flatten::{GpuScene, alias_table, luminance};
+pub use gpu::*;
+pub use load::transform_matrix;
+pub use scene::{
+    Camera, LoadReport, Material, MaterialTextures, NO_TEXTURE, Scene, Sphere, Triangle,
+    cube_quads, push_triangle, quad_triangles, rectangle_quad, transform_triangle,
+};
+pub use traverse::{Hit, Ray, intersect, intersect_within, occluded};

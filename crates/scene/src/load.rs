@@ -1,0 +1,531 @@
+//! Loading a RON scene file into a [`Scene`]: syntax errors come from ron with their line
+//! and column; semantic errors (unknown material, bad radius…) name the shape or material
+//! and point at it in the file.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Quat, Vec3};
+use ron::extensions::Extensions;
+use serde::Deserialize;
+
+use crate::error::{ErrorKind, Pos, SceneError};
+use crate::file::{CameraDesc, MaterialDesc, SceneFile, ShapeDesc, TransformDesc, V3, VERSION};
+use crate::import::import_mesh;
+use crate::scene::{
+    Camera, LoadReport, Material, Scene, Sphere, cube_quads, push_triangle, quad_triangles,
+    rectangle_quad, transform_triangle,
+};
+
+#[derive(Deserialize)]
+struct VersionProbe {
+    version: u32,
+}
+
+/// Finds things in the file text, to point semantic errors at a line and column.
+struct Locator<'a> {
+    text: &'a str,
+    /// Byte offset where each shape starts, in file order.
+    shape_starts: Vec<usize>,
+}
+
+impl<'a> Locator<'a> {
+    fn new(text: &'a str) -> Self {
+        let kinds = ["Mesh", "Sphere", "Rectangle", "Box", "Quad"];
+        let start = text.find("shapes").unwrap_or(0);
+        let mut shape_starts = Vec::new();
+        let bytes = text.as_bytes();
+        let mut i = start;
+        while i < text.len() {
+            let rest = &text[i..];
+            let before_ok =
+                i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_');
+            if before_ok
+                && let Some(k) = kinds.iter().find(|k| {
+                    rest.starts_with(**k) && rest[k.len()..].trim_start().starts_with('(')
+                })
+            {
+                shape_starts.push(i);
+                i += k.len();
+                continue;
+            }
+            i += rest.chars().next().map_or(1, char::len_utf8);
+        }
+        Self { text, shape_starts }
+    }
+
+    fn pos(&self, offset: usize) -> Pos {
+        let before = &self.text[..offset.min(self.text.len())];
+        let line = before.matches('\n').count() + 1;
+        let col = before[before.rfind('\n').map_or(0, |nl| nl + 1)..]
+            .chars()
+            .count()
+            + 1;
+        Pos { line, col }
+    }
+
+    /// Where `needle` first appears in shape `index`, or where the shape starts.
+    fn in_shape(&self, index: usize, needle: &str) -> Option<Pos> {
+        let start = *self.shape_starts.get(index)?;
+        let end = self
+            .shape_starts
+            .get(index + 1)
+            .copied()
+            .unwrap_or(self.text.len());
+        let found = self.text[start..end]
+            .find(needle)
+            .map_or(start, |o| start + o);
+        Some(self.pos(found))
+    }
+
+    /// Where material `name` is defined, then `field` inside it when given.
+    fn in_material(&self, name: &str, field: Option<&str>) -> Option<Pos> {
+        let m = self.text.find("materials")?;
+        let start = m + self.text[m..].find(&format!("\"{name}\""))?;
+        let off = field
+            .and_then(|f| self.text[start..].find(f))
+            .map_or(start, |o| start + o);
+        Some(self.pos(off))
+    }
+
+    fn find(&self, needle: &str) -> Option<Pos> {
+        self.text.find(needle).map(|o| self.pos(o))
+    }
+}
+
+fn bad(field: &'static str, message: impl Into<String>) -> SceneError {
+    SceneError::new(ErrorKind::BadValue {
+        field,
+        message: message.into(),
+    })
+}
+
+fn finite3(field: &'static str, v: V3) -> Result<Vec3, SceneError> {
+    let v = Vec3::from(v);
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(bad(field, format!("{v} is not finite")))
+    }
+}
+
+fn non_negative3(field: &'static str, v: V3) -> Result<Vec3, SceneError> {
+    let v = finite3(field, v)?;
+    if v.min_element() >= 0.0 {
+        Ok(v)
+    } else {
+        Err(bad(field, format!("{v} has a negative component")))
+    }
+}
+
+fn unit_range(field: &'static str, x: f32) -> Result<f32, SceneError> {
+    if (0.0..=1.0).contains(&x) {
+        Ok(x)
+    } else {
+        Err(bad(field, format!("{x} is outside [0, 1]")))
+    }
+}
+
+/// The matrix of a transform description.
+///
+/// # Errors
+/// When `matrix` is given with other fields, a rotation axis is zero, or the result is
+/// singular or not finite.
+pub fn transform_matrix(t: &TransformDesc) -> Result<Mat4, SceneError> {
+    let m = if let Some(rows) = &t.matrix {
+        if t.translate.is_some() || t.scale.is_some() || !t.rotate.is_empty() {
+            return Err(bad(
+                "transform",
+                "give either `matrix` or translate/rotate/scale, not both",
+            ));
+        }
+        if rows.len() != 4 || rows.iter().any(|r| r.len() != 4) {
+            return Err(bad("matrix", "give 4 rows of 4 numbers"));
+        }
+        let mut a = [[0.0; 4]; 4];
+        for (dst, src) in a.iter_mut().zip(rows) {
+            dst.copy_from_slice(src);
+        }
+        Mat4::from_cols_array_2d(&a).transpose()
+    } else {
+        let mut m = Mat4::from_scale(t.scale.map_or(Vec3::ONE, Vec3::from));
+        for r in &t.rotate {
+            let axis = Vec3::from(r.axis);
+            if !(axis.length_squared() > 0.0) || !axis.is_finite() || !r.degrees.is_finite() {
+                return Err(bad(
+                    "rotate",
+                    format!("bad axis {axis} or angle {}", r.degrees),
+                ));
+            }
+            m = Mat4::from_quat(Quat::from_axis_angle(
+                axis.normalize(),
+                r.degrees.to_radians(),
+            )) * m;
+        }
+        Mat4::from_translation(t.translate.map_or(Vec3::ZERO, Vec3::from)) * m
+    };
+    let det = m.determinant();
+    if !m.is_finite() || det == 0.0 || !det.is_finite() {
+        return Err(bad("transform", "the matrix is singular or not finite"));
+    }
+    Ok(m)
+}
+
+fn material_from_desc(name: &str, d: &MaterialDesc) -> Result<Material, SceneError> {
+    let ior = d.ior;
+    if !(ior > 0.0 && ior.is_finite()) {
+        return Err(bad("ior", format!("{ior} must be a positive number")));
+    }
+    Ok(Material {
+        name: name.to_owned(),
+        base_color: non_negative3("base_color", d.base_color)?,
+        emission: non_negative3("emission", d.emission)?,
+        roughness: unit_range("roughness", d.roughness)?,
+        metallic: unit_range("metallic", d.metallic)?,
+        specular: unit_range("specular", d.specular)?,
+        specular_tint: unit_range("specular_tint", d.specular_tint)?,
+        transmission: unit_range("transmission", d.transmission)?,
+        ior,
+        two_sided: d.two_sided,
+        ..Material::named(name)
+    })
+}
+
+impl Scene {
+    /// Loads a scene file and the mesh files it references.
+    ///
+    /// # Errors
+    /// When a file cannot be read or is invalid; the error names the file, the line and
+    /// column when known, and the shape or material concerned.
+    pub fn load(path: &Path) -> Result<Self, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| {
+            SceneError::new(ErrorKind::Io {
+                what: "scene file",
+                source,
+            })
+            .in_file(path)
+        })?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        Self::from_ron(&text, base).map_err(|e| e.in_file(path))
+    }
+
+    /// Parses a scene from RON text; mesh paths are relative to `base_dir`.
+    ///
+    /// # Errors
+    /// As [`Scene::load`], without the file name for errors in the text itself.
+    pub fn from_ron(text: &str, base_dir: &Path) -> Result<Self, SceneError> {
+        let syntax = |e: ron::error::SpannedError| {
+            SceneError::new(ErrorKind::Syntax(e.code.to_string())).at(Some(Pos {
+                line: e.span.start.line,
+                col: e.span.start.col,
+            }))
+        };
+        let options = ron::Options::default().with_default_extension(Extensions::IMPLICIT_SOME);
+        let probe: VersionProbe = options.from_str(text).map_err(syntax)?;
+        if probe.version != VERSION {
+            let loc = Locator::new(text);
+            return Err(SceneError::new(ErrorKind::Version {
+                found: probe.version,
+                supported: VERSION,
+            })
+            .at(loc.find("version")));
+        }
+        let file: SceneFile = options.from_str(text).map_err(syntax)?;
+        Builder::new(text, base_dir).build(&file)
+    }
+}
+
+struct Builder<'a> {
+    loc: Locator<'a>,
+    base_dir: PathBuf,
+    materials: Vec<Material>,
+    by_name: HashMap<String, u32>,
+    /// (base material, emission bits, two-sided) → derived emissive material.
+    derived: HashMap<(u32, [u32; 3], bool), u32>,
+    scene_triangles: Vec<crate::scene::Triangle>,
+    spheres: Vec<Sphere>,
+    report: LoadReport,
+    /// Cameras of each named `Mesh` shape.
+    mesh_cameras: BTreeMap<String, Vec<Camera>>,
+}
+
+impl<'a> Builder<'a> {
+    fn new(text: &'a str, base_dir: &Path) -> Self {
+        Self {
+            loc: Locator::new(text),
+            base_dir: base_dir.to_owned(),
+            materials: Vec::new(),
+            by_name: HashMap::new(),
+            derived: HashMap::new(),
+            scene_triangles: Vec::new(),
+            spheres: Vec::new(),
+            report: LoadReport::default(),
+            mesh_cameras: BTreeMap::new(),
+        }
+    }
+
+    fn build(mut self, file: &SceneFile) -> Result<Scene, SceneError> {
+        for (name, desc) in &file.materials {
+            let m = material_from_desc(name, desc).map_err(|e| {
+                let field = match &e.kind {
+                    ErrorKind::BadValue { field, .. } => Some(*field),
+                    _ => None,
+                };
+                e.about(format!("material \"{name}\""))
+                    .at(self.loc.in_material(name, field))
+            })?;
+            self.by_name
+                .insert(name.clone(), self.materials.len() as u32);
+            self.materials.push(m);
+        }
+        for (i, shape) in file.shapes.iter().enumerate() {
+            let label = match shape.name() {
+                Some(n) => format!("shape \"{n}\""),
+                None => format!("shape {i} ({})", shape.kind()),
+            };
+            self.shape(shape).map_err(|e| {
+                let needle = match &e.kind {
+                    ErrorKind::UnknownMaterial { material, .. } => format!("\"{material}\""),
+                    ErrorKind::BadValue { field, .. } => (*field).to_owned(),
+                    _ => String::new(),
+                };
+                e.about(label).at(self.loc.in_shape(i, &needle))
+            })?;
+        }
+        let camera = self
+            .camera(&file.camera)
+            .map_err(|e| e.about("camera").at(self.loc.find("camera")))?;
+        let s = file.render;
+        if s.width == 0 || s.height == 0 || s.spp == 0 {
+            return Err(bad("render", "width, height and spp must be at least 1")
+                .at(self.loc.find("render")));
+        }
+        Ok(Scene {
+            camera,
+            materials: self.materials,
+            triangles: self.scene_triangles,
+            spheres: self.spheres,
+            environment: file.environment,
+            settings: s,
+            report: self.report,
+        })
+    }
+
+    fn lookup(&self, name: &str) -> Result<u32, SceneError> {
+        self.by_name.get(name).copied().ok_or_else(|| {
+            let known: Vec<_> = self.by_name.keys().map(String::as_str).collect();
+            let mut known = known;
+            known.sort_unstable();
+            SceneError::new(ErrorKind::UnknownMaterial {
+                material: name.to_owned(),
+                known: known.join(", "),
+            })
+        })
+    }
+
+    /// The material to use for `base` given a shape's emission override.
+    fn emissive(
+        &mut self,
+        base: u32,
+        emission: Option<V3>,
+        two_sided: bool,
+    ) -> Result<u32, SceneError> {
+        let emission = match emission {
+            Some(e) => non_negative3("emission", e)?,
+            None if !two_sided => return Ok(base),
+            None => self.materials[base as usize].emission,
+        };
+        let key = (base, emission.to_array().map(f32::to_bits), two_sided);
+        if let Some(&id) = self.derived.get(&key) {
+            return Ok(id);
+        }
+        let mut m = self.materials[base as usize].clone();
+        m.name = format!("{}+emitter{}", m.name, self.derived.len());
+        m.emission = emission;
+        m.two_sided = two_sided;
+        let id = self.materials.len() as u32;
+        self.materials.push(m);
+        self.derived.insert(key, id);
+        Ok(id)
+    }
+
+    fn shape(&mut self, shape: &ShapeDesc) -> Result<(), SceneError> {
+        let (emission, two_sided) = shape.emitter();
+        match shape {
+            ShapeDesc::Sphere {
+                center,
+                radius,
+                material,
+                ..
+            } => {
+                let center = finite3("center", *center)?;
+                if !(*radius > 0.0 && radius.is_finite()) {
+                    return Err(bad("radius", format!("{radius} must be a positive number")));
+                }
+                let m = self.lookup(material)?;
+                let material = self.emissive(m, emission, two_sided)?;
+                self.spheres.push(Sphere {
+                    center,
+                    radius: *radius,
+                    material,
+                });
+            }
+            ShapeDesc::Quad {
+                corners, material, ..
+            } => {
+                let [a, b, c, d] = corners.as_slice() else {
+                    return Err(bad(
+                        "corners",
+                        format!("give 4 corners, not {}", corners.len()),
+                    ));
+                };
+                let c = [
+                    finite3("corners", *a)?,
+                    finite3("corners", *b)?,
+                    finite3("corners", *c)?,
+                    finite3("corners", *d)?,
+                ];
+                let m = self.lookup(material)?;
+                let m = self.emissive(m, emission, two_sided)?;
+                self.push_quads(&[c], &Mat4::IDENTITY, m);
+            }
+            ShapeDesc::Rectangle {
+                transform,
+                material,
+                ..
+            } => {
+                let t = transform_matrix(transform)?;
+                let m = self.lookup(material)?;
+                let m = self.emissive(m, emission, two_sided)?;
+                self.push_quads(&[rectangle_quad()], &t, m);
+            }
+            ShapeDesc::Box {
+                transform,
+                material,
+                ..
+            } => {
+                let t = transform_matrix(transform)?;
+                let m = self.lookup(material)?;
+                let m = self.emissive(m, emission, two_sided)?;
+                self.push_quads(&cube_quads(), &t, m);
+            }
+            ShapeDesc::Mesh {
+                name,
+                path,
+                transform,
+                material,
+                ..
+            } => {
+                let t = transform_matrix(transform)?;
+                let over = material.as_deref().map(|m| self.lookup(m)).transpose()?;
+                let full = self.base_dir.join(path);
+                let mesh = import_mesh(&full, t)?;
+                let prefix = name.clone().unwrap_or_else(|| path.clone());
+                let mut ids = Vec::with_capacity(mesh.materials.len());
+                for m in mesh.materials {
+                    let id = if let Some(o) = over {
+                        o
+                    } else {
+                        self.materials.push(Material {
+                            name: format!("{prefix}/{}", m.name),
+                            ..m
+                        });
+                        self.materials.len() as u32 - 1
+                    };
+                    ids.push(self.emissive(id, emission, two_sided)?);
+                }
+                self.scene_triangles
+                    .extend(mesh.triangles.into_iter().map(|mut t| {
+                        t.material = ids[t.material as usize];
+                        t
+                    }));
+                self.report.merge(mesh.report);
+                if let Some(n) = name {
+                    self.mesh_cameras.insert(n.clone(), mesh.cameras);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn push_quads(&mut self, quads: &[[Vec3; 4]], t: &Mat4, material: u32) {
+        for q in quads {
+            for tri in quad_triangles(*q, material) {
+                push_triangle(
+                    &mut self.scene_triangles,
+                    &mut self.report,
+                    transform_triangle(t, &tri),
+                );
+            }
+        }
+    }
+
+    fn camera(&self, desc: &CameraDesc) -> Result<Camera, SceneError> {
+        let (mut cam, aperture, focus) = match desc {
+            CameraDesc::Perspective {
+                position,
+                target,
+                up,
+                fov_y,
+                aperture_radius,
+                focus_distance,
+            } => {
+                let position = finite3("position", *position)?;
+                let target = finite3("target", *target)?;
+                let up = finite3("up", *up)?;
+                let dir = target - position;
+                if !(dir.length() > 0.0) || !(dir.normalize().cross(up).length() > 1e-6) {
+                    return Err(bad(
+                        "target",
+                        "the camera must look somewhere not parallel to `up`",
+                    ));
+                }
+                let cam = Camera {
+                    position,
+                    forward: dir.normalize(),
+                    up,
+                    fov_y_deg: *fov_y,
+                    aperture_radius: 0.0,
+                    focus_distance: dir.length(),
+                };
+                (cam, *aperture_radius, *focus_distance)
+            }
+            CameraDesc::Gltf {
+                shape,
+                index,
+                aperture_radius,
+                focus_distance,
+            } => {
+                let cams = self.mesh_cameras.get(shape).ok_or_else(|| {
+                    SceneError::new(ErrorKind::Camera(format!(
+                        "no Mesh shape named \"{shape}\""
+                    )))
+                })?;
+                let cam = *cams.get(*index).ok_or_else(|| {
+                    SceneError::new(ErrorKind::Camera(format!(
+                        "shape \"{shape}\" has {} perspective camera(s), no camera {index}",
+                        cams.len()
+                    )))
+                })?;
+                (cam, *aperture_radius, *focus_distance)
+            }
+        };
+        if !(cam.fov_y_deg > 0.0 && cam.fov_y_deg < 180.0) {
+            return Err(bad(
+                "fov_y",
+                format!("{} must be in (0, 180) degrees", cam.fov_y_deg),
+            ));
+        }
+        if !(aperture >= 0.0 && aperture.is_finite()) {
+            return Err(bad("aperture_radius", format!("{aperture} must be >= 0")));
+        }
+        cam.aperture_radius = aperture;
+        if let Some(f) = focus {
+            if !(f > 0.0 && f.is_finite()) {
+                return Err(bad("focus_distance", format!("{f} must be > 0")));
+            }
+            cam.focus_distance = f;
+        }
+        Ok(cam)
+    }
+}

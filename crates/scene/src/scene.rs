@@ -1,0 +1,310 @@
+//! The resolved scene on the CPU: world-space triangles and spheres, materials by index,
+//! a camera, the environment and render settings. Loaders fill it in; [`crate::GpuScene`]
+//! flattens it for the GPU.
+
+use glam::{Mat4, Vec3};
+
+use crate::file::{Environment, RenderSettings};
+
+/// No texture.
+pub const NO_TEXTURE: u32 = u32::MAX;
+
+/// Texture indices of a material (into the source file's texture list), recorded for later
+/// texture support; [`NO_TEXTURE`] when absent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MaterialTextures {
+    /// glTF `baseColorTexture`.
+    pub base_color: u32,
+    /// glTF `metallicRoughnessTexture`.
+    pub metallic_roughness: u32,
+    /// glTF `emissiveTexture`.
+    pub emissive: u32,
+    /// glTF `normalTexture`.
+    pub normal: u32,
+}
+
+impl Default for MaterialTextures {
+    fn default() -> Self {
+        Self {
+            base_color: NO_TEXTURE,
+            metallic_roughness: NO_TEXTURE,
+            emissive: NO_TEXTURE,
+            normal: NO_TEXTURE,
+        }
+    }
+}
+
+impl MaterialTextures {
+    /// Whether any texture is set.
+    pub fn any(&self) -> bool {
+        [
+            self.base_color,
+            self.metallic_roughness,
+            self.emissive,
+            self.normal,
+        ]
+        .iter()
+        .any(|&t| t != NO_TEXTURE)
+    }
+}
+
+/// A material, with the parameters of the path tracer's BSDF.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name, for messages (`"white"`, or `"<shape>/<material>"` for imported ones).
+    pub name: String,
+    /// Diffuse albedo or metal reflectance, linear RGB.
+    pub base_color: Vec3,
+    /// Emitted radiance, linear RGB.
+    pub emission: Vec3,
+    /// Perceptual roughness in [0, 1].
+    pub roughness: f32,
+    /// 0 dielectric, 1 metal.
+    pub metallic: f32,
+    /// Dielectric specular strength (0.5 means F0 = 0.04).
+    pub specular: f32,
+    /// Tint of the dielectric specular towards the base color.
+    pub specular_tint: f32,
+    /// Transmitted fraction of the dielectric lobe.
+    pub transmission: f32,
+    /// Index of refraction.
+    pub ior: f32,
+    /// Emission leaves both sides (default: front only).
+    pub two_sided: bool,
+    /// Texture indices, recorded but not decoded yet.
+    pub textures: MaterialTextures,
+}
+
+impl Material {
+    /// A material with the file format's defaults and the given name.
+    pub fn named(name: impl Into<String>) -> Self {
+        Self {
+            name: name.into(),
+            base_color: Vec3::splat(0.8),
+            emission: Vec3::ZERO,
+            roughness: 0.5,
+            metallic: 0.0,
+            specular: 0.5,
+            specular_tint: 0.0,
+            transmission: 0.0,
+            ior: 1.5,
+            two_sided: false,
+            textures: MaterialTextures::default(),
+        }
+    }
+
+    /// Whether it emits light.
+    pub fn is_emissive(&self) -> bool {
+        self.emission.max_element() > 0.0
+    }
+}
+
+/// A perspective camera in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub position: Vec3,
+    /// Unit view direction.
+    pub forward: Vec3,
+    /// Up hint (not necessarily orthogonal to `forward`).
+    pub up: Vec3,
+    /// Full vertical field of view, degrees.
+    pub fov_y_deg: f32,
+    /// Lens radius; 0 is a pinhole.
+    pub aperture_radius: f32,
+    /// Distance to the plane in focus.
+    pub focus_distance: f32,
+}
+
+impl Camera {
+    /// The orthonormal basis `(right, up, forward)`: image x grows along `right`, image y
+    /// grows along `-up` (Mitsuba's convention).
+    pub fn basis(&self) -> (Vec3, Vec3, Vec3) {
+        let forward = self.forward.normalize();
+        let right = forward.cross(self.up).normalize();
+        let up = right.cross(forward);
+        (right, up, forward)
+    }
+}
+
+/// A world-space triangle. The front side is the one from which the corners appear
+/// counter-clockwise (geometric normal `(p1 - p0) × (p2 - p0)`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    /// Corners.
+    pub positions: [Vec3; 3],
+    /// Unit shading normals at the corners, when the source had them.
+    pub normals: Option<[Vec3; 3]>,
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+}
+
+impl Triangle {
+    /// The unnormalized geometric normal; its length is twice the area.
+    pub fn cross(&self) -> Vec3 {
+        let [p0, p1, p2] = self.positions;
+        (p1 - p0).cross(p2 - p0)
+    }
+
+    /// Area.
+    pub fn area(&self) -> f32 {
+        0.5 * self.cross().length()
+    }
+
+    /// Unit geometric (front) normal.
+    pub fn normal(&self) -> Vec3 {
+        self.cross().normalize()
+    }
+}
+
+/// An analytic sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Center.
+    pub center: Vec3,
+    /// Radius.
+    pub radius: f32,
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+}
+
+/// What loading left out or changed, never fatal.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct LoadReport {
+    /// Triangles dropped because their area is zero (collinear or repeated corners).
+    pub degenerate_triangles: usize,
+    /// Triangles dropped because a corner is NaN or infinite.
+    pub non_finite_triangles: usize,
+    /// Triangles whose vertex normals were unusable and replaced by the flat normal.
+    pub replaced_normals: usize,
+    /// Other warnings, one line each.
+    pub warnings: Vec<String>,
+}
+
+impl LoadReport {
+    /// Whether nothing was dropped or changed.
+    pub fn is_clean(&self) -> bool {
+        *self == Self::default()
+    }
+
+    /// Adds the counts and warnings of `other`.
+    pub fn merge(&mut self, other: Self) {
+        self.degenerate_triangles += other.degenerate_triangles;
+        self.non_finite_triangles += other.non_finite_triangles;
+        self.replaced_normals += other.replaced_normals;
+        self.warnings.extend(other.warnings);
+    }
+}
+
+/// The resolved scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The camera.
+    pub camera: Camera,
+    /// Materials; triangles and spheres index into this.
+    pub materials: Vec<Material>,
+    /// World-space triangles.
+    pub triangles: Vec<Triangle>,
+    /// Analytic spheres.
+    pub spheres: Vec<Sphere>,
+    /// What rays leaving the scene see.
+    pub environment: Environment,
+    /// Image size and sampling.
+    pub settings: RenderSettings,
+    /// What loading dropped or changed.
+    pub report: LoadReport,
+}
+
+/// Checks a triangle and appends it, or counts it as dropped in `report`.
+///
+/// Dropped: any corner NaN or infinite; zero area (the corners are collinear to within
+/// 1e-10 of the edge lengths' product). Vertex normals that are not finite or zero are
+/// replaced by the flat normal; the others are normalized.
+pub fn push_triangle(out: &mut Vec<Triangle>, report: &mut LoadReport, mut tri: Triangle) {
+    if !tri.positions.iter().all(|p| p.is_finite()) {
+        report.non_finite_triangles += 1;
+        return;
+    }
+    let [p0, p1, p2] = tri.positions;
+    let (e1, e2) = (p1 - p0, p2 - p0);
+    let n = e1.cross(e2).length();
+    if !(n > 1e-10 * e1.length() * e2.length() && n.is_finite() && n > 0.0) {
+        report.degenerate_triangles += 1;
+        return;
+    }
+    if let Some(normals) = tri.normals {
+        let ok = normals
+            .iter()
+            .all(|n| n.is_finite() && n.length_squared() > 1e-20);
+        if ok {
+            tri.normals = Some(normals.map(Vec3::normalize));
+        } else {
+            report.replaced_normals += 1;
+            tri.normals = None;
+        }
+    }
+    out.push(tri);
+}
+
+/// Applies `m` to a triangle: positions as points, normals by the inverse transpose;
+/// swaps two corners when `m` mirrors (negative determinant) so the front side follows
+/// the transformed normals, as glTF and Mitsuba do.
+pub fn transform_triangle(m: &Mat4, tri: &Triangle) -> Triangle {
+    let normal_m = m.inverse().transpose();
+    let mut positions = tri.positions.map(|p| m.transform_point3(p));
+    let mut normals = tri
+        .normals
+        .map(|ns| ns.map(|n| normal_m.transform_vector3(n)));
+    if m.determinant() < 0.0 {
+        positions.swap(1, 2);
+        if let Some(ns) = normals.as_mut() {
+            ns.swap(1, 2);
+        }
+    }
+    Triangle {
+        positions,
+        normals,
+        material: tri.material,
+    }
+}
+
+/// The two triangles of a quad given counter-clockwise: (0, 1, 2) and (0, 2, 3).
+pub fn quad_triangles(corners: [Vec3; 4], material: u32) -> [Triangle; 2] {
+    let [a, b, c, d] = corners;
+    [
+        Triangle {
+            positions: [a, b, c],
+            normals: None,
+            material,
+        },
+        Triangle {
+            positions: [a, c, d],
+            normals: None,
+            material,
+        },
+    ]
+}
+
+/// The 6 faces of the cube [-1,1]³ as quads, counter-clockwise seen from outside.
+pub fn cube_quads() -> [[Vec3; 4]; 6] {
+    // (normal, u, v) with u × v = normal.
+    let faces = [
+        (Vec3::X, Vec3::Y, Vec3::Z),
+        (Vec3::NEG_X, Vec3::Z, Vec3::Y),
+        (Vec3::Y, Vec3::Z, Vec3::X),
+        (Vec3::NEG_Y, Vec3::X, Vec3::Z),
+        (Vec3::Z, Vec3::X, Vec3::Y),
+        (Vec3::NEG_Z, Vec3::Y, Vec3::X),
+    ];
+    faces.map(|(n, u, v)| [n - u - v, n + u - v, n + u + v, n - u + v])
+}
+
+/// The square [-1,1]² in z=0, counter-clockwise seen from +z.
+pub fn rectangle_quad() -> [Vec3; 4] {
+    [
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(1.0, 1.0, 0.0),
+        Vec3::new(-1.0, 1.0, 0.0),
+    ]
+}

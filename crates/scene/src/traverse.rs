@@ -1,0 +1,275 @@
+//! Ray queries on the CPU over exactly the flat layout of [`GpuScene`], written to be
+//! mirrored line for line by `shaders/pathtrace/bvh.wgsl` (same names, same order of
+//! operations). Used by tests against brute force, and as the reference for the shader.
+//!
+//! Rays start at `origin` and hits count for `0 < t < t_max`: callers offset origins off
+//! surfaces themselves. Directions need not be normalized; `t` is in units of `dir`.
+
+use glam::Vec3;
+
+use crate::bvh::{BVH_STACK_SIZE, NODE_COUNT_SHIFT, NODE_SPHERES};
+use crate::flatten::GpuScene;
+use crate::gpu::{NO_HIT, PRIM_SPHERE};
+
+/// A ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    /// Origin.
+    pub origin: Vec3,
+    /// Direction, not necessarily unit length.
+    pub dir: Vec3,
+}
+
+/// The closest hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Triangle index, or sphere index | [`PRIM_SPHERE`].
+    pub prim: u32,
+    /// Distance along the ray, in units of `dir`.
+    pub t: f32,
+    /// Barycentric weight of corner 1 (triangles; 0 for spheres).
+    pub u: f32,
+    /// Barycentric weight of corner 2 (triangles; 0 for spheres).
+    pub v: f32,
+}
+
+impl Hit {
+    /// Whether the hit is on a sphere.
+    pub fn is_sphere(&self) -> bool {
+        self.prim & PRIM_SPHERE != 0
+    }
+
+    /// The index in `tri_positions` or `spheres`.
+    pub fn index(&self) -> usize {
+        (self.prim & !PRIM_SPHERE) as usize
+    }
+}
+
+/// Box tests keep a hit at the far side when rounding moves it: the far distance is
+/// scaled by 1 + 2γ₃ (Ize, "Robust BVH ray traversal").
+const ROBUST_FAR: f32 = 1.000_000_4;
+/// Direction components smaller than this are replaced by it (with their sign) before
+/// inverting, so the slab test never computes 0 × ∞.
+const MIN_DIR: f32 = 1e-20;
+
+/// `1 / dir`, finite.
+pub fn safe_inverse(d: Vec3) -> Vec3 {
+    let f = |x: f32| {
+        1.0 / if x.abs() < MIN_DIR {
+            MIN_DIR.copysign(x)
+        } else {
+            x
+        }
+    };
+    Vec3::new(f(d.x), f(d.y), f(d.z))
+}
+
+/// Slab test: whether the ray meets the box at some `0 <= t <= t_max`.
+pub fn ray_aabb(origin: Vec3, inv_dir: Vec3, bmin: Vec3, bmax: Vec3, t_max: f32) -> bool {
+    let t0 = (bmin - origin) * inv_dir;
+    let t1 = (bmax - origin) * inv_dir;
+    let near = t0.min(t1).max_element().max(0.0);
+    let far = (t0.max(t1).min_element() * ROBUST_FAR).min(t_max);
+    near <= far
+}
+
+/// Möller–Trumbore against corner `v0` and edges `e1`, `e2`: `Some((t, u, v))` for a hit
+/// with `0 < t < t_max`. Both sides count.
+pub fn intersect_triangle(
+    origin: Vec3,
+    dir: Vec3,
+    v0: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    t_max: f32,
+) -> Option<(f32, f32, f32)> {
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let s = origin - v0;
+    let u = s.dot(p) * inv_det;
+    let q = s.cross(e1);
+    let v = dir.dot(q) * inv_det;
+    let t = e2.dot(q) * inv_det;
+    // Written so that NaN fails every test.
+    let hit = u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < t_max;
+    hit.then_some((t, u, v))
+}
+
+/// Ray/sphere in the numerically robust form of Haines et al., "Precision improvements for
+/// ray/sphere intersection" (Ray Tracing Gems, ch. 7): the discriminant from the distance
+/// of the center to the line, and the smaller root by the stable quotient. Returns the
+/// nearest `t` with `0 < t < t_max` (the far side when the origin is inside).
+pub fn intersect_sphere(
+    origin: Vec3,
+    dir: Vec3,
+    center: Vec3,
+    radius: f32,
+    t_max: f32,
+) -> Option<f32> {
+    let f = origin - center;
+    let a = dir.dot(dir);
+    let b = -f.dot(dir);
+    let l = f + (b / a) * dir;
+    let disc = a * (radius * radius - l.dot(l));
+    if !(disc >= 0.0) {
+        return None;
+    }
+    let c = f.dot(f) - radius * radius;
+    let root = disc.sqrt();
+    let q = b + if b < 0.0 { -root } else { root };
+    let t0 = c / q;
+    let t1 = q / a;
+    let near = t0.min(t1);
+    let far = t0.max(t1);
+    if near > 0.0 && near < t_max {
+        Some(near)
+    } else if far > 0.0 && far < t_max {
+        Some(far)
+    } else {
+        None
+    }
+}
+
+fn v3(a: [f32; 3]) -> Vec3 {
+    Vec3::from_array(a)
+}
+
+/// The closest hit with `0 < t < t_max`, walking the BVH.
+pub fn intersect_within(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
+    traverse::<false>(scene, ray, t_max)
+}
+
+/// The closest hit, walking the BVH.
+pub fn intersect(scene: &GpuScene, ray: &Ray) -> Option<Hit> {
+    traverse::<false>(scene, ray, f32::MAX)
+}
+
+/// Whether anything is hit with `0 < t < t_max` (shadow rays; stops at the first hit).
+pub fn occluded(scene: &GpuScene, ray: &Ray, t_max: f32) -> bool {
+    traverse::<true>(scene, ray, t_max).is_some()
+}
+
+fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
+    let mut hit = Hit {
+        prim: NO_HIT,
+        t: t_max,
+        u: 0.0,
+        v: 0.0,
+    };
+    if scene.bvh_nodes.is_empty() {
+        return None;
+    }
+    let inv_dir = safe_inverse(ray.dir);
+    let mut stack = [0u32; BVH_STACK_SIZE];
+    let mut sp = 0usize;
+    let mut node_index = 0u32;
+    loop {
+        let node = scene.bvh_nodes[node_index as usize];
+        if ray_aabb(
+            ray.origin,
+            inv_dir,
+            v3(node.aabb_min),
+            v3(node.aabb_max),
+            hit.t,
+        ) {
+            let count = node.meta >> NODE_COUNT_SHIFT;
+            if count == 0 {
+                // Inner node: the first child is adjacent, the second at `index`.
+                let axis = (node.meta & 3) as usize;
+                if ray.dir[axis] < 0.0 {
+                    stack[sp] = node_index + 1;
+                    node_index = node.index;
+                } else {
+                    stack[sp] = node.index;
+                    node_index += 1;
+                }
+                sp += 1;
+                continue;
+            }
+            let first = node.index;
+            if node.meta & NODE_SPHERES == 0 {
+                for i in first..first + count {
+                    let tri = scene.tri_positions[i as usize];
+                    if let Some((t, u, v)) = intersect_triangle(
+                        ray.origin,
+                        ray.dir,
+                        v3(tri.v0),
+                        v3(tri.e1),
+                        v3(tri.e2),
+                        hit.t,
+                    ) {
+                        hit = Hit { prim: i, t, u, v };
+                        if ANY {
+                            return Some(hit);
+                        }
+                    }
+                }
+            } else {
+                for i in first..first + count {
+                    let s = scene.spheres[i as usize];
+                    if let Some(t) =
+                        intersect_sphere(ray.origin, ray.dir, v3(s.center), s.radius, hit.t)
+                    {
+                        hit = Hit {
+                            prim: i | PRIM_SPHERE,
+                            t,
+                            u: 0.0,
+                            v: 0.0,
+                        };
+                        if ANY {
+                            return Some(hit);
+                        }
+                    }
+                }
+            }
+        }
+        if sp == 0 {
+            break;
+        }
+        sp -= 1;
+        node_index = stack[sp];
+    }
+    (hit.prim != NO_HIT).then_some(hit)
+}
+
+/// The closest hit by testing every primitive, in array order: the reference the BVH
+/// traversal is tested against.
+pub fn intersect_brute_force(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
+    let mut hit: Option<Hit> = None;
+    let mut best = t_max;
+    for (i, tri) in scene.tri_positions.iter().enumerate() {
+        let r = intersect_triangle(
+            ray.origin,
+            ray.dir,
+            v3(tri.v0),
+            v3(tri.e1),
+            v3(tri.e2),
+            best,
+        );
+        if let Some((t, u, v)) = r {
+            best = t;
+            hit = Some(Hit {
+                prim: i as u32,
+                t,
+                u,
+                v,
+            });
+        }
+    }
+    for (i, s) in scene.spheres.iter().enumerate() {
+        if let Some(t) = intersect_sphere(ray.origin, ray.dir, v3(s.center), s.radius, best) {
+            best = t;
+            hit = Some(Hit {
+                prim: i as u32 | PRIM_SPHERE,
+                t,
+                u: 0.0,
+                v: 0.0,
+            });
+        }
+    }
+    hit
+}

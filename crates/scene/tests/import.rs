@@ -1,0 +1,159 @@
+//! glTF and OBJ import: counts, bounds, materials, cameras, broken triangles.
+
+mod common;
+
+use glam::{Mat4, Vec3};
+use lumagraph_scene::import::{ImportedMesh, import_mesh};
+
+fn bounds(m: &ImportedMesh) -> (Vec3, Vec3) {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for p in m.triangles.iter().flat_map(|t| t.positions) {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    (lo, hi)
+}
+
+fn close(a: Vec3, b: Vec3, eps: f32) -> bool {
+    (a - b).abs().max_element() <= eps
+}
+
+#[test]
+fn gltf_sphere_grid() {
+    let path = common::assets().join("SphereGrids/SphereGrid_MetalRough.gltf");
+    let m = import_mesh(&path, Mat4::IDENTITY).unwrap();
+    // 25 spheres × 6624 indices / 3 = 55 200 triangles, less the zero-area ones at the
+    // poles of each UV sphere, which are dropped and counted.
+    let dropped = m.report.degenerate_triangles;
+    assert_eq!(m.triangles.len() + dropped, 25 * 2208);
+    assert_eq!(m.report.non_finite_triangles, 0);
+    assert_eq!(dropped % 25, 0, "the same per sphere");
+    // Grid: spacing 1.2, radius 0.5, centered.
+    let (lo, hi) = bounds(&m);
+    assert!(close(lo, Vec3::new(-2.9, -2.9, -0.5), 1e-4), "{lo}");
+    assert!(close(hi, Vec3::new(2.9, 2.9, 0.5), 1e-4), "{hi}");
+    assert_eq!(m.materials.len(), 25);
+    for mat in &m.materials {
+        assert!(close(mat.base_color, Vec3::new(0.95, 0.64, 0.54), 1e-6));
+    }
+    let m00 = m
+        .materials
+        .iter()
+        .find(|x| x.name == "m0.00_r0.00")
+        .unwrap();
+    assert_eq!((m00.metallic, m00.roughness), (0.0, 0.0));
+    let m11 = m
+        .materials
+        .iter()
+        .find(|x| x.name == "m1.00_r1.00")
+        .unwrap();
+    assert_eq!((m11.metallic, m11.roughness), (1.0, 1.0));
+    // Vertex normals are kept, unit, and point away from the sphere centers.
+    assert!(m.triangles.iter().all(|t| t.normals.is_some()));
+    let t = &m.triangles[100];
+    let center = (t.positions[0] + t.positions[1] + t.positions[2]) / 3.0;
+    let sphere_center = (center / 1.2).round() * 1.2;
+    let n = t.normals.unwrap()[0];
+    assert!((n.length() - 1.0).abs() < 1e-5);
+    assert!(n.dot(center - sphere_center) > 0.0);
+    assert!(m.cameras.is_empty());
+}
+
+#[test]
+fn gltf_cornell_box() {
+    let path = common::assets().join("CornellBox/CornellBox.gltf");
+    let m = import_mesh(&path, Mat4::IDENTITY).unwrap();
+    assert!(m.report.is_clean(), "{:?}", m.report);
+    // 5 walls + light: 2 triangles each; 2 blocks × 5 faces × 2.
+    assert_eq!(m.triangles.len(), 32);
+    let (lo, hi) = bounds(&m);
+    assert!(close(lo, Vec3::new(0.0, 0.0, 0.0), 1e-6), "{lo}");
+    assert!(close(hi, Vec3::new(0.556, 0.5488, 0.5592), 1e-6), "{hi}");
+    let light = m.materials.iter().find(|x| x.name == "light").unwrap();
+    assert!(
+        close(light.emission, Vec3::new(17.0, 12.0, 4.0), 1e-4),
+        "{}",
+        light.emission
+    );
+    let red = m.materials.iter().find(|x| x.name == "red").unwrap();
+    assert!(close(red.base_color, Vec3::new(0.63, 0.065, 0.05), 1e-6));
+    assert_eq!(m.cameras.len(), 1);
+    let c = m.cameras[0];
+    assert!(close(c.position, Vec3::new(0.278, 0.273, -0.8), 1e-6));
+    assert!(close(c.forward, Vec3::Z, 1e-6), "{}", c.forward);
+    assert!((c.fov_y_deg - 39.3077).abs() < 1e-3);
+    // The light faces down.
+    let lid = m.materials.iter().position(|x| x.name == "light").unwrap() as u32;
+    let lights: Vec<_> = m.triangles.iter().filter(|t| t.material == lid).collect();
+    assert_eq!(lights.len(), 2);
+    for t in lights {
+        assert!(close(t.normal(), Vec3::NEG_Y, 1e-6));
+    }
+}
+
+#[test]
+fn obj_cornell_box() {
+    let path = common::assets().join("CornellBox/CornellBox.obj");
+    let m = import_mesh(&path, Mat4::from_scale(Vec3::splat(0.001))).unwrap();
+    assert!(m.report.is_clean(), "{:?}", m.report);
+    assert_eq!(m.triangles.len(), 32);
+    let (lo, hi) = bounds(&m);
+    assert!(close(lo, Vec3::ZERO, 1e-6), "{lo}");
+    assert!(close(hi, Vec3::new(0.556, 0.5488, 0.5592), 1e-6), "{hi}");
+    let by_name = |n: &str| m.materials.iter().find(|x| x.name == n).unwrap();
+    assert_eq!(by_name("white").base_color, Vec3::new(0.725, 0.71, 0.68));
+    assert_eq!(by_name("green").base_color, Vec3::new(0.14, 0.45, 0.091));
+    assert_eq!(by_name("light").emission, Vec3::new(17.0, 12.0, 4.0));
+    assert_eq!(by_name("white").emission, Vec3::ZERO);
+    // No normals in the file: flat normals are generated later.
+    assert!(m.triangles.iter().all(|t| t.normals.is_none()));
+    // Light faces down, floor faces up.
+    let lid = m.materials.iter().position(|x| x.name == "light").unwrap() as u32;
+    assert!(
+        m.triangles
+            .iter()
+            .filter(|t| t.material == lid)
+            .all(|t| close(t.normal(), Vec3::NEG_Y, 1e-6))
+    );
+}
+
+#[test]
+fn broken_triangles_are_dropped_and_counted() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let obj = dir.join("broken.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nv nan 0 0\nv inf 1 1\nv 0 0 0\n\
+         vn 0 0 1\nvn 0 0 0\n\
+         f 1 2 3\n\
+         f 1 2 4\n\
+         f 1 7 3\n\
+         f 1 2 5\n\
+         f 6 2 3\n\
+         f 1//1 2//1 3//2\n",
+    )
+    .unwrap();
+    let m = import_mesh(&obj, Mat4::IDENTITY).unwrap();
+    // Good: face 1 and face 6 (its zero normal replaced by the flat one).
+    assert_eq!(m.triangles.len(), 2, "{:?}", m.report);
+    assert_eq!(m.report.degenerate_triangles, 2);
+    assert_eq!(m.report.non_finite_triangles, 2);
+    assert!(m.report.replaced_normals <= 1);
+
+    let e = import_mesh(&dir.join("missing.obj"), Mat4::IDENTITY).unwrap_err();
+    assert!(e.to_string().contains("missing.obj"), "{e}");
+    let e = import_mesh(&dir.join("model.fbx"), Mat4::IDENTITY).unwrap_err();
+    assert!(e.to_string().contains("fbx"), "{e}");
+}
+
+#[test]
+fn mirrored_transform_keeps_front_side() {
+    let path = common::assets().join("CornellBox/CornellBox.gltf");
+    let mirror = Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0));
+    let m = import_mesh(&path, mirror).unwrap();
+    let lid = m.materials.iter().position(|x| x.name == "light").unwrap() as u32;
+    for t in m.triangles.iter().filter(|t| t.material == lid) {
+        assert!(close(t.normal(), Vec3::NEG_Y, 1e-6), "{}", t.normal());
+    }
+}

@@ -1,0 +1,156 @@
+// Scene structs shared by the path tracer, mirroring crates/scene/src/gpu.rs field by
+// field (same names, same offsets; a test in crates/scene checks them with naga).
+// Padding is explicit so the layout reads the same in both languages.
+
+// A hit's `prim` has this bit set for spheres; the low bits index `spheres`.
+const PRIM_SPHERE: u32 = 0x80000000u;
+// A hit's `prim` when nothing was hit.
+const NO_HIT: u32 = 0xffffffffu;
+// `light` of a primitive that does not emit.
+const NO_LIGHT: u32 = 0xffffffffu;
+
+const TRI_VERTEX_NORMALS: u32 = 1u;
+const MATERIAL_TWO_SIDED: u32 = 1u;
+const LIGHT_SPHERE: u32 = 1u;
+const LIGHT_TWO_SIDED: u32 = 2u;
+const ENV_NONE: u32 = 0u;
+const ENV_CONSTANT: u32 = 1u;
+
+const FEATURE_SPHERES: u32 = 1u;
+const FEATURE_TRANSMISSION: u32 = 2u;
+const FEATURE_TEXTURES: u32 = 4u;
+const FEATURE_ENVIRONMENT: u32 = 8u;
+const FEATURE_LIGHTS: u32 = 16u;
+const FEATURE_METAL: u32 = 32u;
+
+// BVH node, 32 bytes. Depth-first order: an inner node's first child is the next node.
+//   meta bits 0-1: split axis (inner); bit 2: leaf kind (1 = spheres, 0 = triangles);
+//   bits 3-31: primitive count (0 = inner node).
+//   index: inner = second child's node index; leaf = first primitive in its kind's array.
+struct BvhNode {
+    aabb_min: vec3<f32>,
+    index: u32,
+    aabb_max: vec3<f32>,
+    meta: u32,
+}
+
+const NODE_SPHERES: u32 = 4u;
+const NODE_COUNT_SHIFT: u32 = 3u;
+
+// Triangle intersection data, 48 bytes: corner 0 and the edges to corners 1 and 2.
+struct TriPositions {
+    v0: vec3<f32>,
+    pad0: u32,
+    e1: vec3<f32>,
+    pad1: u32,
+    e2: vec3<f32>,
+    pad2: u32,
+}
+
+// Triangle shading data, 48 bytes, same index as TriPositions.
+struct TriShading {
+    n0: vec3<f32>,
+    material: u32,
+    n1: vec3<f32>,
+    light: u32,
+    n2: vec3<f32>,
+    flags: u32,
+}
+
+// Sphere, 32 bytes; traversal reads center and radius only.
+struct Sphere {
+    center: vec3<f32>,
+    radius: f32,
+    material: u32,
+    light: u32,
+    pad0: u32,
+    pad1: u32,
+}
+
+// Material, 64 bytes. Texture indices: 16 bits each, 0xffff = none.
+struct Material {
+    base_color: vec3<f32>,
+    roughness: f32,
+    emission: vec3<f32>,
+    metallic: f32,
+    specular: f32,
+    specular_tint: f32,
+    transmission: f32,
+    ior: f32,
+    tex_base_mr: u32,
+    tex_emissive_normal: u32,
+    flags: u32,
+    pad0: u32,
+}
+
+// Emissive triangle (p0, e1, e2) or sphere (center p0, radius e1.x), 64 bytes.
+// Selection probability = power / SceneHeader.total_light_power.
+struct Light {
+    p0: vec3<f32>,
+    flags: u32,
+    e1: vec3<f32>,
+    prim: u32,
+    e2: vec3<f32>,
+    area: f32,
+    emission: vec3<f32>,
+    power: f32,
+}
+
+// Alias table entry over the lights (Vose), 8 bytes.
+struct AliasEntry {
+    prob: f32,
+    alias: u32,
+}
+
+// Camera, 64 bytes. Direction for image coordinates (x, y) in [0,1]^2, y down:
+// forward + (2x - 1) * tan_half_fov * aspect * right - (2y - 1) * tan_half_fov * up.
+struct Camera {
+    position: vec3<f32>,
+    tan_half_fov: f32,
+    right: vec3<f32>,
+    aspect: f32,
+    up: vec3<f32>,
+    aperture_radius: f32,
+    forward: vec3<f32>,
+    focus_distance: f32,
+}
+
+// Render settings and environment, 48 bytes.
+struct Settings {
+    width: u32,
+    height: u32,
+    max_bounces: u32,
+    spp: u32,
+    seed: u32,
+    env_kind: u32,
+    pad0: u32,
+    pad1: u32,
+    env_radiance: vec3<f32>,
+    pad2: u32,
+}
+
+// Counts and scene-wide values, 32 bytes.
+struct SceneHeader {
+    num_nodes: u32,
+    num_triangles: u32,
+    num_spheres: u32,
+    num_materials: u32,
+    num_lights: u32,
+    bvh_depth: u32,
+    features: u32,
+    total_light_power: f32,
+}
+
+struct Ray {
+    origin: vec3<f32>,
+    dir: vec3<f32>,
+}
+
+// prim: triangle index, or sphere index | PRIM_SPHERE, or NO_HIT.
+// u, v: barycentric weights of corners 1 and 2 (0 for spheres).
+struct Hit {
+    prim: u32,
+    t: f32,
+    u: f32,
+    v: f32,
+}
