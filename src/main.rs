@@ -6,7 +6,11 @@ use std::process::ExitCode;
 use anyhow::{Context as _, Result};
 use clap::{Parser, Subcommand};
 use lumagraph::graph::{Graph, Registry, docs};
-use lumagraph::render::{Executor, GpuContext, Paths, compile, image_io};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use lumagraph::render::{Executor, GpuContext, Resources, compile, image_io};
+use lumagraph::scene::{GpuScene, Scene};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -39,6 +43,9 @@ enum Command {
         /// Folder Output paths are relative to (created if missing).
         #[arg(long, default_value = ".")]
         out: PathBuf,
+        /// Samples per pixel for graphs that render the scene (default: the scene's `spp`).
+        #[arg(long)]
+        spp: Option<u32>,
         /// Override a param: `node.param=value` (RON value, or a bare word for names).
         #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
         overrides: Vec<String>,
@@ -60,6 +67,9 @@ enum Command {
     Validate {
         /// The graph file (RON).
         graph: PathBuf,
+        /// Scene file for nodes that render a scene.
+        #[arg(long)]
+        scene: Option<PathBuf>,
     },
     /// List every node kind with its ports and params.
     #[command(after_help = "Example:\n  lumagraph nodes --markdown > nodes.md")]
@@ -120,11 +130,6 @@ fn render(graph_path: &Path, scene: Option<&Path>, out: &Path, overrides: &[Stri
         }
         None => println!("GPU time per pass: not available (adapter has no timestamp queries)"),
     }
-    println!(
-        "frame: {:.1} ms wall (first frame, with shader compilation: {:.1} ms)",
-        report.wall.as_secs_f64() * 1e3,
-        first.wall.as_secs_f64() * 1e3
-    );
     for path in &report.written {
         println!("wrote {}", path.display());
     }
@@ -134,28 +139,44 @@ fn render(graph_path: &Path, scene: Option<&Path>, out: &Path, overrides: &[Stri
     Ok(())
 }
 
+struct RenderArgs<'a> {
+    graph: &'a Path,
+    scene: Option<&'a Path>,
+    out: &'a Path,
+    spp: Option<u32>,
+    overrides: &'a [String],
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Render {
             graph,
             scene,
             out,
+            spp,
             overrides,
-        } => render(&graph, scene.as_deref(), &out, &overrides),
+        } => render(&RenderArgs {
+            graph: &graph,
+            scene: scene.as_deref(),
+            out: &out,
+            spp,
+            overrides: &overrides,
+        }),
         Command::Plan {
             graph,
             scene,
             overrides,
         } => {
             let g = load(&graph, &overrides)?;
-            let plan = compile(&g, &[])?;
-            note_scene(scene.as_deref())?;
+            let scene = load_scene(scene.as_deref())?;
+            let plan = compile(&g, &[], scene.as_ref().map(|s| &*s.gpu))?;
             print!("{plan}");
             Ok(())
         }
-        Command::Validate { graph } => {
+        Command::Validate { graph, scene } => {
             let g = load(&graph, &[])?;
-            let plan = compile(&g, &[])?;
+            let scene = load_scene(scene.as_deref())?;
+            let plan = compile(&g, &[], scene.as_ref().map(|s| &*s.gpu))?;
             println!(
                 "{}: ok ({} passes, {} left out)",
                 graph.display(),

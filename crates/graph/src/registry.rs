@@ -189,6 +189,32 @@ fn builtin_kinds() -> Vec<NodeKind> {
             history: false,
         },
         NodeKind {
+            name: "PathTrace",
+            category: Category::Render,
+            doc: "Path traces the scene (`--scene`) on the GPU: BVH traversal in WGSL, next-event \
+                  estimation with multiple importance sampling, Russian roulette. Each frame adds \
+                  `samples_per_frame` samples per pixel and outputs their mean; feed it to \
+                  Accumulate for a progressive render. Image size, bounces and seed come from \
+                  the scene.",
+            inputs: &[],
+            outputs: &[OutputDef {
+                name: "color",
+                ty: PortType::HdrColor,
+                doc: "this frame's radiance estimate",
+            }],
+            params: vec![ParamDef {
+                name: "samples_per_frame",
+                ty: ParamType::Int {
+                    default: 4,
+                    min: 1,
+                    max: 4096,
+                },
+                doc: "samples per pixel in one frame (one dispatch)",
+            }],
+            sink: false,
+            history: false,
+        },
+        NodeKind {
             name: "Accumulate",
             category: Category::Render,
             doc: "Running mean of its input over frames (progressive rendering). Sums are kept in \

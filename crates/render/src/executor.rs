@@ -11,7 +11,7 @@ use lumagraph_graph::{
 use crate::context::GpuContext;
 use crate::cpu::Image;
 use crate::error::{RenderError, Result};
-use crate::nodes::{self, FrameIo, NodeExec, Paths};
+use crate::nodes::{self, Counter, FrameIo, NodeExec, Resources};
 use crate::pool::{PooledTexture, TexturePool};
 use crate::timing::GpuTimer;
 
@@ -89,7 +89,7 @@ impl Executor {
     /// # Errors
     /// When a node cannot be set up (missing input file, unwritable output, shader error);
     /// the error names the node.
-    pub fn new(ctx: &GpuContext, plan: Plan, paths: &Paths) -> Result<Self> {
+    pub fn new(ctx: &GpuContext, plan: Plan, paths: &Resources) -> Result<Self> {
         let nodes = plan
             .passes
             .iter()
@@ -147,15 +147,17 @@ impl Executor {
     /// # Errors
     /// When a node fails; the error names the node.
     pub fn run_frame(&mut self) -> Result<FrameReport> {
-        self.run_frames(1)
+        self.run_frames(1, true)
     }
 
     /// Runs `n` frames in one submission: passes that feed a node with history (and that
-    /// node) run every frame; the rest run once, in the last frame, which is the one timed.
+    /// node) run every frame. With `finish`, the rest of the graph runs once, in the last
+    /// frame (the one timed), and sinks write their files; without it, only the progressive
+    /// part runs (a long render's intermediate batches).
     ///
     /// # Errors
     /// When a node fails; the error names the node.
-    pub fn run_frames(&mut self, n: u32) -> Result<FrameReport> {
+    pub fn run_frames(&mut self, n: u32, finish: bool) -> Result<FrameReport> {
         let start = Instant::now();
         let mut encoder = self
             .ctx
@@ -173,7 +175,7 @@ impl Executor {
         let mut executed = Vec::with_capacity(self.plan.passes.len());
         let n = n.max(1);
         for frame in 0..n {
-            let last = frame + 1 == n;
+            let last = finish && frame + 1 == n;
             for (p, (pass, node)) in self.plan.passes.iter().zip(&mut self.nodes).enumerate() {
                 if !last && !self.every_frame[p] {
                     continue;
@@ -206,8 +208,8 @@ impl Executor {
             );
         }
         let pass_ms = match &self.timer {
-            Some(t) => Some(t.read(&self.ctx)?),
-            None => None,
+            Some(t) if finish => Some(t.read(&self.ctx)?),
+            _ => None,
         };
         self.frames += u64::from(n);
         Ok(FrameReport {
@@ -216,6 +218,20 @@ impl Executor {
             written,
             executed,
         })
+    }
+
+    /// Every node's counters since its last reset, as `(node id, counter)`.
+    ///
+    /// # Errors
+    /// When a readback fails.
+    pub fn counters(&mut self) -> Result<Vec<(String, Counter)>> {
+        let mut out = Vec::new();
+        for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
+            for c in node.counters(&self.ctx).map_err(|e| e.in_node(&pass.node))? {
+                out.push((pass.node.clone(), c));
+            }
+        }
+        Ok(out)
     }
 
     /// Reads back the current contents of a planned texture (after a frame).

@@ -3,7 +3,7 @@
 //! A [`Kernel`] is a compute pipeline plus the list of bindings its shader declares, in
 //! binding order. Recording a pass reads like its declaration:
 //!
-//! ```ignore
+//! ```text
 //! kernel.pass("exposure").read(&input).write(&output).uniform(&params)
 //!     .dispatch_2d(&ctx, encoder, extent, timer)?;
 //! ```

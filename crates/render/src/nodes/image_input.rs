@@ -6,17 +6,17 @@ use lumagraph_graph::{Pass, TexFormat};
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::nodes::{FrameIo, NodeExec, Paths};
+use crate::nodes::{FrameIo, NodeExec, Resources};
 use crate::pool::{PooledTexture, create};
 use crate::timing::GpuTimer;
 
 pub(crate) struct ImageInput {
-    paths: Paths,
+    paths: Resources,
     loaded: Option<(PathBuf, PooledTexture)>,
 }
 
 impl ImageInput {
-    pub(crate) fn new(ctx: &GpuContext, pass: &Pass, paths: &Paths) -> Result<Self> {
+    pub(crate) fn new(ctx: &GpuContext, pass: &Pass, paths: &Resources) -> Result<Self> {
         let mut node = Self {
             paths: paths.clone(),
             loaded: None,

@@ -4,9 +4,11 @@ mod accumulate;
 mod exposure;
 mod image_input;
 mod output;
+mod pathtrace;
 mod tonemap;
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use lumagraph_graph::{Pass, Plan, TextureId};
 
@@ -15,16 +17,34 @@ use crate::error::{RenderError, Result};
 use crate::pool::PooledTexture;
 use crate::timing::GpuTimer;
 
-/// Where a node's relative paths point.
+/// What nodes read from outside the graph: where relative paths point, and the scene.
 #[derive(Clone, Debug, Default)]
-pub struct Paths {
+pub struct Resources {
     /// Folder input paths are relative to (the graph file's folder).
     pub base_dir: PathBuf,
     /// Folder output paths are relative to.
     pub out_dir: PathBuf,
+    /// The scene, flattened, for nodes that render one.
+    pub scene: Option<Arc<lumagraph_scene::GpuScene>>,
 }
 
-impl Paths {
+/// A named count a node keeps (samples, rays, dropped samples), since its last reset.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Counter {
+    /// What is counted.
+    pub name: &'static str,
+    /// The count.
+    pub value: u64,
+}
+
+impl Counter {
+    /// A counter.
+    pub fn new(name: &'static str, value: u64) -> Self {
+        Self { name, value }
+    }
+}
+
+impl Resources {
     /// An input path resolved against the base folder.
     pub fn input(&self, p: &str) -> PathBuf {
         self.base_dir.join(p)
@@ -86,6 +106,14 @@ pub trait NodeExec {
         timer: Option<&mut GpuTimer>,
     ) -> Result<()>;
 
+    /// The node's counters since its last reset (may read back from the GPU).
+    ///
+    /// # Errors
+    /// When the readback fails.
+    fn counters(&mut self, _ctx: &GpuContext) -> Result<Vec<Counter>> {
+        Ok(Vec::new())
+    }
+
     /// Runs after the frame's GPU work finished; returns files written.
     ///
     /// # Errors
@@ -99,12 +127,13 @@ pub trait NodeExec {
 ///
 /// # Errors
 /// When the kind has no implementation or its setup fails; the error names the node.
-pub fn create(ctx: &GpuContext, pass: &Pass, paths: &Paths) -> Result<Box<dyn NodeExec>> {
+pub fn create(ctx: &GpuContext, pass: &Pass, paths: &Resources) -> Result<Box<dyn NodeExec>> {
     let node: Result<Box<dyn NodeExec>> = match pass.kind {
         "ImageInput" => image_input::ImageInput::new(ctx, pass, paths).map(|n| Box::new(n) as _),
         "Accumulate" => accumulate::Accumulate::new(ctx).map(|n| Box::new(n) as _),
         "Exposure" => exposure::Exposure::new(ctx, pass).map(|n| Box::new(n) as _),
         "Tonemap" => tonemap::Tonemap::new(ctx, pass).map(|n| Box::new(n) as _),
+        "PathTrace" => pathtrace::PathTrace::new(ctx, pass, paths).map(|n| Box::new(n) as _),
         "Output" => output::Output::new(ctx, pass, paths).map(|n| Box::new(n) as _),
         other => Err(RenderError::Unimplemented(other.to_owned())),
     };

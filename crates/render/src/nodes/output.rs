@@ -6,11 +6,11 @@ use lumagraph_graph::{Extent, Pass, PortType, TexFormat};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::nodes::{FrameIo, NodeExec, Paths, check_writable};
+use crate::nodes::{FrameIo, NodeExec, Resources, check_writable};
 use crate::timing::GpuTimer;
 
 pub(crate) struct Output {
-    paths: Paths,
+    paths: Resources,
     staged: Option<Staged>,
 }
 
@@ -23,7 +23,7 @@ struct Staged {
 }
 
 impl Output {
-    pub(crate) fn new(ctx: &GpuContext, pass: &Pass, paths: &Paths) -> Result<Self> {
+    pub(crate) fn new(ctx: &GpuContext, pass: &Pass, paths: &Resources) -> Result<Self> {
         let mut node = Self {
             paths: paths.clone(),
             staged: None,

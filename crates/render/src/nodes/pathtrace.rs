@@ -1,0 +1,160 @@
+//! `PathTrace`: the WGSL megakernel over the scene's BVH; each frame adds
+//! `samples_per_frame` samples per pixel and writes their mean.
+
+use lumagraph_graph::Pass;
+
+use wgpu::util::DeviceExt as _;
+
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+use crate::kernel::{Binding, Kernel, uniform_buffer};
+use crate::nodes::{Counter, FrameIo, NodeExec, Resources};
+use crate::readback::map_read;
+use crate::scene_gpu::SceneBuffers;
+use crate::timing::GpuTimer;
+
+/// `stats` slots: dropped (non-finite) samples, rays traced (low, high 32 bits).
+const STATS: u64 = 4;
+
+pub(crate) struct PathTrace {
+    kernel: Kernel,
+    scene: std::sync::Arc<lumagraph_scene::GpuScene>,
+    buffers: SceneBuffers,
+    frame: wgpu::Buffer,
+    stats: wgpu::Buffer,
+    stats_read: wgpu::Buffer,
+    samples_per_frame: u32,
+    /// Samples per pixel taken since the last reset.
+    samples: u32,
+    /// Dropped samples and rays since the last reset, read back so far.
+    dropped: u64,
+    rays: u64,
+}
+
+impl PathTrace {
+    pub(crate) fn new(ctx: &GpuContext, pass: &Pass, resources: &Resources) -> Result<Self> {
+        let scene = resources
+            .scene
+            .clone()
+            .ok_or_else(|| RenderError::Gpu("PathTrace needs a scene (lumagraph render --scene FILE)".into()))?;
+        let storage = Binding::Storage { read_only: true };
+        let kernel = Kernel::new(
+            ctx,
+            "pathtrace/pathtrace.wgsl",
+            &[
+                Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
+                Binding::Uniform,
+                storage,
+                storage,
+                storage,
+                storage,
+                storage,
+                storage,
+                storage,
+                Binding::Storage { read_only: false },
+            ],
+        )?;
+        let buffers = SceneBuffers::upload(ctx, &scene);
+        let frame = uniform_buffer(ctx, "pathtrace frame", &[0; 160]);
+        let stats = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pathtrace stats"),
+            size: STATS * 4,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let stats_read = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pathtrace stats readback"),
+            size: STATS * 4,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut node = Self {
+            kernel,
+            scene,
+            buffers,
+            frame,
+            stats,
+            stats_read,
+            samples_per_frame: 1,
+            samples: 0,
+            dropped: 0,
+            rays: 0,
+        };
+        node.update(ctx, pass)?;
+        Ok(node)
+    }
+
+    fn frame_bytes(&self) -> Vec<u8> {
+        let s = &self.scene;
+        let mut bytes = Vec::with_capacity(160);
+        bytes.extend_from_slice(bytemuck::bytes_of(&s.settings));
+        bytes.extend_from_slice(bytemuck::bytes_of(&s.camera));
+        bytes.extend_from_slice(bytemuck::bytes_of(&s.header));
+        for v in [self.samples, self.samples_per_frame, 0, 0] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        bytes
+    }
+}
+
+impl NodeExec for PathTrace {
+    fn update(&mut self, _ctx: &GpuContext, pass: &Pass) -> Result<()> {
+        self.samples_per_frame = u32::try_from(pass.params.int("samples_per_frame")).unwrap_or(1);
+        Ok(())
+    }
+
+    fn reset(&mut self) {
+        self.samples = 0;
+        self.dropped = 0;
+        self.rays = 0;
+    }
+
+    fn record(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: &Pass,
+        io: &FrameIo<'_>,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let Some(out) = pass.output("color") else { return Ok(()) };
+        // Each frame has its own uniform contents: stage them through a copy recorded in
+        // order, so many frames can share one submission.
+        let staging = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("pathtrace frame staging"),
+            contents: &self.frame_bytes(),
+            usage: wgpu::BufferUsages::COPY_SRC,
+        });
+        encoder.copy_buffer_to_buffer(&staging, 0, &self.frame, 0, self.frame.size());
+        self.samples += self.samples_per_frame;
+        let b = &self.buffers;
+        self.kernel
+            .pass(&pass.node)
+            .write(&io.texture(out).view)
+            .uniform(&self.frame)
+            .buffer(&b.bvh_nodes)
+            .buffer(&b.tri_positions)
+            .buffer(&b.tri_shading)
+            .buffer(&b.spheres)
+            .buffer(&b.materials)
+            .buffer(&b.lights)
+            .buffer(&b.light_alias)
+            .buffer(&self.stats)
+            .dispatch_2d(ctx, encoder, pass.extent, timer)
+    }
+
+    fn counters(&mut self, ctx: &GpuContext) -> Result<Vec<Counter>> {
+        let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("stats") });
+        encoder.copy_buffer_to_buffer(&self.stats, 0, &self.stats_read, 0, STATS * 4);
+        encoder.clear_buffer(&self.stats, 0, None);
+        ctx.queue.submit([encoder.finish()]);
+        let v: Vec<u32> = map_read(ctx, &self.stats_read, STATS * 4, bytemuck::pod_collect_to_vec)?;
+        self.dropped += u64::from(v[0]);
+        self.rays += u64::from(v[1]) | (u64::from(v[2]) << 32);
+        Ok(vec![
+            Counter::new("samples_per_pixel", u64::from(self.samples)),
+            Counter::new("dropped_samples", self.dropped),
+            Counter::new("rays", self.rays),
+        ])
+    }
+}

@@ -1,0 +1,72 @@
+//! A flattened scene on the GPU: one storage buffer per array of
+//! [`lumagraph_scene::GpuScene`], bound by the path tracer in the order of its shader.
+
+use lumagraph_scene::GpuScene;
+use wgpu::util::DeviceExt as _;
+
+use crate::context::GpuContext;
+
+/// The scene's storage buffers.
+#[derive(Debug)]
+pub struct SceneBuffers {
+    /// BVH nodes.
+    pub bvh_nodes: wgpu::Buffer,
+    /// Triangle intersection data.
+    pub tri_positions: wgpu::Buffer,
+    /// Triangle shading data.
+    pub tri_shading: wgpu::Buffer,
+    /// Spheres.
+    pub spheres: wgpu::Buffer,
+    /// Materials.
+    pub materials: wgpu::Buffer,
+    /// Emitters.
+    pub lights: wgpu::Buffer,
+    /// Alias table over the emitters.
+    pub light_alias: wgpu::Buffer,
+    /// Bytes uploaded, for reports.
+    pub bytes: u64,
+}
+
+fn storage(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
+    // Bindings may not be empty: a scene without spheres still binds a (zeroed) buffer.
+    let mut padded;
+    let contents = if bytes.len() < 64 {
+        padded = bytes.to_vec();
+        padded.resize(64, 0);
+        &padded[..]
+    } else {
+        bytes
+    };
+    ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE,
+    })
+}
+
+impl SceneBuffers {
+    /// Uploads every array of `scene`.
+    pub fn upload(ctx: &GpuContext, scene: &GpuScene) -> Self {
+        let parts: [(&str, &[u8]); 7] = [
+            ("bvh_nodes", bytemuck::cast_slice(&scene.bvh_nodes)),
+            ("tri_positions", bytemuck::cast_slice(&scene.tri_positions)),
+            ("tri_shading", bytemuck::cast_slice(&scene.tri_shading)),
+            ("spheres", bytemuck::cast_slice(&scene.spheres)),
+            ("materials", bytemuck::cast_slice(&scene.materials)),
+            ("lights", bytemuck::cast_slice(&scene.lights)),
+            ("light_alias", bytemuck::cast_slice(&scene.light_alias)),
+        ];
+        let bytes = parts.iter().map(|(_, b)| b.len() as u64).sum();
+        let [b0, b1, b2, b3, b4, b5, b6] = parts.map(|(label, b)| storage(ctx, label, b));
+        Self {
+            bvh_nodes: b0,
+            tri_positions: b1,
+            tri_shading: b2,
+            spheres: b3,
+            materials: b4,
+            lights: b5,
+            light_alias: b6,
+            bytes,
+        }
+    }
+}

@@ -1,0 +1,285 @@
+// Path tracer megakernel: one invocation per pixel traces `samples_per_frame` paths and
+// writes their mean radiance. Unidirectional path tracing with next-event estimation and
+// multiple importance sampling (power heuristic) for emissive triangles and spheres,
+// Russian roulette from the fifth bounce, one-sided Lambertian materials and emitters
+// (Mitsuba 3's conventions, so the references match). Samples that are not finite never
+// reach the output: they are dropped and counted in `stats[0]`.
+#import "pathtrace/scene_types.wgsl"
+#import "common/rng.wgsl"
+#import "common/sampling.wgsl"
+
+struct Frame {
+    settings: Settings,
+    camera: Camera,
+    header: SceneHeader,
+    // Index of this frame's first sample in the pixel's sample sequence.
+    sample_offset: u32,
+    samples_per_frame: u32,
+    pad0: u32,
+    pad1: u32,
+}
+
+@group(0) @binding(0) var output: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(1) var<uniform> frame: Frame;
+@group(0) @binding(2) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(3) var<storage, read> tri_positions: array<TriPositions>;
+@group(0) @binding(4) var<storage, read> tri_shading: array<TriShading>;
+@group(0) @binding(5) var<storage, read> spheres: array<Sphere>;
+@group(0) @binding(6) var<storage, read> materials: array<Material>;
+@group(0) @binding(7) var<storage, read> lights: array<Light>;
+@group(0) @binding(8) var<storage, read> light_alias: array<AliasEntry>;
+@group(0) @binding(9) var<storage, read_write> stats: array<atomic<u32>>;
+
+#import "pathtrace/bvh.wgsl"
+
+const RR_START: u32 = 5u;
+
+// Rays traced by this invocation (camera, extension and shadow rays), for the report.
+var<private> ray_count: u32;
+
+struct Surface {
+    p: vec3f,
+    // Geometric normal, front side (triangles: e1 x e2; spheres: outward).
+    ng: vec3f,
+    // Shading normal, front side.
+    ns: vec3f,
+    material: u32,
+    light: u32,
+}
+
+fn surface_at(ray: Ray, hit: Hit) -> Surface {
+    var s: Surface;
+    s.p = ray.origin + hit.t * ray.dir;
+    if (hit.prim & PRIM_SPHERE) != 0u {
+        let sph = spheres[hit.prim & ~PRIM_SPHERE];
+        s.ng = normalize(s.p - sph.center);
+        s.ns = s.ng;
+        s.material = sph.material;
+        s.light = sph.light;
+    } else {
+        let tri = tri_positions[hit.prim];
+        let sh = tri_shading[hit.prim];
+        // Position from the barycentrics: more accurate than origin + t * dir far away.
+        s.p = tri.v0 + hit.u * tri.e1 + hit.v * tri.e2;
+        s.ng = normalize(cross(tri.e1, tri.e2));
+        if (sh.flags & TRI_VERTEX_NORMALS) != 0u {
+            let n = (1.0 - hit.u - hit.v) * sh.n0 + hit.u * sh.n1 + hit.v * sh.n2;
+            s.ns = select(s.ng, normalize(n), dot(n, n) > 0.0);
+        } else {
+            s.ns = s.ng;
+        }
+        s.material = sh.material;
+        s.light = sh.light;
+    }
+    return s;
+}
+
+struct LightSample {
+    // Unit direction from the shading point to the light.
+    wi: vec3f,
+    dist: f32,
+    radiance: vec3f,
+    // Solid-angle pdf, light selection included; 0 when the sample is invalid.
+    pdf: f32,
+}
+
+fn light_select_pdf(l: Light) -> f32 {
+    return l.power / frame.header.total_light_power;
+}
+
+// Solid-angle pdf of sampling the point `y` (normal `ny`) on light `l` from `x`.
+fn light_pdf(l: Light, x: vec3f, y: vec3f, ny: vec3f) -> f32 {
+    let d = y - x;
+    let dist2 = dot(d, d);
+    if (l.flags & LIGHT_SPHERE) != 0u {
+        let r = l.e1.x;
+        let s = min(1.0, r * r / dot(l.p0 - x, l.p0 - x));
+        let cone = one_minus_sqrt_one_minus(s);
+        return light_select_pdf(l) / (TWO_PI * cone);
+    }
+    let cos_y = abs(dot(ny, d)) / sqrt(dist2);
+    return light_select_pdf(l) * dist2 / (l.area * cos_y);
+}
+
+fn pick_light(u: f32) -> u32 {
+    let n = frame.header.num_lights;
+    let scaled = u * f32(n);
+    let i = min(u32(scaled), n - 1u);
+    let e = light_alias[i];
+    return select(e.other, i, scaled - f32(i) < e.prob);
+}
+
+fn sample_light(x: vec3f) -> LightSample {
+    var out: LightSample;
+    out.pdf = 0.0;
+    let l = lights[pick_light(rand())];
+    let u = rand2();
+    if (l.flags & LIGHT_SPHERE) != 0u {
+        // Uniform direction in the cone the sphere subtends.
+        let r = l.e1.x;
+        let to_c = l.p0 - x;
+        let d2 = dot(to_c, to_c);
+        if d2 <= r * r {
+            return out;
+        }
+        let d = sqrt(d2);
+        let cone = one_minus_sqrt_one_minus(r * r / d2);
+        let cos_t = 1.0 - u.x * cone;
+        let sin_t = sqrt(max(0.0, (1.0 - cos_t) * (1.0 + cos_t)));
+        let phi = TWO_PI * u.y;
+        let axis = to_c / d;
+        let wi = normalize(onb(axis) * vec3f(sin_t * cos(phi), sin_t * sin(phi), cos_t));
+        // Distance to the near intersection with the sphere.
+        let b = dot(to_c, wi);
+        let h = to_c - b * wi;
+        let dist = b - sqrt(max(0.0, r * r - dot(h, h)));
+        out.wi = wi;
+        out.dist = dist;
+        out.radiance = l.emission;
+        out.pdf = light_select_pdf(l) / (TWO_PI * cone);
+        return out;
+    }
+    let b = sample_triangle(u);
+    let y = l.p0 + b.x * l.e1 + b.y * l.e2;
+    let ny = normalize(cross(l.e1, l.e2));
+    let d = y - x;
+    let dist2 = dot(d, d);
+    let dist = sqrt(dist2);
+    let wi = d / dist;
+    let cos_y = dot(ny, -wi);
+    let two_sided = (l.flags & LIGHT_TWO_SIDED) != 0u;
+    if !(cos_y > 0.0 || (two_sided && cos_y < 0.0)) {
+        return out;
+    }
+    out.wi = wi;
+    out.dist = dist;
+    out.radiance = l.emission;
+    out.pdf = light_select_pdf(l) * dist2 / (l.area * abs(cos_y));
+    return out;
+}
+
+fn camera_ray(pixel: vec2u, u: vec2f) -> Ray {
+    let cam = frame.camera;
+    let size = vec2f(f32(frame.settings.width), f32(frame.settings.height));
+    let xy = (vec2f(pixel) + u) / size;
+    let dir = cam.forward + (2.0 * xy.x - 1.0) * cam.tan_half_fov * cam.aspect * cam.right
+        - (2.0 * xy.y - 1.0) * cam.tan_half_fov * cam.up;
+    var ray = Ray(cam.position, normalize(dir));
+    if cam.aperture_radius > 0.0 {
+        let lens = cam.aperture_radius * sample_disk(rand2());
+        let focus = cam.position + ray.dir * (cam.focus_distance / dot(ray.dir, cam.forward));
+        ray.origin = cam.position + lens.x * cam.right + lens.y * cam.up;
+        ray.dir = normalize(focus - ray.origin);
+    }
+    return ray;
+}
+
+fn trace_path(pixel: vec2u) -> vec3f {
+    var ray = camera_ray(pixel, rand2());
+    var throughput = vec3f(1.0);
+    var radiance = vec3f(0.0);
+    // Solid-angle pdf of the BSDF sample that made `ray`, and where it left from (for MIS).
+    var bsdf_pdf = 0.0;
+    var prev_p = ray.origin;
+    let max_bounces = frame.settings.max_bounces;
+    let has_lights = frame.header.num_lights > 0u;
+    for (var bounce = 0u; ; bounce++) {
+        let hit = intersect_scene(ray);
+        ray_count += 1u;
+        if hit.prim == NO_HIT {
+            if frame.settings.env_kind == ENV_CONSTANT {
+                radiance += throughput * frame.settings.env_radiance;
+            }
+            break;
+        }
+        let s = surface_at(ray, hit);
+        let mat = materials[s.material];
+        let front = dot(s.ng, ray.dir) < 0.0;
+        let two_sided = (mat.flags & MATERIAL_TWO_SIDED) != 0u;
+
+        // Emission seen along the ray, weighted against light sampling.
+        if s.light != NO_LIGHT && (front || two_sided) {
+            var w = 1.0;
+            if bounce > 0u {
+                w = mis_power(bsdf_pdf, light_pdf(lights[s.light], prev_p, s.p, s.ng));
+            }
+            radiance += throughput * mat.emission * w;
+        }
+        // One-sided materials are black from behind.
+        if !(front || two_sided) || bounce >= max_bounces {
+            break;
+        }
+        let ng = select(-s.ng, s.ng, front);
+        let ns = select(-s.ns, s.ns, front);
+        let origin = offset_ray(s.p, ng);
+        let albedo = mat.base_color;
+
+        // Next-event estimation.
+        if has_lights {
+            let ls = sample_light(s.p);
+            let cos_x = dot(ns, ls.wi);
+            if ls.pdf > 0.0 && cos_x > 0.0 && dot(ng, ls.wi) > 0.0 {
+                let shadow = Ray(origin, ls.wi);
+                ray_count += 1u;
+                if !occluded(shadow, ls.dist * (1.0 - 1e-4)) {
+                    let f = albedo * INV_PI;
+                    let w = mis_power(ls.pdf, cos_x * INV_PI);
+                    radiance += throughput * f * cos_x * ls.radiance * (w / ls.pdf);
+                }
+            }
+        }
+
+        // Lambertian sampling: f cos / pdf = albedo.
+        let wi = sample_cosine(ns, rand2());
+        let cos_i = dot(ns, wi);
+        if cos_i <= 0.0 || dot(ng, wi) <= 0.0 {
+            break;
+        }
+        throughput *= albedo;
+        bsdf_pdf = cos_i * INV_PI;
+        prev_p = s.p;
+        ray = Ray(origin, wi);
+
+        // Russian roulette.
+        if bounce + 1u >= RR_START {
+            let q = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
+            if rand() >= q {
+                break;
+            }
+            throughput /= q;
+        }
+    }
+    return radiance;
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3u) {
+    let w = frame.settings.width;
+    let h = frame.settings.height;
+    if id.x >= w || id.y >= h {
+        return;
+    }
+    let pixel_index = id.y * w + id.x;
+    var sum = vec3f(0.0);
+    var dropped = 0u;
+    ray_count = 0u;
+    let n = frame.samples_per_frame;
+    for (var i = 0u; i < n; i++) {
+        rng_init(pixel_index, frame.sample_offset + i, frame.settings.seed);
+        let l = trace_path(id.xy);
+        if all_finite(l) {
+            sum += l;
+        } else {
+            dropped += 1u;
+        }
+    }
+    if dropped > 0u {
+        atomicAdd(&stats[0], dropped);
+    }
+    // 64-bit ray count in two words: carry into the high word when the low one wraps.
+    let before = atomicAdd(&stats[1], ray_count);
+    if before > 0xffffffffu - ray_count {
+        atomicAdd(&stats[2], 1u);
+    }
+    textureStore(output, id.xy, vec4f(sum / f32(max(n, 1u)), 1.0));
+}
