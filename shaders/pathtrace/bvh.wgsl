@@ -81,10 +81,10 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
     loop {
         let node = bvh_nodes[node_index];
         if (ray_aabb(ray.origin, inv_dir, node.aabb_min, node.aabb_max, hit.t)) {
-            let count = node.meta >> NODE_COUNT_SHIFT;
+            let count = node.bits >> NODE_COUNT_SHIFT;
             if (count == 0u) {
                 // Inner node: the first child is adjacent, the second at `index`.
-                let axis = node.meta & 3u;
+                let axis = node.bits & 3u;
                 if (ray.dir[axis] < 0.0) {
                     stack[sp] = node_index + 1u;
                     node_index = node.index;
@@ -96,7 +96,7 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                 continue;
             }
             let first = node.index;
-            if ((node.meta & NODE_SPHERES) == 0u) {
+            if ((node.bits & NODE_SPHERES) == 0u) {
                 for (var i = first; i < first + count; i = i + 1u) {
                     let tri = tri_positions[i];
                     let r = intersect_triangle(ray.origin, ray.dir, tri.v0, tri.e1, tri.e2, hit.t);
