@@ -267,6 +267,12 @@ fn bvh_agrees_with_brute_force_on_100k_rays() {
     let mut rng = common::Pcg::new(7);
     let rays: Vec<Ray> = (0..100_000).map(|_| random_ray(&mut rng)).collect();
     let start = Instant::now();
+    let found = rays.iter().filter(|r| intersect(&g, r).is_some()).count();
+    eprintln!(
+        "BVH alone: 100k closest-hit queries in {:?} on one thread ({found} hits)",
+        start.elapsed()
+    );
+    let start = Instant::now();
     let (brute_hits, _) = check_parallel(&g, &rays[..2000], None);
     let brute_time = start.elapsed();
     let start = Instant::now();
