@@ -94,36 +94,163 @@ fn load(path: &Path, overrides: &[String]) -> Result<Graph> {
     Ok(graph)
 }
 
-fn note_scene(scene: Option<&Path>) -> Result<()> {
-    if let Some(scene) = scene {
-        std::fs::metadata(scene)
-            .with_context(|| format!("cannot open scene {}", scene.display()))?;
-        println!(
-            "scene {}: not used (no node of this graph renders a scene)",
-            scene.display()
-        );
-    }
-    Ok(())
+/// A scene loaded and flattened for the GPU.
+struct LoadedScene {
+    scene: Scene,
+    gpu: Arc<GpuScene>,
 }
 
-fn render(graph_path: &Path, scene: Option<&Path>, out: &Path, overrides: &[String]) -> Result<()> {
-    let graph = load(graph_path, overrides)?;
-    let plan = compile(&graph, &[])?;
-    note_scene(scene)?;
+fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
+    let Some(path) = path else { return Ok(None) };
+    let start = Instant::now();
+    let scene = Scene::load(path)?;
+    let r = &scene.report;
+    if r.degenerate_triangles + r.non_finite_triangles + r.replaced_normals > 0 {
+        println!(
+            "scene warning: dropped {} zero-area and {} non-finite triangles, replaced {} unusable normals",
+            r.degenerate_triangles, r.non_finite_triangles, r.replaced_normals
+        );
+    }
+    for w in &r.warnings {
+        println!("scene warning: {w}");
+    }
+    let gpu = GpuScene::build(&scene)?;
+    println!(
+        "scene {}: {} triangles, {} spheres, {} lights, {} BVH nodes ({:.0} ms)",
+        path.display(),
+        gpu.tri_positions.len(),
+        gpu.spheres.len(),
+        gpu.lights.len(),
+        gpu.bvh_nodes.len(),
+        start.elapsed().as_secs_f64() * 1e3
+    );
+    Ok(Some(LoadedScene {
+        scene,
+        gpu: Arc::new(gpu),
+    }))
+}
+
+fn uses_scene(plan: &lumagraph::graph::Plan) -> bool {
+    plan.passes.iter().any(|p| p.kind == "PathTrace")
+}
+
+/// Runs the progressive part of the graph for `spp` samples per pixel, then the rest once,
+/// with a progress bar once the render has taken more than a second.
+fn render_progressive(exec: &mut Executor, spp: u32) -> Result<lumagraph::render::FrameReport> {
+    let spf = exec
+        .plan()
+        .passes
+        .iter()
+        .find(|p| p.kind == "PathTrace")
+        .map_or(1, |p| {
+            u32::try_from(p.params.int("samples_per_frame")).unwrap_or(1)
+        });
+    let frames = spp.div_ceil(spf).max(1);
+    // Warm-up: drivers compile pipelines at their first dispatch; keep that out of the timing.
+    let warm = Instant::now();
+    exec.run_frames(1, false)?;
+    exec.reset_history();
+    exec.counters()?;
+    exec.reset_history();
+    println!(
+        "warm-up (shader compilation): {:.0} ms",
+        warm.elapsed().as_secs_f64() * 1e3
+    );
+
+    let bar = indicatif::ProgressBar::with_draw_target(
+        Some(u64::from(frames)),
+        indicatif::ProgressDrawTarget::hidden(),
+    );
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} frames, {elapsed} (eta {eta})",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let start = Instant::now();
+    let mut done = 0;
+    let mut batch = 1;
+    while done + 1 < frames {
+        let n = batch.min(frames - 1 - done);
+        let t = Instant::now();
+        exec.run_frames(n, false)?;
+        done += n;
+        if t.elapsed() < Duration::from_millis(200) {
+            batch = (batch * 2).min(256);
+        }
+        if bar.is_hidden() && start.elapsed() > Duration::from_secs(1) {
+            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+        bar.set_position(u64::from(done));
+    }
+    let report = exec.run_frames(1, true)?;
+    bar.finish_and_clear();
+    let wall = start.elapsed();
+    let counters = exec.counters()?;
+    let get = |name: &str| {
+        counters
+            .iter()
+            .find(|(_, c)| c.name == name)
+            .map_or(0, |(_, c)| c.value)
+    };
+    let samples = get("samples_per_pixel");
+    let extent = exec
+        .plan()
+        .passes
+        .iter()
+        .find(|p| p.kind == "PathTrace")
+        .map(|p| p.extent);
+    let pixels = extent.map_or(0, lumagraph::graph::Extent::pixels);
+    let secs = wall.as_secs_f64();
+    #[expect(clippy::cast_precision_loss, reason = "report figures")]
+    let (paths, rays) = ((pixels * samples) as f64, get("rays") as f64);
+    println!(
+        "rendered {samples} spp at {} in {secs:.2} s: {:.3} M paths/s, {:.3} M rays/s, {} NaN/Inf samples dropped",
+        extent.map_or_else(String::new, |e| e.to_string()),
+        paths / secs / 1e6,
+        rays / secs / 1e6,
+        get("dropped_samples")
+    );
+    Ok(report)
+}
+
+fn render(args: &RenderArgs<'_>) -> Result<()> {
+    let graph = load(args.graph, args.overrides)?;
+    let scene = load_scene(args.scene)?;
+    let plan = compile(&graph, &[], scene.as_ref().map(|s| &*s.gpu))?;
+    let progressive = uses_scene(&plan);
+    if scene.is_some() && !progressive {
+        println!("scene not used: no node of this graph renders a scene");
+    }
     let ctx = GpuContext::headless()?;
     println!("adapter: {}", ctx.describe());
-    let paths = Paths {
+    let resources = Resources {
         base_dir: graph.base_dir(),
-        out_dir: out.to_owned(),
+        out_dir: args.out.to_owned(),
+        scene: scene.as_ref().map(|s| Arc::clone(&s.gpu)),
     };
     let left_out = plan.left_out.clone();
-    let mut exec = Executor::new(&ctx, plan, &paths)?;
-    // The first frame includes pipeline compilation inside the driver; time a second one.
-    let first = exec.run_frame()?;
-    let report = exec.run_frame()?;
+    let mut exec = Executor::new(&ctx, plan, &resources)?;
+    let report = if progressive {
+        let spp = args
+            .spp
+            .or(scene.as_ref().map(|s| s.scene.settings.spp))
+            .unwrap_or(1);
+        render_progressive(&mut exec, spp)?
+    } else {
+        // The first frame includes pipeline compilation inside the driver; time a second one.
+        let first = exec.run_frame()?;
+        let report = exec.run_frame()?;
+        println!(
+            "frame: {:.1} ms wall (first frame, with shader compilation: {:.1} ms)",
+            report.wall.as_secs_f64() * 1e3,
+            first.wall.as_secs_f64() * 1e3
+        );
+        report
+    };
     match &report.pass_ms {
         Some(times) => {
-            println!("GPU time per pass:");
+            println!("GPU time per pass (last frame):");
             for (name, ms) in times {
                 println!("  {name:<16} {ms:>9.3} ms");
             }

@@ -5,7 +5,7 @@ mod common;
 
 use lumagraph::graph::{Edge, Graph, Node, ParamValue};
 use lumagraph::render::cpu::{Image, KahanMean};
-use lumagraph::render::{Executor, Paths, compile, image_io};
+use lumagraph::render::{Executor, Resources, compile, image_io};
 
 fn acc_graph(input: &std::path::Path) -> Graph {
     Graph {
@@ -57,11 +57,11 @@ fn gpu_keeps_1e5_frames_of_a_constant_within_1e6() {
     let input = dir.path().join("constant.exr");
     let image = Image::filled(8, 8, [VALUES[0], VALUES[1], VALUES[2], 1.0]);
     std::fs::write(&input, image_io::encode_exr(&image, false).unwrap()).unwrap();
-    let plan = compile(&acc_graph(&input), &["acc.color".into()]).unwrap();
-    let mut exec = Executor::new(ctx, plan, &Paths::default()).unwrap();
+    let plan = compile(&acc_graph(&input), &["acc.color".into()], None).unwrap();
+    let mut exec = Executor::new(ctx, plan, &Resources::default()).unwrap();
     let start = std::time::Instant::now();
     for _ in 0..10 {
-        exec.run_frames(10_000).unwrap();
+        exec.run_frames(10_000, true).unwrap();
     }
     assert_eq!(exec.frames(), 100_000);
     eprintln!("1e5 frames in {:.1} s", start.elapsed().as_secs_f64());
@@ -85,9 +85,9 @@ fn gpu_matches_cpu_mirror_bit_for_bit_and_resets() {
         *p = [x, 1.0 / x, x * x, 1.0];
     }
     std::fs::write(&input, image_io::encode_exr(&image, false).unwrap()).unwrap();
-    let plan = compile(&acc_graph(&input), &["acc.color".into()]).unwrap();
-    let mut exec = Executor::new(ctx, plan, &Paths::default()).unwrap();
-    exec.run_frames(777).unwrap();
+    let plan = compile(&acc_graph(&input), &["acc.color".into()], None).unwrap();
+    let mut exec = Executor::new(ctx, plan, &Resources::default()).unwrap();
+    exec.run_frames(777, true).unwrap();
     let gpu = exec.read_port("acc.color").unwrap();
     for (g, p) in gpu.pixels.iter().zip(&image.pixels) {
         let mut k = KahanMean::default();
@@ -98,7 +98,7 @@ fn gpu_matches_cpu_mirror_bit_for_bit_and_resets() {
     }
     // after a reset the mean is of the new frames only
     exec.reset_history();
-    exec.run_frames(1).unwrap();
+    exec.run_frames(1, true).unwrap();
     let fresh = exec.read_port("acc.color").unwrap();
     for (g, p) in fresh.pixels.iter().zip(&image.pixels) {
         assert_eq!(g[..3], p[..3]);

@@ -9,16 +9,17 @@ mod common;
 
 use lumagraph::graph::{Edge, Graph, Node, ParamValue};
 use lumagraph::render::cpu::{self, Image};
-use lumagraph::render::{Executor, Paths, compile, image_io};
+use lumagraph::render::{Executor, Resources, compile, image_io};
 
 /// Runs `graph` once with `keep` ports kept alive and returns them.
 fn run(graph: &Graph, keep: &[&str], out_dir: &std::path::Path) -> Option<Vec<Image>> {
     let ctx = common::gpu()?;
     let keep: Vec<String> = keep.iter().map(|s| (*s).to_owned()).collect();
-    let plan = compile(graph, &keep).unwrap_or_else(|e| panic!("{e}"));
-    let paths = Paths {
+    let plan = compile(graph, &keep, None).unwrap_or_else(|e| panic!("{e}"));
+    let paths = Resources {
         base_dir: common::root(),
         out_dir: out_dir.to_owned(),
+        scene: None,
     };
     let mut exec = Executor::new(ctx, plan, &paths).unwrap();
     exec.run_frame().unwrap();
@@ -204,11 +205,12 @@ fn dead_branch_never_executes() {
     g.nodes.push(Node::new("dead", "Exposure"));
     g.edges.push(Edge::new("ghost.color", "dead.color"));
     let Some(ctx) = common::gpu() else { return };
-    let plan = compile(&g, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let plan = compile(&g, &[], None).unwrap_or_else(|e| panic!("{e}"));
     assert!(plan.pass("dead").is_none() && plan.pass("ghost").is_none());
-    let paths = Paths {
+    let paths = Resources {
         base_dir: common::root(),
         out_dir: dir.path().to_owned(),
+        scene: None,
     };
     let mut exec = Executor::new(ctx, plan, &paths).unwrap();
     let report = exec.run_frame().unwrap();

@@ -1,75 +1,13 @@
-#import "pathtrace/scene_types.wgsl"
+#import "pathtrace/primitives.wgsl"
 
-// BVH traversal and ray/primitive tests, a line-for-line mirror of
-// crates/scene/src/traverse.rs. The including shader declares the storage buffers:
+// BVH traversal, a line-for-line mirror of crates/scene/src/traverse.rs. The including
+// shader declares the storage buffers:
 //   var<storage, read> bvh_nodes: array<BvhNode>;
 //   var<storage, read> tri_positions: array<TriPositions>;
 //   var<storage, read> spheres: array<Sphere>;
 // Hits count for 0 < t < t_max; callers offset ray origins off surfaces.
 
 const BVH_STACK_SIZE: u32 = 64u;
-const F32_MAX: f32 = 3.40282347e38;
-// Far box distance scale, 1 + 2 gamma_3 (Ize, "Robust BVH ray traversal").
-const ROBUST_FAR: f32 = 1.0000004;
-// Direction components below this are replaced by it (with their sign) before inverting.
-const MIN_DIR: f32 = 1e-20;
-
-fn safe_inverse(d: vec3<f32>) -> vec3<f32> {
-    let small = select(vec3<f32>(MIN_DIR), vec3<f32>(-MIN_DIR), d < vec3<f32>(0.0));
-    return 1.0 / select(d, small, abs(d) < vec3<f32>(MIN_DIR));
-}
-
-fn ray_aabb(origin: vec3<f32>, inv_dir: vec3<f32>, bmin: vec3<f32>, bmax: vec3<f32>, t_max: f32) -> bool {
-    let t0 = (bmin - origin) * inv_dir;
-    let t1 = (bmax - origin) * inv_dir;
-    let lo = min(t0, t1);
-    let hi = max(t0, t1);
-    let near = max(max(max(lo.x, lo.y), lo.z), 0.0);
-    let far = min(min(min(hi.x, hi.y), hi.z) * ROBUST_FAR, t_max);
-    return near <= far;
-}
-
-// Moller-Trumbore. Returns vec4(hit ? 1 : 0, t, u, v).
-fn intersect_triangle(origin: vec3<f32>, dir: vec3<f32>, v0: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>, t_max: f32) -> vec4<f32> {
-    let p = cross(dir, e2);
-    let det = dot(e1, p);
-    if (det == 0.0) {
-        return vec4<f32>(0.0);
-    }
-    let inv_det = 1.0 / det;
-    let s = origin - v0;
-    let u = dot(s, p) * inv_det;
-    let q = cross(s, e1);
-    let v = dot(dir, q) * inv_det;
-    let t = dot(e2, q) * inv_det;
-    let hit = u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < t_max;
-    return vec4<f32>(select(0.0, 1.0, hit), t, u, v);
-}
-
-// Robust ray/sphere (Ray Tracing Gems, ch. 7). Returns the nearest t in (0, t_max), or -1.
-fn intersect_sphere(origin: vec3<f32>, dir: vec3<f32>, center: vec3<f32>, radius: f32, t_max: f32) -> f32 {
-    let f = origin - center;
-    let a = dot(dir, dir);
-    let b = -dot(f, dir);
-    let l = f + (b / a) * dir;
-    let disc = a * (radius * radius - dot(l, l));
-    if (!(disc >= 0.0)) {
-        return -1.0;
-    }
-    let c = dot(f, f) - radius * radius;
-    let root = sqrt(disc);
-    let q = b + select(root, -root, b < 0.0);
-    let t0 = c / q;
-    let t1 = q / a;
-    let near = min(t0, t1);
-    let far = max(t0, t1);
-    if (near > 0.0 && near < t_max) {
-        return near;
-    } else if (far > 0.0 && far < t_max) {
-        return far;
-    }
-    return -1.0;
-}
 
 // Closest hit (any_hit false) or first hit found (any_hit true) with 0 < t < t_max.
 fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
@@ -81,10 +19,10 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
     loop {
         let node = bvh_nodes[node_index];
         if (ray_aabb(ray.origin, inv_dir, node.aabb_min, node.aabb_max, hit.t)) {
-            let count = node.meta >> NODE_COUNT_SHIFT;
+            let count = node.bits >> NODE_COUNT_SHIFT;
             if (count == 0u) {
                 // Inner node: the first child is adjacent, the second at `index`.
-                let axis = node.meta & 3u;
+                let axis = node.bits & 3u;
                 if (ray.dir[axis] < 0.0) {
                     stack[sp] = node_index + 1u;
                     node_index = node.index;
@@ -96,7 +34,7 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                 continue;
             }
             let first = node.index;
-            if ((node.meta & NODE_SPHERES) == 0u) {
+            if ((node.bits & NODE_SPHERES) == 0u) {
                 for (var i = first; i < first + count; i = i + 1u) {
                     let tri = tri_positions[i];
                     let r = intersect_triangle(ray.origin, ray.dir, tri.v0, tri.e1, tri.e2, hit.t);

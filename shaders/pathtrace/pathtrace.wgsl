@@ -30,7 +30,7 @@ struct Frame {
 @group(0) @binding(8) var<storage, read> light_alias: array<AliasEntry>;
 @group(0) @binding(9) var<storage, read_write> stats: array<atomic<u32>>;
 
-#import "pathtrace/bvh.wgsl"
+#import "pathtrace/intersect.wgsl"
 
 const RR_START: u32 = 5u;
 

@@ -24,14 +24,14 @@ const FEATURE_LIGHTS: u32 = 16u;
 const FEATURE_METAL: u32 = 32u;
 
 // BVH node, 32 bytes. Depth-first order: an inner node's first child is the next node.
-//   meta bits 0-1: split axis (inner); bit 2: leaf kind (1 = spheres, 0 = triangles);
+//   bits 0-1: split axis (inner); bit 2: leaf kind (1 = spheres, 0 = triangles);
 //   bits 3-31: primitive count (0 = inner node).
 //   index: inner = second child's node index; leaf = first primitive in its kind's array.
 struct BvhNode {
     aabb_min: vec3<f32>,
     index: u32,
     aabb_max: vec3<f32>,
-    meta: u32,
+    bits: u32,
 }
 
 const NODE_SPHERES: u32 = 4u;
@@ -99,7 +99,7 @@ struct Light {
 // Alias table entry over the lights (Vose), 8 bytes.
 struct AliasEntry {
     prob: f32,
-    alias: u32,
+    other: u32,
 }
 
 // Camera, 64 bytes. Direction for image coordinates (x, y) in [0,1]^2, y down:

@@ -8,6 +8,8 @@ use lumagraph_graph::{
     CompileOptions, Extent, Graph, GraphErrors, Node, Params, Plan, Registry, TextureId,
 };
 
+use lumagraph_scene::GpuScene;
+
 use crate::context::GpuContext;
 use crate::cpu::Image;
 use crate::error::{RenderError, Result};
@@ -21,23 +23,34 @@ use crate::timing::GpuTimer;
 /// A message naming the file when a source cannot tell its size.
 pub fn source_extent(
     base_dir: &Path,
+    scene: Option<&GpuScene>,
     node: &Node,
     params: &Params,
 ) -> std::result::Result<Extent, String> {
     match node.kind.as_str() {
         "ImageInput" => crate::image_io::dimensions(&base_dir.join(params.str("path")))
             .map_err(|e| e.to_string()),
+        "PathTrace" => scene
+            .map(|s| Extent::new(s.settings.width, s.settings.height))
+            .ok_or_else(|| {
+                "renders a scene, but none was given (lumagraph render --scene FILE)".to_owned()
+            }),
         other => Err(format!("{other} is not a source")),
     }
 }
 
-/// Compiles `graph` with the built-in registry, sizing sources from their files.
+/// Compiles `graph` with the built-in registry, sizing sources from their files and from
+/// the scene.
 ///
 /// # Errors
 /// Every problem found in the graph.
-pub fn compile(graph: &Graph, keep: &[String]) -> std::result::Result<Plan, GraphErrors> {
+pub fn compile(
+    graph: &Graph,
+    keep: &[String],
+    scene: Option<&GpuScene>,
+) -> std::result::Result<Plan, GraphErrors> {
     let base = graph.base_dir();
-    let extent = |node: &Node, params: &Params| source_extent(&base, node, params);
+    let extent = |node: &Node, params: &Params| source_extent(&base, scene, node, params);
     lumagraph_graph::compile(
         graph,
         Registry::builtin(),
@@ -227,7 +240,10 @@ impl Executor {
     pub fn counters(&mut self) -> Result<Vec<(String, Counter)>> {
         let mut out = Vec::new();
         for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
-            for c in node.counters(&self.ctx).map_err(|e| e.in_node(&pass.node))? {
+            for c in node
+                .counters(&self.ctx)
+                .map_err(|e| e.in_node(&pass.node))?
+            {
                 out.push((pass.node.clone(), c));
             }
         }

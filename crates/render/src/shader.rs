@@ -7,7 +7,6 @@
 //! same resolver is used by the naga validation test, so every shader the program can
 //! load is checked without a GPU.
 
-use std::collections::HashSet;
 use std::path::PathBuf;
 
 use crate::error::{RenderError, Result};
@@ -55,17 +54,45 @@ pub fn raw(name: &str) -> Result<String> {
 /// # Errors
 /// When the file or one it imports is missing, or an import line is malformed.
 pub fn resolve(name: &str) -> Result<String> {
-    let mut seen = HashSet::new();
+    resolve_with(name, &[])
+}
+
+/// Like [`resolve`], with some files replaced by generated text (`(name, text)` pairs):
+/// how shaders are specialized to a scene.
+///
+/// # Errors
+/// When a file or one it imports is missing, or an import line is malformed.
+pub fn resolve_with(name: &str, overrides: &[(&str, String)]) -> Result<String> {
+    let mut seen = Vec::new();
     let mut out = String::new();
-    resolve_into(name, &mut seen, &mut out)?;
+    resolve_into(name, overrides, &mut seen, &mut out)?;
     Ok(out)
 }
 
-fn resolve_into(name: &str, seen: &mut HashSet<String>, out: &mut String) -> Result<()> {
-    if !seen.insert(name.to_owned()) {
+/// Every file `name` imports, directly or not, in inclusion order (itself included).
+///
+/// # Errors
+/// As [`resolve`].
+pub fn imports(name: &str) -> Result<Vec<String>> {
+    let mut seen = Vec::new();
+    resolve_into(name, &[], &mut seen, &mut String::new())?;
+    Ok(seen)
+}
+
+fn resolve_into(
+    name: &str,
+    overrides: &[(&str, String)],
+    seen: &mut Vec<String>,
+    out: &mut String,
+) -> Result<()> {
+    if seen.iter().any(|s| s == name) {
         return Ok(());
     }
-    let text = raw(name)?;
+    seen.push(name.to_owned());
+    let text = match overrides.iter().find(|(n, _)| *n == name) {
+        Some((_, text)) => text.clone(),
+        None => raw(name)?,
+    };
     for (i, line) in text.lines().enumerate() {
         if let Some(rest) = line.trim_start().strip_prefix("#import") {
             let target = rest.trim().trim_matches('"');
@@ -75,7 +102,7 @@ fn resolve_into(name: &str, seen: &mut HashSet<String>, out: &mut String) -> Res
                     message: format!("line {}: expected #import \"path.wgsl\"", i + 1),
                 });
             }
-            resolve_into(target, seen, out).map_err(|e| match e {
+            resolve_into(target, overrides, seen, out).map_err(|e| match e {
                 RenderError::Shader { name: n, message } if n == target => RenderError::Shader {
                     name: name.to_owned(),
                     message: format!("line {}: cannot import {target}: {message}", i + 1),

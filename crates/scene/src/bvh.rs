@@ -11,9 +11,9 @@
 //! |---|---|---|
 //! | `aabb_min`, `aabb_max` | bounds of the subtree | bounds of its primitives |
 //! | `index` | second child's node index | first primitive, in its kind's array |
-//! | `meta` bits 0–1 | split axis (0 x, 1 y, 2 z) | 0 |
-//! | `meta` bit 2 | 0 | kind: 0 triangles (`tri_positions`), 1 spheres (`spheres`) |
-//! | `meta` bits 3–31 | 0 (this is what makes it inner) | primitive count ≥ 1 |
+//! | `bits` bits 0–1 | split axis (0 x, 1 y, 2 z) | 0 |
+//! | `bits` bit 2 | 0 | kind: 0 triangles (`tri_positions`), 1 spheres (`spheres`) |
+//! | `bits` bits 3–31 | 0 (this is what makes it inner) | primitive count ≥ 1 |
 //!
 //! A leaf holds one kind only: when obvhs puts triangles and spheres in one leaf, it is
 //! split into an inner node over two leaves. Triangles and spheres are **reordered** so
@@ -37,9 +37,9 @@ use crate::gpu::GpuBvhNode;
 /// `bvh.wgsl`); trees deeper than this are refused.
 pub const BVH_STACK_SIZE: usize = 64;
 
-/// `meta` bit: the leaf holds spheres.
+/// `bits` bit: the leaf holds spheres.
 pub const NODE_SPHERES: u32 = 4;
-/// `meta` shift of the primitive count.
+/// `bits` shift of the primitive count.
 pub const NODE_COUNT_SHIFT: u32 = 3;
 
 /// BVH build settings.
@@ -150,7 +150,7 @@ impl Flattener<'_> {
                     aabb_min: to3(n.aabb().min),
                     index: right_at,
                     aabb_max: to3(n.aabb().max),
-                    meta: 0,
+                    bits: 0,
                 };
             }
             return Ok(at as u32);
@@ -175,7 +175,7 @@ impl Flattener<'_> {
             aabb_min: to3(n.aabb().min),
             index: right,
             aabb_max: to3(n.aabb().max),
-            meta: axis as u32,
+            bits: axis as u32,
         };
         Ok(at as u32)
     }
@@ -201,7 +201,7 @@ impl Flattener<'_> {
             aabb_min: to3(aabb.min),
             index,
             aabb_max: to3(aabb.max),
-            meta: (count << NODE_COUNT_SHIFT) | kind,
+            bits: (count << NODE_COUNT_SHIFT) | kind,
         }
     }
 }

@@ -48,7 +48,7 @@ pub enum ErrorKind {
     /// A value is out of its range or not finite.
     #[error("{field}: {message}")]
     BadValue {
-        /// The field ("radius", "fov_y").
+        /// The field (`radius`, `fov_y`).
         field: &'static str,
         /// What is wrong.
         message: String,
@@ -58,7 +58,7 @@ pub enum ErrorKind {
     Camera(String),
     /// A glTF file could not be loaded.
     #[error("glTF: {0}")]
-    Gltf(#[from] gltf::Error),
+    Gltf(#[source] Box<gltf::Error>),
     /// An OBJ or MTL file could not be loaded.
     #[error("OBJ: {0}")]
     Obj(#[from] tobj::LoadError),
@@ -76,6 +76,12 @@ pub enum ErrorKind {
     /// More primitives than the GPU layout can index.
     #[error("too many primitives ({0}); the GPU layout indexes at most 2^28")]
     TooManyPrimitives(usize),
+}
+
+impl From<gltf::Error> for ErrorKind {
+    fn from(e: gltf::Error) -> Self {
+        Self::Gltf(Box::new(e))
+    }
 }
 
 /// One scene error with its location.

@@ -79,11 +79,11 @@ fn gpu_material(m: &Material) -> GpuMaterial {
 pub fn alias_table(w: &[f32]) -> Vec<GpuAliasEntry> {
     let n = w.len();
     let total: f64 = w.iter().map(|&x| f64::from(x)).sum();
-    if n == 0 || !(total > 0.0) {
+    if n == 0 || total.is_nan() || total <= 0.0 {
         return vec![
             GpuAliasEntry {
                 prob: 1.0,
-                alias: 0
+                other: 0
             };
             n
         ];
@@ -92,14 +92,14 @@ pub fn alias_table(w: &[f32]) -> Vec<GpuAliasEntry> {
     let mut table: Vec<GpuAliasEntry> = (0..n as u32)
         .map(|i| GpuAliasEntry {
             prob: 1.0,
-            alias: i,
+            other: i,
         })
         .collect();
     let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
     while let (Some(s), Some(&l)) = (small.pop(), large.last()) {
         table[s] = GpuAliasEntry {
             prob: scaled[s] as f32,
-            alias: l as u32,
+            other: l as u32,
         };
         scaled[l] -= 1.0 - scaled[s];
         if scaled[l] < 1.0 {

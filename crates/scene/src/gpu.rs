@@ -62,7 +62,7 @@ pub struct GpuBvhNode {
     pub aabb_max: [f32; 3],
     /// Bits 0–1 split axis (inner), bit 2 leaf kind (1 = spheres), bits 3–31 primitive
     /// count (0 = inner node) (offset 28).
-    pub meta: u32,
+    pub bits: u32,
 }
 
 /// A triangle's intersection data, 48 bytes: corner 0 and the two edges from it, as
@@ -176,14 +176,14 @@ pub struct GpuLight {
 }
 
 /// One entry of the light alias table (Vose), 8 bytes: pick `i` uniformly, keep it with
-/// probability `prob`, else take `alias`.
+/// probability `prob`, else take `other`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuAliasEntry {
     /// Probability of keeping this entry (offset 0).
     pub prob: f32,
     /// The other light of this bucket (offset 4).
-    pub alias: u32,
+    pub other: u32,
 }
 
 /// The camera, 64 bytes. A pixel's ray direction, for image coordinates `(x, y)` in

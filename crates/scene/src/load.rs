@@ -151,7 +151,7 @@ pub fn transform_matrix(t: &TransformDesc) -> Result<Mat4, SceneError> {
         let mut m = Mat4::from_scale(t.scale.map_or(Vec3::ONE, Vec3::from));
         for r in &t.rotate {
             let axis = Vec3::from(r.axis);
-            if !(axis.length_squared() > 0.0) || !axis.is_finite() || !r.degrees.is_finite() {
+            if axis.length_squared() == 0.0 || !axis.is_finite() || !r.degrees.is_finite() {
                 return Err(bad(
                     "rotate",
                     format!("bad axis {axis} or angle {}", r.degrees),
@@ -474,7 +474,7 @@ impl<'a> Builder<'a> {
                 let target = finite3("target", *target)?;
                 let up = finite3("up", *up)?;
                 let dir = target - position;
-                if !(dir.length() > 0.0) || !(dir.normalize().cross(up).length() > 1e-6) {
+                if dir.length() == 0.0 || dir.normalize().cross(up).length() <= 1e-6 {
                     return Err(bad(
                         "target",
                         "the camera must look somewhere not parallel to `up`",

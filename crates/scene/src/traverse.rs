@@ -103,6 +103,10 @@ pub fn intersect_triangle(
 /// ray/sphere intersection" (Ray Tracing Gems, ch. 7): the discriminant from the distance
 /// of the center to the line, and the smaller root by the stable quotient. Returns the
 /// nearest `t` with `0 < t < t_max` (the far side when the origin is inside).
+#[expect(
+    clippy::neg_cmp_op_on_partial_ord,
+    reason = "a NaN discriminant must miss, written as in the WGSL mirror"
+)]
 pub fn intersect_sphere(
     origin: Vec3,
     dir: Vec3,
@@ -176,10 +180,10 @@ fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
             v3(node.aabb_max),
             hit.t,
         ) {
-            let count = node.meta >> NODE_COUNT_SHIFT;
+            let count = node.bits >> NODE_COUNT_SHIFT;
             if count == 0 {
                 // Inner node: the first child is adjacent, the second at `index`.
-                let axis = (node.meta & 3) as usize;
+                let axis = (node.bits & 3) as usize;
                 if ray.dir[axis] < 0.0 {
                     stack[sp] = node_index + 1;
                     node_index = node.index;
@@ -191,7 +195,7 @@ fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
                 continue;
             }
             let first = node.index;
-            if node.meta & NODE_SPHERES == 0 {
+            if node.bits & NODE_SPHERES == 0 {
                 for i in first..first + count {
                     let tri = scene.tri_positions[i as usize];
                     if let Some((t, u, v)) = intersect_triangle(

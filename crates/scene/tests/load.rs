@@ -192,12 +192,12 @@ fn cornell_box_transform_matches_world_quads() {
             let same_face: f32 = reference
                 .iter()
                 .filter(|r| (key(r).1 - n).length() < 1e-5)
-                .map(|r| r.area())
+                .map(lumagraph_scene::Triangle::area)
                 .sum();
             let ours_face: f32 = ours
                 .iter()
                 .filter(|o| (key(o).1 - n).length() < 1e-5)
-                .map(|o| o.area())
+                .map(lumagraph_scene::Triangle::area)
                 .sum();
             assert!(
                 (same_face - ours_face).abs() < 1e-5,
@@ -292,4 +292,25 @@ fn gltf_camera_from_mesh_shape() {
     let e =
         parse(&text.replace("Gltf(shape: \"box\")", "Gltf(shape: \"box\", index: 3)")).unwrap_err();
     assert!(e.to_string().contains("no camera 3"), "{e}");
+}
+
+#[test]
+fn alias_table_reproduces_weights() {
+    let w = [1.0, 2.0, 3.0, 4.0, 0.0, 10.0];
+    let table = lumagraph_scene::alias_table(&w);
+    let n = w.len() as f32;
+    let total: f32 = w.iter().sum();
+    for (i, &wi) in w.iter().enumerate() {
+        let mut p = table[i].prob / n;
+        for e in &table {
+            if e.other as usize == i {
+                p += (1.0 - e.prob) / n;
+            }
+        }
+        // Entries kept with probability 1 point at themselves and add nothing.
+        if table[i].other as usize == i {
+            p -= (1.0 - table[i].prob) / n;
+        }
+        assert!((p - wi / total).abs() < 1e-6, "{i}: {p} vs {}", wi / total);
+    }
 }

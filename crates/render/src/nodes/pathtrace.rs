@@ -33,14 +33,15 @@ pub(crate) struct PathTrace {
 
 impl PathTrace {
     pub(crate) fn new(ctx: &GpuContext, pass: &Pass, resources: &Resources) -> Result<Self> {
-        let scene = resources
-            .scene
-            .clone()
-            .ok_or_else(|| RenderError::Gpu("PathTrace needs a scene (lumagraph render --scene FILE)".into()))?;
+        let scene = resources.scene.clone().ok_or_else(|| {
+            RenderError::Gpu("PathTrace needs a scene (lumagraph render --scene FILE)".into())
+        })?;
         let storage = Binding::Storage { read_only: true };
-        let kernel = Kernel::new(
+        let (source, how) = crate::specialize::pathtrace_source(&scene)?;
+        let kernel = Kernel::from_source(
             ctx,
             "pathtrace/pathtrace.wgsl",
+            &source,
             &[
                 Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
                 Binding::Uniform,
@@ -55,11 +56,14 @@ impl PathTrace {
             ],
         )?;
         let buffers = SceneBuffers::upload(ctx, &scene);
+        let _ = how;
         let frame = uniform_buffer(ctx, "pathtrace frame", &[0; 160]);
         let stats = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pathtrace stats"),
             size: STATS * 4,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let stats_read = ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -117,14 +121,18 @@ impl NodeExec for PathTrace {
         io: &FrameIo<'_>,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let Some(out) = pass.output("color") else { return Ok(()) };
+        let Some(out) = pass.output("color") else {
+            return Ok(());
+        };
         // Each frame has its own uniform contents: stage them through a copy recorded in
         // order, so many frames can share one submission.
-        let staging = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("pathtrace frame staging"),
-            contents: &self.frame_bytes(),
-            usage: wgpu::BufferUsages::COPY_SRC,
-        });
+        let staging = ctx
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("pathtrace frame staging"),
+                contents: &self.frame_bytes(),
+                usage: wgpu::BufferUsages::COPY_SRC,
+            });
         encoder.copy_buffer_to_buffer(&staging, 0, &self.frame, 0, self.frame.size());
         self.samples += self.samples_per_frame;
         let b = &self.buffers;
@@ -144,11 +152,20 @@ impl NodeExec for PathTrace {
     }
 
     fn counters(&mut self, ctx: &GpuContext) -> Result<Vec<Counter>> {
-        let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("stats") });
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("stats"),
+            });
         encoder.copy_buffer_to_buffer(&self.stats, 0, &self.stats_read, 0, STATS * 4);
         encoder.clear_buffer(&self.stats, 0, None);
         ctx.queue.submit([encoder.finish()]);
-        let v: Vec<u32> = map_read(ctx, &self.stats_read, STATS * 4, bytemuck::pod_collect_to_vec)?;
+        let v: Vec<u32> = map_read(
+            ctx,
+            &self.stats_read,
+            STATS * 4,
+            bytemuck::pod_collect_to_vec,
+        )?;
         self.dropped += u64::from(v[0]);
         self.rays += u64::from(v[1]) | (u64::from(v[2]) << 32);
         Ok(vec![

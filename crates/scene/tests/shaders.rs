@@ -1,0 +1,256 @@
+//! The WGSL mirror of the scene layout and traversal: imports resolved as the project
+//! resolves them, validated with naga, struct layouts compared with the Rust structs.
+
+mod common;
+
+use std::collections::HashSet;
+use std::mem::{offset_of, size_of};
+use std::path::Path;
+
+use lumagraph_scene::{
+    GpuAliasEntry, GpuBvhNode, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere,
+    GpuTriShading, GpuTriangle,
+};
+
+/// Resolves `#import "<path relative to shaders/>"` lines by textual inclusion, each file
+/// once (the project's rule).
+fn resolve(root: &Path, rel: &str, seen: &mut HashSet<String>, out: &mut String) {
+    if !seen.insert(rel.to_owned()) {
+        return;
+    }
+    let text = std::fs::read_to_string(root.join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
+    for line in text.lines() {
+        if let Some(rest) = line.trim().strip_prefix("#import") {
+            let path = rest.trim().trim_matches('"');
+            resolve(root, path, seen, out);
+        } else {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+}
+
+fn validate(source: &str, what: &str) -> naga::Module {
+    let module = naga::front::wgsl::parse_str(source)
+        .unwrap_or_else(|e| panic!("{what}: {}", e.emit_to_string(source)));
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::default(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("{what}: {}", e.emit_to_string(source)));
+    module
+}
+
+const STUB: &str = r#"
+@group(0) @binding(0) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(1) var<storage, read> tri_positions: array<TriPositions>;
+@group(0) @binding(2) var<storage, read> spheres: array<Sphere>;
+@group(0) @binding(3) var<storage, read_write> out_hits: array<Hit>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let ray = Ray(vec3<f32>(0.0, 0.0, 4.0), vec3<f32>(0.0, 0.1 * f32(id.x), -1.0));
+    var hit = intersect_scene(ray);
+    if (occluded(ray, 2.0)) {
+        hit.u = -1.0;
+    }
+    out_hits[id.x] = hit;
+    let h2 = intersect_scene_within(ray, 1.0);
+    out_hits[id.x + 1u] = h2;
+}
+"#;
+
+#[test]
+fn bvh_wgsl_validates_with_a_stub() {
+    let mut src = String::new();
+    let mut seen = HashSet::new();
+    resolve(
+        &common::shaders(),
+        "pathtrace/bvh.wgsl",
+        &mut seen,
+        &mut src,
+    );
+    assert!(seen.contains("pathtrace/scene_types.wgsl"));
+    src.push_str(STUB);
+    validate(&src, "bvh.wgsl + stub");
+}
+
+#[test]
+fn scene_types_validate_alone() {
+    let mut src = String::new();
+    resolve(
+        &common::shaders(),
+        "pathtrace/scene_types.wgsl",
+        &mut HashSet::new(),
+        &mut src,
+    );
+    validate(&src, "scene_types.wgsl");
+}
+
+macro_rules! layout {
+    ($rust:ty, $wgsl:literal, [$($field:ident),* $(,)?]) => {
+        (
+            $wgsl,
+            size_of::<$rust>(),
+            vec![$((stringify!($field), offset_of!($rust, $field))),*],
+        )
+    };
+}
+
+#[test]
+fn wgsl_layouts_match_rust() {
+    let expected = [
+        layout!(GpuBvhNode, "BvhNode", [aabb_min, index, aabb_max, bits]),
+        layout!(GpuTriangle, "TriPositions", [v0, pad0, e1, pad1, e2, pad2]),
+        layout!(
+            GpuTriShading,
+            "TriShading",
+            [n0, material, n1, light, n2, flags]
+        ),
+        layout!(
+            GpuSphere,
+            "Sphere",
+            [center, radius, material, light, pad0, pad1]
+        ),
+        layout!(
+            GpuMaterial,
+            "Material",
+            [
+                base_color,
+                roughness,
+                emission,
+                metallic,
+                specular,
+                specular_tint,
+                transmission,
+                ior,
+                tex_base_mr,
+                tex_emissive_normal,
+                flags,
+                pad0
+            ]
+        ),
+        layout!(
+            GpuLight,
+            "Light",
+            [p0, flags, e1, prim, e2, area, emission, power]
+        ),
+        layout!(GpuAliasEntry, "AliasEntry", [prob, other]),
+        layout!(
+            GpuCamera,
+            "Camera",
+            [
+                position,
+                tan_half_fov,
+                right,
+                aspect,
+                up,
+                aperture_radius,
+                forward,
+                focus_distance
+            ]
+        ),
+        layout!(
+            GpuSettings,
+            "Settings",
+            [
+                width,
+                height,
+                max_bounces,
+                spp,
+                seed,
+                env_kind,
+                pad0,
+                pad1,
+                env_radiance,
+                pad2
+            ]
+        ),
+        layout!(
+            GpuHeader,
+            "SceneHeader",
+            [
+                num_nodes,
+                num_triangles,
+                num_spheres,
+                num_materials,
+                num_lights,
+                bvh_depth,
+                features,
+                total_light_power
+            ]
+        ),
+    ];
+    let mut src = String::new();
+    resolve(
+        &common::shaders(),
+        "pathtrace/scene_types.wgsl",
+        &mut HashSet::new(),
+        &mut src,
+    );
+    let module = validate(&src, "scene_types.wgsl");
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    for (name, size, fields) in expected {
+        let (handle, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("no struct {name} in scene_types.wgsl"));
+        let naga::TypeInner::Struct { members, span } = &ty.inner else {
+            panic!("{name} is not a struct");
+        };
+        let wgsl: Vec<_> = members
+            .iter()
+            .map(|m| (m.name.clone().unwrap_or_default(), m.offset as usize))
+            .collect();
+        let rust: Vec<_> = fields.iter().map(|(f, o)| ((*f).to_owned(), *o)).collect();
+        assert_eq!(wgsl, rust, "{name}: members and offsets");
+        assert_eq!(*span as usize, size, "{name}: size");
+        // Array stride in a storage buffer equals the Rust size.
+        let stride = layouter[handle].to_stride();
+        assert_eq!(stride as usize, size, "{name}: array stride");
+    }
+}
+
+#[test]
+fn wgsl_constants_match_rust() {
+    let src = std::fs::read_to_string(common::shaders().join("pathtrace/bvh.wgsl")).unwrap();
+    let stack = format!(
+        "const BVH_STACK_SIZE: u32 = {}u;",
+        lumagraph_scene::BVH_STACK_SIZE
+    );
+    assert!(src.contains(&stack), "bvh.wgsl must declare `{stack}`");
+    let types =
+        std::fs::read_to_string(common::shaders().join("pathtrace/scene_types.wgsl")).unwrap();
+    for (name, value) in [
+        ("PRIM_SPHERE", lumagraph_scene::PRIM_SPHERE),
+        ("NO_HIT", lumagraph_scene::NO_HIT),
+        ("NO_LIGHT", lumagraph_scene::NO_LIGHT),
+        ("NODE_SPHERES", lumagraph_scene::bvh::NODE_SPHERES),
+        ("NODE_COUNT_SHIFT", lumagraph_scene::bvh::NODE_COUNT_SHIFT),
+        ("LIGHT_SPHERE", lumagraph_scene::LIGHT_SPHERE),
+        ("LIGHT_TWO_SIDED", lumagraph_scene::LIGHT_TWO_SIDED),
+        ("MATERIAL_TWO_SIDED", lumagraph_scene::MATERIAL_TWO_SIDED),
+        ("TRI_VERTEX_NORMALS", lumagraph_scene::TRI_VERTEX_NORMALS),
+        ("ENV_NONE", lumagraph_scene::ENV_NONE),
+        ("ENV_CONSTANT", lumagraph_scene::ENV_CONSTANT),
+        ("FEATURE_SPHERES", lumagraph_scene::FEATURE_SPHERES),
+        (
+            "FEATURE_TRANSMISSION",
+            lumagraph_scene::FEATURE_TRANSMISSION,
+        ),
+        ("FEATURE_TEXTURES", lumagraph_scene::FEATURE_TEXTURES),
+        ("FEATURE_ENVIRONMENT", lumagraph_scene::FEATURE_ENVIRONMENT),
+        ("FEATURE_LIGHTS", lumagraph_scene::FEATURE_LIGHTS),
+        ("FEATURE_METAL", lumagraph_scene::FEATURE_METAL),
+    ] {
+        let dec = format!("const {name}: u32 = {value}u;");
+        let hex = format!("const {name}: u32 = {value:#x}u;");
+        assert!(
+            types.contains(&dec) || types.contains(&hex),
+            "scene_types.wgsl must declare `{dec}` (or in hex)"
+        );
+    }
+}
