@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Sets up what is missing, builds, and renders the default graph into out/ (or the folder
+# Sets up what is missing, builds, and renders the Cornell box through the default graph
+# into out/ (or the folder
 # given as the first argument). Extra arguments go to `lumagraph render`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -7,4 +8,4 @@ bash scripts/setup.sh
 . scripts/env.sh
 out="${1:-out}"
 shift || true
-cargo run --locked -- render graphs/post_tonemap.ron --out "$out" "$@"
+cargo run --locked -- render graphs/pathtrace.ron --scene assets/cornell.ron --out "$out" "$@"

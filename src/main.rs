@@ -1,4 +1,6 @@
-//! The `lumagraph` command line: render, plan, validate and list nodes.
+//! The `lumagraph` command line: render, plan, validate, bench and list nodes.
+
+mod bench;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -77,6 +79,20 @@ enum Command {
         /// Print the Markdown reference used in docs/graph-format.md.
         #[arg(long)]
         markdown: bool,
+    },
+    /// Measure path tracing speed (paths/s) on the current adapter, specialized and general
+    /// shaders side by side.
+    #[command(after_help = "Example:\n  lumagraph bench --scene assets/cornell.ron --spp 64")]
+    Bench {
+        /// Scene to trace.
+        #[arg(long, default_value = "assets/cornell.ron")]
+        scene: PathBuf,
+        /// Samples per pixel per timed run.
+        #[arg(long, default_value_t = 64)]
+        spp: u32,
+        /// Timed runs; the best is reported.
+        #[arg(long, default_value_t = 3)]
+        runs: u32,
     },
     /// Write the generated HDR test chart (the source of `assets/test_chart.exr`).
     #[command(hide = true)]
@@ -228,9 +244,13 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
         base_dir: graph.base_dir(),
         out_dir: args.out.to_owned(),
         scene: scene.as_ref().map(|s| Arc::clone(&s.gpu)),
+        general_shaders: false,
     };
     let left_out = plan.left_out.clone();
     let mut exec = Executor::new(&ctx, plan, &resources)?;
+    for (node, note) in exec.notes() {
+        println!("{node}: {note}");
+    }
     let report = if progressive {
         let spp = args
             .spp
@@ -323,6 +343,10 @@ fn run(cli: Cli) -> Result<()> {
                 }
             );
             Ok(())
+        }
+        Command::Bench { scene, spp, runs } => {
+            let loaded = load_scene(Some(&scene))?.context("no scene")?;
+            bench::run(&loaded.gpu, spp, runs)
         }
         Command::TestChart { out } => {
             let chart = image_io::test_chart();

@@ -19,7 +19,7 @@ fn run(graph: &Graph, keep: &[&str], out_dir: &std::path::Path) -> Option<Vec<Im
     let paths = Resources {
         base_dir: common::root(),
         out_dir: out_dir.to_owned(),
-        scene: None,
+        ..Resources::default()
     };
     let mut exec = Executor::new(ctx, plan, &paths).unwrap();
     exec.run_frame().unwrap();
@@ -210,7 +210,7 @@ fn dead_branch_never_executes() {
     let paths = Resources {
         base_dir: common::root(),
         out_dir: dir.path().to_owned(),
-        scene: None,
+        ..Resources::default()
     };
     let mut exec = Executor::new(ctx, plan, &paths).unwrap();
     let report = exec.run_frame().unwrap();

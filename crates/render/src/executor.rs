@@ -233,6 +233,16 @@ impl Executor {
         })
     }
 
+    /// How each node was set up, as `(node id, line)`.
+    pub fn notes(&self) -> Vec<(String, String)> {
+        self.plan
+            .passes
+            .iter()
+            .zip(&self.nodes)
+            .flat_map(|(pass, node)| node.notes().into_iter().map(|n| (pass.node.clone(), n)))
+            .collect()
+    }
+
     /// Every node's counters since its last reset, as `(node id, counter)`.
     ///
     /// # Errors

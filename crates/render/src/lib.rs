@@ -18,6 +18,7 @@ mod kernel;
 pub mod metrics;
 pub mod nodes;
 mod pool;
+pub mod raycast;
 pub mod readback;
 mod scene_gpu;
 pub mod shader;

@@ -73,13 +73,19 @@ fn occluded(ray: Ray, t_max: f32) -> bool {{
     ))
 }
 
-/// The path tracer's source for `scene`, specialized where it pays, and a line saying how.
+/// The path tracer's source for `scene`, specialized where it pays (when `specialize`),
+/// and a line saying how.
 ///
 /// # Errors
 /// When a shader file is missing.
-pub fn pathtrace_source(scene: &GpuScene) -> crate::Result<(String, String)> {
+pub fn pathtrace_source(scene: &GpuScene, specialize: bool) -> crate::Result<(String, String)> {
     let mut overrides = Vec::new();
-    let how = if let Some(code) = inline_intersection(scene) {
+    let inline = if specialize {
+        inline_intersection(scene)
+    } else {
+        None
+    };
+    let how = if let Some(code) = inline {
         overrides.push(("pathtrace/intersect.wgsl", code));
         format!(
             "intersection inlined ({} primitives <= {INLINE_MAX_PRIMITIVES}): BVH traversal left out",

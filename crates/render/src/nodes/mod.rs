@@ -26,6 +26,8 @@ pub struct Resources {
     pub out_dir: PathBuf,
     /// The scene, flattened, for nodes that render one.
     pub scene: Option<Arc<lumagraph_scene::GpuScene>>,
+    /// Use the general shaders even where a scene-specialized one exists (benchmarks).
+    pub general_shaders: bool,
 }
 
 /// A named count a node keeps (samples, rays, dropped samples), since its last reset.
@@ -105,6 +107,11 @@ pub trait NodeExec {
         io: &FrameIo<'_>,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()>;
+
+    /// Lines describing how the node was set up (shader specialization and such).
+    fn notes(&self) -> Vec<String> {
+        Vec::new()
+    }
 
     /// The node's counters since its last reset (may read back from the GPU).
     ///

@@ -29,6 +29,8 @@ pub(crate) struct PathTrace {
     /// Dropped samples and rays since the last reset, read back so far.
     dropped: u64,
     rays: u64,
+    /// How the shader was specialized, for reports.
+    how: String,
 }
 
 impl PathTrace {
@@ -37,7 +39,8 @@ impl PathTrace {
             RenderError::Gpu("PathTrace needs a scene (lumagraph render --scene FILE)".into())
         })?;
         let storage = Binding::Storage { read_only: true };
-        let (source, how) = crate::specialize::pathtrace_source(&scene)?;
+        let (source, how) =
+            crate::specialize::pathtrace_source(&scene, !resources.general_shaders)?;
         let kernel = Kernel::from_source(
             ctx,
             "pathtrace/pathtrace.wgsl",
@@ -56,7 +59,6 @@ impl PathTrace {
             ],
         )?;
         let buffers = SceneBuffers::upload(ctx, &scene);
-        let _ = how;
         let frame = uniform_buffer(ctx, "pathtrace frame", &[0; 160]);
         let stats = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pathtrace stats"),
@@ -83,6 +85,7 @@ impl PathTrace {
             samples: 0,
             dropped: 0,
             rays: 0,
+            how,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -149,6 +152,10 @@ impl NodeExec for PathTrace {
             .buffer(&b.light_alias)
             .buffer(&self.stats)
             .dispatch_2d(ctx, encoder, pass.extent, timer)
+    }
+
+    fn notes(&self) -> Vec<String> {
+        vec![format!("shader: {}", self.how)]
     }
 
     fn counters(&mut self, ctx: &GpuContext) -> Result<Vec<Counter>> {

@@ -1,0 +1,135 @@
+//! Ray queries on the GPU: the closest hit of each ray, through the path tracer's BVH
+//! traversal (`shaders/pathtrace/raycast.wgsl`). Used to check the GPU traversal against
+//! the CPU one and for picking.
+
+use bytemuck::{Pod, Zeroable};
+use lumagraph_scene::Hit;
+use wgpu::util::DeviceExt as _;
+
+use crate::context::GpuContext;
+use crate::error::Result;
+use crate::kernel::{Binding, Kernel, uniform_buffer};
+use crate::readback::map_read;
+use crate::scene_gpu::SceneBuffers;
+
+/// One ray: origin, direction (any length) and the largest `t` that counts.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct RayQuery {
+    /// Origin.
+    pub origin: [f32; 3],
+    /// Hits count for `0 < t < t_max`.
+    pub t_max: f32,
+    /// Direction; `t` is measured in its length.
+    pub dir: [f32; 3],
+    /// Padding.
+    pub pad: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+struct GpuHit {
+    prim: u32,
+    t: f32,
+    u: f32,
+    v: f32,
+}
+
+/// A ray-query kernel bound to one scene's buffers.
+#[derive(Debug)]
+pub struct Raycaster {
+    kernel: Kernel,
+}
+
+impl Raycaster {
+    /// Compiles the kernel.
+    ///
+    /// # Errors
+    /// When the shader does not compile.
+    pub fn new(ctx: &GpuContext) -> Result<Self> {
+        let read = Binding::Storage { read_only: true };
+        let kernel = Kernel::new(
+            ctx,
+            "pathtrace/raycast.wgsl",
+            &[
+                Binding::Uniform,
+                read,
+                Binding::Storage { read_only: false },
+                read,
+                read,
+                read,
+            ],
+        )?;
+        Ok(Self { kernel })
+    }
+
+    /// The closest hit of every ray (`prim == NO_HIT` for a miss).
+    ///
+    /// # Errors
+    /// When the GPU work fails.
+    pub fn cast(
+        &self,
+        ctx: &GpuContext,
+        scene: &SceneBuffers,
+        rays: &[RayQuery],
+    ) -> Result<Vec<Hit>> {
+        if rays.is_empty() {
+            return Ok(Vec::new());
+        }
+        let count = u32::try_from(rays.len()).unwrap_or(u32::MAX);
+        let params = uniform_buffer(ctx, "raycast params", bytemuck::bytes_of(&[count, 0, 0, 0]));
+        let queries = ctx
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("raycast queries"),
+                contents: bytemuck::cast_slice(rays),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+        let size = rays.len() as u64 * 16;
+        let hits = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("raycast hits"),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("raycast readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("raycast"),
+            });
+        let groups = count.div_ceil(64);
+        self.kernel
+            .pass("raycast")
+            .uniform(&params)
+            .buffer(&queries)
+            .buffer(&hits)
+            .buffer(&scene.bvh_nodes)
+            .buffer(&scene.tri_positions)
+            .buffer(&scene.spheres)
+            .dispatch(
+                ctx,
+                &mut encoder,
+                [groups.min(65535), groups.div_ceil(65535), 1],
+                None,
+            )?;
+        encoder.copy_buffer_to_buffer(&hits, 0, &readback, 0, size);
+        ctx.queue.submit([encoder.finish()]);
+        map_read(ctx, &readback, size, |bytes| {
+            bytemuck::pod_collect_to_vec::<u8, GpuHit>(bytes)
+                .into_iter()
+                .map(|h| Hit {
+                    prim: h.prim,
+                    t: h.t,
+                    u: h.u,
+                    v: h.v,
+                })
+                .collect()
+        })
+    }
+}
