@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets up what is missing, builds, and renders the Cornell box through the default graph
-# into out/ (or the folder
-# given as the first argument). Extra arguments go to `lumagraph render`.
+# into out/ (or the folder given as the first argument). Extra arguments go to
+# `lumagraph render` (e.g. --spp 1024).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh

@@ -130,6 +130,19 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
     for w in &r.warnings {
         println!("scene warning: {w}");
     }
+    let unrendered: Vec<&str> = scene
+        .materials
+        .iter()
+        .filter(|m| m.metallic > 0.0 || m.specular > 0.0 || m.transmission > 0.0)
+        .map(|m| m.name.as_str())
+        .collect();
+    if !unrendered.is_empty() {
+        println!(
+            "scene warning: materials {} set specular, metallic or transmission, which this build \
+             renders as Lambertian (base_color only)",
+            unrendered.join(", ")
+        );
+    }
     let gpu = GpuScene::build(&scene)?;
     println!(
         "scene {}: {} triangles, {} spheres, {} lights, {} BVH nodes ({:.0} ms)",

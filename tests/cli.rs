@@ -353,3 +353,69 @@ fn missing_graph_file() {
         "{stderr}"
     );
 }
+
+#[test]
+fn path_traced_render_reports_its_figures() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let out = tempfile::tempdir().unwrap();
+    let o = lumagraph(&[
+        "render",
+        "graphs/pathtrace.ron",
+        "--scene",
+        "assets/cornell.ron",
+        "--spp",
+        "8",
+        "--out",
+        out.path().to_str().unwrap(),
+    ]);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stdout}\n{stderr}");
+    for expected in [
+        "rendered 8 spp at 256x256",
+        "M paths/s",
+        "M rays/s",
+        "0 NaN/Inf samples dropped",
+        "intersection inlined",
+    ] {
+        assert!(
+            stdout.contains(expected),
+            "missing {expected:?} in:\n{stdout}"
+        );
+    }
+    let exr = lumagraph::render::image_io::load(&out.path().join("render.exr")).unwrap();
+    assert_eq!((exr.width, exr.height), (256, 256));
+    assert!(out.path().join("render.png").is_file());
+}
+
+#[test]
+fn scene_graph_without_scene_is_a_clear_error() {
+    let o = lumagraph(&["render", "graphs/pathtrace.ron"]);
+    let (_, stderr) = text(&o);
+    assert!(!o.status.success());
+    assert!(
+        stderr.contains("node \"pathtrace\"") && stderr.contains("--scene"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn bad_scene_file_names_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("bad.ron");
+    std::fs::write(&scene, "(\n    version: 1,\n    camera: Perspective(position: (0, 0, 1), target: (0, 0, 0), fov_y: 40),\n    shapes: [Sphere(center: (0, 0, 0), radius: 1, material: \"nope\")],\n    render: (width: 8, height: 8),\n)\n").unwrap();
+    let o = lumagraph(&[
+        "plan",
+        "graphs/pathtrace.ron",
+        "--scene",
+        scene.to_str().unwrap(),
+    ]);
+    let (_, stderr) = text(&o);
+    assert!(!o.status.success());
+    assert!(
+        stderr.contains("bad.ron:4:") && stderr.contains("\"nope\""),
+        "{stderr}"
+    );
+}
