@@ -40,7 +40,7 @@ fn measure(
         .map(|(_, n)| n)
         .collect::<Vec<_>>()
         .join("; ");
-    exec.run_frames(1, false)?; // warm-up: the driver compiles the pipeline here
+    exec.warm_up()?; // the driver compiles the pipeline at the first dispatch
     let frames = spp.div_ceil(spf);
     let pixels = f64::from(scene.settings.width) * f64::from(scene.settings.height);
     let mut best = 0.0_f64;

@@ -177,10 +177,7 @@ fn render_progressive(exec: &mut Executor, spp: u32) -> Result<lumagraph::render
     let frames = spp.div_ceil(spf).max(1);
     // Warm-up: drivers compile pipelines at their first dispatch; keep that out of the timing.
     let warm = Instant::now();
-    exec.run_frames(1, false)?;
-    exec.reset_history();
-    exec.counters()?;
-    exec.reset_history();
+    exec.warm_up()?;
     println!(
         "warm-up (shader compilation): {:.0} ms",
         warm.elapsed().as_secs_f64() * 1e3

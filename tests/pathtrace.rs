@@ -177,3 +177,58 @@ fn same_seed_same_image() {
         "same seed and spp must be bit-identical"
     );
 }
+
+#[test]
+fn first_hit_aovs_see_the_back_wall() {
+    let cornell = scene("cornell.ron");
+    let Some(ctx) = common::gpu() else { return };
+    let graph = Graph {
+        nodes: vec![Node::new("pt", "PathTrace")],
+        edges: Vec::new(),
+        origin: None,
+    };
+    let keep = [
+        "pt.albedo".to_owned(),
+        "pt.normal".to_owned(),
+        "pt.depth".to_owned(),
+    ];
+    let plan = compile(&graph, &keep, Some(&cornell)).unwrap();
+    let resources = Resources {
+        scene: Some(Arc::clone(&cornell)),
+        ..Resources::default()
+    };
+    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    exec.run_frame().unwrap();
+    assert!(
+        exec.notes()[0].1.contains("first-hit AOVs written"),
+        "{:?}",
+        exec.notes()
+    );
+    // Pixel (128, 70) sees the back wall above the boxes: white, facing +z, at z = -1
+    // seen from z = 3.9, along the ray through the pixel center.
+    let (px, py) = (128_u32, 70_u32);
+    let i = (py * 256 + px) as usize;
+    let albedo = exec.read_port("pt.albedo").unwrap().pixels[i];
+    let normal = exec.read_port("pt.normal").unwrap().pixels[i];
+    let depth = exec.read_port("pt.depth").unwrap().pixels[i];
+    let tan = (39.3077_f64.to_radians() / 2.0).tan();
+    let dx = (2.0 * (f64::from(px) + 0.5) / 256.0 - 1.0) * tan;
+    let dy = (1.0 - 2.0 * (f64::from(py) + 0.5) / 256.0) * tan;
+    let expected_depth = 4.9 * (1.0 + dx * dx + dy * dy).sqrt();
+    assert!(
+        (albedo[0] - 0.885_809).abs() < 1e-6 && (albedo[1] - 0.698_859).abs() < 1e-6,
+        "{albedo:?}"
+    );
+    assert!((normal[2] - 1.0).abs() < 1e-6, "{normal:?}");
+    assert!(
+        (f64::from(depth[0]) - expected_depth).abs() < 1e-4,
+        "{depth:?} vs {expected_depth}"
+    );
+    // Nothing reads the color: the plan leaves it out, the shader still runs.
+    assert!(
+        exec.plan()
+            .left_out
+            .iter()
+            .any(|l| l.what == "texture pt.color")
+    );
+}

@@ -7,6 +7,7 @@
 #import "pathtrace/scene_types.wgsl"
 #import "common/rng.wgsl"
 #import "common/sampling.wgsl"
+#import "pathtrace/options.wgsl"
 
 struct Frame {
     settings: Settings,
@@ -29,6 +30,10 @@ struct Frame {
 @group(0) @binding(7) var<storage, read> lights: array<Light>;
 @group(0) @binding(8) var<storage, read> light_alias: array<AliasEntry>;
 @group(0) @binding(9) var<storage, read_write> stats: array<atomic<u32>>;
+// First-hit AOVs (when WRITE_AOVS): albedo, world-space shading normal, distance.
+@group(0) @binding(10) var out_albedo: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(11) var out_normal: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(12) var out_depth: texture_storage_2d<r32float, write>;
 
 #import "pathtrace/intersect.wgsl"
 
@@ -158,13 +163,19 @@ fn sample_light(x: vec3f) -> LightSample {
     return out;
 }
 
-fn camera_ray(pixel: vec2u, u: vec2f) -> Ray {
+// The pinhole ray through image position `u` within `pixel`.
+fn pinhole_ray(pixel: vec2u, u: vec2f) -> Ray {
     let cam = frame.camera;
     let size = vec2f(f32(frame.settings.width), f32(frame.settings.height));
     let xy = (vec2f(pixel) + u) / size;
     let dir = cam.forward + (2.0 * xy.x - 1.0) * cam.tan_half_fov * cam.aspect * cam.right
         - (2.0 * xy.y - 1.0) * cam.tan_half_fov * cam.up;
-    var ray = Ray(cam.position, normalize(dir));
+    return Ray(cam.position, normalize(dir));
+}
+
+fn camera_ray(pixel: vec2u, u: vec2f) -> Ray {
+    let cam = frame.camera;
+    var ray = pinhole_ray(pixel, u);
     if cam.aperture_radius > 0.0 {
         let lens = cam.aperture_radius * sample_disk(rand2());
         let focus = cam.position + ray.dir * (cam.focus_distance / dot(ray.dir, cam.forward));
@@ -282,4 +293,22 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         atomicAdd(&stats[2], 1u);
     }
     textureStore(output, id.xy, vec4f(sum / f32(max(n, 1u)), 1.0));
+
+    if WRITE_AOVS {
+        // First hit through the pixel center: what a raster G-buffer sees.
+        let ray = pinhole_ray(id.xy, vec2f(0.5));
+        let hit = intersect_scene(ray);
+        var albedo = vec3f(0.0);
+        var normal = vec3f(0.0);
+        var depth = 0.0;
+        if hit.prim != NO_HIT {
+            let s = surface_at(ray, hit);
+            albedo = materials[s.material].base_color;
+            normal = s.ns;
+            depth = hit.t;
+        }
+        textureStore(out_albedo, id.xy, vec4f(albedo, 1.0));
+        textureStore(out_normal, id.xy, vec4f(normal, 1.0));
+        textureStore(out_depth, id.xy, vec4f(depth, 0.0, 0.0, 0.0));
+    }
 }

@@ -197,11 +197,28 @@ fn builtin_kinds() -> Vec<NodeKind> {
                   Accumulate for a progressive render. Image size, bounces and seed come from \
                   the scene.",
             inputs: &[],
-            outputs: &[OutputDef {
-                name: "color",
-                ty: PortType::HdrColor,
-                doc: "this frame's radiance estimate",
-            }],
+            outputs: &[
+                OutputDef {
+                    name: "color",
+                    ty: PortType::HdrColor,
+                    doc: "this frame's radiance estimate",
+                },
+                OutputDef {
+                    name: "albedo",
+                    ty: PortType::Albedo,
+                    doc: "base color at the first hit through the pixel center (0 on a miss)",
+                },
+                OutputDef {
+                    name: "normal",
+                    ty: PortType::Normal,
+                    doc: "world-space shading normal at that hit (0 on a miss)",
+                },
+                OutputDef {
+                    name: "depth",
+                    ty: PortType::Depth,
+                    doc: "distance from the camera to that hit (0 on a miss)",
+                },
+            ],
             params: vec![ParamDef {
                 name: "samples_per_frame",
                 ty: ParamType::Int {

@@ -61,6 +61,17 @@ pub fn compile(
     )
 }
 
+/// Which passes a batch of frames records.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Mode {
+    /// Progressive passes every frame; everything in the last frame, timed; sinks write.
+    Finish,
+    /// Progressive passes only.
+    Progress,
+    /// Everything once, untimed, no files.
+    WarmUp,
+}
+
 /// What one frame did.
 #[derive(Clone, Debug, Default)]
 pub struct FrameReport {
@@ -171,6 +182,24 @@ impl Executor {
     /// # Errors
     /// When a node fails; the error names the node.
     pub fn run_frames(&mut self, n: u32, finish: bool) -> Result<FrameReport> {
+        self.run(n, if finish { Mode::Finish } else { Mode::Progress })
+    }
+
+    /// Records every pass once without writing files or keeping history, so drivers that
+    /// compile pipelines at their first dispatch do it here rather than in a timed frame.
+    ///
+    /// # Errors
+    /// When a node fails; the error names the node.
+    pub fn warm_up(&mut self) -> Result<()> {
+        self.run(1, Mode::WarmUp)?;
+        self.reset_history();
+        self.counters()?;
+        self.reset_history();
+        self.frames = 0;
+        Ok(())
+    }
+
+    fn run(&mut self, n: u32, mode: Mode) -> Result<FrameReport> {
         let start = Instant::now();
         let mut encoder = self
             .ctx
@@ -188,12 +217,16 @@ impl Executor {
         let mut executed = Vec::with_capacity(self.plan.passes.len());
         let n = n.max(1);
         for frame in 0..n {
-            let last = finish && frame + 1 == n;
+            let last = mode != Mode::Progress && frame + 1 == n;
             for (p, (pass, node)) in self.plan.passes.iter().zip(&mut self.nodes).enumerate() {
                 if !last && !self.every_frame[p] {
                     continue;
                 }
-                let timer = if last { self.timer.as_mut() } else { None };
+                let timer = if last && mode == Mode::Finish {
+                    self.timer.as_mut()
+                } else {
+                    None
+                };
                 node.record(&self.ctx, &mut encoder, pass, &io, timer)
                     .map_err(|e| e.in_node(&pass.node))?;
                 if last {
@@ -214,14 +247,16 @@ impl Executor {
         }
         self.ctx.wait()?;
         let mut written = Vec::new();
-        for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
-            written.extend(
-                node.finish(&self.ctx, pass)
-                    .map_err(|e| e.in_node(&pass.node))?,
-            );
+        if mode == Mode::Finish {
+            for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
+                written.extend(
+                    node.finish(&self.ctx, pass)
+                        .map_err(|e| e.in_node(&pass.node))?,
+                );
+            }
         }
         let pass_ms = match &self.timer {
-            Some(t) if finish => Some(t.read(&self.ctx)?),
+            Some(t) if mode == Mode::Finish => Some(t.read(&self.ctx)?),
             _ => None,
         };
         self.frames += u64::from(n);

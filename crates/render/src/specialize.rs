@@ -73,14 +73,28 @@ fn occluded(ray: Ray, t_max: f32) -> bool {{
     ))
 }
 
-/// The path tracer's source for `scene`, specialized where it pays (when `specialize`),
-/// and a line saying how.
+/// What the graph needs of the path tracer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PathTraceOptions {
+    /// Specialize to the scene where it pays (off: the general shader, for benchmarks).
+    pub specialize: bool,
+    /// Write the first-hit AOVs (albedo, normal, depth): something reads them.
+    pub aovs: bool,
+}
+
+/// The path tracer's source for `scene`, specialized where it pays, and a line saying how.
 ///
 /// # Errors
 /// When a shader file is missing.
-pub fn pathtrace_source(scene: &GpuScene, specialize: bool) -> crate::Result<(String, String)> {
-    let mut overrides = Vec::new();
-    let inline = if specialize {
+pub fn pathtrace_source(
+    scene: &GpuScene,
+    options: PathTraceOptions,
+) -> crate::Result<(String, String)> {
+    let mut overrides = vec![(
+        "pathtrace/options.wgsl",
+        format!("const WRITE_AOVS: bool = {};\n", options.aovs),
+    )];
+    let inline = if options.specialize {
         inline_intersection(scene)
     } else {
         None
@@ -93,6 +107,11 @@ pub fn pathtrace_source(scene: &GpuScene, specialize: bool) -> crate::Result<(St
         )
     } else {
         format!("BVH traversal ({} nodes)", scene.bvh_nodes.len())
+    };
+    let how = if options.aovs {
+        format!("{how}; first-hit AOVs written")
+    } else {
+        format!("{how}; AOVs left out (nothing reads them)")
     };
     let source = crate::shader::resolve_with("pathtrace/pathtrace.wgsl", &overrides)?;
     Ok((source, how))

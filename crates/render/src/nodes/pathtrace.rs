@@ -8,7 +8,10 @@ use wgpu::util::DeviceExt as _;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::kernel::{Binding, Kernel, uniform_buffer};
+use lumagraph_graph::TexFormat;
+
 use crate::nodes::{Counter, FrameIo, NodeExec, Resources};
+use crate::pool::{PooledTexture, create};
 use crate::readback::map_read;
 use crate::scene_gpu::SceneBuffers;
 use crate::timing::GpuTimer;
@@ -31,6 +34,8 @@ pub(crate) struct PathTrace {
     rays: u64,
     /// How the shader was specialized, for reports.
     how: String,
+    /// Stand-ins for outputs nothing reads (color, albedo, normal, depth).
+    unused: [PooledTexture; 4],
 }
 
 impl PathTrace {
@@ -39,8 +44,14 @@ impl PathTrace {
             RenderError::Gpu("PathTrace needs a scene (lumagraph render --scene FILE)".into())
         })?;
         let storage = Binding::Storage { read_only: true };
-        let (source, how) =
-            crate::specialize::pathtrace_source(&scene, !resources.general_shaders)?;
+        let aovs = ["albedo", "normal", "depth"]
+            .iter()
+            .any(|p| pass.output(p).is_some());
+        let options = crate::specialize::PathTraceOptions {
+            specialize: !resources.general_shaders,
+            aovs,
+        };
+        let (source, how) = crate::specialize::pathtrace_source(&scene, options)?;
         let kernel = Kernel::from_source(
             ctx,
             "pathtrace/pathtrace.wgsl",
@@ -56,8 +67,19 @@ impl PathTrace {
                 storage,
                 storage,
                 Binding::Storage { read_only: false },
+                Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
+                Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
+                Binding::StorageTexture(wgpu::TextureFormat::R32Float),
             ],
         )?;
+        // Outputs nothing reads are bound to 1x1 stand-ins (stores outside them are dropped).
+        let one = lumagraph_graph::Extent::new(1, 1);
+        let unused = [
+            create(ctx, "unused color", TexFormat::Rgba32Float, one),
+            create(ctx, "unused albedo", TexFormat::Rgba32Float, one),
+            create(ctx, "unused normal", TexFormat::Rgba32Float, one),
+            create(ctx, "unused depth", TexFormat::R32Float, one),
+        ];
         let buffers = SceneBuffers::upload(ctx, &scene);
         let frame = uniform_buffer(ctx, "pathtrace frame", &[0; 160]);
         let stats = ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -86,6 +108,7 @@ impl PathTrace {
             dropped: 0,
             rays: 0,
             how,
+            unused,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -124,9 +147,6 @@ impl NodeExec for PathTrace {
         io: &FrameIo<'_>,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let Some(out) = pass.output("color") else {
-            return Ok(());
-        };
         // Each frame has its own uniform contents: stage them through a copy recorded in
         // order, so many frames can share one submission.
         let staging = ctx
@@ -139,9 +159,13 @@ impl NodeExec for PathTrace {
         encoder.copy_buffer_to_buffer(&staging, 0, &self.frame, 0, self.frame.size());
         self.samples += self.samples_per_frame;
         let b = &self.buffers;
+        let aov = |port: &str, i: usize| {
+            pass.output(port)
+                .map_or(&self.unused[i].view, |t| &io.texture(t).view)
+        };
         self.kernel
             .pass(&pass.node)
-            .write(&io.texture(out).view)
+            .write(aov("color", 0))
             .uniform(&self.frame)
             .buffer(&b.bvh_nodes)
             .buffer(&b.tri_positions)
@@ -151,6 +175,9 @@ impl NodeExec for PathTrace {
             .buffer(&b.lights)
             .buffer(&b.light_alias)
             .buffer(&self.stats)
+            .write(aov("albedo", 1))
+            .write(aov("normal", 2))
+            .write(aov("depth", 3))
             .dispatch_2d(ctx, encoder, pass.extent, timer)
     }
 
