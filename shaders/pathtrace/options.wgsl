@@ -4,3 +4,12 @@
 
 // Write first-hit albedo, normal and depth (through the pixel center) to the AOV outputs.
 const WRITE_AOVS: bool = true;
+
+// Lobes some material of the scene uses; the code of the others is left out.
+const HAS_SPECULAR: bool = true;
+const HAS_METAL: bool = true;
+const HAS_GLASS: bool = true;
+// Emissive primitives exist: next-event estimation compiled in.
+const HAS_LIGHTS: bool = true;
+// The environment is not black.
+const HAS_ENVIRONMENT: bool = true;

@@ -8,6 +8,7 @@
 #import "common/rng.wgsl"
 #import "common/sampling.wgsl"
 #import "pathtrace/options.wgsl"
+#import "pathtrace/bsdf.wgsl"
 
 struct Frame {
     settings: Settings,
@@ -34,6 +35,8 @@ struct Frame {
 @group(0) @binding(10) var out_albedo: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(11) var out_normal: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(12) var out_depth: texture_storage_2d<r32float, write>;
+// GGX albedo tables for the material model (see bsdf.wgsl).
+@group(0) @binding(13) var<storage, read> ggx_table: array<vec2f>;
 
 #import "pathtrace/intersect.wgsl"
 
@@ -189,16 +192,17 @@ fn trace_path(pixel: vec2u) -> vec3f {
     var ray = camera_ray(pixel, rand2());
     var throughput = vec3f(1.0);
     var radiance = vec3f(0.0);
-    // Solid-angle pdf of the BSDF sample that made `ray`, and where it left from (for MIS).
+    // Solid-angle pdf of the BSDF sample that made `ray` (0: a mirror, interface or camera
+    // ray, which light sampling cannot produce), and where it left from (for MIS).
     var bsdf_pdf = 0.0;
     var prev_p = ray.origin;
     let max_bounces = frame.settings.max_bounces;
-    let has_lights = frame.header.num_lights > 0u;
+    let has_lights = HAS_LIGHTS && frame.header.num_lights > 0u;
     for (var bounce = 0u; ; bounce++) {
         let hit = intersect_scene(ray);
         ray_count += 1u;
         if hit.prim == NO_HIT {
-            if frame.settings.env_kind == ENV_CONSTANT {
+            if HAS_ENVIRONMENT && frame.settings.env_kind == ENV_CONSTANT {
                 radiance += throughput * frame.settings.env_radiance;
             }
             break;
@@ -207,49 +211,56 @@ fn trace_path(pixel: vec2u) -> vec3f {
         let mat = materials[s.material];
         let front = dot(s.ng, ray.dir) < 0.0;
         let two_sided = (mat.flags & MATERIAL_TWO_SIDED) != 0u;
+        let glass = HAS_GLASS && mat.transmission > 0.0 && mat.metallic < 1.0;
 
         // Emission seen along the ray, weighted against light sampling.
         if s.light != NO_LIGHT && (front || two_sided) {
             var w = 1.0;
-            if bounce > 0u {
+            if bsdf_pdf > 0.0 {
                 w = mis_power(bsdf_pdf, light_pdf(lights[s.light], prev_p, s.p, s.ng));
             }
             radiance += throughput * mat.emission * w;
         }
-        // One-sided materials are black from behind.
-        if !(front || two_sided) || bounce >= max_bounces {
+        // One-sided opaque materials are black from behind; an interface has two sides.
+        if !(front || two_sided || glass) || bounce >= max_bounces {
             break;
         }
-        let ng = select(-s.ng, s.ng, front);
-        let ns = select(-s.ns, s.ns, front);
-        let origin = offset_ray(s.p, ng);
-        let albedo = mat.base_color;
+        // Shading frame: opaque surfaces face the ray; an interface keeps its orientation
+        // so the BSDF knows which side is inside.
+        let flip = !front && !glass;
+        let ng = select(s.ng, -s.ng, flip);
+        let frame_n = select(s.ns, -s.ns, flip);
+        let basis = onb(frame_n);
+        let to_local = transpose(basis);
+        let wo = to_local * -ray.dir;
 
-        // Next-event estimation.
-        if has_lights {
+        // Next-event estimation through the non-delta lobes.
+        if has_lights && wo.z > 0.0 {
             let ls = sample_light(s.p);
-            let cos_x = dot(ns, ls.wi);
-            if ls.pdf > 0.0 && cos_x > 0.0 && dot(ng, ls.wi) > 0.0 {
-                let shadow = Ray(origin, ls.wi);
-                ray_count += 1u;
-                if !occluded(shadow, ls.dist * (1.0 - 1e-4)) {
-                    let f = albedo * INV_PI;
-                    let w = mis_power(ls.pdf, cos_x * INV_PI);
-                    radiance += throughput * f * cos_x * ls.radiance * (w / ls.pdf);
+            if ls.pdf > 0.0 && dot(ng, ls.wi) * select(-1.0, 1.0, front || flip) > 0.0 {
+                let e = eval_bsdf(mat, wo, to_local * ls.wi);
+                if e.pdf > 0.0 || any(e.f_cos > vec3f(0.0)) {
+                    let shadow = Ray(offset_ray(s.p, select(-ng, ng, dot(ng, ls.wi) > 0.0)), ls.wi);
+                    ray_count += 1u;
+                    if !occluded(shadow, ls.dist * (1.0 - 1e-4)) {
+                        let w = mis_power(ls.pdf, e.pdf);
+                        radiance += throughput * e.f_cos * ls.radiance * (w / ls.pdf);
+                    }
                 }
             }
         }
 
-        // Lambertian sampling: f cos / pdf = albedo.
-        let wi = sample_cosine(ns, rand2());
-        let cos_i = dot(ns, wi);
-        if cos_i <= 0.0 || dot(ng, wi) <= 0.0 {
+        let bs = sample_bsdf(mat, wo, rand(), vec3f(rand2(), rand()));
+        if !bs.valid {
             break;
         }
-        throughput *= albedo;
-        bsdf_pdf = cos_i * INV_PI;
+        let wi = basis * bs.wi;
+        // Leave from the side of the surface the new ray goes to.
+        let side = select(-ng, ng, dot(ng, wi) > 0.0);
+        throughput *= bs.weight;
+        bsdf_pdf = bs.pdf;
         prev_p = s.p;
-        ray = Ray(origin, wi);
+        ray = Ray(offset_ray(s.p, side), wi);
 
         // Russian roulette.
         if bounce + 1u >= RR_START {

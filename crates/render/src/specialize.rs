@@ -82,6 +82,100 @@ pub struct PathTraceOptions {
     pub aovs: bool,
 }
 
+/// One feature of the path tracer, compiled in or left out for a scene, and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Feature {
+    /// What the feature is.
+    pub name: &'static str,
+    /// Whether its code is compiled in.
+    pub included: bool,
+    /// Why.
+    pub reason: String,
+}
+
+fn feature(name: &'static str, included: bool, reason: impl Into<String>) -> Feature {
+    Feature {
+        name,
+        included,
+        reason: reason.into(),
+    }
+}
+
+/// The features of the path tracer for `scene`: what is compiled in, what is left out.
+pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
+    let all = !options.specialize;
+    let m = &scene.materials;
+    let count =
+        |f: &dyn Fn(&lumagraph_scene::GpuMaterial) -> bool| m.iter().filter(|x| f(x)).count();
+    let specular = count(&|x| x.specular > 0.0 && x.metallic < 1.0 && x.transmission < 1.0);
+    let metal = count(&|x| x.metallic > 0.0);
+    let glass = count(&|x| x.transmission > 0.0 && x.metallic < 1.0);
+    let prims = scene.tri_positions.len() + scene.spheres.len();
+    let inline = options.specialize && prims <= INLINE_MAX_PRIMITIVES;
+    let env = scene.settings.env_kind != lumagraph_scene::ENV_NONE;
+    let lights = scene.lights.len();
+    let why = |n: usize, what: &str| {
+        if all {
+            "general shader (specialization off)".to_owned()
+        } else if n > 0 {
+            format!("{n} {what}")
+        } else {
+            format!("no {what}")
+        }
+    };
+    vec![
+        feature(
+            "BVH traversal",
+            !inline,
+            if inline {
+                format!("{prims} primitives <= {INLINE_MAX_PRIMITIVES}: tested inline")
+            } else {
+                format!("{} nodes", scene.bvh_nodes.len())
+            },
+        ),
+        feature("inline intersection", inline, format!("{prims} primitives")),
+        feature(
+            "light sampling (NEE + MIS)",
+            all || lights > 0,
+            why(lights, "emissive primitives"),
+        ),
+        feature(
+            "environment",
+            all || env,
+            if env || all {
+                "environment not black".to_owned()
+            } else {
+                "black environment".to_owned()
+            },
+        ),
+        feature(
+            "dielectric specular lobe",
+            all || specular > 0,
+            why(specular, "materials with specular > 0"),
+        ),
+        feature(
+            "metal lobe",
+            all || metal > 0,
+            why(metal, "materials with metallic > 0"),
+        ),
+        feature(
+            "glass lobe",
+            all || glass > 0,
+            why(glass, "materials with transmission > 0"),
+        ),
+        feature(
+            "first-hit AOVs",
+            options.aovs,
+            if options.aovs {
+                "albedo, normal or depth is read"
+            } else {
+                "nothing reads albedo, normal or depth"
+            },
+        ),
+        feature("textures", false, "not supported by this build yet"),
+    ]
+}
+
 /// The path tracer's source for `scene`, specialized where it pays, and a line saying how.
 ///
 /// # Errors
@@ -90,29 +184,42 @@ pub fn pathtrace_source(
     scene: &GpuScene,
     options: PathTraceOptions,
 ) -> crate::Result<(String, String)> {
-    let mut overrides = vec![(
-        "pathtrace/options.wgsl",
-        format!("const WRITE_AOVS: bool = {};\n", options.aovs),
-    )];
-    let inline = if options.specialize {
-        inline_intersection(scene)
-    } else {
-        None
-    };
-    let how = if let Some(code) = inline {
+    let features = features(scene, options);
+    let on = |name: &str| features.iter().any(|f| f.name == name && f.included);
+    let consts = format!(
+        "const WRITE_AOVS: bool = {};\nconst HAS_SPECULAR: bool = {};\nconst HAS_METAL: bool = {};\n\
+         const HAS_GLASS: bool = {};\nconst HAS_LIGHTS: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n",
+        on("first-hit AOVs"),
+        on("dielectric specular lobe"),
+        on("metal lobe"),
+        on("glass lobe"),
+        on("light sampling (NEE + MIS)"),
+        on("environment"),
+    );
+    let mut overrides = vec![("pathtrace/options.wgsl", consts)];
+    if on("inline intersection")
+        && let Some(code) = inline_intersection(scene)
+    {
         overrides.push(("pathtrace/intersect.wgsl", code));
-        format!(
-            "intersection inlined ({} primitives <= {INLINE_MAX_PRIMITIVES}): BVH traversal left out",
-            scene.tri_positions.len() + scene.spheres.len()
-        )
-    } else {
-        format!("BVH traversal ({} nodes)", scene.bvh_nodes.len())
-    };
-    let how = if options.aovs {
-        format!("{how}; first-hit AOVs written")
-    } else {
-        format!("{how}; AOVs left out (nothing reads them)")
-    };
+    }
+    let left_out: Vec<&str> = features
+        .iter()
+        .filter(|f| !f.included)
+        .map(|f| f.name)
+        .collect();
+    let how = format!(
+        "{}; left out: {}",
+        if on("inline intersection") {
+            "intersection inlined"
+        } else {
+            "BVH traversal"
+        },
+        if left_out.is_empty() {
+            "nothing".to_owned()
+        } else {
+            left_out.join(", ")
+        }
+    );
     let source = crate::shader::resolve_with("pathtrace/pathtrace.wgsl", &overrides)?;
     Ok((source, how))
 }

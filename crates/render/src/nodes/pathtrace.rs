@@ -36,6 +36,8 @@ pub(crate) struct PathTrace {
     how: String,
     /// Stand-ins for outputs nothing reads (color, albedo, normal, depth).
     unused: [PooledTexture; 4],
+    /// GGX albedo tables of the material model.
+    ggx_table: wgpu::Buffer,
 }
 
 impl PathTrace {
@@ -70,8 +72,16 @@ impl PathTrace {
                 Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
                 Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
                 Binding::StorageTexture(wgpu::TextureFormat::R32Float),
+                storage,
             ],
         )?;
+        let ggx_table = ctx
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("ggx albedo table"),
+                contents: bytemuck::cast_slice(crate::bsdf_tables::ggx_table()),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
         // Outputs nothing reads are bound to 1x1 stand-ins (stores outside them are dropped).
         let one = lumagraph_graph::Extent::new(1, 1);
         let unused = [
@@ -109,6 +119,7 @@ impl PathTrace {
             rays: 0,
             how,
             unused,
+            ggx_table,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -178,6 +189,7 @@ impl NodeExec for PathTrace {
             .write(aov("albedo", 1))
             .write(aov("normal", 2))
             .write(aov("depth", 3))
+            .buffer(&self.ggx_table)
             .dispatch_2d(ctx, encoder, pass.extent, timer)
     }
 

@@ -1,0 +1,293 @@
+// The material model: three lobes mixed by metallic and transmission.
+//   dielectric layer  (1 - metallic)(1 - transmission): GGX specular with Schlick Fresnel
+//                     (F0 = 0.08 specular, tinted by specular_tint) over a Lambertian base
+//                     that receives exactly the energy the specular does not reflect;
+//   metal             metallic: GGX with Schlick Fresnel on base_color, plus Kulla-Conty
+//                     multiple-scattering compensation;
+//   glass             (1 - metallic) transmission: dielectric interface (exact Fresnel with
+//                     ior), reflection or refraction chosen by Fresnel, rough by GGX.
+// The GGX albedo tables (`ggx_table`, computed by crates/render/src/bsdf_tables.rs and
+// declared by the includer) make the white furnace white at every roughness.
+// Vectors are in the shading frame (normal = +z); wo points to the viewer.
+#import "pathtrace/scene_types.wgsl"
+#import "common/color.wgsl"
+#import "common/sampling.wgsl"
+
+// Below this alpha (= roughness^2) a lobe is a perfect mirror or interface.
+const ALPHA_MIN: f32 = 1e-3;
+const GGX_TABLE_N: u32 = 32u;
+
+// Albedo of a GGX lobe with Schlick Fresnel F0, F90 at view cosine mu is F0 t.x + F90 t.y.
+fn ggx_albedo(mu: f32, roughness: f32) -> vec2f {
+    let last = f32(GGX_TABLE_N - 1u);
+    let x = clamp(mu, 0.0, 1.0) * last;
+    let y = clamp(roughness, 0.0, 1.0) * last;
+    let x0 = min(u32(x), GGX_TABLE_N - 2u);
+    let y0 = min(u32(y), GGX_TABLE_N - 2u);
+    let i = y0 * GGX_TABLE_N + x0;
+    let lo = mix(ggx_table[i], ggx_table[i + 1u], x - f32(x0));
+    let hi = mix(ggx_table[i + GGX_TABLE_N], ggx_table[i + GGX_TABLE_N + 1u], x - f32(x0));
+    return mix(lo, hi, y - f32(y0));
+}
+
+// Cosine-weighted hemispherical average of `ggx_albedo`.
+fn ggx_albedo_avg(roughness: f32) -> vec2f {
+    let last = f32(GGX_TABLE_N - 1u);
+    let y = clamp(roughness, 0.0, 1.0) * last;
+    let y0 = min(u32(y), GGX_TABLE_N - 2u);
+    let base = GGX_TABLE_N * GGX_TABLE_N;
+    return mix(ggx_table[base + y0], ggx_table[base + y0 + 1u], y - f32(y0));
+}
+
+fn ggx_d(z: f32, a2: f32) -> f32 {
+    let t = z * z * (a2 - 1.0) + 1.0;
+    return a2 / (PI * t * t);
+}
+
+fn smith_term(z: f32, a2: f32) -> f32 {
+    return sqrt(a2 + (1.0 - a2) * z * z);
+}
+
+fn smith_g1(z: f32, a2: f32) -> f32 {
+    return 2.0 * z / (z + smith_term(z, a2));
+}
+
+// Height-correlated masking-shadowing.
+fn smith_g2(zo: f32, zi: f32, a2: f32) -> f32 {
+    return 2.0 * zo * zi / (zo * smith_term(zi, a2) + zi * smith_term(zo, a2));
+}
+
+// Visible normal of GGX seen from wo (wo.z > 0), by the spherical cap method
+// (Dupuy and Benyoub 2023).
+fn sample_vndf(wo: vec3f, alpha: f32, u: vec2f) -> vec3f {
+    let v = normalize(vec3f(wo.xy * alpha, wo.z));
+    let phi = TWO_PI * u.x;
+    let z = (1.0 - u.y) * (1.0 + v.z) - v.z;
+    let sin_t = sqrt(clamp(1.0 - z * z, 0.0, 1.0));
+    let h = vec3f(sin_t * cos(phi), sin_t * sin(phi), z) + v;
+    return normalize(vec3f(h.xy * alpha, max(h.z, 1e-7)));
+}
+
+// Reflectance at grazing incidence: 1 for real materials, 0 when F0 is 0, so a material
+// with no specular is purely Lambertian (F90 = min(1, 50 F0), as Filament does).
+fn schlick_f90(f0: vec3f) -> f32 {
+    return clamp(50.0 * max(f0.x, max(f0.y, f0.z)), 0.0, 1.0);
+}
+
+fn schlick(f0: vec3f, c: f32) -> vec3f {
+    let m = clamp(1.0 - c, 0.0, 1.0);
+    let m2 = m * m;
+    return f0 + (schlick_f90(f0) - f0) * (m2 * m2 * m);
+}
+
+// Albedo of a GGX lobe with Fresnel `schlick(f0, .)` from the (A, B) table entry t.
+fn lobe_albedo(f0: vec3f, t: vec2f) -> vec3f {
+    return f0 * t.x + schlick_f90(f0) * t.y;
+}
+
+// Unpolarized Fresnel reflectance of a dielectric interface; eta = eta_t / eta_i.
+fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = sqrt(1.0 - sin2_t);
+    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+// Mixing weights (dielectric layer, metal, glass); they sum to 1 and are also the
+// probabilities of sampling each lobe.
+fn lobe_weights(m: Material) -> vec3f {
+    let metal = clamp(m.metallic, 0.0, 1.0);
+    let t = clamp(m.transmission, 0.0, 1.0);
+    return vec3f((1.0 - metal) * (1.0 - t), metal, (1.0 - metal) * t);
+}
+
+fn dielectric_f0(m: Material) -> vec3f {
+    let l = luminance(m.base_color);
+    let tint = select(vec3f(1.0), m.base_color / l, l > 0.0);
+    return clamp(0.08 * m.specular, 0.0, 1.0) * mix(vec3f(1.0), tint, clamp(m.specular_tint, 0.0, 1.0));
+}
+
+// Probability of sampling the specular part of the dielectric layer.
+fn layer_spec_prob(m: Material, es_o: vec3f) -> f32 {
+    let s = luminance(es_o);
+    let d = luminance(m.base_color * (1.0 - es_o));
+    return clamp(s / max(s + d, 1e-6), 0.1, 0.9);
+}
+
+// Probability of sampling the single-scattering part of the metal lobe.
+fn metal_ss_prob(e_o: f32) -> f32 {
+    return clamp(e_o, 0.25, 1.0);
+}
+
+struct LobeParams {
+    roughness: f32,
+    a2: f32,
+    is_smooth: bool,
+}
+
+fn lobe_params(m: Material) -> LobeParams {
+    let r = clamp(m.roughness, 0.0, 1.0);
+    let alpha = r * r;
+    return LobeParams(r, alpha * alpha, alpha < ALPHA_MIN);
+}
+
+// The non-delta, non-glass part of the BSDF: f * cos(wi) and the solid-angle pdf with which
+// `sample_bsdf` produces wi (lobe choice included). Light sampling evaluates this; the
+// glass lobe and perfect mirrors are reached by BSDF sampling only.
+struct BsdfEval {
+    f_cos: vec3f,
+    pdf: f32,
+}
+
+fn eval_bsdf(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
+    var out = BsdfEval(vec3f(0.0), 0.0);
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return out;
+    }
+    let w = lobe_weights(m);
+    let cos_pdf = wi.z * INV_PI;
+    if !HAS_SPECULAR && !HAS_METAL {
+        // The scene has only Lambertian and glass lobes: no microfacet code compiled in.
+        out.f_cos = w.x * m.base_color * cos_pdf;
+        out.pdf = w.x * cos_pdf;
+        return out;
+    }
+    let lp = lobe_params(m);
+    let h = normalize(wo + wi);
+    var g2_over = 0.0;
+    var vndf_pdf = 0.0;
+    if !lp.is_smooth {
+        let d = ggx_d(h.z, lp.a2);
+        // D * G2 / (4 wo.z): f * cos(wi) of the microfacet lobe without Fresnel.
+        g2_over = d * smith_g2(wo.z, wi.z, lp.a2) / (4.0 * wo.z);
+        vndf_pdf = smith_g1(wo.z, lp.a2) * d / (4.0 * wo.z);
+    }
+    let to = ggx_albedo(wo.z, lp.roughness);
+    let ti = ggx_albedo(wi.z, lp.roughness);
+    let ta = ggx_albedo_avg(lp.roughness);
+    if w.x > 0.0 {
+        let f0 = dielectric_f0(m);
+        let es_o = lobe_albedo(f0, to);
+        let es_i = lobe_albedo(f0, ti);
+        let es_avg = lobe_albedo(f0, ta);
+        let diffuse = m.base_color * (1.0 - es_o) * (1.0 - es_i) / (PI * max(1.0 - es_avg, vec3f(1e-4))) * wi.z;
+        let spec = g2_over * schlick(f0, dot(wo, h));
+        let ps = layer_spec_prob(m, es_o);
+        out.f_cos += w.x * (diffuse + spec);
+        out.pdf += w.x * (ps * vndf_pdf + (1.0 - ps) * cos_pdf);
+    }
+    if HAS_METAL && w.y > 0.0 {
+        let f0 = m.base_color;
+        let e_o = to.x + to.y;
+        let e_i = ti.x + ti.y;
+        let e_avg = ta.x + ta.y;
+        let f_avg = f0 + (schlick_f90(f0) - f0) / 21.0;
+        let f_ms = f_avg * f_avg * e_avg / (1.0 - f_avg * (1.0 - e_avg));
+        let ms = f_ms * (1.0 - e_o) * (1.0 - e_i) / (PI * max(1.0 - e_avg, 1e-4)) * wi.z;
+        let ss = g2_over * schlick(f0, dot(wo, h));
+        let q = select(metal_ss_prob(e_o), 1.0, lp.is_smooth);
+        out.f_cos += w.y * (ss + ms);
+        out.pdf += w.y * (q * vndf_pdf + (1.0 - q) * cos_pdf);
+    }
+    return out;
+}
+
+struct BsdfSample {
+    wi: vec3f,
+    // f * cos / pdf of the sampling actually done.
+    weight: vec3f,
+    // Solid-angle pdf for MIS; 0 for mirror, interface and glass samples (not light-sampled).
+    pdf: f32,
+    valid: bool,
+}
+
+fn sample_glass(m: Material, lp: LobeParams, wo: vec3f, u: vec3f) -> BsdfSample {
+    // Work on the side wo is on: flip z so that wo_l.z > 0.
+    let s = select(-1.0, 1.0, wo.z >= 0.0);
+    let wo_l = vec3f(wo.xy, abs(wo.z));
+    let eta = select(1.0 / m.ior, m.ior, s > 0.0);
+    var mh = vec3f(0.0, 0.0, 1.0);
+    if !lp.is_smooth {
+        mh = sample_vndf(wo_l, sqrt(sqrt(lp.a2)), u.xy);
+    }
+    let c = dot(wo_l, mh);
+    let f = fresnel_dielectric(c, eta);
+    var wi: vec3f;
+    var weight = vec3f(1.0);
+    if u.z < f {
+        wi = 2.0 * c * mh - wo_l;
+        // A reflection into the surface would scatter again on the microsurface; send it
+        // out mirrored instead, which keeps the energy (a multiple-scattering stand-in).
+        wi.z = abs(wi.z);
+    } else {
+        wi = refract(-wo_l, mh, 1.0 / eta);
+        wi.z = -abs(wi.z);
+        // Radiance is compressed into a smaller solid angle entering a denser medium.
+        weight = m.base_color / (eta * eta);
+    }
+    return BsdfSample(normalize(vec3f(wi.xy, wi.z * s)), weight, 0.0, true);
+}
+
+fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
+    var out = BsdfSample(vec3f(0.0, 0.0, 1.0), vec3f(0.0), 0.0, false);
+    let w = lobe_weights(m);
+    let lp = lobe_params(m);
+    if HAS_GLASS && u_lobe < w.z {
+        return sample_glass(m, lp, wo, u);
+    }
+    if wo.z <= 0.0 {
+        return out;
+    }
+    if !HAS_SPECULAR && !HAS_METAL {
+        // Lambertian: f cos / pdf = base_color for the dielectric share of the material.
+        out.wi = sample_cosine(vec3f(0.0, 0.0, 1.0), u.xy);
+        out.weight = m.base_color * (w.x / max(1.0 - w.z, 1e-6));
+        out.pdf = w.x * out.wi.z * INV_PI;
+        out.valid = out.wi.z > 0.0;
+        return out;
+    }
+    let to = ggx_albedo(wo.z, lp.roughness);
+    // Choose a sub-lobe: mirror-like (GGX or perfect mirror) or diffuse-like (cosine).
+    var p_mirror: f32;
+    var fresnel_f0: vec3f;
+    let v = (u_lobe - w.z) / max(1.0 - w.z, 1e-6);
+    if v * (w.x + w.y) < w.x {
+        fresnel_f0 = dielectric_f0(m);
+        p_mirror = w.x * layer_spec_prob(m, lobe_albedo(fresnel_f0, to));
+    } else {
+        fresnel_f0 = m.base_color;
+        p_mirror = w.y * select(metal_ss_prob(to.x + to.y), 1.0, lp.is_smooth);
+    }
+    let p_lobe = select(w.y, w.x, v * (w.x + w.y) < w.x);
+    let mirror = u.z * p_lobe < p_mirror;
+    if mirror && lp.is_smooth {
+        // Perfect mirror: a delta lobe, weighted by its Fresnel over its probability.
+        out.wi = vec3f(-wo.xy, wo.z);
+        out.weight = p_lobe * schlick(fresnel_f0, wo.z) / p_mirror;
+        out.valid = true;
+        return out;
+    }
+    var wi: vec3f;
+    if mirror {
+        let mh = sample_vndf(wo, sqrt(sqrt(lp.a2)), u.xy);
+        wi = 2.0 * dot(wo, mh) * mh - wo;
+    } else {
+        wi = sample_cosine(vec3f(0.0, 0.0, 1.0), u.xy);
+    }
+    if wi.z <= 0.0 {
+        return out;
+    }
+    let e = eval_bsdf(m, wo, wi);
+    if !(e.pdf > 0.0) {
+        return out;
+    }
+    out.wi = wi;
+    out.weight = e.f_cos / e.pdf;
+    out.pdf = e.pdf;
+    out.valid = true;
+    return out;
+}
