@@ -68,6 +68,12 @@ enum Command {
         #[arg(long)]
         markdown: bool,
     },
+    /// Open the node editor, optionally on a graph file.
+    #[command(after_help = "Example:\n  lumagraph edit graphs/post_tonemap.ron")]
+    Edit {
+        /// The graph file (RON) to open.
+        graph: Option<PathBuf>,
+    },
     /// Write the generated HDR test chart (the source of `assets/test_chart.exr`).
     #[command(hide = true)]
     TestChart {
@@ -176,6 +182,7 @@ fn run(cli: Cli) -> Result<()> {
             );
             Ok(())
         }
+        Command::Edit { graph } => Ok(lumagraph_editor::run(graph)?),
         Command::TestChart { out } => {
             let chart = image_io::test_chart();
             let bytes = image_io::encode_exr(&chart, true)?;
