@@ -582,10 +582,8 @@ impl Editor {
                 Dialog::Unsaved(then) => close = self.unsaved_dialog(ui, then),
             }
         });
-        if close || modal.should_close() {
-            if self.dialog.as_ref() == Some(&dialog) {
-                self.dialog = None;
-            }
+        if (close || modal.should_close()) && self.dialog.as_ref() == Some(&dialog) {
+            self.dialog = None;
         }
     }
 

@@ -18,6 +18,9 @@ use crate::document::Document;
 /// Horizontal gap used for nodes that have no position in the file.
 const AUTO_SPACING: f32 = 220.0;
 
+/// Each node's id, kind and position: when this changes, the snarl is rebuilt.
+type Layout = Vec<(String, String, Option<(f32, f32)>)>;
+
 /// What happened on the canvas that the app must act on.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CanvasEvent {
@@ -37,7 +40,7 @@ pub enum CanvasEvent {
 #[derive(Default)]
 pub struct Canvas {
     snarl: Snarl<String>,
-    built_from: Option<Vec<(String, String, Option<(f32, f32)>)>>,
+    built_from: Option<Layout>,
     built_edges: Vec<(String, String)>,
     auto_pos: HashMap<String, Pos2>,
     last_selection: Vec<NodeId>,
@@ -74,7 +77,7 @@ fn kind_of(graph: &Graph, id: &str) -> Option<&'static NodeKind> {
         .and_then(|n| Registry::builtin().get(&n.kind))
 }
 
-fn structure(graph: &Graph) -> Vec<(String, String, Option<(f32, f32)>)> {
+fn structure(graph: &Graph) -> Layout {
     graph
         .nodes
         .iter()

@@ -1,4 +1,4 @@
-//! The editor driven headless through egui_kittest on the shared wgpu device (lavapipe on
+//! The editor driven headless through `egui_kittest` on the shared wgpu device (lavapipe on
 //! a machine without a GPU): loading, editing through the UI, connection rules, undo,
 //! files, snapshots, and the preview against a headless render of the saved graph.
 
@@ -17,7 +17,7 @@ fn post_tonemap() -> std::path::PathBuf {
 
 #[test]
 fn loads_a_graph_and_previews_it() {
-    let Some(ed) = editor(Some(post_tonemap()), None) else {
+    let Some(ed) = editor(Some(&post_tonemap()), None) else {
         return;
     };
     let mut h = harness(ed);
@@ -37,7 +37,7 @@ fn loads_a_graph_and_previews_it() {
 
 #[test]
 fn a_param_changed_in_the_inspector_changes_the_model_without_a_rebuild() {
-    let Some(mut ed) = editor(Some(post_tonemap()), None) else {
+    let Some(mut ed) = editor(Some(&post_tonemap()), None) else {
         return;
     };
     ed.select(vec!["tonemap".into()]);
@@ -65,7 +65,7 @@ fn a_param_changed_in_the_inspector_changes_the_model_without_a_rebuild() {
 
 #[test]
 fn add_a_node_from_the_menu_and_connect_it() {
-    let Some(ed) = editor(Some(post_tonemap()), None) else {
+    let Some(ed) = editor(Some(&post_tonemap()), None) else {
         return;
     };
     let mut h = harness(ed);
@@ -104,7 +104,7 @@ fn add_a_node_from_the_menu_and_connect_it() {
 
 #[test]
 fn an_incompatible_connection_is_refused_with_the_reason() {
-    let Some(ed) = editor(Some(post_tonemap()), None) else {
+    let Some(ed) = editor(Some(&post_tonemap()), None) else {
         return;
     };
     let mut h = harness(ed);
@@ -132,7 +132,7 @@ fn an_incompatible_connection_is_refused_with_the_reason() {
 
 #[test]
 fn undo_and_redo_restore_the_graph() {
-    let Some(mut ed) = editor(Some(post_tonemap()), None) else {
+    let Some(mut ed) = editor(Some(&post_tonemap()), None) else {
         return;
     };
     ed.select(vec!["exposure".into()]);
@@ -164,7 +164,7 @@ fn undo_and_redo_restore_the_graph() {
 
 #[test]
 fn copy_paste_and_delete() {
-    let Some(mut ed) = editor(Some(post_tonemap()), None) else {
+    let Some(mut ed) = editor(Some(&post_tonemap()), None) else {
         return;
     };
     ed.select(vec!["exposure".into(), "tonemap".into()]);
@@ -188,7 +188,7 @@ fn copy_paste_and_delete() {
 
 #[test]
 fn save_and_reload_round_trip() {
-    let Some(mut ed) = editor(Some(post_tonemap()), None) else {
+    let Some(mut ed) = editor(Some(&post_tonemap()), None) else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
@@ -220,7 +220,7 @@ fn save_and_reload_round_trip() {
         Some(true)
     );
     // And the editor opens it again.
-    let ed2 = editor(Some(path), None).unwrap();
+    let ed2 = editor(Some(&path), None).unwrap();
     assert_eq!(ed2.doc.graph, reloaded);
     assert!(!ed2.doc.is_dirty());
 }
@@ -231,7 +231,7 @@ fn a_bad_file_opens_with_errors_not_a_crash() {
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.ron");
     std::fs::write(&bad, "(version: 1, nodes: [ (id: \"a\", kind: ").unwrap();
-    let ed = editor(Some(bad), None).unwrap();
+    let ed = editor(Some(&bad), None).unwrap();
     let mut h = harness(ed);
     let (msg, is_err) = h.state().message.clone().unwrap();
     assert!(is_err && msg.contains("bad.ron"), "{msg}");
@@ -260,7 +260,7 @@ fn a_bad_file_opens_with_errors_not_a_crash() {
 
 #[test]
 fn snapshot_of_the_editor() {
-    let Some(mut ed) = editor(Some(post_tonemap()), None) else {
+    let Some(mut ed) = editor(Some(&post_tonemap()), None) else {
         return;
     };
     ed.select(vec!["tonemap".into()]);

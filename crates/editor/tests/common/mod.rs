@@ -6,7 +6,7 @@
 
 #![allow(dead_code, reason = "each test binary uses a different subset")]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::LazyLock;
 
 use egui_kittest::{Harness, SnapshotOptions};
@@ -89,11 +89,11 @@ pub fn repo(rel: &str) -> PathBuf {
 }
 
 /// An editor on the shared device, with the recent-files list in `recent`.
-pub fn editor(graph: Option<PathBuf>, recent: Option<PathBuf>) -> Option<Editor> {
+pub fn editor(graph: Option<&Path>, recent: Option<PathBuf>) -> Option<Editor> {
     let gpu = gpu()?;
     Some(Editor::new(
         gpu,
-        graph.as_deref(),
+        graph,
         &EditorConfig {
             recent_store: recent,
         },
