@@ -175,7 +175,15 @@ impl Editor {
     /// Selects nodes (as a click on the canvas would) and previews the first one.
     pub fn select(&mut self, ids: Vec<String>) {
         if let Some(first) = ids.first() {
-            self.preview_port = self.port_for_node(first);
+            // Keep a port of this node chosen by clicking its pin; else its first output.
+            let chosen_here = self
+                .preview_port
+                .as_deref()
+                .and_then(split_port_ref)
+                .is_some_and(|(n, _)| n == first);
+            if !chosen_here {
+                self.preview_port = self.port_for_node(first);
+            }
         }
         self.selected = ids;
     }

@@ -159,15 +159,60 @@ impl Canvas {
             info,
             events: &mut events,
             search: &mut self.search,
+            rects: Vec::new(),
         };
         let style = SnarlStyle {
             collapsible: Some(false),
             ..SnarlStyle::new()
         };
+        let canvas_rect = ui.max_rect();
         SnarlWidget::new()
             .id(canvas_id())
             .style(style)
             .show(&mut self.snarl, &mut viewer, ui);
+        let rects = std::mem::take(&mut viewer.rects);
+
+        // A plain click selects a node (shift or ctrl adds or removes it); a click on
+        // empty canvas clears the selection. Snarl's own rectangle selection is followed
+        // below.
+        let (click, modifiers, pointer) = ui.input(|i| {
+            (
+                i.pointer.primary_clicked(),
+                i.modifiers,
+                i.pointer.interact_pos(),
+            )
+        });
+        // Only clicks that land on the canvas itself, not on a menu above it.
+        let on_canvas = pointer.is_some_and(|p| {
+            canvas_rect.contains(p)
+                && ui
+                    .ctx()
+                    .layer_id_at(p)
+                    .is_some_and(|l| l.id == canvas_id() || l == ui.layer_id())
+        });
+        let click = click && on_canvas;
+        let clicked = pointer
+            .filter(|_| click)
+            .and_then(|p| rects.iter().rev().find(|(_, r)| r.contains(p)))
+            .map(|(id, _)| id.clone());
+        let node_clicked = clicked.is_some();
+        if let Some(id) = clicked {
+            let mut ids = if modifiers.shift || modifiers.command {
+                let mut ids = info.selected.to_vec();
+                if let Some(i) = ids.iter().position(|s| *s == id) {
+                    ids.remove(i);
+                } else {
+                    ids.push(id);
+                }
+                ids
+            } else {
+                vec![id]
+            };
+            ids.dedup();
+            events.push(CanvasEvent::Select(ids));
+        } else if click && !info.selected.is_empty() {
+            events.push(CanvasEvent::Select(Vec::new()));
+        }
 
         // Positions back into the graph (one undo step per drag).
         let moves: Vec<(String, (f32, f32))> = self
@@ -188,7 +233,7 @@ impl Canvas {
         }
 
         let selected = egui_snarl::ui::get_selected_nodes(canvas_id(), ui.ctx());
-        if selected != self.last_selection {
+        if selected != self.last_selection && !node_clicked {
             let ids = selected
                 .iter()
                 .filter_map(|n| self.snarl.get_node(*n).cloned())
@@ -218,6 +263,8 @@ struct Viewer<'a, 'i> {
     info: &'a NodeInfo<'i>,
     events: &'a mut Vec<CanvasEvent>,
     search: &'a mut String,
+    /// Each node's rectangle on screen, in drawing order (topmost last).
+    rects: Vec<(String, egui::Rect)>,
 }
 
 impl Viewer<'_, '_> {
@@ -423,6 +470,20 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
             ui.weak(format!("GPU {ms:.2} ms"))
                 .on_hover_text("GPU time of this node's passes in the last preview frame");
         }
+    }
+
+    fn final_node_rect(
+        &mut self,
+        node: NodeId,
+        rect: egui::Rect,
+        ui: &mut Ui,
+        snarl: &mut Snarl<String>,
+    ) {
+        let global = ui
+            .ctx()
+            .layer_transform_to_global(ui.layer_id())
+            .map_or(rect, |t| t * rect);
+        self.rects.push((snarl[node].clone(), global));
     }
 
     fn has_graph_menu(&mut self, _pos: Pos2, _snarl: &mut Snarl<String>) -> bool {

@@ -338,3 +338,31 @@ fn a_chain_built_in_the_editor_renders_headless_like_its_preview() {
     assert!(max_diff <= 1, "preview and render differ by {max_diff}/255");
     assert_eq!(max_diff, 0, "expected identical pixels");
 }
+
+#[test]
+fn clicking_a_node_selects_it() {
+    let Some(ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    let mut h = harness(ed);
+    // The canvas is a transformed scene whose accesskit bounds kittest does not map, so
+    // click where the node is drawn at the default zoom: the tonemap node's header.
+    click_at(&mut h, egui::pos2(500.0, 316.0));
+    assert_eq!(h.state().selected, vec!["tonemap".to_owned()]);
+    h.get_by_role_and_label(Role::ComboBox, "operator");
+}
+
+fn click_at(h: &mut egui_kittest::Harness<'_, lumagraph_editor::Editor>, pos: egui::Pos2) {
+    h.hover_at(pos);
+    h.run_ok();
+    for pressed in [true, false] {
+        h.event(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+        h.step();
+    }
+    h.run_ok();
+}
