@@ -366,3 +366,54 @@ fn click_at(h: &mut egui_kittest::Harness<'_, lumagraph_editor::Editor>, pos: eg
     }
     h.run_ok();
 }
+
+/// Closing with unsaved changes asks first; a clean document closes at once.
+#[test]
+fn closing_with_unsaved_changes_asks_first() {
+    let Some(mut ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    assert!(ed.on_close_requested());
+    ed.doc.set_param("exposure", "ev", ParamValue::Float(0.5));
+    assert!(!ed.on_close_requested());
+    let mut h = harness(ed);
+    h.get_by_label("Unsaved changes");
+    h.get_by_label("Discard").click();
+    h.run_ok();
+    assert!(h.state().quit_confirmed && h.state().wants_close);
+}
+
+/// Time of a param edit (compile, `update_params`, frame, readback) against a rebuild,
+/// printed for the docs; asserts only that a param edit does not rebuild.
+#[test]
+fn param_edits_are_cheaper_than_rebuilds() {
+    let Some(mut ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    let base = ed.doc.base_dir();
+    let port = Some("tonemap.color");
+    let t = std::time::Instant::now();
+    ed.preview.update(&ed.doc.graph, &base, port);
+    let first = t.elapsed();
+    let n: u32 = 10;
+    let t = std::time::Instant::now();
+    for i in 0..n {
+        ed.doc
+            .set_param("exposure", "ev", ParamValue::Float(f64::from(i + 1) * 0.1));
+        assert!(ed.preview.update(&ed.doc.graph, &base, port));
+    }
+    let per_edit = t.elapsed() / n;
+    let s = &ed.preview.stats;
+    eprintln!(
+        "preview 512x256: first (build + shader compile) {:.1} ms; param edit {:.1} ms \
+         (last frame {:.1} ms, readback+encode {:.1} ms); rebuilds {}, param updates {}",
+        first.as_secs_f64() * 1e3,
+        per_edit.as_secs_f64() * 1e3,
+        s.frame_ms,
+        s.readback_ms,
+        s.rebuilds,
+        s.param_updates
+    );
+    assert_eq!(s.rebuilds, 1);
+    assert_eq!(s.param_updates, u64::from(n));
+}
