@@ -94,6 +94,12 @@ enum Command {
         #[arg(long, default_value_t = 3)]
         runs: u32,
     },
+    /// Open the node editor, optionally on a graph file.
+    #[command(after_help = "Example:\n  lumagraph edit graphs/post_tonemap.ron")]
+    Edit {
+        /// The graph file (RON) to open.
+        graph: Option<PathBuf>,
+    },
     /// Write the generated HDR test chart (the source of `assets/test_chart.exr`).
     #[command(hide = true)]
     TestChart {
@@ -358,6 +364,7 @@ fn run(cli: Cli) -> Result<()> {
             let loaded = load_scene(Some(&scene))?.context("no scene")?;
             bench::run(&loaded.gpu, spp, runs)
         }
+        Command::Edit { graph } => Ok(lumagraph_editor::run(graph)?),
         Command::TestChart { out } => {
             let chart = image_io::test_chart();
             let bytes = image_io::encode_exr(&chart, true)?;

@@ -166,6 +166,38 @@ impl Executor {
         }
     }
 
+    /// Takes a recompiled plan that differs from the current one only in params: each
+    /// node whose params changed gets [`NodeExec::update`] (a uniform write, a file
+    /// reload), and no pipeline, texture or node is recreated. Nodes whose params did not
+    /// change are not touched, so state they keep across frames (a progressive
+    /// accumulation) survives edits elsewhere in the graph.
+    ///
+    /// Returns `Ok(false)`, keeping the current plan, when the structure differs (other
+    /// passes, ports, sizes or texture assignment): the caller must build a new executor.
+    ///
+    /// # Errors
+    /// When a node cannot apply its new params; the error names the node. The plan is
+    /// then left as it was for the nodes not yet updated, so build a new executor.
+    pub fn update_params(&mut self, plan: Plan) -> Result<bool> {
+        if !same_structure(&self.plan, &plan) {
+            return Ok(false);
+        }
+        for ((old, new), node) in self
+            .plan
+            .passes
+            .iter()
+            .zip(&plan.passes)
+            .zip(&mut self.nodes)
+        {
+            if old.params != new.params {
+                node.update(&self.ctx, new)
+                    .map_err(|e| e.in_node(&new.node))?;
+            }
+        }
+        self.plan = plan;
+        Ok(true)
+    }
+
     /// Records, submits and finishes one frame.
     ///
     /// # Errors
@@ -340,4 +372,32 @@ fn every_frame(plan: &Plan) -> Vec<bool> {
         }
     }
     flags
+}
+
+/// Whether two plans run the same passes on the same textures (params aside).
+fn same_structure(a: &Plan, b: &Plan) -> bool {
+    let passes = a.passes.len() == b.passes.len()
+        && a.passes.iter().zip(&b.passes).all(|(p, q)| {
+            p.node == q.node
+                && p.kind == q.kind
+                && p.inputs == q.inputs
+                && p.outputs == q.outputs
+                && p.extent == q.extent
+        });
+    let textures = a.textures.len() == b.textures.len()
+        && a.textures.iter().zip(&b.textures).all(|(s, t)| {
+            s.name == t.name
+                && s.ty == t.ty
+                && s.format == t.format
+                && s.extent == t.extent
+                && s.first == t.first
+                && s.last == t.last
+                && s.slot == t.slot
+        });
+    let slots = a.slots.len() == b.slots.len()
+        && a.slots
+            .iter()
+            .zip(&b.slots)
+            .all(|(s, t)| s.format == t.format && s.extent == t.extent && s.textures == t.textures);
+    passes && textures && slots
 }

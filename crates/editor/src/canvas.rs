@@ -1,0 +1,564 @@
+//! The canvas: an egui-snarl view of the document's graph.
+//!
+//! The snarl holds only node ids; it is rebuilt from the [`Graph`] whenever the graph's
+//! nodes or edges change (an edit, an undo, a paste), and every user action on it (a wire
+//! made or cut, a node added, moved or deleted) goes to the [`Document`] first, where it
+//! is checked against the registry and recorded for undo. Pins, menus and node labels
+//! all come from the registry, so new node kinds appear without editor changes.
+
+use std::collections::{BTreeMap, HashMap};
+
+use egui::{Color32, Pos2, RichText, Ui, pos2};
+use egui_snarl::ui::{PinInfo, SnarlPin, SnarlStyle, SnarlViewer, SnarlWidget};
+use egui_snarl::{InPin, InPinId, NodeId, OutPin, OutPinId, Snarl};
+use lumagraph_graph::{Category, Graph, NodeKind, PortType, Registry, split_port_ref};
+
+use crate::document::Document;
+
+/// Horizontal gap used for nodes that have no position in the file.
+const AUTO_SPACING: f32 = 220.0;
+
+/// Each node's id, kind and position: when this changes, the snarl is rebuilt.
+type Layout = Vec<(String, String, Option<(f32, f32)>)>;
+
+/// What happened on the canvas that the app must act on.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CanvasEvent {
+    /// The user selected these nodes on the canvas.
+    Select(Vec<String>),
+    /// Preview this output port.
+    Preview(String),
+    /// An edit was refused; the message says why.
+    Refused(String),
+    /// Delete these nodes.
+    Delete(Vec<String>),
+    /// A node was added from the menu.
+    Added(String),
+}
+
+/// The snarl view and what it was built from.
+#[derive(Default)]
+pub struct Canvas {
+    snarl: Snarl<String>,
+    built_from: Option<Layout>,
+    built_edges: Vec<(String, String)>,
+    auto_pos: HashMap<String, Pos2>,
+    last_selection: Vec<NodeId>,
+    /// The add-node menu's search text.
+    pub search: String,
+}
+
+impl std::fmt::Debug for Canvas {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Canvas").finish_non_exhaustive()
+    }
+}
+
+/// The id of the canvas widget (its selection is kept under it).
+pub fn canvas_id() -> egui::Id {
+    egui::Id::new("lumagraph-canvas")
+}
+
+/// A color per port type, for pins and wires.
+pub fn port_color(ty: PortType) -> Color32 {
+    match ty {
+        PortType::HdrColor => Color32::from_rgb(240, 170, 60),
+        PortType::LdrColor => Color32::from_rgb(120, 200, 110),
+        PortType::Albedo => Color32::from_rgb(200, 120, 200),
+        PortType::Normal => Color32::from_rgb(100, 150, 240),
+        PortType::Depth => Color32::from_rgb(170, 170, 170),
+        _ => Color32::from_rgb(220, 90, 90),
+    }
+}
+
+fn kind_of(graph: &Graph, id: &str) -> Option<&'static NodeKind> {
+    graph
+        .node(id)
+        .and_then(|n| Registry::builtin().get(&n.kind))
+}
+
+fn structure(graph: &Graph) -> Layout {
+    graph
+        .nodes
+        .iter()
+        .map(|n| (n.id.clone(), n.kind.clone(), n.pos))
+        .collect()
+}
+
+fn edges(graph: &Graph) -> Vec<(String, String)> {
+    graph
+        .edges
+        .iter()
+        .map(|e| (e.from.clone(), e.to.clone()))
+        .collect()
+}
+
+impl Canvas {
+    /// Rebuilds the snarl when the graph's nodes, positions or edges changed.
+    fn sync(&mut self, graph: &Graph) {
+        let s = structure(graph);
+        let e = edges(graph);
+        if self.built_from.as_ref() == Some(&s) && self.built_edges == e {
+            return;
+        }
+        let mut snarl = Snarl::new();
+        let mut ids = HashMap::new();
+        self.auto_pos.clear();
+        for (i, n) in graph.nodes.iter().enumerate() {
+            #[expect(clippy::cast_precision_loss, reason = "node counts are small")]
+            let pos = n
+                .pos
+                .map_or_else(|| pos2(i as f32 * AUTO_SPACING, 0.0), |(x, y)| pos2(x, y));
+            if n.pos.is_none() {
+                self.auto_pos.insert(n.id.clone(), pos);
+            }
+            ids.insert(n.id.clone(), snarl.insert_node(pos, n.id.clone()));
+        }
+        for edge in &graph.edges {
+            let (Some((fnode, fport)), Some((tnode, tport))) =
+                (split_port_ref(&edge.from), split_port_ref(&edge.to))
+            else {
+                continue;
+            };
+            let (Some(fk), Some(tk)) = (kind_of(graph, fnode), kind_of(graph, tnode)) else {
+                continue;
+            };
+            let (Some(o), Some(i)) = (
+                fk.outputs.iter().position(|p| p.name == fport),
+                tk.inputs.iter().position(|p| p.name == tport),
+            ) else {
+                continue;
+            };
+            snarl.connect(
+                OutPinId {
+                    node: ids[fnode],
+                    output: o,
+                },
+                InPinId {
+                    node: ids[tnode],
+                    input: i,
+                },
+            );
+        }
+        self.snarl = snarl;
+        self.built_from = Some(s);
+        self.built_edges = e;
+    }
+
+    /// Shows the canvas; edits go to `doc`, other outcomes come back as events.
+    pub fn show(
+        &mut self,
+        ui: &mut Ui,
+        doc: &mut Document,
+        info: &NodeInfo<'_>,
+    ) -> Vec<CanvasEvent> {
+        self.sync(&doc.graph);
+        let mut events = Vec::new();
+        let mut viewer = Viewer {
+            doc,
+            info,
+            events: &mut events,
+            search: &mut self.search,
+            rects: Vec::new(),
+        };
+        let style = SnarlStyle {
+            collapsible: Some(false),
+            ..SnarlStyle::new()
+        };
+        let canvas_rect = ui.max_rect();
+        SnarlWidget::new()
+            .id(canvas_id())
+            .style(style)
+            .show(&mut self.snarl, &mut viewer, ui);
+        let rects = std::mem::take(&mut viewer.rects);
+
+        // A plain click selects a node (shift or ctrl adds or removes it); a click on
+        // empty canvas clears the selection. Snarl's own rectangle selection is followed
+        // below.
+        let (click, modifiers, pointer) = ui.input(|i| {
+            (
+                i.pointer.primary_clicked(),
+                i.modifiers,
+                i.pointer.interact_pos(),
+            )
+        });
+        // Only clicks that land on the canvas itself, not on a menu above it.
+        let on_canvas = pointer.is_some_and(|p| {
+            canvas_rect.contains(p)
+                && ui
+                    .ctx()
+                    .layer_id_at(p)
+                    .is_some_and(|l| l.id == canvas_id() || l == ui.layer_id())
+        });
+        let click = click && on_canvas;
+        let clicked = pointer
+            .filter(|_| click)
+            .and_then(|p| rects.iter().rev().find(|(_, r)| r.contains(p)))
+            .map(|(id, _)| id.clone());
+        let node_clicked = clicked.is_some();
+        if let Some(id) = clicked {
+            let mut ids = if modifiers.shift || modifiers.command {
+                let mut ids = info.selected.to_vec();
+                if let Some(i) = ids.iter().position(|s| *s == id) {
+                    ids.remove(i);
+                } else {
+                    ids.push(id);
+                }
+                ids
+            } else {
+                vec![id]
+            };
+            ids.dedup();
+            events.push(CanvasEvent::Select(ids));
+        } else if click && !info.selected.is_empty() {
+            events.push(CanvasEvent::Select(Vec::new()));
+        }
+
+        // Positions back into the graph (one undo step per drag).
+        let moves: Vec<(String, (f32, f32))> = self
+            .snarl
+            .nodes_pos_ids()
+            .filter(|(_, pos, id)| {
+                let graph_pos = doc.graph.node(id).and_then(|n| n.pos);
+                match graph_pos {
+                    Some((x, y)) => pos2(x, y) != *pos,
+                    None => self.auto_pos.get(*id) != Some(pos),
+                }
+            })
+            .map(|(_, pos, id)| (id.clone(), (pos.x, pos.y)))
+            .collect();
+        if !moves.is_empty() {
+            doc.move_nodes(&moves);
+            self.built_from = Some(structure(&doc.graph));
+        }
+
+        let selected = egui_snarl::ui::get_selected_nodes(canvas_id(), ui.ctx());
+        if selected != self.last_selection && !node_clicked {
+            let ids = selected
+                .iter()
+                .filter_map(|n| self.snarl.get_node(*n).cloned())
+                .collect();
+            events.push(CanvasEvent::Select(ids));
+            self.last_selection = selected;
+        }
+        events
+    }
+}
+
+/// What the canvas shows on nodes besides the graph itself.
+#[derive(Debug)]
+pub struct NodeInfo<'a> {
+    /// Compile errors per node id.
+    pub errors: &'a BTreeMap<String, Vec<String>>,
+    /// GPU ms per node id, from the last preview frame.
+    pub pass_ms: &'a BTreeMap<String, f64>,
+    /// The previewed port.
+    pub preview: Option<&'a str>,
+    /// Nodes selected in the app (highlighted header).
+    pub selected: &'a [String],
+}
+
+struct Viewer<'a, 'i> {
+    doc: &'a mut Document,
+    info: &'a NodeInfo<'i>,
+    events: &'a mut Vec<CanvasEvent>,
+    search: &'a mut String,
+    /// Each node's rectangle on screen, in drawing order (topmost last).
+    rects: Vec<(String, egui::Rect)>,
+}
+
+impl Viewer<'_, '_> {
+    fn kind(&self, id: &str) -> Option<&'static NodeKind> {
+        kind_of(&self.doc.graph, id)
+    }
+
+    fn out_ref(&self, snarl: &Snarl<String>, pin: OutPinId) -> Option<String> {
+        let id = snarl.get_node(pin.node)?;
+        let port = self.kind(id)?.outputs.get(pin.output)?.name;
+        Some(format!("{id}.{port}"))
+    }
+
+    fn in_ref(&self, snarl: &Snarl<String>, pin: InPinId) -> Option<String> {
+        let id = snarl.get_node(pin.node)?;
+        let port = self.kind(id)?.inputs.get(pin.input)?.name;
+        Some(format!("{id}.{port}"))
+    }
+}
+
+/// The add-node menu: a search field and the registry's kinds grouped by category.
+/// Returns the kind picked.
+pub fn add_node_menu(ui: &mut Ui, search: &mut String) -> Option<&'static str> {
+    ui.add(egui::TextEdit::singleline(search).hint_text("search nodes"))
+        .request_focus();
+    let needle = search.to_lowercase();
+    let reg = Registry::builtin();
+    let mut by_cat: BTreeMap<Category, Vec<&NodeKind>> = BTreeMap::new();
+    for k in reg.kinds() {
+        if needle.is_empty()
+            || k.name.to_lowercase().contains(&needle)
+            || k.doc.to_lowercase().contains(&needle)
+        {
+            by_cat.entry(k.category).or_default().push(k);
+        }
+    }
+    let mut picked = None;
+    if by_cat.is_empty() {
+        ui.weak("no node matches");
+    }
+    for (cat, kinds) in by_cat {
+        ui.label(RichText::new(cat.name()).strong());
+        for k in kinds {
+            if ui.button(k.name).on_hover_text(k.doc).clicked() {
+                picked = Some(k.name);
+            }
+        }
+    }
+    if picked.is_some() {
+        search.clear();
+        ui.close();
+    }
+    picked
+}
+
+impl SnarlViewer<String> for Viewer<'_, '_> {
+    fn title(&mut self, node: &String) -> String {
+        node.clone()
+    }
+
+    fn node_frame(
+        &mut self,
+        default: egui::Frame,
+        node: NodeId,
+        _inputs: &[InPin],
+        _outputs: &[OutPin],
+        snarl: &Snarl<String>,
+    ) -> egui::Frame {
+        let id = &snarl[node];
+        if self.info.errors.contains_key(id) {
+            default.stroke(egui::Stroke::new(2.0, Color32::from_rgb(230, 60, 60)))
+        } else if self.info.selected.contains(id) {
+            default.stroke(egui::Stroke::new(2.0, Color32::from_rgb(90, 160, 255)))
+        } else {
+            default
+        }
+    }
+
+    fn show_header(
+        &mut self,
+        node: NodeId,
+        _inputs: &[InPin],
+        _outputs: &[OutPin],
+        ui: &mut Ui,
+        snarl: &mut Snarl<String>,
+    ) {
+        let id = snarl[node].clone();
+        let kind = self
+            .doc
+            .graph
+            .node(&id)
+            .map(|n| n.kind.clone())
+            .unwrap_or_default();
+        ui.horizontal(|ui| {
+            ui.label(RichText::new(&id).strong());
+            let weak = ui.weak(&kind);
+            if let Some(k) = self.kind(&id) {
+                weak.on_hover_text(k.doc);
+            }
+            if let Some(errs) = self.info.errors.get(&id) {
+                ui.colored_label(Color32::from_rgb(230, 60, 60), "⚠")
+                    .on_hover_text(errs.join("\n"));
+            }
+        });
+    }
+
+    fn inputs(&mut self, node: &String) -> usize {
+        self.kind(node).map_or(0, |k| k.inputs.len())
+    }
+
+    fn outputs(&mut self, node: &String) -> usize {
+        self.kind(node).map_or(0, |k| k.outputs.len())
+    }
+
+    fn show_input(
+        &mut self,
+        pin: &InPin,
+        ui: &mut Ui,
+        snarl: &mut Snarl<String>,
+    ) -> impl SnarlPin + 'static {
+        let Some(def) = self
+            .kind(&snarl[pin.id.node])
+            .and_then(|k| k.inputs.get(pin.id.input))
+        else {
+            return PinInfo::circle();
+        };
+        let types: Vec<_> = def.accepts.iter().map(|t| t.name()).collect();
+        ui.label(def.name)
+            .on_hover_text(format!("{}\naccepts {}", def.doc, types.join(" or ")));
+        let fill = if def.accepts.len() == 1 {
+            port_color(def.accepts[0])
+        } else {
+            Color32::GRAY
+        };
+        PinInfo::circle().with_fill(fill)
+    }
+
+    fn show_output(
+        &mut self,
+        pin: &OutPin,
+        ui: &mut Ui,
+        snarl: &mut Snarl<String>,
+    ) -> impl SnarlPin + 'static {
+        let id = snarl[pin.id.node].clone();
+        let Some(def) = self.kind(&id).and_then(|k| k.outputs.get(pin.id.output)) else {
+            return PinInfo::circle();
+        };
+        let port = format!("{id}.{}", def.name);
+        let shown = self.info.preview == Some(port.as_str());
+        let label = if shown {
+            format!("👁 {}", def.name)
+        } else {
+            def.name.to_owned()
+        };
+        if ui
+            .selectable_label(shown, label)
+            .on_hover_text(format!(
+                "{}\nproduces {}\nclick to preview",
+                def.doc, def.ty
+            ))
+            .clicked()
+        {
+            self.events.push(CanvasEvent::Preview(port));
+        }
+        PinInfo::circle()
+            .with_fill(port_color(def.ty))
+            .with_wire_color(port_color(def.ty))
+    }
+
+    fn has_body(&mut self, node: &String) -> bool {
+        self.info.errors.contains_key(node)
+    }
+
+    fn show_body(
+        &mut self,
+        node: NodeId,
+        _inputs: &[InPin],
+        _outputs: &[OutPin],
+        ui: &mut Ui,
+        snarl: &mut Snarl<String>,
+    ) {
+        if let Some(errs) = self.info.errors.get(&snarl[node]) {
+            ui.set_max_width(240.0);
+            for e in errs {
+                ui.colored_label(Color32::from_rgb(230, 80, 80), e);
+            }
+        }
+    }
+
+    fn has_footer(&mut self, node: &String) -> bool {
+        self.info.pass_ms.contains_key(node)
+    }
+
+    fn show_footer(
+        &mut self,
+        node: NodeId,
+        _inputs: &[InPin],
+        _outputs: &[OutPin],
+        ui: &mut Ui,
+        snarl: &mut Snarl<String>,
+    ) {
+        if let Some(ms) = self.info.pass_ms.get(&snarl[node]) {
+            ui.weak(format!("GPU {ms:.2} ms"))
+                .on_hover_text("GPU time of this node's passes in the last preview frame");
+        }
+    }
+
+    fn final_node_rect(
+        &mut self,
+        node: NodeId,
+        rect: egui::Rect,
+        ui: &mut Ui,
+        snarl: &mut Snarl<String>,
+    ) {
+        let global = ui
+            .ctx()
+            .layer_transform_to_global(ui.layer_id())
+            .map_or(rect, |t| t * rect);
+        self.rects.push((snarl[node].clone(), global));
+    }
+
+    fn has_graph_menu(&mut self, _pos: Pos2, _snarl: &mut Snarl<String>) -> bool {
+        true
+    }
+
+    fn show_graph_menu(&mut self, pos: Pos2, ui: &mut Ui, _snarl: &mut Snarl<String>) {
+        ui.label("Add node");
+        if let Some(kind) = add_node_menu(ui, self.search) {
+            match self.doc.add_node(kind, Some((pos.x, pos.y))) {
+                Ok(id) => self.events.push(CanvasEvent::Added(id)),
+                Err(e) => self.events.push(CanvasEvent::Refused(e)),
+            }
+        }
+    }
+
+    fn has_node_menu(&mut self, _node: &String) -> bool {
+        true
+    }
+
+    fn show_node_menu(
+        &mut self,
+        node: NodeId,
+        _inputs: &[InPin],
+        _outputs: &[OutPin],
+        ui: &mut Ui,
+        snarl: &mut Snarl<String>,
+    ) {
+        let id = snarl[node].clone();
+        if let Some(k) = self.kind(&id) {
+            for o in k.outputs {
+                if ui.button(format!("Preview {}", o.name)).clicked() {
+                    self.events
+                        .push(CanvasEvent::Preview(format!("{id}.{}", o.name)));
+                    ui.close();
+                }
+            }
+        }
+        if ui.button("Delete").clicked() {
+            self.events.push(CanvasEvent::Delete(vec![id]));
+            ui.close();
+        }
+    }
+
+    fn connect(&mut self, from: &OutPin, to: &InPin, snarl: &mut Snarl<String>) {
+        let (Some(f), Some(t)) = (self.out_ref(snarl, from.id), self.in_ref(snarl, to.id)) else {
+            return;
+        };
+        match self.doc.connect(&f, &t) {
+            Ok(()) => {
+                snarl.drop_inputs(to.id);
+                snarl.connect(from.id, to.id);
+            }
+            Err(why) => self.events.push(CanvasEvent::Refused(why)),
+        }
+    }
+
+    fn disconnect(&mut self, from: &OutPin, to: &InPin, snarl: &mut Snarl<String>) {
+        if let (Some(f), Some(t)) = (self.out_ref(snarl, from.id), self.in_ref(snarl, to.id)) {
+            self.doc.disconnect(&f, &t);
+        }
+        snarl.disconnect(from.id, to.id);
+    }
+
+    fn drop_outputs(&mut self, pin: &OutPin, snarl: &mut Snarl<String>) {
+        if let Some(p) = self.out_ref(snarl, pin.id) {
+            self.doc.disconnect_port(&p);
+        }
+        snarl.drop_outputs(pin.id);
+    }
+
+    fn drop_inputs(&mut self, pin: &InPin, snarl: &mut Snarl<String>) {
+        if let Some(p) = self.in_ref(snarl, pin.id) {
+            self.doc.disconnect_port(&p);
+        }
+        snarl.drop_inputs(pin.id);
+    }
+}

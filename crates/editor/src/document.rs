@@ -1,0 +1,377 @@
+//! The document: the [`Graph`] being edited (the source of truth), its file, and every
+//! edit the editor can make, each checked against the registry and recorded for undo.
+//!
+//! The canvas, the inspector and the tests all edit through these methods, so what the
+//! UI can do and what the tests check is one code path. The canvas (egui-snarl) is only a
+//! view rebuilt from this graph: the file keeps its node and edge order.
+
+use std::collections::{BTreeMap, HashSet};
+use std::path::{Path, PathBuf};
+
+use lumagraph_graph::{Edge, ErrorKind, Graph, Node, ParamValue, Registry, split_port_ref};
+
+use crate::undo::History;
+
+/// A graph being edited.
+#[derive(Debug, Default)]
+pub struct Document {
+    /// The graph: what is saved, compiled and previewed.
+    pub graph: Graph,
+    /// The file it was opened from or last saved to.
+    pub path: Option<PathBuf>,
+    saved: Graph,
+    history: History,
+}
+
+/// Where a new node goes when none is given: right of the rightmost node.
+const NODE_SPACING: f32 = 220.0;
+
+impl Document {
+    /// A document for `graph`, as if just opened from `path`.
+    pub fn new(graph: Graph, path: Option<PathBuf>) -> Self {
+        Self {
+            saved: graph.clone(),
+            graph,
+            path,
+            history: History::default(),
+        }
+    }
+
+    /// Whether the graph differs from the file.
+    pub fn is_dirty(&self) -> bool {
+        self.graph != self.saved || (self.path.is_none() && !self.graph.nodes.is_empty())
+    }
+
+    /// Marks the current graph as saved to `path`.
+    pub fn mark_saved(&mut self, path: PathBuf) {
+        self.saved = self.graph.clone();
+        self.path = Some(path);
+    }
+
+    /// The folder relative input paths are resolved against.
+    pub fn base_dir(&self) -> PathBuf {
+        self.path
+            .as_deref()
+            .and_then(Path::parent)
+            .map(Path::to_path_buf)
+            .unwrap_or_default()
+    }
+
+    /// The registry the document is checked against.
+    pub fn registry() -> &'static Registry {
+        Registry::builtin()
+    }
+
+    fn record(&mut self, key: Option<&str>) {
+        self.history.record(&self.graph, key);
+    }
+
+    /// Ends a gesture (pointer released): the next slider or drag edit is a new undo step.
+    pub fn end_gesture(&mut self) {
+        self.history.end_gesture();
+    }
+
+    /// Undoes the last edit; returns whether there was one.
+    pub fn undo(&mut self) -> bool {
+        match self.history.undo(&self.graph) {
+            Some(g) => {
+                self.restore(g);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Redoes the last undone edit; returns whether there was one.
+    pub fn redo(&mut self) -> bool {
+        match self.history.redo(&self.graph) {
+            Some(g) => {
+                self.restore(g);
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn restore(&mut self, g: Graph) {
+        // Keep the origin (base folder, error locations) of the current graph.
+        let origin = self.graph.origin.take();
+        self.graph = g;
+        self.graph.origin = origin;
+    }
+
+    /// Whether undo / redo would do something.
+    pub fn can_undo_redo(&self) -> (bool, bool) {
+        (self.history.can_undo(), self.history.can_redo())
+    }
+
+    /// A node id not used yet, from `base` (`exposure`, `exposure_2`, ...).
+    pub fn unique_id(&self, base: &str) -> String {
+        let base: String = base
+            .chars()
+            .filter(|c| c.is_ascii_alphanumeric() || *c == '_' || *c == '-')
+            .collect::<String>()
+            .to_lowercase();
+        let base = if base.is_empty() { "node".into() } else { base };
+        let taken: HashSet<&str> = self.graph.nodes.iter().map(|n| n.id.as_str()).collect();
+        if !taken.contains(base.as_str()) {
+            return base;
+        }
+        (2..)
+            .map(|i| format!("{base}_{i}"))
+            .find(|id| !taken.contains(id.as_str()))
+            .unwrap_or(base)
+    }
+
+    /// Adds a node of `kind` with default params at `pos` (or right of the others).
+    ///
+    /// # Errors
+    /// When the registry has no such kind.
+    pub fn add_node(&mut self, kind: &str, pos: Option<(f32, f32)>) -> Result<String, String> {
+        if Self::registry().get(kind).is_none() {
+            return Err(format!("unknown node kind \"{kind}\""));
+        }
+        let pos = pos.unwrap_or_else(|| {
+            let x = self
+                .graph
+                .nodes
+                .iter()
+                .filter_map(|n| n.pos)
+                .map(|p| p.0)
+                .fold(None, |m: Option<f32>, x| Some(m.map_or(x, |m| m.max(x))));
+            (x.map_or(0.0, |x| x + NODE_SPACING), 0.0)
+        });
+        self.record(None);
+        let id = self.unique_id(kind);
+        let mut node = Node::new(id.clone(), kind);
+        node.pos = Some(pos);
+        self.graph.nodes.push(node);
+        Ok(id)
+    }
+
+    /// Why an edge `from` → `to` (each `"node.port"`) cannot be made, in the compiler's
+    /// words; `None` when it can.
+    pub fn check_edge(&self, from: &str, to: &str) -> Option<String> {
+        let reg = Self::registry();
+        let (Some((fnode, fport)), Some((tnode, tport))) =
+            (split_port_ref(from), split_port_ref(to))
+        else {
+            return Some(ErrorKind::BadPortRef(format!("{from} -> {to}")).to_string());
+        };
+        let kind_of = |id: &str| {
+            self.graph
+                .node(id)
+                .and_then(|n| reg.get(&n.kind))
+                .ok_or_else(|| format!("edge {from} -> {to}: no node \"{id}\" of a known kind"))
+        };
+        let (fk, tk) = match (kind_of(fnode), kind_of(tnode)) {
+            (Ok(f), Ok(t)) => (f, t),
+            (Err(e), _) | (_, Err(e)) => return Some(e),
+        };
+        let Some(out) = fk.output(fport) else {
+            return Some(format!("{} has no output port \"{fport}\"", fk.name));
+        };
+        let Some(inp) = tk.input(tport) else {
+            return Some(format!("{} has no input port \"{tport}\"", tk.name));
+        };
+        if !inp.accepts.contains(&out.ty) {
+            let accepted: Vec<_> = inp.accepts.iter().map(|t| t.name()).collect();
+            return Some(
+                ErrorKind::IncompatibleTypes {
+                    from: from.to_owned(),
+                    to: to.to_owned(),
+                    produced: out.ty.name().to_owned(),
+                    accepted: accepted.join(" or "),
+                }
+                .to_string(),
+            );
+        }
+        if fnode == tnode || self.reaches(tnode, fnode) {
+            return Some(format!(
+                "edge {from} -> {to}: it would make a cycle ({tnode} already feeds {fnode})"
+            ));
+        }
+        None
+    }
+
+    /// Whether data flows from node `a` to node `b` along edges.
+    fn reaches(&self, a: &str, b: &str) -> bool {
+        let mut stack = vec![a.to_owned()];
+        let mut seen = HashSet::new();
+        while let Some(n) = stack.pop() {
+            if n == b {
+                return true;
+            }
+            if !seen.insert(n.clone()) {
+                continue;
+            }
+            for e in &self.graph.edges {
+                if split_port_ref(&e.from).is_some_and(|(f, _)| f == n)
+                    && let Some((t, _)) = split_port_ref(&e.to)
+                {
+                    stack.push(t.to_owned());
+                }
+            }
+        }
+        false
+    }
+
+    /// Connects output `from` to input `to` (each `"node.port"`), replacing the edge that
+    /// fed `to` before.
+    ///
+    /// # Errors
+    /// Why the edge is refused (incompatible types, a cycle, a missing port), in the same
+    /// words as the compiler; the graph is unchanged then.
+    pub fn connect(&mut self, from: &str, to: &str) -> Result<(), String> {
+        if let Some(why) = self.check_edge(from, to) {
+            return Err(why);
+        }
+        if self
+            .graph
+            .edges
+            .iter()
+            .any(|e| e.from == from && e.to == to)
+        {
+            return Ok(());
+        }
+        self.record(None);
+        let edge = Edge::new(from, to);
+        // Keep the file order: a replaced edge keeps its place.
+        if let Some(e) = self.graph.edges.iter_mut().find(|e| e.to == to) {
+            *e = edge;
+        } else {
+            self.graph.edges.push(edge);
+        }
+        Ok(())
+    }
+
+    /// Removes the edge `from` → `to`; returns whether there was one.
+    pub fn disconnect(&mut self, from: &str, to: &str) -> bool {
+        if !self
+            .graph
+            .edges
+            .iter()
+            .any(|e| e.from == from && e.to == to)
+        {
+            return false;
+        }
+        self.record(None);
+        self.graph.edges.retain(|e| !(e.from == from && e.to == to));
+        true
+    }
+
+    /// Removes every edge that starts or ends at `port` (`"node.port"`).
+    pub fn disconnect_port(&mut self, port: &str) {
+        if !self
+            .graph
+            .edges
+            .iter()
+            .any(|e| e.from == port || e.to == port)
+        {
+            return;
+        }
+        self.record(None);
+        self.graph.edges.retain(|e| e.from != port && e.to != port);
+    }
+
+    /// Removes nodes and their edges.
+    pub fn remove_nodes(&mut self, ids: &[String]) {
+        if !self.graph.nodes.iter().any(|n| ids.contains(&n.id)) {
+            return;
+        }
+        self.record(None);
+        self.graph.nodes.retain(|n| !ids.contains(&n.id));
+        let node_of = |r: &str| split_port_ref(r).map(|(n, _)| n.to_owned());
+        self.graph.edges.retain(|e| {
+            !node_of(&e.from).is_some_and(|n| ids.contains(&n))
+                && !node_of(&e.to).is_some_and(|n| ids.contains(&n))
+        });
+    }
+
+    /// Sets a param. Successive calls with the same node and param are one undo step
+    /// until [`Self::end_gesture`] (one slider drag).
+    pub fn set_param(&mut self, id: &str, param: &str, value: ParamValue) {
+        let Some(node) = self.graph.node(id) else {
+            return;
+        };
+        if node.params.get(param) == Some(&value) {
+            return;
+        }
+        self.record(Some(&format!("param {id}.{param}")));
+        if let Some(node) = self.graph.node_mut(id) {
+            node.params.insert(param.to_owned(), value);
+        }
+    }
+
+    /// Moves nodes; a drag is one undo step until [`Self::end_gesture`].
+    pub fn move_nodes(&mut self, moves: &[(String, (f32, f32))]) {
+        let changed = moves
+            .iter()
+            .any(|(id, p)| self.graph.node(id).is_some_and(|n| n.pos != Some(*p)));
+        if !changed {
+            return;
+        }
+        self.record(Some("move"));
+        for (id, p) in moves {
+            if let Some(n) = self.graph.node_mut(id) {
+                n.pos = Some(*p);
+            }
+        }
+    }
+
+    /// The nodes `ids` and the edges between them, as a graph (for the clipboard).
+    pub fn copy(&self, ids: &[String]) -> Graph {
+        let mut g = Graph::new();
+        g.nodes = self
+            .graph
+            .nodes
+            .iter()
+            .filter(|n| ids.contains(&n.id))
+            .cloned()
+            .collect();
+        let inside = |r: &str| split_port_ref(r).is_some_and(|(n, _)| ids.iter().any(|i| i == n));
+        g.edges = self
+            .graph
+            .edges
+            .iter()
+            .filter(|e| inside(&e.from) && inside(&e.to))
+            .cloned()
+            .collect();
+        g
+    }
+
+    /// Pastes a copied graph, renaming ids that are taken and offsetting positions by
+    /// `offset`; returns the new ids.
+    pub fn paste(&mut self, clip: &Graph, offset: (f32, f32)) -> Vec<String> {
+        if clip.nodes.is_empty() {
+            return Vec::new();
+        }
+        self.record(None);
+        let mut renamed = BTreeMap::new();
+        let mut new_ids = Vec::new();
+        for n in &clip.nodes {
+            let id = self.unique_id(&n.id);
+            let mut node = n.clone();
+            node.id.clone_from(&id);
+            node.pos = Some(n.pos.map_or(offset, |p| (p.0 + offset.0, p.1 + offset.1)));
+            self.graph.nodes.push(node);
+            renamed.insert(n.id.clone(), id.clone());
+            new_ids.push(id);
+        }
+        let rename = |r: &str| {
+            let (n, p) = split_port_ref(r)?;
+            Some(format!("{}.{p}", renamed.get(n)?))
+        };
+        for e in &clip.edges {
+            if let (Some(from), Some(to)) = (rename(&e.from), rename(&e.to)) {
+                self.graph.edges.push(Edge::new(from, to));
+            }
+        }
+        new_ids
+    }
+
+    /// Replaces the whole graph (for example a file opened in place), clearing history.
+    pub fn replace(&mut self, graph: Graph, path: Option<PathBuf>) {
+        *self = Self::new(graph, path);
+    }
+}

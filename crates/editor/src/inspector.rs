@@ -1,0 +1,288 @@
+//! The inspector: one widget per param of the selected node, chosen by the param's type
+//! in the registry: sliders over the declared range (logarithmic for wide positive
+//! ranges), combo boxes for enums, checkboxes for bools, and a path field that checks the
+//! extension (and, for inputs, that the file exists) with a picker listing the matching
+//! files of the graph's folder. Every param's doc is its tooltip.
+
+use std::path::Path;
+
+use egui::{Color32, RichText, Ui};
+use lumagraph_graph::registry::ParamDef;
+use lumagraph_graph::{ParamType, ParamValue, Registry};
+
+use crate::document::Document;
+
+/// Shows the inspector for node `id`.
+pub fn show(ui: &mut Ui, doc: &mut Document, id: &str, errors: Option<&Vec<String>>) {
+    let Some(node) = doc.graph.node(id).cloned() else {
+        ui.weak("no node selected");
+        return;
+    };
+    ui.heading(&node.id);
+    let Some(kind) = Registry::builtin().get(&node.kind) else {
+        ui.colored_label(
+            Color32::from_rgb(230, 60, 60),
+            format!("unknown node kind \"{}\"", node.kind),
+        );
+        return;
+    };
+    ui.label(RichText::new(kind.name).strong())
+        .on_hover_text(kind.doc);
+    ui.add(egui::Label::new(RichText::new(kind.doc).weak()).wrap());
+    if let Some(errs) = errors {
+        for e in errs {
+            ui.colored_label(Color32::from_rgb(230, 80, 80), e);
+        }
+    }
+    ui.separator();
+    if kind.params.is_empty() {
+        ui.weak("no params");
+    }
+    let base = doc.base_dir();
+    egui::Grid::new("params")
+        .num_columns(2)
+        .spacing([8.0, 6.0])
+        .show(ui, |ui| {
+            for def in &kind.params {
+                let current = node
+                    .params
+                    .get(def.name)
+                    .cloned()
+                    .unwrap_or_else(|| def.ty.default_value());
+                let label = ui.label(def.name).on_hover_text(tooltip(def)).id;
+                if let Some(v) = param_widget(ui, def, &current, &base, kind.sink, label) {
+                    doc.set_param(id, def.name, v);
+                }
+                ui.end_row();
+            }
+        });
+}
+
+fn tooltip(def: &ParamDef) -> String {
+    let range = match &def.ty {
+        ParamType::Float { min, max, default } => {
+            format!("float in [{min}, {max}], default {default}")
+        }
+        ParamType::Int { min, max, default } => format!("int in [{min}, {max}], default {default}"),
+        ParamType::Bool { default } => format!("bool, default {default}"),
+        ParamType::Enum { default, .. } => {
+            format!("one of the listed names, default \"{default}\"")
+        }
+        ParamType::Path {
+            default,
+            extensions,
+        } => format!("file ({}), default \"{default}\"", extensions.join(", ")),
+        _ => String::new(),
+    };
+    format!("{}\n{range}", def.doc)
+}
+
+/// The widget for one param; returns the new value when the user changed it.
+fn param_widget(
+    ui: &mut Ui,
+    def: &ParamDef,
+    current: &ParamValue,
+    base: &Path,
+    sink: bool,
+    label: egui::Id,
+) -> Option<ParamValue> {
+    let tip = tooltip(def);
+    match &def.ty {
+        ParamType::Float { min, max, .. } => {
+            let mut v = current.as_f64().unwrap_or(*min);
+            let log = *min > 0.0 && *max / *min > 1e3;
+            let r = ui
+                .add(
+                    egui::Slider::new(&mut v, *min..=*max)
+                        .logarithmic(log)
+                        .clamping(egui::SliderClamping::Always),
+                )
+                .on_hover_text(tip)
+                .labelled_by(label);
+            r.changed().then_some(ParamValue::Float(v))
+        }
+        ParamType::Int { min, max, .. } => {
+            let mut v = match current {
+                ParamValue::Int(v) => *v,
+                _ => *min,
+            };
+            let r = ui
+                .add(egui::Slider::new(&mut v, *min..=*max))
+                .on_hover_text(tip)
+                .labelled_by(label);
+            r.changed().then_some(ParamValue::Int(v))
+        }
+        ParamType::Bool { .. } => {
+            let mut v = matches!(current, ParamValue::Bool(true));
+            let r = ui
+                .checkbox(&mut v, "")
+                .on_hover_text(tip)
+                .labelled_by(label);
+            r.changed().then_some(ParamValue::Bool(v))
+        }
+        ParamType::Enum { options, .. } => {
+            let selected = match current {
+                ParamValue::Str(s) => s.clone(),
+                other => other.to_string(),
+            };
+            let mut picked = None;
+            egui::ComboBox::from_id_salt(def.name)
+                .selected_text(&selected)
+                .show_ui(ui, |ui| {
+                    for (name, doc) in *options {
+                        if ui
+                            .selectable_label(selected == *name, *name)
+                            .on_hover_text(*doc)
+                            .clicked()
+                            && selected != *name
+                        {
+                            picked = Some(ParamValue::Str((*name).to_owned()));
+                        }
+                    }
+                })
+                .response
+                .on_hover_text(tip)
+                .labelled_by(label);
+            picked
+        }
+        ParamType::Path { extensions, .. } => {
+            path_widget(ui, def, current, base, sink, extensions, label)
+        }
+        _ => {
+            ui.weak(current.to_string());
+            None
+        }
+    }
+}
+
+/// What is wrong with a path value, if anything.
+pub fn check_path(
+    value: &str,
+    extensions: &[&str],
+    base: &Path,
+    must_exist: bool,
+) -> Option<String> {
+    if value.trim().is_empty() {
+        return Some("the path is empty".into());
+    }
+    let ext = Path::new(value)
+        .extension()
+        .map(|e| e.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
+    if !extensions.contains(&ext.as_str()) {
+        return Some(format!("use one of: .{}", extensions.join(" .")));
+    }
+    if must_exist && !base.join(value).is_file() {
+        return Some(format!("no file {}", base.join(value).display()));
+    }
+    None
+}
+
+fn path_widget(
+    ui: &mut Ui,
+    def: &ParamDef,
+    current: &ParamValue,
+    base: &Path,
+    sink: bool,
+    extensions: &[&str],
+    label: egui::Id,
+) -> Option<ParamValue> {
+    let value = match current {
+        ParamValue::Str(s) => s.clone(),
+        other => other.to_string(),
+    };
+    // The text being typed lives in egui's memory until it is valid and committed.
+    let id = ui.id().with(("path", def.name));
+    let mut text: String = ui.data(|d| d.get_temp(id)).unwrap_or_else(|| value.clone());
+    let mut out = None;
+    ui.vertical(|ui| {
+        ui.horizontal(|ui| {
+            let r = ui
+                .add(egui::TextEdit::singleline(&mut text).desired_width(180.0))
+                .labelled_by(label);
+            let problem = check_path(&text, extensions, base, !sink);
+            if r.changed() {
+                ui.data_mut(|d| d.insert_temp(id, text.clone()));
+            }
+            if (r.lost_focus() || !r.has_focus()) && problem.is_none() && text != value {
+                out = Some(ParamValue::Str(text.clone()));
+                ui.data_mut(|d| d.remove::<String>(id));
+            }
+            if !sink {
+                ui.menu_button("…", |ui| {
+                    let files = list_files(base, extensions);
+                    if files.is_empty() {
+                        ui.weak(format!(
+                            "no .{} file in {}",
+                            extensions.join(" ."),
+                            base.display()
+                        ));
+                    }
+                    for f in files {
+                        if ui.button(&f).clicked() {
+                            out = Some(ParamValue::Str(f.clone()));
+                            ui.data_mut(|d| d.remove::<String>(id));
+                            ui.close();
+                        }
+                    }
+                })
+                .response
+                .on_hover_text("pick a file from the graph's folder and its neighbours");
+            }
+            if let Some(p) = &problem {
+                ui.colored_label(Color32::from_rgb(230, 80, 80), "⚠")
+                    .on_hover_text(p);
+            }
+        });
+        if let Some(p) = check_path(&text, extensions, base, !sink) {
+            ui.colored_label(Color32::from_rgb(230, 80, 80), p);
+        }
+    });
+    out
+}
+
+/// Files with one of `extensions` in `base`, its subfolders and its parent's subfolders
+/// (one level each), as paths relative to `base`.
+fn list_files(base: &Path, extensions: &[&str]) -> Vec<String> {
+    let base = if base.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        base
+    };
+    let mut out = Vec::new();
+    let mut dirs = vec![(base.to_path_buf(), String::new())];
+    for (sub, prefix) in [
+        (base.to_path_buf(), String::new()),
+        (base.join(".."), "../".to_owned()),
+    ] {
+        if let Ok(rd) = std::fs::read_dir(&sub) {
+            for e in rd.flatten() {
+                if e.path().is_dir() {
+                    let name = e.file_name().to_string_lossy().into_owned();
+                    if !name.starts_with('.') && name != "target" {
+                        dirs.push((e.path(), format!("{prefix}{name}/")));
+                    }
+                }
+            }
+        }
+    }
+    for (dir, prefix) in dirs {
+        let Ok(rd) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for e in rd.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let ext = Path::new(&name)
+                .extension()
+                .map(|x| x.to_string_lossy().to_lowercase())
+                .unwrap_or_default();
+            if e.path().is_file() && extensions.contains(&ext.as_str()) {
+                out.push(format!("{prefix}{name}"));
+            }
+        }
+    }
+    out.sort();
+    out.dedup();
+    out.truncate(200);
+    out
+}
