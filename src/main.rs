@@ -160,7 +160,9 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
 }
 
 fn uses_scene(plan: &lumagraph::graph::Plan) -> bool {
-    plan.passes.iter().any(|p| p.kind == "PathTrace")
+    plan.passes
+        .iter()
+        .any(|p| p.kind == "PathTrace" || p.kind == "GBuffer")
 }
 
 /// Runs the progressive part of the graph for `spp` samples per pixel, then the rest once,
@@ -328,6 +330,19 @@ fn run(cli: Cli) -> Result<()> {
             let scene = load_scene(scene.as_deref())?;
             let plan = compile(&g, &[], scene.as_ref().map(|s| &*s.gpu))?;
             print!("{plan}");
+            let owned: Vec<_> = plan
+                .passes
+                .iter()
+                .filter_map(|p| lumagraph::render::nodes::owned_memory(p).map(|m| (p, m)))
+                .collect();
+            if !owned.is_empty() {
+                println!("node-owned memory (outside the textures above):");
+                for (p, (bytes, what)) in owned {
+                    #[expect(clippy::cast_precision_loss, reason = "report figures")]
+                    let mib = bytes as f64 / (1024.0 * 1024.0);
+                    println!("  {:<16} {bytes:>10} bytes ({mib:.2} MiB): {what}", p.node);
+                }
+            }
             Ok(())
         }
         Command::Validate { graph, scene } => {

@@ -4,12 +4,22 @@
 //   comp[i].rgb Kahan compensation (the low-order bits the sum lost).
 // Mirrored by `cpu::KahanMean`.
 //
+// When `params.variance` is 1, a third buffer keeps Welford's second moment of the frames
+//   m2[i].rgb  sum of (x - mean_before)(x - mean_after) per channel,  m2[i].a  the same of
+//   the luminance,
+// with the means taken from the Kahan sums above (which it never changes), and `variance_out`
+// gets the variance of the mean, m2 / (n (n - 1)). After one frame that is unknown; it is
+// reported as the squared mean (a relative standard deviation of 1), which is what a filter
+// should assume of a single sample.
+//
 // Shader compilers may simplify `((s + y) - s) - y` to 0 (Mesa's NIR does, since naga marks no
 // operation exact), which silently turns Kahan summation into a plain sum. Multiplying by
 // `params.one` (1.0, but unknown to the compiler) keeps the compensation term alive.
 
 struct Params {
     one: f32,
+    variance: u32,
+    size: vec2u,
 }
 
 @group(0) @binding(0) var input: texture_2d<f32>;
@@ -17,10 +27,14 @@ struct Params {
 @group(0) @binding(2) var<storage, read_write> sum: array<vec4f>;
 @group(0) @binding(3) var<storage, read_write> comp: array<vec4f>;
 @group(0) @binding(4) var<uniform> params: Params;
+@group(0) @binding(5) var<storage, read_write> m2: array<vec4f>;
+@group(0) @binding(6) var variance_out: texture_storage_2d<rgba32float, write>;
+
+const LUMA = vec3f(0.2126, 0.7152, 0.0722);
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3u) {
-    let size = textureDimensions(output);
+    let size = params.size;
     if id.x >= size.x || id.y >= size.y {
         return;
     }
@@ -31,7 +45,23 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     let y = x - c;
     let t = (s.rgb + y) * params.one;
     comp[i] = vec4f((t - s.rgb) - y, 0.0);
+    let before = s;
     s = vec4f(t, s.a + 1.0);
     sum[i] = s;
-    textureStore(output, id.xy, vec4f(s.rgb / s.a, 1.0));
+    let mean = s.rgb / s.a;
+    textureStore(output, id.xy, vec4f(mean, 1.0));
+
+    if params.variance == 1u {
+        let mean_before = select(x, before.rgb / before.a, before.a > 0.0);
+        let d = vec4f(x - mean_before, dot(x - mean_before, LUMA));
+        let e = vec4f(x - mean, dot(x - mean, LUMA));
+        let moment = m2[i] + d * e;
+        m2[i] = moment;
+        let n = s.a;
+        var v = vec4f(mean * mean, dot(mean, LUMA) * dot(mean, LUMA));
+        if n >= 2.0 {
+            v = max(moment, vec4f(0.0)) / (n * (n - 1.0));
+        }
+        textureStore(variance_out, id.xy, v);
+    }
 }

@@ -30,7 +30,7 @@ pub fn source_extent(
     match node.kind.as_str() {
         "ImageInput" => crate::image_io::dimensions(&base_dir.join(params.str("path")))
             .map_err(|e| e.to_string()),
-        "PathTrace" => scene
+        "PathTrace" | "GBuffer" => scene
             .map(|s| Extent::new(s.settings.width, s.settings.height))
             .ok_or_else(|| {
                 "renders a scene, but none was given (lumagraph render --scene FILE)".to_owned()
