@@ -1,6 +1,8 @@
 //! The `lumagraph` command line: render, plan, validate, bench and list nodes.
 
 mod bench;
+mod converge;
+mod plot;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -93,6 +95,37 @@ enum Command {
         /// Timed runs; the best is reported.
         #[arg(long, default_value_t = 3)]
         runs: u32,
+    },
+    /// Error against run time: render progressively at 1, 2, 4… spp and score the raw
+    /// accumulation and every Denoise output against a reference (RMSE, relMSE, SSIM);
+    /// writes a CSV and a log-log plot.
+    #[command(
+        after_help = "Example:\n  lumagraph converge graphs/pathtrace_denoise.ron --scene assets/cornell.ron \\\n    --reference tests/reference/cornell_ref.exr --seconds 10 \\\n    --compare tests/reference/cornell_converge.csv --out converge"
+    )]
+    Converge {
+        /// The graph file (RON); its Output nodes are ignored.
+        graph: PathBuf,
+        /// Scene file.
+        #[arg(long)]
+        scene: PathBuf,
+        /// Reference image (EXR, linear, same size as the render).
+        #[arg(long, conflicts_with = "reference_spp")]
+        reference: Option<PathBuf>,
+        /// Render the reference first with the same graph at this many spp (another seed).
+        #[arg(long)]
+        reference_spp: Option<u32>,
+        /// Time budget in seconds: no checkpoint is started that would pass it.
+        #[arg(long, default_value_t = 10.0)]
+        seconds: f64,
+        /// CSV with Mitsuba (and OIDN) figures per spp to plot beside ours.
+        #[arg(long)]
+        compare: Option<PathBuf>,
+        /// Folder for converge.csv and converge.png (created if missing).
+        #[arg(long, default_value = "converge")]
+        out: PathBuf,
+        /// Override a param: `node.param=value`.
+        #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
+        overrides: Vec<String>,
     },
     /// Write the generated HDR test chart (the source of `assets/test_chart.exr`).
     #[command(hide = true)]
@@ -373,6 +406,25 @@ fn run(cli: Cli) -> Result<()> {
             let loaded = load_scene(Some(&scene))?.context("no scene")?;
             bench::run(&loaded.gpu, spp, runs)
         }
+        Command::Converge {
+            graph,
+            scene,
+            reference,
+            reference_spp,
+            seconds,
+            compare,
+            out,
+            overrides,
+        } => converge::run(&converge::Args {
+            graph: &graph,
+            scene: &scene,
+            reference: reference.as_deref(),
+            reference_spp,
+            seconds,
+            compare: compare.as_deref(),
+            out: &out,
+            overrides: &overrides,
+        }),
         Command::TestChart { out } => {
             let chart = image_io::test_chart();
             let bytes = image_io::encode_exr(&chart, true)?;

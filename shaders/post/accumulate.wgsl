@@ -8,9 +8,9 @@
 //   m2[i].rgb  sum of (x - mean_before)(x - mean_after) per channel,  m2[i].a  the same of
 //   the luminance,
 // with the means taken from the Kahan sums above (which it never changes), and `variance_out`
-// gets the variance of the mean, m2 / (n (n - 1)). After one frame that is unknown; it is
-// reported as the squared mean (a relative standard deviation of 1), which is what a filter
-// should assume of a single sample.
+// gets the variance of the mean, m2 / (n (n - 1)). After one frame there is no second frame
+// to compare with; the variance is then estimated spatially, as SVGF does for short
+// histories: the sample variance of the input over the pixel's 3×3 neighborhood.
 //
 // Shader compilers may simplify `((s + y) - s) - y` to 0 (Mesa's NIR does, since naga marks no
 // operation exact), which silently turns Kahan summation into a plain sum. Multiplying by
@@ -31,6 +31,27 @@ struct Params {
 @group(0) @binding(6) var variance_out: texture_storage_2d<rgba32float, write>;
 
 const LUMA = vec3f(0.2126, 0.7152, 0.0722);
+
+// Sample variance (rgb, luminance) of the input over the 3×3 neighborhood of `p`.
+fn spatial_variance(p: vec2i, size: vec2i) -> vec4f {
+    var sum = vec4f(0.0);
+    var sum2 = vec4f(0.0);
+    var n = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = p + vec2i(dx, dy);
+            if all(q >= vec2i(0)) && all(q < size) {
+                let x = textureLoad(input, q, 0).rgb;
+                let v = vec4f(x, dot(x, LUMA));
+                sum += v;
+                sum2 += v * v;
+                n += 1.0;
+            }
+        }
+    }
+    let mean = sum / n;
+    return max(sum2 / n - mean * mean, vec4f(0.0)) * (n / max(n - 1.0, 1.0));
+}
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3u) {
@@ -58,9 +79,11 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         let moment = m2[i] + d * e;
         m2[i] = moment;
         let n = s.a;
-        var v = vec4f(mean * mean, dot(mean, LUMA) * dot(mean, LUMA));
+        var v: vec4f;
         if n >= 2.0 {
             v = max(moment, vec4f(0.0)) / (n * (n - 1.0));
+        } else {
+            v = spatial_variance(vec2i(id.xy), vec2i(size));
         }
         textureStore(variance_out, id.xy, v);
     }

@@ -254,7 +254,7 @@ fn builtin_kinds() -> Vec<NodeKind> {
                     ty: PortType::Variance,
                     doc: "variance of that mean per pixel (rgb per channel, alpha of the \
                           luminance), from a Welford second moment over frames; after a single \
-                          frame it is unknown and reported as the squared mean",
+                          frame, the input's variance over the pixel's 3×3 neighborhood",
                 },
             ],
             params: vec![],
@@ -376,7 +376,7 @@ fn builtin_kinds() -> Vec<NodeKind> {
                 ParamDef {
                     name: "sigma_depth",
                     ty: ParamType::Float {
-                        default: 1.0,
+                        default: 0.5,
                         min: 0.0,
                         max: 1000.0,
                     },
