@@ -31,7 +31,11 @@ fn scene(name: &str) -> Arc<GpuScene> {
 fn render(scene: &Arc<GpuScene>) -> Option<([Image; 3], [Image; 3])> {
     let ctx = common::gpu()?;
     let graph = Graph {
-        nodes: vec![Node::new("gb", "GBuffer"), Node::new("pt", "PathTrace")],
+        nodes: vec![
+            Node::new("gb", "GBuffer"),
+            Node::new("pt", "PathTrace")
+                .with("samples_per_frame", lumagraph::graph::ParamValue::Int(1)),
+        ],
         edges: Vec::new(),
         origin: None,
     };
@@ -116,6 +120,35 @@ fn cornell_gbuffer_matches_pathtrace_aovs() {
 #[test]
 fn furnace_sphere_gbuffer_matches_pathtrace_aovs() {
     check_against_pathtrace("furnace.ron");
+}
+
+/// A glTF mesh with vertex normals (55 200 triangles) and analytic spheres in front of it.
+#[test]
+fn smooth_mesh_and_spheres_gbuffer_matches_pathtrace_aovs() {
+    const SCENE: &str = r#"(
+        version: 1,
+        camera: Perspective(position: (0, 0, 8), target: (0, 0, 0), up: (0, 1, 0), fov_y: 40),
+        materials: { "grey": (base_color: (0.5, 0.5, 0.5)) },
+        shapes: [
+            Mesh(name: "grid", path: "SphereGrids/SphereGrid_MetalRough.gltf"),
+            Sphere(center: (0.6, 0.3, 0.3), radius: 0.4, material: "grey"),
+            Sphere(center: (1.8, 1.5, 0.0), radius: 0.5, material: "grey"),
+        ],
+        render: (width: 256, height: 256),
+    )"#;
+    let scene = Scene::from_ron(SCENE, &common::repo("assets")).unwrap();
+    let scene = Arc::new(GpuScene::build(&scene).unwrap());
+    let Some((gb, pt)) = render(&scene) else {
+        return;
+    };
+    let [albedo, normal, depth] = agreement(&gb, &pt);
+    eprintln!(
+        "sphere grid: GBuffer vs PathTrace AOVs: albedo {:.3} %, normal {:.3} %, depth {:.3} % of pixels agree",
+        albedo * 100.0,
+        normal * 100.0,
+        depth * 100.0
+    );
+    assert!(albedo >= 0.99 && normal >= 0.99 && depth >= 0.99);
 }
 
 #[test]

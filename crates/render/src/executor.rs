@@ -189,7 +189,9 @@ impl Executor {
 
     /// Runs only the part of the graph downstream of history (what `run_frames(_, true)`
     /// adds in its last frame: G-buffer, denoiser, post nodes, sinks) over the history as it
-    /// is, without adding a frame, so its cost can be timed apart from rendering.
+    /// is, without adding a frame, so its cost can be timed apart from rendering. Call it
+    /// after at least one progressive frame since the last finishing run: textures the
+    /// progressive part writes may share memory with textures of the part it runs.
     ///
     /// # Errors
     /// When a node fails; the error names the node.
