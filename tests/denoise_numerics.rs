@@ -150,11 +150,18 @@ fn black_input_gives_black_output() {
         height: SIZE,
         pixels: vec![[0.0, 0.0, 0.0, 1.0]; (SIZE * SIZE) as usize],
     };
-    let Some((out, ..)) = denoise(&black, 2, &[]) else {
-        return;
-    };
-    assert_finite(&out, "black");
-    assert!(out.pixels.iter().all(|p| p[..3] == [0.0; 3]));
+    // 1 pass (no ping-pong), 2 (one image of each), 8 (the most, taps 128 px apart).
+    for iterations in [1, 2, 8] {
+        let Some((out, ..)) = denoise(&black, 2, &[("iterations", ParamValue::Int(iterations))])
+        else {
+            return;
+        };
+        assert_finite(&out, "black");
+        assert!(
+            out.pixels.iter().all(|p| p[..3] == [0.0; 3]),
+            "{iterations} iterations"
+        );
+    }
 }
 
 #[test]
