@@ -1,13 +1,14 @@
 // Denoise: one pass of the edge-avoiding à-trous wavelet filter (Dammertz et al. 2010) with
-// SVGF's edge-stopping functions (Schied et al. 2017). The node runs it `iterations` times
-// with `step` = 1, 2, 4, …: a 5×5 B3-spline kernel (1/16, 1/4, 3/8, 1/4, 1/16) whose taps are
-// `step` pixels apart.
+// SVGF's edge-stopping functions (Schied et al. 2017). The node runs a demodulation pass,
+// then this filter `iterations` times with `step` = 1, 2, 4, …: a 5×5 B3-spline kernel
+// (1/16, 1/4, 3/8, 1/4, 1/16) whose taps are `step` pixels apart.
 //
-// It filters illumination, not color: the first pass divides the color by max(albedo, EPS)
-// (and the variance by the square of the albedo's luminance), the last multiplies the result
-// by the same max(albedo, EPS). Between passes, the ping-pong image holds the illumination in
-// rgb and its luminance variance in alpha; each pass filters the variance with the squared
-// weights, as SVGF does, so later passes stop at smaller luminance differences.
+// It filters illumination, not color: the demodulation pass (`params.first` = 1) divides the
+// color by max(albedo, EPS) (and the variance by the square of the albedo's luminance) and
+// writes illumination in rgb and its luminance variance in alpha; the filter passes read and
+// write that layout; the last one (`params.last` = 1) multiplies the result by the same
+// max(albedo, EPS). Each pass filters the variance with the squared weights, as SVGF does,
+// so later passes stop at smaller luminance differences.
 //
 // Weight of tap q around pixel p (the center tap always gets its kernel weight alone, so the
 // sum of weights is never 0):
@@ -56,12 +57,14 @@ fn depth_at(p: vec2i) -> f32 {
     return finite(textureLoad(depth, p, 0)).r;
 }
 
-// Illumination (rgb) and its luminance variance (a) at `p`.
+// Illumination (rgb) and its luminance variance (a) at `p`, from the ping-pong image.
 fn illumination(p: vec2i) -> vec4f {
+    return finite(textureLoad(src, p, 0));
+}
+
+// The demodulation pass's value at `p`: color / albedo and variance / luminance(albedo)².
+fn demodulate(p: vec2i) -> vec4f {
     let s = finite(textureLoad(src, p, 0));
-    if params.first == 0u {
-        return s;
-    }
     let a = albedo_at(p);
     let v = max(finite(textureLoad(variance, p, 0)).a, 0.0);
     let la = max(dot(a, LUMA), EPS);
@@ -115,6 +118,10 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     let size = vec2i(textureDimensions(dst));
     let p = vec2i(id.xy);
     if !in_image(p, size) {
+        return;
+    }
+    if params.first == 1u {
+        textureStore(dst, p, demodulate(p));
         return;
     }
     let center = illumination(p);

@@ -1,11 +1,12 @@
-//! `Denoise`: the edge-avoiding à-trous wavelet filter, `iterations` compute passes of
-//! `shaders/post/denoise.wgsl` with the kernel's taps 1, 2, 4, 8, 16… pixels apart.
+//! `Denoise`: the edge-avoiding à-trous wavelet filter: a demodulation pass, then
+//! `iterations` filter passes of `shaders/post/denoise.wgsl` with the kernel's taps 1, 2, 4,
+//! 8, 16… pixels apart, the last one remodulating into the output texture.
 //!
-//! Memory: the first pass reads the node's inputs and the last writes its output texture;
-//! in between, passes ping-pong between two node-owned `rgba32float` images of the pass's
-//! size (illumination in rgb, its variance in alpha), created once and reused every frame.
-//! Those two images are all the memory the filter adds ([`scratch_bytes`]); with one
-//! iteration none is created.
+//! Memory: the demodulation pass reads the node's inputs and writes illumination (rgb) and
+//! its variance (alpha) into a node-owned `rgba32float` image of the pass's size; the filter
+//! passes ping-pong between it and a second one; the last writes the output texture. Those
+//! two images, created once and reused every frame, are all the memory the filter adds
+//! ([`scratch_bytes`]); with one iteration only the first is created.
 //!
 //! The `variance` input is always connected (every input is, in this graph model); with
 //! `variance_guided` off the shader never reads it and the luminance tolerance is a fixed
@@ -25,21 +26,23 @@ const MAX_ITERATIONS: u32 = 8;
 
 pub(crate) struct Denoise {
     kernel: Kernel,
-    /// One uniform buffer per pass (step, first/last flags, sigmas).
+    /// One uniform buffer per pass (step, first/last flags, sigmas); the demodulation
+    /// pass's is the last.
     params: Vec<wgpu::Buffer>,
     iterations: u32,
     extent: Extent,
-    ping_pong: Option<(Extent, [PooledTexture; 2])>,
+    ping_pong: Option<(Extent, Vec<PooledTexture>)>,
+}
+
+/// Images of node-owned memory a Denoise pass with `iterations` uses.
+fn scratch_images(iterations: u32) -> u64 {
+    if iterations <= 1 { 1 } else { 2 }
 }
 
 /// Bytes of node-owned memory a Denoise pass over `extent` with `iterations` adds: two
-/// `rgba32float` ping-pong images, or none for a single pass.
+/// `rgba32float` ping-pong images (one for a single iteration).
 pub fn scratch_bytes(extent: Extent, iterations: u32) -> u64 {
-    if iterations <= 1 {
-        0
-    } else {
-        2 * extent.pixels() * TexFormat::Rgba32Float.bytes_per_pixel()
-    }
+    scratch_images(iterations) * extent.pixels() * TexFormat::Rgba32Float.bytes_per_pixel()
 }
 
 fn iterations(pass: &Pass) -> u32 {
@@ -63,7 +66,7 @@ impl Denoise {
                 Binding::Uniform,
             ],
         )?;
-        let params = (0..MAX_ITERATIONS)
+        let params = (0..=MAX_ITERATIONS)
             .map(|i| uniform_buffer(ctx, &format!("denoise params {i}"), &[0; 32]))
             .collect();
         let mut node = Self {
@@ -89,10 +92,16 @@ impl NodeExec for Denoise {
             p.float("sigma_depth") as f32,
         );
         let guided = u32::from(p.bool("variance_guided"));
+        let demodulate: [u32; 8] = [0, 1, 0, 0, 0, 0, 0, 0];
+        ctx.queue.write_buffer(
+            &self.params[MAX_ITERATIONS as usize],
+            0,
+            bytemuck::bytes_of(&demodulate),
+        );
         for i in 0..self.iterations {
             let words: [u32; 8] = [
                 1_u32 << i,
-                u32::from(i == 0),
+                0,
                 u32::from(i + 1 == self.iterations),
                 guided,
                 sigma_color.to_bits(),
@@ -118,7 +127,12 @@ impl NodeExec for Denoise {
             return Ok(());
         };
         let extent = pass.extent;
-        if self.iterations > 1 && self.ping_pong.as_ref().is_none_or(|(e, _)| *e != extent) {
+        let images = scratch_images(self.iterations) as usize;
+        if self
+            .ping_pong
+            .as_ref()
+            .is_none_or(|(e, pp)| *e != extent || pp.len() != images)
+        {
             let make = |i| {
                 create(
                     ctx,
@@ -127,31 +141,23 @@ impl NodeExec for Denoise {
                     extent,
                 )
             };
-            self.ping_pong = Some((extent, [make(0), make(1)]));
+            self.ping_pong = Some((extent, (0..images).map(make).collect()));
         }
+        let Some((_, pp)) = &self.ping_pong else {
+            return Ok(());
+        };
         let color = io.input(pass, "color")?;
         let variance = io.input(pass, "variance")?;
         let albedo = io.input(pass, "albedo")?;
         let normal = io.input(pass, "normal")?;
         let depth = io.input(pass, "depth")?;
         let output = &io.texture(out).view;
-        for i in 0..self.iterations {
-            let last = i + 1 == self.iterations;
-            let (src, dst) = match &self.ping_pong {
-                Some((_, pp)) => (
-                    if i == 0 {
-                        &color.view
-                    } else {
-                        &pp[((i + 1) % 2) as usize].view
-                    },
-                    if last {
-                        output
-                    } else {
-                        &pp[(i % 2) as usize].view
-                    },
-                ),
-                None => (&color.view, output),
-            };
+        // Pass -1 demodulates into image 0; pass i reads image i % 2 and writes the other
+        // one, or the output for the last.
+        let mut record = |src: &wgpu::TextureView,
+                          dst: &wgpu::TextureView,
+                          params: &wgpu::Buffer|
+         -> Result<()> {
             self.kernel
                 .pass(&pass.node)
                 .read(src)
@@ -160,20 +166,33 @@ impl NodeExec for Denoise {
                 .read(&normal.view)
                 .read(&depth.view)
                 .write(dst)
-                .uniform(&self.params[i as usize])
-                .dispatch_2d(ctx, encoder, extent, timer.as_deref_mut())?;
+                .uniform(params)
+                .dispatch_2d(ctx, encoder, extent, timer.as_deref_mut())
+        };
+        record(
+            &color.view,
+            &pp[0].view,
+            &self.params[MAX_ITERATIONS as usize],
+        )?;
+        for i in 0..self.iterations as usize {
+            let src = &pp[i % 2].view;
+            let dst = if i + 1 == self.iterations as usize {
+                output
+            } else {
+                &pp[(i + 1) % 2].view
+            };
+            record(src, dst, &self.params[i])?;
         }
         Ok(())
     }
 
     fn notes(&self) -> Vec<String> {
         let bytes = scratch_bytes(self.extent, self.iterations);
-        if bytes == 0 {
-            return Vec::new();
-        }
         vec![format!(
-            "{} à-trous passes, ping-pong between 2 node-owned rgba32f images ({bytes} bytes)",
-            self.iterations
+            "demodulation + {} à-trous passes, ping-pong between {} node-owned rgba32f \
+             images ({bytes} bytes)",
+            self.iterations,
+            scratch_images(self.iterations)
         )]
     }
 }

@@ -155,7 +155,12 @@ pub fn owned_memory(pass: &Pass) -> Option<(u64, String)> {
         "Denoise" => {
             let n = u32::try_from(pass.params.int("iterations")).unwrap_or(1);
             let bytes = denoise::scratch_bytes(pass.extent, n);
-            (bytes > 0).then(|| (bytes, "2 rgba32f ping-pong images".to_owned()))
+            let what = if n > 1 {
+                "2 rgba32f ping-pong images"
+            } else {
+                "1 rgba32f image (demodulated input)"
+            };
+            Some((bytes, what.to_owned()))
         }
         "GBuffer" => Some((4 * px, "depth attachment (depth32float)".to_owned())),
         _ => None,
