@@ -114,7 +114,8 @@ enum Command {
         /// Render the reference first with the same graph at this many spp (another seed).
         #[arg(long)]
         reference_spp: Option<u32>,
-        /// Time budget in seconds: no checkpoint is started that would pass it.
+        /// Time budget in seconds: no checkpoint is started that is predicted to pass it
+        /// (twice the render time so far plus the last denoise time).
         #[arg(long, default_value_t = 10.0)]
         seconds: f64,
         /// CSV with Mitsuba (and OIDN) figures per spp to plot beside ours.

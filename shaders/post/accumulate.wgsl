@@ -10,7 +10,9 @@
 // with the means taken from the Kahan sums above (which it never changes), and `variance_out`
 // gets the variance of the mean, m2 / (n (n - 1)). After one frame there is no second frame
 // to compare with; the variance is then estimated spatially, as SVGF does for short
-// histories: the sample variance of the input over the pixel's 3×3 neighborhood.
+// histories, over the pixel's 3×3 neighborhood: the sample variance per channel, and for the
+// luminance (what Denoise reads) a robust one from the median absolute deviation, so a wall
+// pixel beside the light does not look noisy.
 //
 // Shader compilers may simplify `((s + y) - s) - y` to 0 (Mesa's NIR does, since naga marks no
 // operation exact), which silently turns Kahan summation into a plain sum. Multiplying by
@@ -50,7 +52,46 @@ fn spatial_variance(p: vec2i, size: vec2i) -> vec4f {
         }
     }
     let mean = sum / n;
-    return max(sum2 / n - mean * mean, vec4f(0.0)) * (n / max(n - 1.0, 1.0));
+    let v = max(sum2 / n - mean * mean, vec4f(0.0)) * (n / max(n - 1.0, 1.0));
+    return vec4f(v.rgb, robust_luminance_variance(p, size));
+}
+
+// (1.4826 × median absolute deviation)² of the luminance over the 3×3 neighborhood: the
+// variance of Gaussian noise, but a pixel next to an edge (a light beside a wall) is not
+// made to look noisy by the other side, as long as its own side is the majority.
+fn robust_luminance_variance(p: vec2i, size: vec2i) -> f32 {
+    var v: array<f32, 9>;
+    var n = 0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = p + vec2i(dx, dy);
+            if all(q >= vec2i(0)) && all(q < size) {
+                v[n] = dot(textureLoad(input, q, 0).rgb, LUMA);
+                n++;
+            }
+        }
+    }
+    let median = median_of(&v, n);
+    for (var i = 0; i < n; i++) {
+        v[i] = abs(v[i] - median);
+    }
+    let mad = 1.4826 * median_of(&v, n);
+    return mad * mad;
+}
+
+// Median of the first `n` values (insertion sort; n <= 9).
+fn median_of(v: ptr<function, array<f32, 9>>, n: i32) -> f32 {
+    for (var i = 1; i < n; i++) {
+        let x = (*v)[i];
+        var j = i - 1;
+        while j >= 0 && (*v)[j] > x {
+            (*v)[j + 1] = (*v)[j];
+            j--;
+        }
+        (*v)[j + 1] = x;
+    }
+    let h = n / 2;
+    return select(0.5 * ((*v)[h - 1] + (*v)[h]), (*v)[h], n % 2 == 1);
 }
 
 @compute @workgroup_size(8, 8)

@@ -254,7 +254,8 @@ fn builtin_kinds() -> Vec<NodeKind> {
                     ty: PortType::Variance,
                     doc: "variance of that mean per pixel (rgb per channel, alpha of the \
                           luminance), from a Welford second moment over frames; after a single \
-                          frame, the input's variance over the pixel's 3×3 neighborhood",
+                          frame, estimated over the pixel's 3×3 neighborhood (luminance: from the median \
+                          absolute deviation)",
                 },
             ],
             params: vec![],
