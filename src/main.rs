@@ -1,6 +1,8 @@
 //! The `lumagraph` command line: render, plan, validate, bench and list nodes.
 
 mod bench;
+mod converge;
+mod plot;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -100,6 +102,38 @@ enum Command {
         /// The graph file (RON) to open.
         graph: Option<PathBuf>,
     },
+    /// Error against run time: render progressively at 1, 2, 4… spp and score the raw
+    /// accumulation and every Denoise output against a reference (RMSE, relMSE, SSIM);
+    /// writes a CSV and a log-log plot.
+    #[command(
+        after_help = "Example:\n  lumagraph converge graphs/pathtrace_denoise.ron --scene assets/cornell.ron \\\n    --reference tests/reference/cornell_ref.exr --seconds 10 \\\n    --compare tests/reference/cornell_converge.csv --out converge"
+    )]
+    Converge {
+        /// The graph file (RON); its Output nodes are ignored.
+        graph: PathBuf,
+        /// Scene file.
+        #[arg(long)]
+        scene: PathBuf,
+        /// Reference image (EXR, linear, same size as the render).
+        #[arg(long, conflicts_with = "reference_spp")]
+        reference: Option<PathBuf>,
+        /// Render the reference first with the same graph at this many spp (another seed).
+        #[arg(long)]
+        reference_spp: Option<u32>,
+        /// Time budget in seconds: no checkpoint is started that is predicted to pass it
+        /// (twice the render time so far plus the last denoise time).
+        #[arg(long, default_value_t = 10.0)]
+        seconds: f64,
+        /// CSV with Mitsuba (and OIDN) figures per spp to plot beside ours.
+        #[arg(long)]
+        compare: Option<PathBuf>,
+        /// Folder for converge.csv and converge.png (created if missing).
+        #[arg(long, default_value = "converge")]
+        out: PathBuf,
+        /// Override a param: `node.param=value`.
+        #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
+        overrides: Vec<String>,
+    },
     /// Write the generated HDR test chart (the source of `assets/test_chart.exr`).
     #[command(hide = true)]
     TestChart {
@@ -166,7 +200,9 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
 }
 
 fn uses_scene(plan: &lumagraph::graph::Plan) -> bool {
-    plan.passes.iter().any(|p| p.kind == "PathTrace")
+    plan.passes
+        .iter()
+        .any(|p| p.kind == "PathTrace" || p.kind == "GBuffer")
 }
 
 /// Runs the progressive part of the graph for `spp` samples per pixel, then the rest once,
@@ -334,6 +370,19 @@ fn run(cli: Cli) -> Result<()> {
             let scene = load_scene(scene.as_deref())?;
             let plan = compile(&g, &[], scene.as_ref().map(|s| &*s.gpu))?;
             print!("{plan}");
+            let owned: Vec<_> = plan
+                .passes
+                .iter()
+                .filter_map(|p| lumagraph::render::nodes::owned_memory(p).map(|m| (p, m)))
+                .collect();
+            if !owned.is_empty() {
+                println!("node-owned memory (outside the textures above):");
+                for (p, (bytes, what)) in owned {
+                    #[expect(clippy::cast_precision_loss, reason = "report figures")]
+                    let mib = bytes as f64 / (1024.0 * 1024.0);
+                    println!("  {:<16} {bytes:>10} bytes ({mib:.2} MiB): {what}", p.node);
+                }
+            }
             Ok(())
         }
         Command::Validate { graph, scene } => {
@@ -365,6 +414,25 @@ fn run(cli: Cli) -> Result<()> {
             bench::run(&loaded.gpu, spp, runs)
         }
         Command::Edit { graph } => Ok(lumagraph_editor::run(graph)?),
+        Command::Converge {
+            graph,
+            scene,
+            reference,
+            reference_spp,
+            seconds,
+            compare,
+            out,
+            overrides,
+        } => converge::run(&converge::Args {
+            graph: &graph,
+            scene: &scene,
+            reference: reference.as_deref(),
+            reference_spp,
+            seconds,
+            compare: compare.as_deref(),
+            out: &out,
+            overrides: &overrides,
+        }),
         Command::TestChart { out } => {
             let chart = image_io::test_chart();
             let bytes = image_io::encode_exr(&chart, true)?;

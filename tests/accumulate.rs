@@ -104,3 +104,61 @@ fn gpu_matches_cpu_mirror_bit_for_bit_and_resets() {
         assert_eq!(g[..3], p[..3]);
     }
 }
+
+/// Accumulate's `variance` output: over 4 path-traced frames it matches a CPU two-pass
+/// variance of the mean of the frames it saw, and reading it leaves the mean bit-identical.
+#[test]
+fn variance_of_the_mean_matches_cpu_and_keeps_the_mean_exact() {
+    use std::sync::Arc;
+    let Some(ctx) = common::gpu() else { return };
+    let scene = lumagraph::scene::Scene::load(&common::repo("assets/cornell.ron")).unwrap();
+    let scene = Arc::new(lumagraph::scene::GpuScene::build(&scene).unwrap());
+    let graph = Graph {
+        nodes: vec![
+            Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(1)),
+            Node::new("acc", "Accumulate"),
+        ],
+        edges: vec![Edge::new("pt.color", "acc.color")],
+        origin: None,
+    };
+    let resources = Resources {
+        scene: Some(Arc::clone(&scene)),
+        ..Resources::default()
+    };
+    let run = |keep: &[&str]| {
+        let keep: Vec<String> = keep.iter().map(|s| (*s).to_owned()).collect();
+        let plan = compile(&graph, &keep, Some(&scene)).unwrap();
+        let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+        let mut frames = Vec::new();
+        for _ in 0..4 {
+            exec.run_frames(1, true).unwrap();
+            if keep.iter().any(|k| k == "pt.color") {
+                frames.push(exec.read_port("pt.color").unwrap());
+            }
+        }
+        let variance = keep
+            .iter()
+            .any(|k| k == "acc.variance")
+            .then(|| exec.read_port("acc.variance").unwrap());
+        (exec.read_port("acc.color").unwrap(), variance, frames)
+    };
+    let (mean, variance, frames) = run(&["acc.color", "acc.variance", "pt.color"]);
+    let (plain_mean, ..) = run(&["acc.color"]);
+    assert_eq!(
+        mean.pixels, plain_mean.pixels,
+        "the variance changed the mean"
+    );
+    let variance = variance.unwrap();
+    let mut worst = 0.0_f64;
+    for i in 0..mean.pixels.len() {
+        for c in 0..3 {
+            let xs: Vec<f64> = frames.iter().map(|f| f64::from(f.pixels[i][c])).collect();
+            let m = xs.iter().sum::<f64>() / 4.0;
+            let var_of_mean = xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / 3.0 / 4.0;
+            let got = f64::from(variance.pixels[i][c]);
+            let err = (got - var_of_mean).abs() / (var_of_mean + 1e-4);
+            worst = worst.max(err);
+        }
+    }
+    assert!(worst < 1e-3, "variance off by {worst} (relative)");
+}

@@ -419,3 +419,76 @@ fn bad_scene_file_names_file_and_line() {
         "{stderr}"
     );
 }
+
+#[test]
+fn default_denoise_graph_renders_and_reports_denoise_time() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let out = tempfile::tempdir().unwrap();
+    let o = lumagraph(&[
+        "render",
+        "graphs/pathtrace_denoise.ron",
+        "--scene",
+        "assets/cornell.ron",
+        "--spp",
+        "4",
+        "--out",
+        out.path().to_str().unwrap(),
+    ]);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stdout}\n{stderr}");
+    assert!(stdout.contains("rendered 4 spp at 256x256"), "{stdout}");
+    for name in ["render.png", "render.exr", "raw.exr"] {
+        assert!(out.path().join(name).is_file(), "{name} missing");
+    }
+    let plan = lumagraph(&[
+        "plan",
+        "graphs/pathtrace_denoise.ron",
+        "--scene",
+        "assets/cornell.ron",
+    ]);
+    let (stdout, _) = text(&plan);
+    assert!(
+        stdout.contains("2097152 bytes") && stdout.contains("2 rgba32f ping-pong images"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn converge_writes_csv_and_plot() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let out = tempfile::tempdir().unwrap();
+    let o = lumagraph(&[
+        "converge",
+        "graphs/pathtrace_denoise.ron",
+        "--scene",
+        "assets/cornell.ron",
+        "--reference",
+        "tests/reference/cornell_ref.exr",
+        "--seconds",
+        "0.5",
+        "--compare",
+        "tests/reference/cornell_converge.csv",
+        "--out",
+        out.path().to_str().unwrap(),
+    ]);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("denoise") && stdout.contains("ms per frame"),
+        "{stdout}"
+    );
+    let csv = std::fs::read_to_string(out.path().join("converge.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("output,spp,seconds,rmse,relmse,ssim,gpu_ms")
+    );
+    assert!(lines.any(|l| l.starts_with("denoise,1,")), "{csv}");
+    if !stdout.contains("plot not written") {
+        assert!(out.path().join("converge.png").is_file());
+    }
+}

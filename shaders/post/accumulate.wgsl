@@ -4,12 +4,24 @@
 //   comp[i].rgb Kahan compensation (the low-order bits the sum lost).
 // Mirrored by `cpu::KahanMean`.
 //
+// When `params.variance` is 1, a third buffer keeps Welford's second moment of the frames
+//   m2[i].rgb  sum of (x - mean_before)(x - mean_after) per channel,  m2[i].a  the same of
+//   the luminance,
+// with the means taken from the Kahan sums above (which it never changes), and `variance_out`
+// gets the variance of the mean, m2 / (n (n - 1)). After one frame there is no second frame
+// to compare with; the variance is then estimated spatially, as SVGF does for short
+// histories, over the pixel's 3×3 neighborhood: the sample variance per channel, and for the
+// luminance (what Denoise reads) a robust one from the median absolute deviation, so a wall
+// pixel beside the light does not look noisy.
+//
 // Shader compilers may simplify `((s + y) - s) - y` to 0 (Mesa's NIR does, since naga marks no
 // operation exact), which silently turns Kahan summation into a plain sum. Multiplying by
 // `params.one` (1.0, but unknown to the compiler) keeps the compensation term alive.
 
 struct Params {
     one: f32,
+    variance: u32,
+    size: vec2u,
 }
 
 @group(0) @binding(0) var input: texture_2d<f32>;
@@ -17,10 +29,74 @@ struct Params {
 @group(0) @binding(2) var<storage, read_write> sum: array<vec4f>;
 @group(0) @binding(3) var<storage, read_write> comp: array<vec4f>;
 @group(0) @binding(4) var<uniform> params: Params;
+@group(0) @binding(5) var<storage, read_write> m2: array<vec4f>;
+@group(0) @binding(6) var variance_out: texture_storage_2d<rgba32float, write>;
+
+const LUMA = vec3f(0.2126, 0.7152, 0.0722);
+
+// Sample variance (rgb, luminance) of the input over the 3×3 neighborhood of `p`.
+fn spatial_variance(p: vec2i, size: vec2i) -> vec4f {
+    var sum = vec4f(0.0);
+    var sum2 = vec4f(0.0);
+    var n = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = p + vec2i(dx, dy);
+            if all(q >= vec2i(0)) && all(q < size) {
+                let x = textureLoad(input, q, 0).rgb;
+                let v = vec4f(x, dot(x, LUMA));
+                sum += v;
+                sum2 += v * v;
+                n += 1.0;
+            }
+        }
+    }
+    let mean = sum / n;
+    let v = max(sum2 / n - mean * mean, vec4f(0.0)) * (n / max(n - 1.0, 1.0));
+    return vec4f(v.rgb, robust_luminance_variance(p, size));
+}
+
+// (1.4826 × median absolute deviation)² of the luminance over the 3×3 neighborhood: the
+// variance of Gaussian noise, but a pixel next to an edge (a light beside a wall) is not
+// made to look noisy by the other side, as long as its own side is the majority.
+fn robust_luminance_variance(p: vec2i, size: vec2i) -> f32 {
+    var v: array<f32, 9>;
+    var n = 0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = p + vec2i(dx, dy);
+            if all(q >= vec2i(0)) && all(q < size) {
+                v[n] = dot(textureLoad(input, q, 0).rgb, LUMA);
+                n++;
+            }
+        }
+    }
+    let median = median_of(&v, n);
+    for (var i = 0; i < n; i++) {
+        v[i] = abs(v[i] - median);
+    }
+    let mad = 1.4826 * median_of(&v, n);
+    return mad * mad;
+}
+
+// Median of the first `n` values (insertion sort; n <= 9).
+fn median_of(v: ptr<function, array<f32, 9>>, n: i32) -> f32 {
+    for (var i = 1; i < n; i++) {
+        let x = (*v)[i];
+        var j = i - 1;
+        while j >= 0 && (*v)[j] > x {
+            (*v)[j + 1] = (*v)[j];
+            j--;
+        }
+        (*v)[j + 1] = x;
+    }
+    let h = n / 2;
+    return select(0.5 * ((*v)[h - 1] + (*v)[h]), (*v)[h], n % 2 == 1);
+}
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3u) {
-    let size = textureDimensions(output);
+    let size = params.size;
     if id.x >= size.x || id.y >= size.y {
         return;
     }
@@ -31,7 +107,25 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     let y = x - c;
     let t = (s.rgb + y) * params.one;
     comp[i] = vec4f((t - s.rgb) - y, 0.0);
+    let before = s;
     s = vec4f(t, s.a + 1.0);
     sum[i] = s;
-    textureStore(output, id.xy, vec4f(s.rgb / s.a, 1.0));
+    let mean = s.rgb / s.a;
+    textureStore(output, id.xy, vec4f(mean, 1.0));
+
+    if params.variance == 1u {
+        let mean_before = select(x, before.rgb / before.a, before.a > 0.0);
+        let d = vec4f(x - mean_before, dot(x - mean_before, LUMA));
+        let e = vec4f(x - mean, dot(x - mean, LUMA));
+        let moment = m2[i] + d * e;
+        m2[i] = moment;
+        let n = s.a;
+        var v: vec4f;
+        if n >= 2.0 {
+            v = max(moment, vec4f(0.0)) / (n * (n - 1.0));
+        } else {
+            v = spatial_variance(vec2i(id.xy), vec2i(size));
+        }
+        textureStore(variance_out, id.xy, v);
+    }
 }

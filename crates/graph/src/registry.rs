@@ -236,20 +236,163 @@ fn builtin_kinds() -> Vec<NodeKind> {
             category: Category::Render,
             doc: "Running mean of its input over frames (progressive rendering). Sums are kept in \
                   f32 with Kahan compensation, so millions of frames do not drift. Restarts when \
-                  the scene, the camera or anything upstream changes.",
+                  the scene, the camera or anything upstream changes. Also estimates the \
+                  variance of the mean (for Denoise) when its `variance` output is read.",
             inputs: &[InputDef {
                 name: "color",
                 accepts: COLOR_TYPES,
                 doc: "this frame's estimate",
             }],
-            outputs: &[OutputDef {
-                name: "color",
-                ty: PortType::HdrColor,
-                doc: "mean of all frames so far",
-            }],
+            outputs: &[
+                OutputDef {
+                    name: "color",
+                    ty: PortType::HdrColor,
+                    doc: "mean of all frames so far",
+                },
+                OutputDef {
+                    name: "variance",
+                    ty: PortType::Variance,
+                    doc: "variance of that mean per pixel (rgb per channel, alpha of the \
+                          luminance), from a Welford second moment over frames; after a single \
+                          frame, estimated over the pixel's 3×3 neighborhood (luminance: from the median \
+                          absolute deviation)",
+                },
+            ],
             params: vec![],
             sink: false,
             history: true,
+        },
+        NodeKind {
+            name: "GBuffer",
+            category: Category::Render,
+            doc: "Rasterizes the scene (`--scene`) from the path tracer's camera: triangles with \
+                  their shading normals, spheres tessellated and then intersected exactly per \
+                  pixel. Writes what the path tracer's first hit through the pixel center sees, \
+                  without tracing a ray; the guides of Denoise. Image size from the scene.",
+            inputs: &[],
+            outputs: &[
+                OutputDef {
+                    name: "albedo",
+                    ty: PortType::Albedo,
+                    doc: "material base color (0 where nothing is hit)",
+                },
+                OutputDef {
+                    name: "normal",
+                    ty: PortType::Normal,
+                    doc: "world-space shading normal, interpolated vertex normals where the \
+                          triangle has them (0 where nothing is hit)",
+                },
+                OutputDef {
+                    name: "depth",
+                    ty: PortType::Depth,
+                    doc: "distance from the camera along the ray through the pixel center \
+                          (0 where nothing is hit)",
+                },
+            ],
+            params: vec![ParamDef {
+                name: "sphere_segments",
+                ty: ParamType::Int {
+                    default: 48,
+                    min: 8,
+                    max: 512,
+                },
+                doc: "segments around a sphere's tessellation (the silhouette is exact anyway: \
+                      each fragment intersects the true sphere)",
+            }],
+            sink: false,
+            history: false,
+        },
+        NodeKind {
+            name: "Denoise",
+            category: Category::Render,
+            doc: "Edge-avoiding à-trous wavelet filter (Dammertz et al. 2010, with SVGF's \
+                  weights): `iterations` passes of the 5×5 B3-spline kernel with holes of \
+                  1, 2, 4, 8, 16… pixels. Color is divided by the albedo before filtering and \
+                  multiplied back after; each tap is weighted by luminance (scaled by the \
+                  pixel's standard deviation when `variance_guided`), normal and depth \
+                  differences. Two ping-pong images are the only memory it adds.",
+            inputs: &[
+                InputDef {
+                    name: "color",
+                    accepts: COLOR_TYPES,
+                    doc: "noisy linear color (e.g. Accumulate.color)",
+                },
+                InputDef {
+                    name: "albedo",
+                    accepts: &[PortType::Albedo],
+                    doc: "first-hit albedo (GBuffer or PathTrace)",
+                },
+                InputDef {
+                    name: "normal",
+                    accepts: &[PortType::Normal],
+                    doc: "first-hit world-space normal",
+                },
+                InputDef {
+                    name: "depth",
+                    accepts: &[PortType::Depth],
+                    doc: "first-hit distance along the camera ray",
+                },
+                InputDef {
+                    name: "variance",
+                    accepts: &[PortType::Variance],
+                    doc: "variance of the color's mean (Accumulate.variance); read only when \
+                          `variance_guided` is on, but always connected",
+                },
+            ],
+            outputs: &[OutputDef {
+                name: "color",
+                ty: PortType::HdrColor,
+                doc: "filtered linear color",
+            }],
+            params: vec![
+                ParamDef {
+                    name: "iterations",
+                    ty: ParamType::Int {
+                        default: 5,
+                        min: 1,
+                        max: 8,
+                    },
+                    doc: "à-trous passes; pass i spaces the kernel's taps 2^i pixels apart",
+                },
+                ParamDef {
+                    name: "sigma_color",
+                    ty: ParamType::Float {
+                        default: 4.0,
+                        min: 0.0,
+                        max: 1000.0,
+                    },
+                    doc: "luminance tolerance: in standard deviations when variance-guided, \
+                          else in units of luminance, halved every pass (0 = stop at any \
+                          difference)",
+                },
+                ParamDef {
+                    name: "sigma_normal",
+                    ty: ParamType::Float {
+                        default: 0.02,
+                        min: 0.0,
+                        max: 10.0,
+                    },
+                    doc: "normal tolerance: weight exp(-(1 - n_p·n_q) / sigma_normal)",
+                },
+                ParamDef {
+                    name: "sigma_depth",
+                    ty: ParamType::Float {
+                        default: 0.5,
+                        min: 0.0,
+                        max: 1000.0,
+                    },
+                    doc: "depth tolerance, in multiples of the depth change the local gradient \
+                          predicts over the tap's offset",
+                },
+                ParamDef {
+                    name: "variance_guided",
+                    ty: ParamType::Bool { default: true },
+                    doc: "scale the luminance tolerance by the per-pixel standard deviation \
+                          (SVGF); off: a fixed tolerance halved every pass (Dammertz)",
+                },
+            ],
+            sink: false,
+            history: false,
         },
         NodeKind {
             name: "Exposure",

@@ -1,5 +1,5 @@
-//! Plain-Rust reference implementations of the GPU post nodes, written to mirror the
-//! WGSL line for line. Tests run both and compare.
+//! Plain-Rust reference implementations of the GPU post nodes and the à-trous filter,
+//! written to mirror the WGSL line for line. Tests run both and compare.
 
 /// An image as linear RGBA `f32`, row-major, top row first.
 #[derive(Clone, Debug, PartialEq)]
@@ -214,5 +214,162 @@ impl KahanMean {
     /// The mean so far.
     pub fn mean(&self) -> [f32; 3] {
         self.sum.map(|s| s / self.frames)
+    }
+}
+
+/// Params of the à-trous filter, as the `Denoise` node's.
+#[derive(Clone, Copy, Debug)]
+pub struct DenoiseParams {
+    /// Filter passes (taps 1, 2, 4… pixels apart).
+    pub iterations: u32,
+    /// Luminance tolerance.
+    pub sigma_color: f32,
+    /// Normal tolerance.
+    pub sigma_normal: f32,
+    /// Depth tolerance.
+    pub sigma_depth: f32,
+    /// Scale the luminance tolerance by the standard deviation.
+    pub variance_guided: bool,
+}
+
+fn finite4(p: [f32; 4]) -> [f32; 4] {
+    p.map(|v| if v.is_finite() { v } else { 0.0 })
+}
+
+/// The à-trous filter of `shaders/post/denoise.wgsl`, mirrored: demodulation, then
+/// `iterations` passes, then remodulation. Depth is read from channel 0 of `depth`.
+///
+/// # Panics
+/// When the images differ in size.
+pub fn denoise(
+    color: &Image,
+    variance: &Image,
+    albedo: &Image,
+    normal: &Image,
+    depth: &Image,
+    params: &DenoiseParams,
+) -> Image {
+    const EPS: f32 = 1e-3;
+    const KERNEL: [f32; 3] = [0.375, 0.25, 0.0625];
+    let (w, h) = (color.width as i32, color.height as i32);
+    for other in [variance, albedo, normal, depth] {
+        assert_eq!((other.width, other.height), (color.width, color.height));
+    }
+    let idx = |x: i32, y: i32| (y * w + x) as usize;
+    let inside = |x: i32, y: i32| x >= 0 && y >= 0 && x < w && y < h;
+    let alb = |i: usize| map3(rgb(finite4(albedo.pixels[i])), |v| v.max(EPS));
+    let z = |i: usize| finite4(depth.pixels[i])[0];
+    let nrm = |i: usize| rgb(finite4(normal.pixels[i]));
+    let dot3 = |a: V3, b: V3| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    // Demodulation.
+    let mut cur: Vec<[f32; 4]> = (0..color.pixels.len())
+        .map(|i| {
+            let s = finite4(color.pixels[i]);
+            let a = alb(i);
+            let v = finite4(variance.pixels[i])[3].max(0.0);
+            let la = luminance(a).max(EPS);
+            let c = [
+                s[0].max(0.0) / a[0],
+                s[1].max(0.0) / a[1],
+                s[2].max(0.0) / a[2],
+            ];
+            finite4([c[0], c[1], c[2], v / (la * la)])
+        })
+        .collect();
+    for pass in 0..params.iterations {
+        let step = 1_i32 << pass;
+        let last = pass + 1 == params.iterations;
+        let scale = 0.5_f32.powi(pass as i32);
+        let mut next = cur.clone();
+        for y in 0..h {
+            for x in 0..w {
+                let i = idx(x, y);
+                let center = finite4(cur[i]);
+                let l_p = luminance(rgb(center));
+                let n_p = nrm(i);
+                let z_p = z(i);
+                let mut grad = [0.0_f32; 2];
+                for (axis, g) in grad.iter_mut().enumerate() {
+                    let (ex, ey) = if axis == 0 { (1, 0) } else { (0, 1) };
+                    let mut best = 1e30_f32;
+                    if inside(x + ex, y + ey) {
+                        best = z(idx(x + ex, y + ey)) - z_p;
+                    }
+                    if inside(x - ex, y - ey) {
+                        let b = z_p - z(idx(x - ex, y - ey));
+                        if b.abs() < best.abs() {
+                            best = b;
+                        }
+                    }
+                    *g = if best.abs() < 1e29 { best } else { 0.0 };
+                }
+                let s = if params.variance_guided {
+                    let (mut sum, mut wsum) = (0.0, 0.0);
+                    for dy in -1..=1 {
+                        for dx in -1..=1 {
+                            if inside(x + dx, y + dy) {
+                                let wt = if dx == 0 { 0.5 } else { 0.25 }
+                                    * if dy == 0 { 0.5 } else { 0.25 };
+                                sum += wt * finite4(cur[idx(x + dx, y + dy)])[3];
+                                wsum += wt;
+                            }
+                        }
+                    }
+                    (sum / wsum).max(0.0).sqrt()
+                } else {
+                    scale
+                };
+                let l_denom = params.sigma_color * s + 1e-6;
+                let n_denom = params.sigma_normal.max(1e-6);
+                let z_eps = 1e-3 * z_p + 1e-6;
+                let h0 = KERNEL[0] * KERNEL[0];
+                let mut acc = [h0 * center[0], h0 * center[1], h0 * center[2]];
+                let mut var_sum = h0 * h0 * center[3];
+                let mut wsum = h0;
+                for dy in -2_i32..=2 {
+                    for dx in -2_i32..=2 {
+                        let (qx, qy) = (x + dx * step, y + dy * step);
+                        if (dx == 0 && dy == 0) || !inside(qx, qy) {
+                            continue;
+                        }
+                        let q = idx(qx, qy);
+                        let c = finite4(cur[q]);
+                        let hk =
+                            KERNEL[dx.unsigned_abs() as usize] * KERNEL[dy.unsigned_abs() as usize];
+                        let w_l = (l_p - luminance(rgb(c))).abs() / l_denom;
+                        let w_n = (1.0 - dot3(n_p, nrm(q))).max(0.0) / n_denom;
+                        #[expect(clippy::cast_precision_loss, reason = "small offsets")]
+                        let off = [(dx * step) as f32, (dy * step) as f32];
+                        let z_scale = params.sigma_depth
+                            * (grad[0] * off[0] + grad[1] * off[1]).abs()
+                            + z_eps;
+                        let w_z = (z_p - z(q)).abs() / z_scale;
+                        let wt = hk * (-(w_l + w_n + w_z)).exp();
+                        for k in 0..3 {
+                            acc[k] += wt * c[k];
+                        }
+                        var_sum += wt * wt * c[3];
+                        wsum += wt;
+                    }
+                }
+                let mut out = finite4([
+                    acc[0] / wsum,
+                    acc[1] / wsum,
+                    acc[2] / wsum,
+                    var_sum / (wsum * wsum),
+                ]);
+                if last {
+                    let a = alb(i);
+                    out = [out[0] * a[0], out[1] * a[1], out[2] * a[2], 1.0];
+                }
+                next[i] = out;
+            }
+        }
+        cur = next;
+    }
+    Image {
+        width: color.width,
+        height: color.height,
+        pixels: cur,
     }
 }

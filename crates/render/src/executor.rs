@@ -30,7 +30,7 @@ pub fn source_extent(
     match node.kind.as_str() {
         "ImageInput" => crate::image_io::dimensions(&base_dir.join(params.str("path")))
             .map_err(|e| e.to_string()),
-        "PathTrace" => scene
+        "PathTrace" | "GBuffer" => scene
             .map(|s| Extent::new(s.settings.width, s.settings.height))
             .ok_or_else(|| {
                 "renders a scene, but none was given (lumagraph render --scene FILE)".to_owned()
@@ -70,6 +70,8 @@ enum Mode {
     Progress,
     /// Everything once, untimed, no files.
     WarmUp,
+    /// Only the passes that do not run every frame, timed; sinks write. No frame is added.
+    Tail,
 }
 
 /// What one frame did.
@@ -217,6 +219,18 @@ impl Executor {
         self.run(n, if finish { Mode::Finish } else { Mode::Progress })
     }
 
+    /// Runs only the part of the graph downstream of history (what `run_frames(_, true)`
+    /// adds in its last frame: G-buffer, denoiser, post nodes, sinks) over the history as it
+    /// is, without adding a frame, so its cost can be timed apart from rendering. Call it
+    /// after at least one progressive frame since the last finishing run: textures the
+    /// progressive part writes may share memory with textures of the part it runs.
+    ///
+    /// # Errors
+    /// When a node fails; the error names the node.
+    pub fn run_tail(&mut self) -> Result<FrameReport> {
+        self.run(1, Mode::Tail)
+    }
+
     /// Records every pass once without writing files or keeping history, so drivers that
     /// compile pipelines at their first dispatch do it here rather than in a timed frame.
     ///
@@ -251,10 +265,10 @@ impl Executor {
         for frame in 0..n {
             let last = mode != Mode::Progress && frame + 1 == n;
             for (p, (pass, node)) in self.plan.passes.iter().zip(&mut self.nodes).enumerate() {
-                if !last && !self.every_frame[p] {
+                if (!last && !self.every_frame[p]) || (mode == Mode::Tail && self.every_frame[p]) {
                     continue;
                 }
-                let timer = if last && mode == Mode::Finish {
+                let timer = if last && matches!(mode, Mode::Finish | Mode::Tail) {
                     self.timer.as_mut()
                 } else {
                     None
@@ -279,7 +293,7 @@ impl Executor {
         }
         self.ctx.wait()?;
         let mut written = Vec::new();
-        if mode == Mode::Finish {
+        if matches!(mode, Mode::Finish | Mode::Tail) {
             for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
                 written.extend(
                     node.finish(&self.ctx, pass)
@@ -288,10 +302,12 @@ impl Executor {
             }
         }
         let pass_ms = match &self.timer {
-            Some(t) if mode == Mode::Finish => Some(t.read(&self.ctx)?),
+            Some(t) if matches!(mode, Mode::Finish | Mode::Tail) => Some(t.read(&self.ctx)?),
             _ => None,
         };
-        self.frames += u64::from(n);
+        if mode != Mode::Tail {
+            self.frames += u64::from(n);
+        }
         Ok(FrameReport {
             pass_ms,
             wall: start.elapsed(),

@@ -1,5 +1,6 @@
 //! Image error metrics, as the reference renders define them: over every pixel and RGB
-//! channel, `rmse = sqrt(mean((x - ref)^2))` and `relmse = mean((x - ref)^2 / (ref^2 + 1e-2))`.
+//! channel, `rmse = sqrt(mean((x - ref)^2))` and `relmse = mean((x - ref)^2 / (ref^2 + 1e-2))`;
+//! and SSIM on clipped luminance ([`ssim`]).
 
 use crate::cpu::Image;
 
@@ -74,4 +75,95 @@ pub fn channel_means(image: &Image) -> [f64; 3] {
     #[expect(clippy::cast_precision_loss, reason = "pixel counts")]
     let n = image.pixels.len() as f64;
     m.map(|v| v / n)
+}
+
+/// Luminance (Rec. 709 weights) of each pixel, clipped to \[0, 1\] (non-finite values → 0).
+fn clipped_luminance(image: &Image) -> Vec<f64> {
+    image
+        .pixels
+        .iter()
+        .map(|p| {
+            let y = 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]);
+            if y.is_finite() {
+                y.clamp(0.0, 1.0)
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// Separable Gaussian blur (σ = 1.5, 11 taps) with the window renormalized at the borders.
+fn gaussian(v: &[f64], w: usize, h: usize) -> Vec<f64> {
+    const R: isize = 5;
+    let k: Vec<f64> = (-R..=R)
+        .map(|i| {
+            #[expect(clippy::cast_precision_loss, reason = "small offsets")]
+            let x = i as f64;
+            (-x * x / (2.0 * 1.5 * 1.5)).exp()
+        })
+        .collect();
+    let pass = |src: &[f64], horizontal: bool| {
+        let mut out = vec![0.0; src.len()];
+        for y in 0..h {
+            for x in 0..w {
+                let (mut s, mut ws) = (0.0, 0.0);
+                for (j, kw) in k.iter().enumerate() {
+                    let d = j.cast_signed() - R;
+                    let (u, v) = if horizontal {
+                        (x.cast_signed() + d, y.cast_signed())
+                    } else {
+                        (x.cast_signed(), y.cast_signed() + d)
+                    };
+                    if u >= 0 && v >= 0 && u < w.cast_signed() && v < h.cast_signed() {
+                        s += kw * src[v.cast_unsigned() * w + u.cast_unsigned()];
+                        ws += kw;
+                    }
+                }
+                out[y * w + x] = s / ws;
+            }
+        }
+        out
+    };
+    pass(&pass(v, true), false)
+}
+
+/// Mean SSIM (Wang et al. 2004) of `x` against `reference`, on luminance clipped to
+/// \[0, 1\] (dynamic range L = 1, so C1 = 0.01², C2 = 0.03²), with an 11×11 Gaussian window
+/// of σ = 1.5 (renormalized at the borders). 1 means identical. Linear HDR values above 1
+/// (light sources) count as 1: the index is about the image's visible structure, relMSE is
+/// the HDR measure.
+///
+/// # Panics
+/// When the sizes differ.
+pub fn ssim(x: &Image, reference: &Image) -> f64 {
+    assert_eq!(
+        (x.width, x.height),
+        (reference.width, reference.height),
+        "images differ in size"
+    );
+    let (w, h) = (x.width as usize, x.height as usize);
+    let (a, b) = (clipped_luminance(x), clipped_luminance(reference));
+    let prod = |p: &[f64], q: &[f64]| p.iter().zip(q).map(|(u, v)| u * v).collect::<Vec<_>>();
+    let (ma, mb) = (gaussian(&a, w, h), gaussian(&b, w, h));
+    let (aa, bb, ab) = (
+        gaussian(&prod(&a, &a), w, h),
+        gaussian(&prod(&b, &b), w, h),
+        gaussian(&prod(&a, &b), w, h),
+    );
+    let (c1, c2) = (0.01_f64.powi(2), 0.03_f64.powi(2));
+    let sum: f64 = (0..w * h)
+        .map(|i| {
+            let (va, vb, cov) = (
+                aa[i] - ma[i] * ma[i],
+                bb[i] - mb[i] * mb[i],
+                ab[i] - ma[i] * mb[i],
+            );
+            ((2.0 * ma[i] * mb[i] + c1) * (2.0 * cov + c2))
+                / ((ma[i] * ma[i] + mb[i] * mb[i] + c1) * (va + vb + c2))
+        })
+        .sum();
+    #[expect(clippy::cast_precision_loss, reason = "pixel counts")]
+    let n = (w * h).max(1) as f64;
+    sum / n
 }

@@ -75,7 +75,8 @@ impl TexturePool {
     }
 }
 
-/// Creates a texture usable as a storage target, a sampled input and a copy source/target.
+/// Creates a texture usable as a storage target, a sampled input, a copy source/target and
+/// a render target (every planned format is renderable; the G-buffer rasterizes into them).
 pub fn create(ctx: &GpuContext, label: &str, format: TexFormat, extent: Extent) -> PooledTexture {
     let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
@@ -91,7 +92,8 @@ pub fn create(ctx: &GpuContext, label: &str, format: TexFormat, extent: Extent) 
         usage: wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::STORAGE_BINDING
             | wgpu::TextureUsages::COPY_SRC
-            | wgpu::TextureUsages::COPY_DST,
+            | wgpu::TextureUsages::COPY_DST
+            | wgpu::TextureUsages::RENDER_ATTACHMENT,
         view_formats: &[],
     });
     let view = texture.create_view(&wgpu::TextureViewDescriptor::default());

@@ -70,6 +70,15 @@ impl GpuTimer {
         })
     }
 
+    /// Timestamp writes for the next render pass, named `label`; `None` once full.
+    pub fn render_writes(&mut self, label: &str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        self.writes(label).map(|w| wgpu::RenderPassTimestampWrites {
+            query_set: w.query_set,
+            beginning_of_pass_write_index: w.beginning_of_pass_write_index,
+            end_of_pass_write_index: w.end_of_pass_write_index,
+        })
+    }
+
     /// Records the copy of this frame's timestamps; call after the last pass.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
         let n = u32::try_from(self.labels.len()).unwrap_or(self.capacity) * 2;

@@ -2,24 +2,34 @@
 //!
 //! The sums are history that outlives a frame, so they live in buffers the node owns, not
 //! in the per-frame texture pool. [`NodeExec::reset`] clears them (scene or camera changed).
+//!
+//! When the `variance` output is read, a third buffer keeps Welford's second moment over
+//! frames (the Kahan sums, and so the mean, are computed exactly as without it), and the
+//! pass also writes the variance of the mean; otherwise that buffer and output are 16-byte
+//! and 1×1 stand-ins and the shader skips the work.
 
-use lumagraph_graph::{Extent, Pass};
+use lumagraph_graph::{Extent, Pass, TexFormat};
 
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::kernel::{Binding, Kernel, uniform_buffer};
 use crate::nodes::{FrameIo, NodeExec};
+use crate::pool::{PooledTexture, create};
 use crate::timing::GpuTimer;
 
 pub(crate) struct Accumulate {
     kernel: Kernel,
     params: wgpu::Buffer,
-    history: Option<(Extent, wgpu::Buffer, wgpu::Buffer)>,
+    /// Size, sum, compensation and second moment (a stand-in without `variance`).
+    history: Option<(Extent, wgpu::Buffer, wgpu::Buffer, wgpu::Buffer)>,
     clear: bool,
+    variance: bool,
+    /// Stand-ins for an output nothing reads (color, variance).
+    unused: [PooledTexture; 2],
 }
 
 impl Accumulate {
-    pub(crate) fn new(ctx: &GpuContext) -> Result<Self> {
+    pub(crate) fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
         let kernel = Kernel::new(
             ctx,
             "post/accumulate.wgsl",
@@ -29,18 +39,31 @@ impl Accumulate {
                 Binding::Storage { read_only: false },
                 Binding::Storage { read_only: false },
                 Binding::Uniform,
+                Binding::Storage { read_only: false },
+                Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
             ],
         )?;
-        let params = uniform_buffer(
-            ctx,
-            "accumulate params",
-            bytemuck::bytes_of(&[1.0_f32, 0.0, 0.0, 0.0]),
-        );
+        let variance = pass.output("variance").is_some();
+        let mut words = [0_u32; 4];
+        words[0] = 1.0_f32.to_bits();
+        words[1] = u32::from(variance);
+        let params = uniform_buffer(ctx, "accumulate params", bytemuck::bytes_of(&words));
+        let one = Extent::new(1, 1);
         Ok(Self {
             kernel,
             params,
             history: None,
             clear: true,
+            variance,
+            unused: [
+                create(ctx, "unused accumulate color", TexFormat::Rgba32Float, one),
+                create(
+                    ctx,
+                    "unused accumulate variance",
+                    TexFormat::Rgba32Float,
+                    one,
+                ),
+            ],
         })
     }
 }
@@ -63,41 +86,64 @@ impl NodeExec for Accumulate {
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let input = io.input(pass, "color")?;
-        let Some(out) = pass.output("color") else {
+        let (out, var) = (pass.output("color"), pass.output("variance"));
+        if out.is_none() && var.is_none() {
             return Ok(());
-        };
+        }
         let mut clear = std::mem::take(&mut self.clear);
         let extent = pass.extent;
-        if self.history.as_ref().is_none_or(|(e, _, _)| *e != extent) {
-            let make = |label| {
+        if self.history.as_ref().is_none_or(|(e, ..)| *e != extent) {
+            let make = |label, size| {
                 ctx.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(label),
-                    size: extent.pixels() * 16,
+                    size,
                     usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 })
             };
+            let bytes = extent.pixels() * 16;
             self.history = Some((
                 extent,
-                make("accumulate sum"),
-                make("accumulate compensation"),
+                make("accumulate sum", bytes),
+                make("accumulate compensation", bytes),
+                make(
+                    "accumulate second moment",
+                    if self.variance { bytes } else { 16 },
+                ),
             ));
             clear = true;
         }
-        let Some((_, sum, comp)) = &self.history else {
+        let Some((_, sum, comp, m2)) = &self.history else {
             return Ok(());
         };
         if clear {
             encoder.clear_buffer(sum, 0, None);
             encoder.clear_buffer(comp, 0, None);
+            encoder.clear_buffer(m2, 0, None);
         }
+        if clear {
+            // The image size rides with the params (outputs may be 1×1 stand-ins).
+            let mut words = [0_u32; 4];
+            words[0] = 1.0_f32.to_bits();
+            words[1] = u32::from(self.variance);
+            words[2] = extent.width;
+            words[3] = extent.height;
+            ctx.queue
+                .write_buffer(&self.params, 0, bytemuck::bytes_of(&words));
+        }
+        let view = |t: Option<lumagraph_graph::TextureId>, i: usize| {
+            t.map_or(&self.unused[i].view, |t| &io.texture(t).view)
+        };
+        let color_view = view(out, 0);
         self.kernel
             .pass(&pass.node)
             .read(&input.view)
-            .write(&io.texture(out).view)
+            .write(color_view)
             .buffer(sum)
             .buffer(comp)
             .uniform(&self.params)
+            .buffer(m2)
+            .write(view(var, 1))
             .dispatch_2d(ctx, encoder, pass.extent, timer)
     }
 }

@@ -1,7 +1,9 @@
 //! GPU implementations of the node kinds, one file per kind, each named as in the registry.
 
 mod accumulate;
+mod denoise;
 mod exposure;
+mod gbuffer;
 mod image_input;
 mod output;
 mod pathtrace;
@@ -130,6 +132,41 @@ pub trait NodeExec {
     }
 }
 
+/// Memory a node allocates for itself, outside the plan's textures (history, scratch
+/// images, depth attachments), in bytes with what it is; `None` for nodes that own none.
+/// The CLI's `plan` prints it beside the plan's textures.
+pub fn owned_memory(pass: &Pass) -> Option<(u64, String)> {
+    let px = pass.extent.pixels();
+    match pass.kind {
+        "Accumulate" => {
+            let buffers = if pass.output("variance").is_some() {
+                3
+            } else {
+                2
+            };
+            Some((
+                buffers * 16 * px,
+                format!(
+                    "{buffers} history buffers of 16 B per pixel (sum, compensation{})",
+                    if buffers == 3 { ", second moment" } else { "" }
+                ),
+            ))
+        }
+        "Denoise" => {
+            let n = u32::try_from(pass.params.int("iterations")).unwrap_or(1);
+            let bytes = denoise::scratch_bytes(pass.extent, n);
+            let what = if n > 1 {
+                "2 rgba32f ping-pong images"
+            } else {
+                "1 rgba32f image (demodulated input)"
+            };
+            Some((bytes, what.to_owned()))
+        }
+        "GBuffer" => Some((4 * px, "depth attachment (depth32float)".to_owned())),
+        _ => None,
+    }
+}
+
 /// Creates the GPU side of the node a pass runs.
 ///
 /// # Errors
@@ -137,10 +174,12 @@ pub trait NodeExec {
 pub fn create(ctx: &GpuContext, pass: &Pass, paths: &Resources) -> Result<Box<dyn NodeExec>> {
     let node: Result<Box<dyn NodeExec>> = match pass.kind {
         "ImageInput" => image_input::ImageInput::new(ctx, pass, paths).map(|n| Box::new(n) as _),
-        "Accumulate" => accumulate::Accumulate::new(ctx).map(|n| Box::new(n) as _),
+        "Accumulate" => accumulate::Accumulate::new(ctx, pass).map(|n| Box::new(n) as _),
         "Exposure" => exposure::Exposure::new(ctx, pass).map(|n| Box::new(n) as _),
         "Tonemap" => tonemap::Tonemap::new(ctx, pass).map(|n| Box::new(n) as _),
         "PathTrace" => pathtrace::PathTrace::new(ctx, pass, paths).map(|n| Box::new(n) as _),
+        "GBuffer" => gbuffer::GBuffer::new(ctx, pass, paths).map(|n| Box::new(n) as _),
+        "Denoise" => denoise::Denoise::new(ctx, pass).map(|n| Box::new(n) as _),
         "Output" => output::Output::new(ctx, pass, paths).map(|n| Box::new(n) as _),
         other => Err(RenderError::Unimplemented(other.to_owned())),
     };

@@ -1,0 +1,198 @@
+//! `Denoise`: the edge-avoiding à-trous wavelet filter: a demodulation pass, then
+//! `iterations` filter passes of `shaders/post/denoise.wgsl` with the kernel's taps 1, 2, 4,
+//! 8, 16… pixels apart, the last one remodulating into the output texture.
+//!
+//! Memory: the demodulation pass reads the node's inputs and writes illumination (rgb) and
+//! its variance (alpha) into a node-owned `rgba32float` image of the pass's size; the filter
+//! passes ping-pong between it and a second one; the last writes the output texture. Those
+//! two images, created once and reused every frame, are all the memory the filter adds
+//! ([`scratch_bytes`]); with one iteration only the first is created.
+//!
+//! The `variance` input is always connected (every input is, in this graph model); with
+//! `variance_guided` off the shader never reads it and the luminance tolerance is a fixed
+//! one halved every pass, as in Dammertz et al.
+
+use lumagraph_graph::{Extent, Pass, TexFormat};
+
+use crate::context::GpuContext;
+use crate::error::Result;
+use crate::kernel::{Binding, Kernel, uniform_buffer};
+use crate::nodes::{FrameIo, NodeExec};
+use crate::pool::{PooledTexture, create};
+use crate::timing::GpuTimer;
+
+/// Most passes the registry allows.
+const MAX_ITERATIONS: u32 = 8;
+
+pub(crate) struct Denoise {
+    kernel: Kernel,
+    /// One uniform buffer per pass (step, first/last flags, sigmas); the demodulation
+    /// pass's is the last.
+    params: Vec<wgpu::Buffer>,
+    iterations: u32,
+    extent: Extent,
+    ping_pong: Option<(Extent, Vec<PooledTexture>)>,
+}
+
+/// Images of node-owned memory a Denoise pass with `iterations` uses.
+fn scratch_images(iterations: u32) -> u64 {
+    if iterations <= 1 { 1 } else { 2 }
+}
+
+/// Bytes of node-owned memory a Denoise pass over `extent` with `iterations` adds: two
+/// `rgba32float` ping-pong images (one for a single iteration).
+pub fn scratch_bytes(extent: Extent, iterations: u32) -> u64 {
+    scratch_images(iterations) * extent.pixels() * TexFormat::Rgba32Float.bytes_per_pixel()
+}
+
+fn iterations(pass: &Pass) -> u32 {
+    u32::try_from(pass.params.int("iterations"))
+        .unwrap_or(1)
+        .clamp(1, MAX_ITERATIONS)
+}
+
+impl Denoise {
+    pub(crate) fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
+        let kernel = Kernel::new(
+            ctx,
+            "post/denoise.wgsl",
+            &[
+                Binding::Texture,
+                Binding::Texture,
+                Binding::Texture,
+                Binding::Texture,
+                Binding::Texture,
+                Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
+                Binding::Uniform,
+            ],
+        )?;
+        let params = (0..=MAX_ITERATIONS)
+            .map(|i| uniform_buffer(ctx, &format!("denoise params {i}"), &[0; 32]))
+            .collect();
+        let mut node = Self {
+            kernel,
+            params,
+            iterations: 1,
+            extent: pass.extent,
+            ping_pong: None,
+        };
+        node.update(ctx, pass)?;
+        Ok(node)
+    }
+}
+
+impl NodeExec for Denoise {
+    fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
+        self.iterations = iterations(pass);
+        let p = &pass.params;
+        #[expect(clippy::cast_possible_truncation, reason = "params fit f32")]
+        let (sigma_color, sigma_normal, sigma_depth) = (
+            p.float("sigma_color") as f32,
+            p.float("sigma_normal") as f32,
+            p.float("sigma_depth") as f32,
+        );
+        let guided = u32::from(p.bool("variance_guided"));
+        let demodulate: [u32; 8] = [0, 1, 0, 0, 0, 0, 0, 0];
+        ctx.queue.write_buffer(
+            &self.params[MAX_ITERATIONS as usize],
+            0,
+            bytemuck::bytes_of(&demodulate),
+        );
+        for i in 0..self.iterations {
+            let words: [u32; 8] = [
+                1_u32 << i,
+                0,
+                u32::from(i + 1 == self.iterations),
+                guided,
+                sigma_color.to_bits(),
+                sigma_normal.to_bits(),
+                sigma_depth.to_bits(),
+                0.5_f32.powi(i32::try_from(i).unwrap_or(0)).to_bits(),
+            ];
+            ctx.queue
+                .write_buffer(&self.params[i as usize], 0, bytemuck::bytes_of(&words));
+        }
+        Ok(())
+    }
+
+    fn record(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: &Pass,
+        io: &FrameIo<'_>,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let Some(out) = pass.output("color") else {
+            return Ok(());
+        };
+        let extent = pass.extent;
+        let images = scratch_images(self.iterations) as usize;
+        if self
+            .ping_pong
+            .as_ref()
+            .is_none_or(|(e, pp)| *e != extent || pp.len() != images)
+        {
+            let make = |i| {
+                create(
+                    ctx,
+                    &format!("denoise ping-pong {i}"),
+                    TexFormat::Rgba32Float,
+                    extent,
+                )
+            };
+            self.ping_pong = Some((extent, (0..images).map(make).collect()));
+        }
+        let Some((_, pp)) = &self.ping_pong else {
+            return Ok(());
+        };
+        let color = io.input(pass, "color")?;
+        let variance = io.input(pass, "variance")?;
+        let albedo = io.input(pass, "albedo")?;
+        let normal = io.input(pass, "normal")?;
+        let depth = io.input(pass, "depth")?;
+        let output = &io.texture(out).view;
+        // Pass -1 demodulates into image 0; pass i reads image i % 2 and writes the other
+        // one, or the output for the last.
+        let mut record = |src: &wgpu::TextureView,
+                          dst: &wgpu::TextureView,
+                          params: &wgpu::Buffer|
+         -> Result<()> {
+            self.kernel
+                .pass(&pass.node)
+                .read(src)
+                .read(&variance.view)
+                .read(&albedo.view)
+                .read(&normal.view)
+                .read(&depth.view)
+                .write(dst)
+                .uniform(params)
+                .dispatch_2d(ctx, encoder, extent, timer.as_deref_mut())
+        };
+        record(
+            &color.view,
+            &pp[0].view,
+            &self.params[MAX_ITERATIONS as usize],
+        )?;
+        for i in 0..self.iterations as usize {
+            let src = &pp[i % 2].view;
+            let dst = if i + 1 == self.iterations as usize {
+                output
+            } else {
+                &pp[(i + 1) % 2].view
+            };
+            record(src, dst, &self.params[i])?;
+        }
+        Ok(())
+    }
+
+    fn notes(&self) -> Vec<String> {
+        let bytes = scratch_bytes(self.extent, self.iterations);
+        vec![format!(
+            "demodulation + {} à-trous passes, ping-pong between {} node-owned rgba32f \
+             images ({bytes} bytes)",
+            self.iterations,
+            scratch_images(self.iterations)
+        )]
+    }
+}

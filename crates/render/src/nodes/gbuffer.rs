@@ -1,0 +1,361 @@
+//! `GBuffer`: a raster pass (vertex + fragment, depth-tested) from the path tracer's camera,
+//! writing first-hit albedo, shading normal and distance along the ray.
+//!
+//! The scene's triangles go to one non-indexed vertex buffer with their corner normals and
+//! material color; each sphere becomes a UV sphere circumscribing the true one, and the
+//! fragment shader intersects the true sphere along the pixel-center ray (dropping misses,
+//! writing the exact normal and depth), so spheres agree with the ray tracer to the pixel.
+//! See `shaders/gbuffer/gbuffer.wgsl` for the projection (reversed, infinite depth).
+//!
+//! Outputs nothing reads are rendered into node-owned stand-ins of the same size, since
+//! every attachment of a render pass must have the same size.
+
+use lumagraph_graph::{Extent, Pass, TexFormat};
+use lumagraph_scene::{GpuScene, TRI_VERTEX_NORMALS};
+use wgpu::util::DeviceExt as _;
+
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+use crate::kernel::uniform_buffer;
+use crate::nodes::{FrameIo, NodeExec, Resources};
+use crate::pool::{PooledTexture, create, wgpu_format};
+use crate::timing::GpuTimer;
+
+/// Floats per vertex: position, normal, albedo (3 each), sphere (4).
+const VERTEX_FLOATS: usize = 13;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+const PORTS: [(&str, TexFormat); 3] = [
+    ("albedo", TexFormat::Rgba32Float),
+    ("normal", TexFormat::Rgba32Float),
+    ("depth", TexFormat::R32Float),
+];
+
+pub(crate) struct GBuffer {
+    scene: std::sync::Arc<GpuScene>,
+    pipeline: wgpu::RenderPipeline,
+    bind_group: wgpu::BindGroup,
+    vertices: Option<(wgpu::Buffer, u32)>,
+    segments: u32,
+    /// Depth attachment and stand-ins for unread outputs, at the pass's size.
+    targets: Option<(Extent, wgpu::TextureView, [Option<PooledTexture>; 3])>,
+}
+
+impl GBuffer {
+    pub(crate) fn new(ctx: &GpuContext, pass: &Pass, resources: &Resources) -> Result<Self> {
+        let scene = resources.scene.clone().ok_or_else(|| {
+            RenderError::Gpu("GBuffer needs a scene (lumagraph render --scene FILE)".into())
+        })?;
+        let device = &ctx.device;
+        let source = crate::shader::resolve("gbuffer/gbuffer.wgsl")?;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("gbuffer"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gbuffer"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("gbuffer"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let attributes = wgpu::vertex_attr_array![
+            0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x4
+        ];
+        let target = |format| {
+            Some(wgpu::ColorTargetState {
+                format: wgpu_format(format),
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })
+        };
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("gbuffer"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: wgpu::PipelineCompilationOptions::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: (VERTEX_FLOATS * 4) as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &attributes,
+                })],
+            },
+            // No culling: the path tracer sees back faces too.
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Greater),
+                stencil: wgpu::StencilState::default(),
+                bias: wgpu::DepthBiasState::default(),
+            }),
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: wgpu::PipelineCompilationOptions::default(),
+                targets: &PORTS.map(|(_, f)| target(f)),
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(RenderError::Shader {
+                name: "gbuffer/gbuffer.wgsl".into(),
+                message: e.to_string(),
+            });
+        }
+        let camera = uniform_buffer(ctx, "gbuffer camera", &camera_bytes(&scene));
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gbuffer"),
+            layout: &layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: camera.as_entire_binding(),
+            }],
+        });
+        let mut node = Self {
+            scene,
+            pipeline,
+            bind_group,
+            vertices: None,
+            segments: 0,
+            targets: None,
+        };
+        node.update(ctx, pass)?;
+        Ok(node)
+    }
+}
+
+/// The camera uniform: `GpuCamera` with the image size in its two spare floats.
+fn camera_bytes(scene: &GpuScene) -> Vec<u8> {
+    let c = &scene.camera;
+    #[expect(clippy::cast_precision_loss, reason = "image sizes are small")]
+    let (w, h) = (scene.settings.width as f32, scene.settings.height as f32);
+    let mut v = Vec::with_capacity(16);
+    v.extend_from_slice(&c.position);
+    v.push(c.tan_half_fov);
+    v.extend_from_slice(&c.right);
+    v.push(c.aspect);
+    v.extend_from_slice(&c.up);
+    v.push(w);
+    v.extend_from_slice(&c.forward);
+    v.push(h);
+    bytemuck::cast_slice(&v).to_vec()
+}
+
+fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+fn normalize(a: [f32; 3]) -> [f32; 3] {
+    let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    if l > 0.0 { a.map(|x| x / l) } else { a }
+}
+
+fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// The vertex data of every triangle and tessellated sphere, `VERTEX_FLOATS` per vertex.
+pub(crate) fn vertices(scene: &GpuScene, segments: u32) -> Vec<f32> {
+    let albedo = |m: u32| {
+        scene
+            .materials
+            .get(m as usize)
+            .map_or([0.0; 3], |m| m.base_color)
+    };
+    let mut out = Vec::new();
+    let mut push = |p: [f32; 3], n: [f32; 3], a: [f32; 3], s: [f32; 4]| {
+        out.extend_from_slice(&p);
+        out.extend_from_slice(&n);
+        out.extend_from_slice(&a);
+        out.extend_from_slice(&s);
+    };
+    for (t, sh) in scene.tri_positions.iter().zip(&scene.tri_shading) {
+        let corners = [t.v0, add(t.v0, t.e1), add(t.v0, t.e2)];
+        let ng = normalize(cross(t.e1, t.e2));
+        let normals = if sh.flags & TRI_VERTEX_NORMALS != 0 {
+            [sh.n0, sh.n1, sh.n2]
+        } else {
+            [sh.n0; 3]
+        };
+        let a = albedo(sh.material);
+        for i in 0..3 {
+            push(corners[i], normals[i], a, [ng[0], ng[1], ng[2], 0.0]);
+        }
+    }
+    // UV spheres: `segments` around, `segments / 2` from pole to pole, with corners pushed
+    // out by 1/cos(step) so the faces enclose the true sphere.
+    let around = segments.max(8);
+    let rings = (around / 2).max(4);
+    let step = std::f32::consts::PI / rings as f32;
+    let scale = 1.0 / step.cos();
+    for s in &scene.spheres {
+        let r = s.radius * scale;
+        let a = albedo(s.material);
+        let sphere = [s.center[0], s.center[1], s.center[2], s.radius];
+        let point = |i: u32, j: u32| {
+            let theta = j as f32 * step;
+            let phi = i as f32 * std::f32::consts::TAU / around as f32;
+            let d = [
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            ];
+            add(s.center, d.map(|x| x * r))
+        };
+        for j in 0..rings {
+            for i in 0..around {
+                let q = [
+                    point(i, j),
+                    point(i + 1, j),
+                    point(i + 1, j + 1),
+                    point(i, j + 1),
+                ];
+                for k in [0, 1, 2, 0, 2, 3] {
+                    push(q[k], normalize(sub(q[k], s.center)), a, sphere);
+                }
+            }
+        }
+    }
+    out
+}
+
+impl NodeExec for GBuffer {
+    fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
+        let segments = u32::try_from(pass.params.int("sphere_segments")).unwrap_or(48);
+        if self.vertices.is_none() || segments != self.segments {
+            let data = vertices(&self.scene, segments);
+            let count = u32::try_from(data.len() / VERTEX_FLOATS)
+                .map_err(|_| RenderError::Gpu("too many G-buffer vertices".into()))?;
+            let buffer = ctx
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("gbuffer vertices"),
+                    contents: bytemuck::cast_slice(if data.is_empty() {
+                        &[0.0_f32; VERTEX_FLOATS]
+                    } else {
+                        &data
+                    }),
+                    usage: wgpu::BufferUsages::VERTEX,
+                });
+            self.vertices = Some((buffer, count));
+            self.segments = segments;
+        }
+        Ok(())
+    }
+
+    fn record(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: &Pass,
+        io: &FrameIo<'_>,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let extent = pass.extent;
+        if self.targets.as_ref().is_none_or(|(e, _, _)| *e != extent) {
+            let depth = ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("gbuffer depth"),
+                size: wgpu::Extent3d {
+                    width: extent.width,
+                    height: extent.height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: DEPTH_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            });
+            let view = depth.create_view(&wgpu::TextureViewDescriptor::default());
+            let stand_ins = PORTS.map(|(port, format)| {
+                pass.output(port)
+                    .is_none()
+                    .then(|| create(ctx, &format!("unused gbuffer {port}"), format, extent))
+            });
+            self.targets = Some((extent, view, stand_ins));
+        }
+        let Some((_, depth, stand_ins)) = &self.targets else {
+            return Ok(());
+        };
+        let views: Vec<&wgpu::TextureView> = PORTS
+            .iter()
+            .zip(stand_ins)
+            .map(
+                |((port, _), stand_in)| match (pass.output(port), stand_in) {
+                    (Some(t), _) => Ok(&io.texture(t).view),
+                    (None, Some(s)) => Ok(&s.view),
+                    (None, None) => Err(RenderError::Gpu(format!("no target for {port}"))),
+                },
+            )
+            .collect::<Result<_>>()?;
+        let clear = |a: f64| wgpu::Operations {
+            load: wgpu::LoadOp::Clear(wgpu::Color {
+                r: 0.0,
+                g: 0.0,
+                b: 0.0,
+                a,
+            }),
+            store: wgpu::StoreOp::Store,
+        };
+        let attachments: Vec<_> = views
+            .iter()
+            .zip([1.0, 1.0, 0.0])
+            .map(|(view, a)| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: clear(a),
+                })
+            })
+            .collect();
+        let timestamp_writes = timer.and_then(|t| t.render_writes(&pass.node));
+        let mut rpass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(&pass.node),
+            color_attachments: &attachments,
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if let Some((buffer, count)) = &self.vertices {
+            rpass.set_pipeline(&self.pipeline);
+            rpass.set_bind_group(0, &self.bind_group, &[]);
+            rpass.set_vertex_buffer(0, buffer.slice(..));
+            rpass.draw(0..*count, 0..1);
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,113 @@
+// GBuffer: rasterizes what the path tracer's first hit through each pixel center sees.
+//
+// Projection, from the path tracer's pinhole camera (image y down): a world point p, with
+// d = p - position, lands at
+//   x_ndc = dot(d, right) / (z tan_half_fov aspect),  y_ndc = dot(d, up) / (z tan_half_fov)
+// where z = dot(d, forward) (NDC y up is image row 0 at the top, as in the path tracer).
+// Depth is reversed and infinite: clip.z = NEAR, clip.w = z, so NDC depth = NEAR / z, cleared
+// to 0 and tested with `greater`.
+//
+// Triangles interpolate their corner normals (perspective-correct, so the same barycentrics
+// as the ray hit). Spheres arrive as a circumscribed tessellation; each fragment intersects
+// the true sphere along its pixel-center ray, drops the fragment on a miss and writes the
+// exact normal and depth, so silhouettes and normals match the ray tracer's.
+// Outputs: albedo (base color), shading normal, distance along the ray; 0 where nothing is hit.
+
+struct Camera {
+    position: vec3f,
+    tan_half_fov: f32,
+    right: vec3f,
+    aspect: f32,
+    up: vec3f,
+    width: f32,
+    forward: vec3f,
+    height: f32,
+}
+
+const NEAR: f32 = 1e-4;
+
+@group(0) @binding(0) var<uniform> cam: Camera;
+
+struct VertexIn {
+    @location(0) position: vec3f,
+    @location(1) normal: vec3f,
+    @location(2) albedo: vec3f,
+    // Sphere center and radius; for a triangle, its unit geometric normal and 0.
+    @location(3) sphere: vec4f,
+}
+
+struct VertexOut {
+    @builtin(position) clip: vec4f,
+    @location(0) world: vec3f,
+    @location(1) normal: vec3f,
+    @location(2) @interpolate(flat) albedo: vec3f,
+    @location(3) @interpolate(flat) sphere: vec4f,
+}
+
+@vertex
+fn vs_main(v: VertexIn) -> VertexOut {
+    let d = v.position - cam.position;
+    let z = dot(d, cam.forward);
+    var out: VertexOut;
+    out.clip = vec4f(
+        dot(d, cam.right) / (cam.tan_half_fov * cam.aspect),
+        dot(d, cam.up) / cam.tan_half_fov,
+        NEAR,
+        z,
+    );
+    out.world = v.position;
+    out.normal = v.normal;
+    out.albedo = v.albedo;
+    out.sphere = v.sphere;
+    return out;
+}
+
+struct FragmentOut {
+    @location(0) albedo: vec4f,
+    @location(1) normal: vec4f,
+    @location(2) depth: vec4f,
+    @builtin(frag_depth) frag_depth: f32,
+}
+
+// The unit ray through framebuffer position `xy` (pixel centers at .5), as `pinhole_ray`.
+fn pixel_ray(xy: vec2f) -> vec3f {
+    let u = xy / vec2f(cam.width, cam.height);
+    return normalize(cam.forward + (2.0 * u.x - 1.0) * cam.tan_half_fov * cam.aspect * cam.right
+        - (2.0 * u.y - 1.0) * cam.tan_half_fov * cam.up);
+}
+
+@fragment
+fn fs_main(f: VertexOut) -> FragmentOut {
+    let dir = pixel_ray(f.clip.xy);
+    var out: FragmentOut;
+    out.albedo = vec4f(f.albedo, 1.0);
+    if f.sphere.w > 0.0 {
+        // The ray-sphere hit nearest the camera in front of it (the path tracer's test).
+        let oc = cam.position - f.sphere.xyz;
+        let b = dot(oc, dir);
+        let c = dot(oc, oc) - f.sphere.w * f.sphere.w;
+        let disc = b * b - c;
+        if disc < 0.0 {
+            discard;
+        }
+        let s = sqrt(disc);
+        var t = -b - s;
+        if t <= 0.0 {
+            t = -b + s;
+        }
+        if t <= 0.0 {
+            discard;
+        }
+        let p = cam.position + t * dir;
+        out.normal = vec4f(normalize(p - f.sphere.xyz), 1.0);
+        out.depth = vec4f(t, 0.0, 0.0, 0.0);
+        out.frag_depth = NEAR / max(dot(p - cam.position, cam.forward), NEAR);
+    } else {
+        let n = f.normal;
+        // A zero interpolated normal falls back to the geometric one, as in the path tracer.
+        out.normal = vec4f(select(f.sphere.xyz, normalize(n), dot(n, n) > 0.0), 1.0);
+        out.depth = vec4f(length(f.world - cam.position), 0.0, 0.0, 0.0);
+        out.frag_depth = f.clip.z;
+    }
+    return out;
+}

@@ -1,0 +1,304 @@
+//! `lumagraph converge`: error against run time, for the raw accumulation and every
+//! denoised output of a graph.
+//!
+//! The graph's `Output` nodes are dropped and every `PathTrace` takes 1 sample a frame, so
+//! checkpoints fall at 1, 2, 4, 8… spp. At each checkpoint:
+//! - the progressive part (path tracing + accumulation) has run for `render` seconds, wall
+//!   time, summed over every batch so far (shader compilation excluded by a warm-up);
+//! - the rest of the graph (G-buffer, every `Denoise`) then runs once on its own
+//!   ([`Executor::run_tail`]), wall time `tail`, with its GPU time per pass;
+//! - each `Accumulate` output (named by node id) is scored at `render` seconds, each
+//!   `Denoise` output at `render + tail` seconds: what a render that stopped here and then
+//!   denoised would have cost. Readbacks and scoring are not timed.
+//!
+//! Scores against the reference: RMSE, relMSE (`metrics::relmse`, as Mitsuba's CSVs) and mean
+//! SSIM on clipped luminance (`metrics::ssim`). The reference is a file, or rendered first
+//! with the same graph at `--reference-spp` samples and a different seed (so its noise is
+//! independent of the runs it scores).
+//!
+//! Writes `converge.csv` and `converge.png` (log-log relMSE against seconds, one line per
+//! output, plus Mitsuba and OIDN points from `--compare`) into `--out`.
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context as _, Result, bail};
+use lumagraph::graph::{Graph, ParamValue};
+use lumagraph::render::cpu::Image;
+use lumagraph::render::{Executor, GpuContext, Resources, compile, image_io, metrics};
+use lumagraph::scene::GpuScene;
+
+/// What `converge` was asked.
+pub struct Args<'a> {
+    pub graph: &'a Path,
+    pub scene: &'a Path,
+    pub reference: Option<&'a Path>,
+    pub reference_spp: Option<u32>,
+    pub seconds: f64,
+    pub compare: Option<&'a Path>,
+    pub out: &'a Path,
+    pub overrides: &'a [String],
+}
+
+/// One scored output at one checkpoint.
+struct Row {
+    output: String,
+    spp: u32,
+    seconds: f64,
+    rmse: f64,
+    relmse: f64,
+    ssim: f64,
+    /// GPU ms of this output's Denoise passes (none for raw).
+    gpu_ms: Option<f64>,
+}
+
+/// The graph without sinks, 1 spp per frame; returns it with the ports scored, as
+/// `(port, is_denoised)`.
+fn prepare(graph: &mut Graph) -> Result<Vec<(String, bool)>> {
+    let sinks: Vec<String> = graph
+        .nodes
+        .iter()
+        .filter(|n| n.kind == "Output")
+        .map(|n| n.id.clone())
+        .collect();
+    graph.nodes.retain(|n| n.kind != "Output");
+    graph.edges.retain(|e| {
+        let to = e.to.rsplit_once('.').map_or(e.to.as_str(), |(n, _)| n);
+        !sinks.iter().any(|s| s == to)
+    });
+    let mut ports = Vec::new();
+    for n in &mut graph.nodes {
+        match n.kind.as_str() {
+            "PathTrace" => {
+                n.params
+                    .insert("samples_per_frame".into(), ParamValue::Int(1));
+            }
+            "Accumulate" => ports.push((format!("{}.color", n.id), false)),
+            "Denoise" => ports.push((format!("{}.color", n.id), true)),
+            _ => {}
+        }
+    }
+    if !ports.iter().any(|(_, d)| !d) {
+        bail!("the graph has no Accumulate node: nothing to converge");
+    }
+    Ok(ports)
+}
+
+fn executor(
+    ctx: &GpuContext,
+    graph: &Graph,
+    keep: &[String],
+    scene: &Arc<GpuScene>,
+) -> Result<Executor> {
+    let plan = compile(graph, keep, Some(scene))?;
+    let resources = Resources {
+        base_dir: graph.base_dir(),
+        scene: Some(Arc::clone(scene)),
+        ..Resources::default()
+    };
+    Ok(Executor::new(ctx, plan, &resources)?)
+}
+
+fn render_reference(
+    ctx: &GpuContext,
+    graph: &Graph,
+    port: &str,
+    scene: &GpuScene,
+    spp: u32,
+) -> Result<Image> {
+    let mut other = scene.clone();
+    other.settings.seed ^= 0x9e37_79b9;
+    let other = Arc::new(other);
+    let mut exec = executor(ctx, graph, &[port.to_owned()], &other)?;
+    let start = Instant::now();
+    let mut done = 0;
+    while done < spp {
+        let n = (spp - done).min(64);
+        exec.run_frames(n, done + n >= spp)?;
+        done += n;
+    }
+    println!(
+        "reference: {spp} spp with seed {:#x} in {:.1} s",
+        other.settings.seed,
+        start.elapsed().as_secs_f64()
+    );
+    Ok(exec.read_port(port)?)
+}
+
+/// Runs the measurement; prints the table and writes the CSV and the plot.
+pub fn run(args: &Args<'_>) -> Result<()> {
+    let mut graph = Graph::load(args.graph)?;
+    for o in args.overrides {
+        graph.apply_override(o)?;
+    }
+    let ports = prepare(&mut graph)?;
+    let scene = super::load_scene(Some(args.scene))?.context("no scene")?;
+    let ctx = GpuContext::headless()?;
+    println!("adapter: {}", ctx.describe());
+    let raw_port = ports
+        .iter()
+        .find(|(_, d)| !d)
+        .map(|(p, _)| p.clone())
+        .unwrap_or_default();
+    let reference = match (args.reference, args.reference_spp) {
+        (Some(path), _) => image_io::load(path)?,
+        (None, Some(spp)) => render_reference(&ctx, &graph, &raw_port, &scene.gpu, spp)?,
+        (None, None) => bail!("give --reference FILE.exr or --reference-spp N"),
+    };
+    let keep: Vec<String> = ports.iter().map(|(p, _)| p.clone()).collect();
+    let mut exec = executor(&ctx, &graph, &keep, &scene.gpu)?;
+    let extent = exec.plan().passes.first().map(|p| p.extent);
+    if extent.is_some_and(|e| (e.width, e.height) != (reference.width, reference.height)) {
+        bail!(
+            "the reference is {}x{}, the render {}",
+            reference.width,
+            reference.height,
+            extent.map_or_else(String::new, |e| e.to_string())
+        );
+    }
+    exec.warm_up()?;
+
+    let mut rows = Vec::new();
+    let mut render_secs = 0.0;
+    let mut spp = 1;
+    let last_tail_ms = loop {
+        let t = Instant::now();
+        let frames = spp - u32::try_from(exec.frames()).unwrap_or(spp);
+        exec.run_frames(frames, false)?;
+        render_secs += t.elapsed().as_secs_f64();
+        let tail = exec.run_tail()?;
+        let tail_secs = tail.wall.as_secs_f64();
+        let pass_ms = tail.pass_ms.unwrap_or_default();
+        for (port, denoised) in &ports {
+            let image = exec.read_port(port)?;
+            let node = port.split('.').next().unwrap_or(port);
+            rows.push(Row {
+                output: node.to_owned(),
+                spp,
+                seconds: render_secs + if *denoised { tail_secs } else { 0.0 },
+                rmse: metrics::rmse(&image, &reference),
+                relmse: metrics::relmse(&image, &reference),
+                ssim: metrics::ssim(&image, &reference),
+                gpu_ms: denoised
+                    .then(|| pass_ms.iter().find(|(n, _)| n == node).map(|(_, ms)| *ms))
+                    .flatten(),
+            });
+        }
+        // Stop when the next checkpoint (twice the rendering) would pass the budget.
+        if 2.0 * render_secs + tail_secs > args.seconds || spp >= 1 << 20 {
+            break pass_ms;
+        }
+        spp *= 2;
+    };
+
+    print_table(&rows);
+    println!("GPU time per pass of the part run after rendering (last checkpoint):");
+    if last_tail_ms.is_empty() {
+        println!("  not available (adapter has no timestamp queries)");
+    }
+    for (name, ms) in &last_tail_ms {
+        println!("  {name:<16} {ms:>9.3} ms per frame");
+    }
+    std::fs::create_dir_all(args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let csv = args.out.join("converge.csv");
+    lumagraph::graph::write_atomic(&csv, csv_text(&rows).as_bytes())
+        .with_context(|| format!("cannot write {}", csv.display()))?;
+    println!("wrote {}", csv.display());
+    let compare = args.compare.map(read_compare).transpose()?;
+    let png = args.out.join("converge.png");
+    match crate::plot::write(&png, &rows_by_output(&rows), compare.as_ref()) {
+        Ok(()) => println!("wrote {}", png.display()),
+        Err(e) => println!("plot not written: {e:#}"),
+    }
+    Ok(())
+}
+
+fn print_table(rows: &[Row]) {
+    println!(
+        "{:>6}  {:<14} {:>9}  {:>10}  {:>10}  {:>7}  {:>9}",
+        "spp", "output", "seconds", "rmse", "relmse", "ssim", "gpu ms"
+    );
+    for r in rows {
+        println!(
+            "{:>6}  {:<14} {:>9.3}  {:>10.4e}  {:>10.4e}  {:>7.4}  {:>9}",
+            r.spp,
+            r.output,
+            r.seconds,
+            r.rmse,
+            r.relmse,
+            r.ssim,
+            r.gpu_ms
+                .map_or_else(|| "-".to_owned(), |ms| format!("{ms:.2}"))
+        );
+    }
+}
+
+fn csv_text(rows: &[Row]) -> String {
+    let mut s = String::from("output,spp,seconds,rmse,relmse,ssim,gpu_ms\n");
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "{},{},{:.6},{:.6e},{:.6e},{:.6},{}",
+            r.output,
+            r.spp,
+            r.seconds,
+            r.rmse,
+            r.relmse,
+            r.ssim,
+            r.gpu_ms.map_or_else(String::new, |ms| format!("{ms:.4}"))
+        );
+    }
+    s
+}
+
+/// `(output, [(seconds, relmse)])` in first-seen order.
+fn rows_by_output(rows: &[Row]) -> Vec<(String, Vec<(f64, f64)>)> {
+    let mut out: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    for r in rows {
+        match out.iter_mut().find(|(n, _)| *n == r.output) {
+            Some((_, pts)) => pts.push((r.seconds, r.relmse)),
+            None => out.push((r.output.clone(), vec![(r.seconds, r.relmse)])),
+        }
+    }
+    out
+}
+
+/// Mitsuba and OIDN points of a `cornell_converge.csv`-style file: `(label, [(s, relmse)])`.
+pub type Compare = Vec<(String, Vec<(f64, f64)>)>;
+
+fn read_compare(path: &Path) -> Result<Compare> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .with_context(|| format!("{}: no column {name}", path.display()))
+    };
+    let (s, r) = (col("seconds")?, col("relmse")?);
+    let oidn = (col("oidn_seconds"), col("oidn_relmse"));
+    let (mut mitsuba, mut denoised) = (Vec::new(), Vec::new());
+    for (i, line) in lines.enumerate() {
+        let f: Vec<f64> = line
+            .split(',')
+            .map(|v| v.trim().parse::<f64>())
+            .collect::<std::result::Result<_, _>>()
+            .with_context(|| format!("{}:{}: not a number", path.display(), i + 2))?;
+        let get = |c: usize| f.get(c).copied().context("short line");
+        mitsuba.push((get(s)?, get(r)?));
+        if let (Ok(os), Ok(or)) = (&oidn.0, &oidn.1) {
+            // OIDN runs after the render: its point sits at render + filter time.
+            denoised.push((get(s)? + get(*os)?, get(*or)?));
+        }
+    }
+    let mut out = vec![("Mitsuba 3 (raw)".to_owned(), mitsuba)];
+    if !denoised.is_empty() {
+        out.push(("Mitsuba 3 + OIDN 2.5".to_owned(), denoised));
+    }
+    Ok(out)
+}
