@@ -65,11 +65,13 @@ fn mis_power(a: f32, b: f32) -> f32 {
     return select(0.0, a2 / (a2 + b2), a2 + b2 > 0.0);
 }
 
-// Offsets a ray origin off a surface along the geometric normal, scaled to the position's
-// magnitude in float steps (Wächter and Binder, Ray Tracing Gems, ch. 6), so a ray leaving
-// a surface never hits it again, near the origin or 1e5 units away.
-fn offset_ray(p: vec3f, n: vec3f) -> vec3f {
-    let of_i = vec3i(256.0 * n);
+// Offsets a ray origin off a surface along the geometric normal by `steps` float steps of
+// the position's magnitude (Wächter and Binder, Ray Tracing Gems, ch. 6, who use 256). The
+// path tracer skips the triangle a ray leaves, so off triangles a few steps only have to
+// clear coplanar neighbours (256 steps are 2 units at 1e5, wider than a room); spheres,
+// which a ray can hit again from inside, keep the full 256.
+fn offset_ray(p: vec3f, n: vec3f, steps: f32) -> vec3f {
+    let of_i = vec3i(steps * n);
     let pi = bitcast<vec3f>(bitcast<vec3i>(p) + select(of_i, -of_i, p < vec3f(0.0)));
     let origin = 1.0 / 32.0;
     let float_scale = 1.0 / 65536.0;

@@ -212,7 +212,7 @@ fn sample_glass(m: Material, lp: LobeParams, wo: vec3f, u: vec3f) -> BsdfSample 
     let eta = select(1.0 / m.ior, m.ior, s > 0.0);
     var mh = vec3f(0.0, 0.0, 1.0);
     if !lp.is_smooth {
-        mh = sample_vndf(wo_l, sqrt(sqrt(lp.a2)), u.xy);
+        mh = sample_vndf(wo_l, sqrt(lp.a2), u.xy);
     }
     let c = dot(wo_l, mh);
     let f = fresnel_dielectric(c, eta);
@@ -273,7 +273,7 @@ fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     }
     var wi: vec3f;
     if mirror {
-        let mh = sample_vndf(wo, sqrt(sqrt(lp.a2)), u.xy);
+        let mh = sample_vndf(wo, sqrt(lp.a2), u.xy);
         wi = 2.0 * dot(wo, mh) * mh - wo;
     } else {
         wi = sample_cosine(vec3f(0.0, 0.0, 1.0), u.xy);

@@ -38,7 +38,7 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                 for (var i = first; i < first + count; i = i + 1u) {
                     let tri = tri_positions[i];
                     let r = intersect_triangle(ray.origin, ray.dir, tri.v0, tri.e1, tri.e2, hit.t);
-                    if (r.x != 0.0) {
+                    if (r.x != 0.0 && i != skip_prim) {
                         hit = Hit(i, r.y, r.z, r.w);
                         if (any_hit) {
                             return hit;

@@ -198,6 +198,8 @@ fn trace_path(pixel: vec2u) -> vec3f {
     var prev_p = ray.origin;
     let max_bounces = frame.settings.max_bounces;
     let has_lights = HAS_LIGHTS && frame.header.num_lights > 0u;
+    // The triangle the current ray leaves (never hit again); camera rays leave none.
+    skip_prim = NO_HIT;
     for (var bounce = 0u; ; bounce++) {
         let hit = intersect_scene(ray);
         ray_count += 1u;
@@ -208,6 +210,11 @@ fn trace_path(pixel: vec2u) -> vec3f {
             break;
         }
         let s = surface_at(ray, hit);
+        // Rays leaving this surface skip it if it is a triangle (spheres can be hit again
+        // from inside).
+        let on_sphere = (hit.prim & PRIM_SPHERE) != 0u;
+        skip_prim = select(hit.prim, NO_HIT, on_sphere);
+        let offset_steps = select(4.0, 256.0, on_sphere);
         let mat = materials[s.material];
         let front = dot(s.ng, ray.dir) < 0.0;
         let two_sided = (mat.flags & MATERIAL_TWO_SIDED) != 0u;
@@ -240,7 +247,7 @@ fn trace_path(pixel: vec2u) -> vec3f {
             if ls.pdf > 0.0 && dot(ng, ls.wi) * select(-1.0, 1.0, front || flip) > 0.0 {
                 let e = eval_bsdf(mat, wo, to_local * ls.wi);
                 if e.pdf > 0.0 || any(e.f_cos > vec3f(0.0)) {
-                    let shadow = Ray(offset_ray(s.p, select(-ng, ng, dot(ng, ls.wi) > 0.0)), ls.wi);
+                    let shadow = Ray(offset_ray(s.p, select(-ng, ng, dot(ng, ls.wi) > 0.0), offset_steps), ls.wi);
                     ray_count += 1u;
                     if !occluded(shadow, ls.dist * (1.0 - 1e-4)) {
                         let w = mis_power(ls.pdf, e.pdf);
@@ -260,7 +267,7 @@ fn trace_path(pixel: vec2u) -> vec3f {
         throughput *= bs.weight;
         bsdf_pdf = bs.pdf;
         prev_p = s.p;
-        ray = Ray(offset_ray(s.p, side), wi);
+        ray = Ray(offset_ray(s.p, side, offset_steps), wi);
 
         // Russian roulette.
         if bounce + 1u >= RR_START {
@@ -308,6 +315,7 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     if WRITE_AOVS {
         // First hit through the pixel center: what a raster G-buffer sees.
         let ray = pinhole_ray(id.xy, vec2f(0.5));
+        skip_prim = NO_HIT;
         let hit = intersect_scene(ray);
         var albedo = vec3f(0.0);
         var normal = vec3f(0.0);

@@ -4,6 +4,11 @@
 // intersection code the renderer generates for small scenes. Mirrors
 // crates/scene/src/traverse.rs. Hits count for 0 < t < t_max.
 const F32_MAX: f32 = 3.40282347e38;
+
+// A triangle rays must not hit: the one they leave from. A flat triangle cannot be hit again
+// by a ray leaving it, so skipping it removes self-intersection whatever the coordinates'
+// magnitude, and the origin offset only has to clear coplanar neighbours.
+var<private> skip_prim: u32 = NO_HIT;
 // Far box distance scale, 1 + 2 gamma_3 (Ize, "Robust BVH ray traversal").
 const ROBUST_FAR: f32 = 1.0000004;
 // Direction components below this are replaced by it (with their sign) before inverting.

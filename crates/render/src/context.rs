@@ -47,7 +47,7 @@ impl GpuContext {
     }
 
     async fn headless_async(prefer_cpu: bool) -> Result<Self> {
-        let desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        let desc = Self::instance_descriptor();
         let backends = desc.backends;
         let instance = wgpu::Instance::new(desc);
         let adapter = if let Ok(name) = std::env::var("WGPU_ADAPTER_NAME") {
@@ -83,6 +83,15 @@ impl GpuContext {
                 .map_err(|e| RenderError::NoAdapter(format!(": {e}")))?
         };
         Self::from_adapter(adapter).await
+    }
+
+    /// The instance lumagraph creates: Vulkan, Metal and DX12 unless `WGPU_BACKEND` says
+    /// otherwise (the GL backend's EGL contexts are not safe to share between the threads
+    /// of a test run), other flags from the environment as wgpu's own tools read them.
+    pub fn instance_descriptor() -> wgpu::InstanceDescriptor {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = wgpu::Backends::PRIMARY;
+        desc.with_env()
     }
 
     /// Opens a device on `adapter` with the features lumagraph uses where available.

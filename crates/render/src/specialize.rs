@@ -30,11 +30,11 @@ pub fn inline_intersection(scene: &GpuScene) -> Option<String> {
         let args = format!("{}, {}, {}", v3(t.v0), v3(t.e1), v3(t.e2));
         let _ = writeln!(
             closest,
-            "    r = intersect_triangle(ray.origin, ray.dir, {args}, hit.t);\n    if (r.x != 0.0) {{ hit = Hit({i}u, r.y, r.z, r.w); }}"
+            "    r = intersect_triangle(ray.origin, ray.dir, {args}, hit.t);\n    if (r.x != 0.0 && skip_prim != {i}u) {{ hit = Hit({i}u, r.y, r.z, r.w); }}"
         );
         let _ = writeln!(
             any,
-            "    if (intersect_triangle(ray.origin, ray.dir, {args}, t_max).x != 0.0) {{ return true; }}"
+            "    if (skip_prim != {i}u && intersect_triangle(ray.origin, ray.dir, {args}, t_max).x != 0.0) {{ return true; }}"
         );
     }
     for (i, s) in spheres.iter().enumerate() {

@@ -34,7 +34,7 @@ struct Shared {
 fn shared() -> Option<&'static Shared> {
     static GPU: LazyLock<Option<Shared>> = LazyLock::new(|| {
         let made = pollster::block_on(async {
-            let desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+            let desc = GpuContext::instance_descriptor();
             let backends = desc.backends;
             let instance = wgpu::Instance::new(desc);
             let adapters = instance.enumerate_adapters(backends).await;
