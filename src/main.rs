@@ -338,6 +338,26 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
     Ok(())
 }
 
+/// The path tracer's shader features for the scene: compiled in, and left out with why.
+fn print_features(plan: &lumagraph::graph::Plan, scene: &GpuScene) {
+    for pass in plan.passes.iter().filter(|p| p.kind == "PathTrace") {
+        let options = lumagraph::render::specialize::PathTraceOptions {
+            specialize: true,
+            aovs: ["albedo", "normal", "depth"]
+                .iter()
+                .any(|port| pass.output(port).is_some()),
+        };
+        let features = lumagraph::render::specialize::features(scene, options);
+        println!("shader features of {} for this scene:", pass.node);
+        for included in [true, false] {
+            println!("  {}:", if included { "compiled in" } else { "left out" });
+            for f in features.iter().filter(|f| f.included == included) {
+                println!("    {:<28} {}", f.name, f.reason);
+            }
+        }
+    }
+}
+
 struct RenderArgs<'a> {
     graph: &'a Path,
     scene: Option<&'a Path>,
@@ -382,6 +402,9 @@ fn run(cli: Cli) -> Result<()> {
                     let mib = bytes as f64 / (1024.0 * 1024.0);
                     println!("  {:<16} {bytes:>10} bytes ({mib:.2} MiB): {what}", p.node);
                 }
+            }
+            if let Some(scene) = &scene {
+                print_features(&plan, &scene.gpu);
             }
             Ok(())
         }
