@@ -170,17 +170,17 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
     for w in &r.warnings {
         println!("scene warning: {w}");
     }
-    let unrendered: Vec<&str> = scene
+    let textured: Vec<&str> = scene
         .materials
         .iter()
-        .filter(|m| m.metallic > 0.0 || m.specular > 0.0 || m.transmission > 0.0)
+        .filter(|m| m.textures.any())
         .map(|m| m.name.as_str())
         .collect();
-    if !unrendered.is_empty() {
+    if !textured.is_empty() {
         println!(
-            "scene warning: materials {} set specular, metallic or transmission, which this build \
-             renders as Lambertian (base_color only)",
-            unrendered.join(", ")
+            "scene warning: materials {} have textures, which this build does not read yet \
+             (their factors are used)",
+            textured.join(", ")
         );
     }
     let gpu = GpuScene::build(&scene)?;

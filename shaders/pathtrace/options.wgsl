@@ -13,3 +13,5 @@ const HAS_GLASS: bool = true;
 const HAS_LIGHTS: bool = true;
 // The environment is not black.
 const HAS_ENVIRONMENT: bool = true;
+// The environment is an equirectangular map: its sampling is compiled in.
+const HAS_ENV_MAP: bool = true;

@@ -9,6 +9,7 @@
 #import "common/sampling.wgsl"
 #import "pathtrace/options.wgsl"
 #import "pathtrace/bsdf.wgsl"
+#import "pathtrace/env.wgsl"
 
 struct Frame {
     settings: Settings,
@@ -17,8 +18,9 @@ struct Frame {
     // Index of this frame's first sample in the pixel's sample sequence.
     sample_offset: u32,
     samples_per_frame: u32,
-    pad0: u32,
-    pad1: u32,
+    // Size of the environment map (1x1 without one).
+    env_width: u32,
+    env_height: u32,
 }
 
 @group(0) @binding(0) var output: texture_storage_2d<rgba32float, write>;
@@ -37,6 +39,9 @@ struct Frame {
 @group(0) @binding(12) var out_depth: texture_storage_2d<r32float, write>;
 // GGX albedo tables for the material model (see bsdf.wgsl).
 @group(0) @binding(13) var<storage, read> ggx_table: array<vec2f>;
+// Environment map texels (rgb radiance, a = pixel probability) and their alias table.
+@group(0) @binding(14) var<storage, read> env_texels: array<vec4f>;
+@group(0) @binding(15) var<storage, read> env_alias: array<AliasEntry>;
 
 #import "pathtrace/intersect.wgsl"
 
@@ -91,8 +96,20 @@ struct LightSample {
     pdf: f32,
 }
 
+fn env_map_on() -> bool {
+    return HAS_ENV_MAP && frame.settings.env_kind == ENV_MAP;
+}
+
+// Probability that light sampling takes the environment map rather than an area light.
+fn env_select_prob() -> f32 {
+    if !env_map_on() {
+        return 0.0;
+    }
+    return select(1.0, 0.5, HAS_LIGHTS && frame.header.num_lights > 0u);
+}
+
 fn light_select_pdf(l: Light) -> f32 {
-    return l.power / frame.header.total_light_power;
+    return (1.0 - env_select_prob()) * l.power / frame.header.total_light_power;
 }
 
 // Solid-angle pdf of sampling the point `y` (normal `ny`) on light `l` from `x`.
@@ -204,8 +221,18 @@ fn trace_path(pixel: vec2u) -> vec3f {
         let hit = intersect_scene(ray);
         ray_count += 1u;
         if hit.prim == NO_HIT {
-            if HAS_ENVIRONMENT && frame.settings.env_kind == ENV_CONSTANT {
+            // Camera rays see the environment only when it is shown as background.
+            let visible = bounce > 0u || (frame.settings.env_flags & ENV_SHOW_BACKGROUND) != 0u;
+            if HAS_ENVIRONMENT && visible && frame.settings.env_kind == ENV_CONSTANT {
                 radiance += throughput * frame.settings.env_radiance;
+            }
+            if visible && env_map_on() {
+                let e = env_eval(ray.dir);
+                var w = 1.0;
+                if bsdf_pdf > 0.0 {
+                    w = mis_power(bsdf_pdf, e.a * env_select_prob());
+                }
+                radiance += throughput * e.rgb * w;
             }
             break;
         }
@@ -242,8 +269,15 @@ fn trace_path(pixel: vec2u) -> vec3f {
         let wo = to_local * -ray.dir;
 
         // Next-event estimation through the non-delta lobes.
-        if has_lights && wo.z > 0.0 {
-            let ls = sample_light(s.p);
+        let p_env = env_select_prob();
+        if (has_lights || p_env > 0.0) && wo.z > 0.0 {
+            var ls: LightSample;
+            if rand() < p_env {
+                let es = sample_env(rand(), rand2());
+                ls = LightSample(es.wi, F32_MAX, es.radiance, es.pdf * p_env);
+            } else {
+                ls = sample_light(s.p);
+            }
             if ls.pdf > 0.0 && dot(ng, ls.wi) * select(-1.0, 1.0, front || flip) > 0.0 {
                 let e = eval_bsdf(mat, wo, to_local * ls.wi);
                 if e.pdf > 0.0 || any(e.f_cos > vec3f(0.0)) {

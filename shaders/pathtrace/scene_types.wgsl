@@ -15,6 +15,8 @@ const LIGHT_SPHERE: u32 = 1u;
 const LIGHT_TWO_SIDED: u32 = 2u;
 const ENV_NONE: u32 = 0u;
 const ENV_CONSTANT: u32 = 1u;
+const ENV_MAP: u32 = 2u;
+const ENV_SHOW_BACKGROUND: u32 = 1u;
 
 const FEATURE_SPHERES: u32 = 1u;
 const FEATURE_TRANSMISSION: u32 = 2u;
@@ -123,10 +125,10 @@ struct Settings {
     spp: u32,
     seed: u32,
     env_kind: u32,
-    pad0: u32,
-    pad1: u32,
+    env_flags: u32,
+    env_azimuth: f32,
     env_radiance: vec3<f32>,
-    pad2: u32,
+    env_elevation: f32,
 }
 
 // Counts and scene-wide values, 32 bytes.

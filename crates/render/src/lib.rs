@@ -12,6 +12,7 @@
 pub mod bsdf_tables;
 mod context;
 pub mod cpu;
+pub mod env_map;
 mod error;
 mod executor;
 pub mod image_io;

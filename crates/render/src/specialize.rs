@@ -113,6 +113,7 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
     let prims = scene.tri_positions.len() + scene.spheres.len();
     let inline = options.specialize && prims <= INLINE_MAX_PRIMITIVES;
     let env = scene.settings.env_kind != lumagraph_scene::ENV_NONE;
+    let env_map = scene.settings.env_kind == lumagraph_scene::ENV_MAP;
     let lights = scene.lights.len();
     let why = |n: usize, what: &str| {
         if all {
@@ -146,6 +147,15 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
                 "environment not black".to_owned()
             } else {
                 "black environment".to_owned()
+            },
+        ),
+        feature(
+            "environment map sampling",
+            all || env_map,
+            if env_map || all {
+                "equirectangular map, importance sampled"
+            } else {
+                "no environment map"
             },
         ),
         feature(
@@ -188,13 +198,15 @@ pub fn pathtrace_source(
     let on = |name: &str| features.iter().any(|f| f.name == name && f.included);
     let consts = format!(
         "const WRITE_AOVS: bool = {};\nconst HAS_SPECULAR: bool = {};\nconst HAS_METAL: bool = {};\n\
-         const HAS_GLASS: bool = {};\nconst HAS_LIGHTS: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n",
+         const HAS_GLASS: bool = {};\nconst HAS_LIGHTS: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
+         const HAS_ENV_MAP: bool = {};\n",
         on("first-hit AOVs"),
         on("dielectric specular lobe"),
         on("metal lobe"),
         on("glass lobe"),
         on("light sampling (NEE + MIS)"),
         on("environment"),
+        on("environment map sampling"),
     );
     let mut overrides = vec![("pathtrace/options.wgsl", consts)];
     if on("inline intersection")

@@ -316,9 +316,8 @@ impl ShapeDesc {
     }
 }
 
-/// What rays that leave the scene see. More kinds (an equirectangular map with its
-/// sampling tables) will be added; match with a wildcard arm.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Deserialize)]
+/// What rays that leave the scene see.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
 #[non_exhaustive]
 pub enum Environment {
     /// Black.
@@ -326,6 +325,31 @@ pub enum Environment {
     None,
     /// The same radiance (linear RGB) from every direction.
     Constant(V3),
+    /// An equirectangular image (Radiance `.hdr` or `.exr`, linear), importance sampled.
+    Map {
+        /// The image, relative to the scene file (made absolute on load).
+        path: String,
+        /// Radiance scale.
+        #[serde(default = "one")]
+        intensity: f32,
+        /// Rotation about the up (y) axis, degrees.
+        #[serde(default)]
+        azimuth: f32,
+        /// Tilt of the map's horizon, degrees (rotation about x).
+        #[serde(default)]
+        elevation: f32,
+        /// Whether camera rays that miss see the map (else black); lighting is unchanged.
+        #[serde(default = "yes")]
+        show_background: bool,
+    },
+}
+
+fn one() -> f32 {
+    1.0
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// Image size and sampling.

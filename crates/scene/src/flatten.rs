@@ -8,10 +8,10 @@ use crate::bvh::{self, BvhOptions};
 use crate::error::{ErrorKind, SceneError};
 use crate::file::Environment;
 use crate::gpu::{
-    ENV_CONSTANT, ENV_NONE, FEATURE_ENVIRONMENT, FEATURE_LIGHTS, FEATURE_METAL, FEATURE_SPHERES,
-    FEATURE_TEXTURES, FEATURE_TRANSMISSION, GpuAliasEntry, GpuBvhNode, GpuCamera, GpuHeader,
-    GpuLight, GpuMaterial, GpuSettings, GpuSphere, GpuTriShading, GpuTriangle, LIGHT_SPHERE,
-    LIGHT_TWO_SIDED, MATERIAL_TWO_SIDED, NO_LIGHT, TRI_VERTEX_NORMALS,
+    ENV_CONSTANT, ENV_MAP, ENV_NONE, ENV_SHOW_BACKGROUND, FEATURE_ENVIRONMENT, FEATURE_LIGHTS,
+    FEATURE_METAL, FEATURE_SPHERES, FEATURE_TEXTURES, FEATURE_TRANSMISSION, GpuAliasEntry,
+    GpuBvhNode, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere, GpuTriShading,
+    GpuTriangle, LIGHT_SPHERE, LIGHT_TWO_SIDED, MATERIAL_TWO_SIDED, NO_LIGHT, TRI_VERTEX_NORMALS,
 };
 use crate::scene::{Material, NO_TEXTURE, Scene};
 
@@ -43,6 +43,9 @@ pub struct GpuScene {
     pub tri_source: Vec<u32>,
     /// For each GPU sphere, its index in [`Scene::spheres`] (CPU side only).
     pub sphere_source: Vec<u32>,
+    /// The environment map's file, when the environment is a map (CPU side only: the
+    /// renderer loads it and builds its sampling tables).
+    pub environment_map: Option<std::path::PathBuf>,
 }
 
 /// Rec. 709 luminance of linear RGB.
@@ -154,6 +157,10 @@ impl GpuScene {
             bvh_nodes: flat.nodes,
             tri_source: flat.tri_order,
             sphere_source: flat.sphere_order,
+            environment_map: match &scene.environment {
+                Environment::Map { path, .. } => Some(path.into()),
+                _ => None,
+            },
             ..Self::default()
         };
         let mut weights = Vec::new();
@@ -254,7 +261,12 @@ fn header(scene: &Scene, g: &GpuScene, depth: usize, total_power: f32) -> GpuHea
     if scene.materials.iter().any(|m| m.textures.any()) {
         features |= FEATURE_TEXTURES;
     }
-    if matches!(scene.environment, Environment::Constant(c) if c.iter().any(|&x| x > 0.0)) {
+    let lit = match &scene.environment {
+        Environment::Constant(c) => c.iter().any(|&x| x > 0.0),
+        Environment::Map { intensity, .. } => *intensity > 0.0,
+        _ => false,
+    };
+    if lit {
         features |= FEATURE_ENVIRONMENT;
     }
     GpuHeader {
@@ -287,18 +299,38 @@ fn camera(scene: &Scene) -> GpuCamera {
 
 fn settings(scene: &Scene) -> GpuSettings {
     let s = scene.settings;
-    let (env_kind, env_radiance) = match scene.environment {
-        Environment::Constant(c) => (ENV_CONSTANT, c),
-        Environment::None => (ENV_NONE, [0.0; 3]),
-    };
-    GpuSettings {
+    let mut g = GpuSettings {
         width: s.width,
         height: s.height,
         max_bounces: s.max_bounces,
         spp: s.spp,
         seed: s.seed,
-        env_kind,
-        env_radiance,
         ..GpuSettings::default()
+    };
+    match &scene.environment {
+        Environment::Constant(c) => {
+            g.env_kind = ENV_CONSTANT;
+            g.env_radiance = *c;
+            g.env_flags = ENV_SHOW_BACKGROUND;
+        }
+        Environment::Map {
+            intensity,
+            azimuth,
+            elevation,
+            show_background,
+            ..
+        } => {
+            g.env_kind = ENV_MAP;
+            g.env_radiance = [*intensity; 3];
+            g.env_azimuth = azimuth.to_radians();
+            g.env_elevation = elevation.to_radians();
+            g.env_flags = if *show_background {
+                ENV_SHOW_BACKGROUND
+            } else {
+                0
+            };
+        }
+        _ => g.env_kind = ENV_NONE,
     }
+    g
 }

@@ -35,6 +35,11 @@ pub const LIGHT_TWO_SIDED: u32 = 2;
 pub const ENV_NONE: u32 = 0;
 /// [`GpuSettings::env_kind`]: constant radiance `env_radiance`.
 pub const ENV_CONSTANT: u32 = 1;
+/// [`GpuSettings::env_kind`]: an equirectangular map (uploaded by the renderer), scaled by
+/// `env_radiance`.
+pub const ENV_MAP: u32 = 2;
+/// [`GpuSettings::env_flags`]: camera rays that miss see the environment.
+pub const ENV_SHOW_BACKGROUND: u32 = 1;
 
 /// [`GpuHeader::features`]: the scene has spheres.
 pub const FEATURE_SPHERES: u32 = 1;
@@ -223,16 +228,16 @@ pub struct GpuSettings {
     pub spp: u32,
     /// Random seed (offset 16).
     pub seed: u32,
-    /// [`ENV_NONE`] or [`ENV_CONSTANT`] (offset 20).
+    /// [`ENV_NONE`], [`ENV_CONSTANT`] or [`ENV_MAP`] (offset 20).
     pub env_kind: u32,
-    /// Padding (offset 24).
-    pub pad0: u32,
-    /// Padding (offset 28).
-    pub pad1: u32,
-    /// Constant environment radiance, linear RGB (offset 32).
+    /// [`ENV_SHOW_BACKGROUND`] (offset 24).
+    pub env_flags: u32,
+    /// Map rotation about the up axis, radians (offset 28).
+    pub env_azimuth: f32,
+    /// Constant environment radiance, or the map's scale, linear RGB (offset 32).
     pub env_radiance: [f32; 3],
-    /// Padding (offset 44).
-    pub pad2: u32,
+    /// Map tilt about the x axis, radians (offset 44).
+    pub env_elevation: f32,
 }
 
 /// Counts and scene-wide values, 32 bytes.

@@ -10,7 +10,9 @@ use ron::extensions::Extensions;
 use serde::Deserialize;
 
 use crate::error::{ErrorKind, Pos, SceneError};
-use crate::file::{CameraDesc, MaterialDesc, SceneFile, ShapeDesc, TransformDesc, V3, VERSION};
+use crate::file::{
+    CameraDesc, Environment, MaterialDesc, SceneFile, ShapeDesc, TransformDesc, V3, VERSION,
+};
 use crate::import::import_mesh;
 use crate::scene::{
     Camera, LoadReport, Material, Scene, Sphere, cube_quads, push_triangle, quad_triangles,
@@ -300,12 +302,24 @@ impl<'a> Builder<'a> {
             return Err(bad("render", "width, height and spp must be at least 1")
                 .at(self.loc.find("render")));
         }
+        let mut environment = file.environment.clone();
+        if let Environment::Map { path, .. } = &mut environment {
+            let full = self.base_dir.join(&*path);
+            if !full.is_file() {
+                return Err(bad(
+                    "environment",
+                    format!("cannot open environment map {}", full.display()),
+                )
+                .at(self.loc.find("environment")));
+            }
+            *path = full.to_string_lossy().into_owned();
+        }
         Ok(Scene {
             camera,
             materials: self.materials,
             triangles: self.scene_triangles,
             spheres: self.spheres,
-            environment: file.environment,
+            environment,
             settings: s,
             report: self.report,
         })

@@ -161,10 +161,10 @@ fn wgsl_layouts_match_rust() {
                 spp,
                 seed,
                 env_kind,
-                pad0,
-                pad1,
+                env_flags,
+                env_azimuth,
                 env_radiance,
-                pad2
+                env_elevation
             ]
         ),
         layout!(
@@ -236,6 +236,8 @@ fn wgsl_constants_match_rust() {
         ("TRI_VERTEX_NORMALS", lumagraph_scene::TRI_VERTEX_NORMALS),
         ("ENV_NONE", lumagraph_scene::ENV_NONE),
         ("ENV_CONSTANT", lumagraph_scene::ENV_CONSTANT),
+        ("ENV_MAP", lumagraph_scene::ENV_MAP),
+        ("ENV_SHOW_BACKGROUND", lumagraph_scene::ENV_SHOW_BACKGROUND),
         ("FEATURE_SPHERES", lumagraph_scene::FEATURE_SPHERES),
         (
             "FEATURE_TRANSMISSION",

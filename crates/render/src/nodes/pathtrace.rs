@@ -38,6 +38,8 @@ pub(crate) struct PathTrace {
     unused: [PooledTexture; 4],
     /// GGX albedo tables of the material model.
     ggx_table: wgpu::Buffer,
+    /// The environment map and its sampling tables (a 1x1 stand-in without one).
+    env: crate::env_map::EnvMap,
 }
 
 impl PathTrace {
@@ -73,8 +75,14 @@ impl PathTrace {
                 Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
                 Binding::StorageTexture(wgpu::TextureFormat::R32Float),
                 storage,
+                storage,
+                storage,
             ],
         )?;
+        let env = match &scene.environment_map {
+            Some(path) => crate::env_map::EnvMap::load(ctx, path)?,
+            None => crate::env_map::EnvMap::empty(ctx),
+        };
         let ggx_table = ctx
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -120,6 +128,7 @@ impl PathTrace {
             how,
             unused,
             ggx_table,
+            env,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -131,7 +140,12 @@ impl PathTrace {
         bytes.extend_from_slice(bytemuck::bytes_of(&s.settings));
         bytes.extend_from_slice(bytemuck::bytes_of(&s.camera));
         bytes.extend_from_slice(bytemuck::bytes_of(&s.header));
-        for v in [self.samples, self.samples_per_frame, 0, 0] {
+        for v in [
+            self.samples,
+            self.samples_per_frame,
+            self.env.width,
+            self.env.height,
+        ] {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
         bytes
@@ -190,6 +204,8 @@ impl NodeExec for PathTrace {
             .write(aov("normal", 2))
             .write(aov("depth", 3))
             .buffer(&self.ggx_table)
+            .buffer(&self.env.texels)
+            .buffer(&self.env.alias)
             .dispatch_2d(ctx, encoder, pass.extent, timer)
     }
 
