@@ -521,3 +521,34 @@ fn plan_lists_shader_features_for_the_scene() {
         "{stdout}"
     );
 }
+
+#[test]
+fn firefly_clamp_is_reported_when_on() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let out = tempfile::tempdir().unwrap();
+    let dir = out.path().to_str().unwrap();
+    let args = [
+        "render",
+        "graphs/pathtrace.ron",
+        "--scene",
+        "assets/cornell.ron",
+        "--spp",
+        "4",
+        "--out",
+        dir,
+    ];
+    let o = lumagraph(&args);
+    assert!(o.status.success());
+    assert!(
+        !text(&o).0.contains("firefly clamp"),
+        "clamp reported while off"
+    );
+    let mut on = args.to_vec();
+    on.extend(["--set", "pathtrace.firefly_clamp=10"]);
+    let o = lumagraph(&on);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    assert!(stdout.contains("firefly clamp ON"), "{stdout}");
+}

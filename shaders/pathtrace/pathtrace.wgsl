@@ -21,6 +21,11 @@ struct Frame {
     // Size of the environment map (1x1 without one).
     env_width: u32,
     env_height: u32,
+    // Largest channel value one sample may contribute (0: no clamp).
+    firefly_clamp: f32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 @group(0) @binding(0) var output: texture_storage_2d<rgba32float, write>;
@@ -329,7 +334,11 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     let n = frame.samples_per_frame;
     for (var i = 0u; i < n; i++) {
         rng_init(pixel_index, frame.sample_offset + i, frame.settings.seed);
-        let l = trace_path(id.xy);
+        var l = trace_path(id.xy);
+        if frame.firefly_clamp > 0.0 {
+            let peak = max(l.x, max(l.y, l.z));
+            l *= select(1.0, frame.firefly_clamp / peak, peak > frame.firefly_clamp);
+        }
         if all_finite(l) {
             sum += l;
         } else {

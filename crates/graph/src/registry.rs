@@ -219,15 +219,26 @@ fn builtin_kinds() -> Vec<NodeKind> {
                     doc: "distance from the camera to that hit (0 on a miss)",
                 },
             ],
-            params: vec![ParamDef {
-                name: "samples_per_frame",
-                ty: ParamType::Int {
-                    default: 4,
-                    min: 1,
-                    max: 4096,
+            params: vec![
+                ParamDef {
+                    name: "samples_per_frame",
+                    ty: ParamType::Int {
+                        default: 4,
+                        min: 1,
+                        max: 4096,
+                    },
+                    doc: "samples per pixel in one frame (one dispatch)",
                 },
-                doc: "samples per pixel in one frame (one dispatch)",
-            }],
+                ParamDef {
+                    name: "firefly_clamp",
+                    ty: ParamType::Float {
+                        default: 0.0,
+                        min: 0.0,
+                        max: 1e9,
+                    },
+                    doc: "largest channel value one sample may contribute; 0 is off (on is biased, and the render report says so)",
+                },
+            ],
             sink: false,
             history: false,
         },

@@ -40,6 +40,8 @@ pub(crate) struct PathTrace {
     ggx_table: wgpu::Buffer,
     /// The environment map and its sampling tables (a 1x1 stand-in without one).
     env: crate::env_map::EnvMap,
+    /// Largest channel value a sample may contribute; 0 is off.
+    firefly_clamp: f32,
 }
 
 impl PathTrace {
@@ -99,7 +101,7 @@ impl PathTrace {
             create(ctx, "unused depth", TexFormat::R32Float, one),
         ];
         let buffers = SceneBuffers::upload(ctx, &scene);
-        let frame = uniform_buffer(ctx, "pathtrace frame", &[0; 160]);
+        let frame = uniform_buffer(ctx, "pathtrace frame", &[0; 176]);
         let stats = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pathtrace stats"),
             size: STATS * 4,
@@ -129,6 +131,7 @@ impl PathTrace {
             unused,
             ggx_table,
             env,
+            firefly_clamp: 0.0,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -148,6 +151,8 @@ impl PathTrace {
         ] {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
+        bytes.extend_from_slice(&self.firefly_clamp.to_le_bytes());
+        bytes.extend_from_slice(&[0; 12]);
         bytes
     }
 }
@@ -155,6 +160,9 @@ impl PathTrace {
 impl NodeExec for PathTrace {
     fn update(&mut self, _ctx: &GpuContext, pass: &Pass) -> Result<()> {
         self.samples_per_frame = u32::try_from(pass.params.int("samples_per_frame")).unwrap_or(1);
+        #[expect(clippy::cast_possible_truncation, reason = "GPU math is f32")]
+        let clamp = pass.params.float("firefly_clamp") as f32;
+        self.firefly_clamp = clamp;
         Ok(())
     }
 
@@ -210,7 +218,14 @@ impl NodeExec for PathTrace {
     }
 
     fn notes(&self) -> Vec<String> {
-        vec![format!("shader: {}", self.how)]
+        let mut notes = vec![format!("shader: {}", self.how)];
+        if self.firefly_clamp > 0.0 {
+            notes.push(format!(
+                "firefly clamp ON: each sample's channels are scaled to at most {} (biased: energy is lost)",
+                self.firefly_clamp
+            ));
+        }
+        notes
     }
 
     fn counters(&mut self, ctx: &GpuContext) -> Result<Vec<Counter>> {
