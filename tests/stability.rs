@@ -10,6 +10,13 @@
 //!   self-intersection), 32×32 block means within 3 % at 256 spp (measured 0.9 %). Both
 //!   copies use the same geometry, quantized as f32 keeps it at 1e4, so the comparison sees
 //!   tracing precision only. At 1e5 the worst block still differs by 5 %: not yet solved.
+//! - An environment map of constant 1, importance sampled and rotated: the furnace stays
+//!   white within 1 %.
+//! - One environment pixel of 1e7: finite, no sample dropped. A bright patch on a dim sky:
+//!   importance sampling's RMSE at 16 spp at least 2× below uniform sampling's (measured
+//!   46×).
+//! - A sphere light of radius 1e-3 and radiance 1e6 against radius 1e-1 and 1e2 (equal
+//!   power): the lit floor agrees within 2 % (measured 0.1 %).
 //! - Every case: 0 NaN/Inf samples dropped.
 
 mod common;
@@ -377,4 +384,102 @@ fn a_single_hot_pixel_environment_converges_without_nan() {
     );
     let lit = image.pixels.iter().filter(|p| p[0] > 1.0).count();
     assert!(lit > 100, "only {lit} lit pixels");
+}
+
+/// Renders `scene` with the PathTrace params `params`.
+fn render_with(scene: &Scene, spp: u32, params: &[(&str, ParamValue)]) -> Option<Image> {
+    let ctx = common::gpu()?;
+    let gpu = Arc::new(GpuScene::build(scene).unwrap());
+    let mut pt = Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(16));
+    for (k, v) in params {
+        pt = pt.with(k, v.clone());
+    }
+    let graph = Graph {
+        nodes: vec![pt, Node::new("acc", "Accumulate")],
+        edges: vec![Edge::new("pt.color", "acc.color")],
+        origin: None,
+    };
+    let plan = compile(&graph, &["acc.color".into()], Some(&gpu)).unwrap();
+    let resources = Resources {
+        scene: Some(Arc::clone(&gpu)),
+        ..Resources::default()
+    };
+    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    exec.run_frames(spp.div_ceil(16), true).unwrap();
+    Some(exec.read_port("acc.color").unwrap())
+}
+
+#[test]
+fn environment_importance_sampling_beats_uniform_at_equal_spp() {
+    // A small bright patch (1e3) on a dim sky (0.05) lighting a diffuse sphere.
+    let dir = tempfile::tempdir().unwrap();
+    let map = env_map(dir.path(), 64, 32, |x, y| {
+        if (20..22).contains(&x) && (8..10).contains(&y) {
+            1e3
+        } else {
+            0.05
+        }
+    });
+    let scene = sphere_under_map(
+        &map,
+        "(base_color: (0.8, 0.8, 0.8), roughness: 1.0, specular: 0.0)",
+        ", show_background: false",
+    );
+    let importance = [("env_sampling", ParamValue::Str("importance".into()))];
+    let uniform = [("env_sampling", ParamValue::Str("uniform".into()))];
+    let Some(reference) = render_with(&scene, 1024, &importance) else {
+        return;
+    };
+    let a = render_with(&scene, 16, &importance).unwrap();
+    let b = render_with(&scene, 16, &uniform).unwrap();
+    let (ea, eb) = (metrics::rmse(&a, &reference), metrics::rmse(&b, &reference));
+    eprintln!(
+        "16 spp RMSE: importance {ea:.4e}, uniform {eb:.4e} ({:.1}x)",
+        eb / ea
+    );
+    assert!(
+        ea * 2.0 < eb,
+        "importance sampling RMSE {ea:.4e} is not well below uniform {eb:.4e}"
+    );
+    assert!(
+        b.pixels
+            .iter()
+            .all(|p| p[..3].iter().all(|v| v.is_finite()))
+    );
+}
+
+#[test]
+fn a_tiny_intense_light_matches_a_larger_one_of_equal_power() {
+    // A sphere light of radius 1e-3 and radiance 1e6 above a floor, against radius 1e-1 and
+    // radiance 1e2 (the same power): a sphere's irradiance depends only on L·r² outside it,
+    // so the floors must agree, and the tiny light must produce no NaN/Inf.
+    let scene = |r: f32, l: f32| {
+        let text = format!(
+            r#"(
+    version: 1,
+    camera: Perspective(position: (0, 3, 3), target: (0, 0, 0), up: (0, 1, 0), fov_y: 50),
+    materials: {{ "floor": (base_color: (0.7, 0.7, 0.7), roughness: 1.0, specular: 0.0), "lamp": (base_color: (0, 0, 0)) }},
+    shapes: [
+        Quad(material: "floor", corners: [(-3, 0, 3), (3, 0, 3), (3, 0, -3), (-3, 0, -3)]),
+        Sphere(center: (0, 1, 0), radius: {r}, material: "lamp", emission: ({l}, {l}, {l})),
+    ],
+    render: (width: 64, height: 64, max_bounces: 20, spp: 64, seed: 5),
+)"#
+        );
+        Scene::from_ron(&text, &common::root()).unwrap()
+    };
+    let Some((tiny, _, dropped)) = render(&scene(1e-3, 1e6), 64) else {
+        return;
+    };
+    assert_eq!(dropped, 0);
+    let (large, _, _) = render(&scene(1e-1, 1e2), 64).unwrap();
+    // Compare the floor in the lower rows, away from where the lamp itself is seen (the
+    // tiny one covers a thousandth of a pixel, so seeing it directly is all noise).
+    let rows = |img: &Image| {
+        let lower = &img.pixels[40 * 64..];
+        lower.iter().map(|p| f64::from(p[0])).sum::<f64>() / lower.len() as f64
+    };
+    let (mt, ml) = (rows(&tiny), rows(&large));
+    eprintln!("floor (rows 40-63) means: tiny light {mt:.5}, larger light {ml:.5}");
+    assert!((mt - ml).abs() <= 0.02 * ml, "{mt} vs {ml}");
 }

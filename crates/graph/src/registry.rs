@@ -238,6 +238,20 @@ fn builtin_kinds() -> Vec<NodeKind> {
                     },
                     doc: "largest channel value one sample may contribute; 0 is off (on is biased, and the render report says so)",
                 },
+                ParamDef {
+                    name: "env_sampling",
+                    ty: ParamType::Enum {
+                        default: "importance",
+                        options: &[
+                            (
+                                "importance",
+                                "environment map pixels drawn by luminance x solid angle",
+                            ),
+                            ("uniform", "uniform directions (a baseline for comparisons)"),
+                        ],
+                    },
+                    doc: "how light sampling draws directions from an environment map",
+                },
             ],
             sink: false,
             history: false,

@@ -26,8 +26,13 @@ pub struct EnvMap {
     pub height: u32,
 }
 
-/// Texels with probabilities, and the alias table, of an equirectangular image.
-pub fn tables(image: &crate::cpu::Image) -> (Vec<[f32; 4]>, Vec<lumagraph_scene::GpuAliasEntry>) {
+/// Texels with probabilities, and the alias table, of an equirectangular image. With
+/// `uniform`, pixels are drawn by solid angle alone (uniform directions), the baseline
+/// importance sampling is measured against.
+pub fn tables(
+    image: &crate::cpu::Image,
+    uniform: bool,
+) -> (Vec<[f32; 4]>, Vec<lumagraph_scene::GpuAliasEntry>) {
     let (w, h) = (image.width as usize, image.height as usize);
     let mut weights = Vec::with_capacity(w * h);
     for y in 0..h {
@@ -35,7 +40,11 @@ pub fn tables(image: &crate::cpu::Image) -> (Vec<[f32; 4]>, Vec<lumagraph_scene:
         let sin_theta = ((y as f64 + 0.5) / h as f64 * std::f64::consts::PI).sin();
         for x in 0..w {
             let p = image.pixels[y * w + x];
-            let l = luminance(glam::Vec3::new(p[0], p[1], p[2])).max(0.0);
+            let l = if uniform {
+                1.0
+            } else {
+                luminance(glam::Vec3::new(p[0], p[1], p[2])).max(0.0)
+            };
             #[expect(clippy::cast_possible_truncation, reason = "weights in f32")]
             weights.push(if l.is_finite() {
                 l * sin_theta as f32
@@ -63,13 +72,14 @@ pub fn tables(image: &crate::cpu::Image) -> (Vec<[f32; 4]>, Vec<lumagraph_scene:
 }
 
 impl EnvMap {
-    /// Loads the image at `path` and uploads it with its sampling tables.
+    /// Loads the image at `path` and uploads it with its sampling tables (`uniform`: see
+    /// [`tables`]).
     ///
     /// # Errors
     /// When the image cannot be read.
-    pub fn load(ctx: &GpuContext, path: &Path) -> Result<Self> {
+    pub fn load(ctx: &GpuContext, path: &Path, uniform: bool) -> Result<Self> {
         let image = crate::image_io::load(path)?;
-        let (texels, alias) = tables(&image);
+        let (texels, alias) = tables(&image, uniform);
         Ok(Self::upload(
             ctx,
             &texels,

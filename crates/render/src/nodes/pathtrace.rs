@@ -82,7 +82,11 @@ impl PathTrace {
             ],
         )?;
         let env = match &scene.environment_map {
-            Some(path) => crate::env_map::EnvMap::load(ctx, path)?,
+            Some(path) => crate::env_map::EnvMap::load(
+                ctx,
+                path,
+                pass.params.str("env_sampling") == "uniform",
+            )?,
             None => crate::env_map::EnvMap::empty(ctx),
         };
         let ggx_table = ctx
