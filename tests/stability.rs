@@ -386,7 +386,7 @@ fn a_single_hot_pixel_environment_converges_without_nan() {
     assert!(lit > 100, "only {lit} lit pixels");
 }
 
-/// Renders `scene` with the PathTrace params `params`.
+/// Renders `scene` with the `PathTrace` params `params`.
 fn render_with(scene: &Scene, spp: u32, params: &[(&str, ParamValue)]) -> Option<Image> {
     let ctx = common::gpu()?;
     let gpu = Arc::new(GpuScene::build(scene).unwrap());
