@@ -76,6 +76,9 @@ pub enum CameraDesc {
         /// Distance to the plane in focus; the distance to `target` when absent.
         #[serde(default)]
         focus_distance: Option<f32>,
+        /// Focus on whatever the image center sees (overrides `focus_distance`).
+        #[serde(default)]
+        autofocus: bool,
     },
     /// A camera of a glTF file loaded by a `Mesh` shape, placed by its node (and the
     /// shape's transform).
@@ -91,6 +94,9 @@ pub enum CameraDesc {
         /// Distance to the plane in focus; 1 when absent.
         #[serde(default)]
         focus_distance: Option<f32>,
+        /// Focus on whatever the image center sees (overrides `focus_distance`).
+        #[serde(default)]
+        autofocus: bool,
     },
 }
 

@@ -239,6 +239,16 @@ impl GpuScene {
         out.light_alias = alias_table(&weights);
         out.header = header(scene, &out, flat.depth, weights.iter().sum());
         out.camera = camera(scene);
+        if scene.camera.autofocus {
+            let c = &scene.camera;
+            let center = crate::traverse::Ray {
+                origin: c.position,
+                dir: c.forward,
+            };
+            if let Some(hit) = crate::traverse::intersect(&out, &center) {
+                out.camera.focus_distance = hit.t * c.forward.length();
+            }
+        }
         out.settings = settings(scene);
         Ok(out)
     }

@@ -483,6 +483,7 @@ impl<'a> Builder<'a> {
                 fov_y,
                 aperture_radius,
                 focus_distance,
+                autofocus,
             } => {
                 let position = finite3("position", *position)?;
                 let target = finite3("target", *target)?;
@@ -501,6 +502,7 @@ impl<'a> Builder<'a> {
                     fov_y_deg: *fov_y,
                     aperture_radius: 0.0,
                     focus_distance: dir.length(),
+                    autofocus: *autofocus,
                 };
                 (cam, *aperture_radius, *focus_distance)
             }
@@ -509,18 +511,20 @@ impl<'a> Builder<'a> {
                 index,
                 aperture_radius,
                 focus_distance,
+                autofocus,
             } => {
                 let cams = self.mesh_cameras.get(shape).ok_or_else(|| {
                     SceneError::new(ErrorKind::Camera(format!(
                         "no Mesh shape named \"{shape}\""
                     )))
                 })?;
-                let cam = *cams.get(*index).ok_or_else(|| {
+                let mut cam = *cams.get(*index).ok_or_else(|| {
                     SceneError::new(ErrorKind::Camera(format!(
                         "shape \"{shape}\" has {} perspective camera(s), no camera {index}",
                         cams.len()
                     )))
                 })?;
+                cam.autofocus = *autofocus;
                 (cam, *aperture_radius, *focus_distance)
             }
         };

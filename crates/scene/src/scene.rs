@@ -114,6 +114,8 @@ pub struct Camera {
     pub aperture_radius: f32,
     /// Distance to the plane in focus.
     pub focus_distance: f32,
+    /// Focus on the first surface through the image center (set when the scene is flattened).
+    pub autofocus: bool,
 }
 
 impl Camera {

@@ -44,6 +44,7 @@ fn sphere_grid_scene() -> Scene {
             fov_y_deg: 40.0,
             aperture_radius: 0.0,
             focus_distance: 8.0,
+            autofocus: false,
         },
         materials,
         triangles: mesh.triangles,

@@ -314,3 +314,25 @@ fn alias_table_reproduces_weights() {
         assert!((p - wi / total).abs() < 1e-6, "{i}: {p} vs {}", wi / total);
     }
 }
+
+#[test]
+fn autofocus_focuses_on_the_image_center() {
+    let text = r#"(
+        version: 1,
+        camera: Perspective(position: (0, 0, 5), target: (0, 0, -10), fov_y: 30, aperture_radius: 0.1, autofocus: true),
+        materials: { "m": (base_color: (0.5, 0.5, 0.5)) },
+        shapes: [ Sphere(center: (0, 0, 0), radius: 1, material: "m") ],
+        render: (width: 8, height: 8),
+    )"#;
+    let scene = parse(text).unwrap();
+    let gpu = lumagraph_scene::GpuScene::build(&scene).unwrap();
+    assert!(
+        (gpu.camera.focus_distance - 4.0).abs() < 1e-5,
+        "{}",
+        gpu.camera.focus_distance
+    );
+    // Without autofocus: the distance to the target.
+    let plain = parse(&text.replace("autofocus: true", "autofocus: false")).unwrap();
+    let gpu = lumagraph_scene::GpuScene::build(&plain).unwrap();
+    assert!((gpu.camera.focus_distance - 15.0).abs() < 1e-5);
+}

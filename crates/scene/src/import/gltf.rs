@@ -46,6 +46,7 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
                     fov_y_deg: p.yfov().to_degrees(),
                     aperture_radius: 0.0,
                     focus_distance: 1.0,
+                    autofocus: false,
                 });
             } else {
                 out.report.warnings.push(format!(
