@@ -10,7 +10,7 @@ mod common;
 
 use std::sync::Arc;
 
-use lumagraph::graph::{Edge, Graph, Node, ParamValue};
+use lumagraph::graph::{Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
 use lumagraph::render::{Executor, Resources, compile, image_io, metrics};
 use lumagraph::scene::{GpuScene, Scene};
@@ -26,27 +26,8 @@ fn cornell(seed: Option<u32>) -> Arc<GpuScene> {
 
 /// `PathTrace` (1 spp a frame) → `Accumulate` → `Denoise`, guided by `GBuffer`.
 fn graph(params: &[(&str, ParamValue)]) -> Graph {
-    let mut dn = Node::new("dn", "Denoise");
-    for (k, v) in params {
-        dn = dn.with(k, v.clone());
-    }
-    Graph {
-        nodes: vec![
-            Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(1)),
-            Node::new("acc", "Accumulate"),
-            Node::new("gb", "GBuffer"),
-            dn,
-        ],
-        edges: vec![
-            Edge::new("pt.color", "acc.color"),
-            Edge::new("acc.color", "dn.color"),
-            Edge::new("acc.variance", "dn.variance"),
-            Edge::new("gb.albedo", "dn.albedo"),
-            Edge::new("gb.normal", "dn.normal"),
-            Edge::new("gb.depth", "dn.depth"),
-        ],
-        origin: None,
-    }
+    let source = Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(1));
+    common::denoise_graph(source, params)
 }
 
 /// `(raw, filtered)` after `spp` frames.

@@ -14,7 +14,7 @@ mod common;
 
 use std::sync::Arc;
 
-use lumagraph::graph::{Edge, Graph, Node, ParamValue};
+use lumagraph::graph::{Node, ParamValue};
 use lumagraph::render::cpu::Image;
 use lumagraph::render::{Executor, Resources, compile, image_io};
 use lumagraph::scene::{GpuScene, Scene};
@@ -54,28 +54,9 @@ fn denoise(
     std::fs::write(&path, image_io::encode_exr(color, false).unwrap()).unwrap();
     let scene = Scene::load(&common::repo("assets/cornell.ron")).unwrap();
     let scene = Arc::new(GpuScene::build(&scene).unwrap());
-    let mut dn = Node::new("dn", "Denoise");
-    for (k, v) in params {
-        dn = dn.with(k, v.clone());
-    }
-    let graph = Graph {
-        nodes: vec![
-            Node::new("img", "ImageInput")
-                .with("path", ParamValue::Str(path.to_string_lossy().into_owned())),
-            Node::new("acc", "Accumulate"),
-            Node::new("gb", "GBuffer"),
-            dn,
-        ],
-        edges: vec![
-            Edge::new("img.color", "acc.color"),
-            Edge::new("acc.color", "dn.color"),
-            Edge::new("acc.variance", "dn.variance"),
-            Edge::new("gb.albedo", "dn.albedo"),
-            Edge::new("gb.normal", "dn.normal"),
-            Edge::new("gb.depth", "dn.depth"),
-        ],
-        origin: None,
-    };
+    let source = Node::new("img", "ImageInput")
+        .with("path", ParamValue::Str(path.to_string_lossy().into_owned()));
+    let graph = common::denoise_graph(source, params);
     let plan = compile(
         &graph,
         &["dn.color".into(), "acc.variance".into(), "acc.color".into()],

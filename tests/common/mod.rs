@@ -51,3 +51,34 @@ pub fn repo(rel: &str) -> PathBuf {
 pub fn is_empty_dir(dir: &Path) -> bool {
     std::fs::read_dir(dir).map_or(true, |mut d| d.next().is_none())
 }
+
+/// `source` → `Accumulate` (`acc`) → `Denoise` (`dn`, with `params`), guided by `GBuffer`
+/// (`gb`) and by `acc`'s variance.
+pub fn denoise_graph(
+    source: lumagraph::graph::Node,
+    params: &[(&str, lumagraph::graph::ParamValue)],
+) -> lumagraph::graph::Graph {
+    use lumagraph::graph::{Edge, Graph, Node};
+    let mut dn = Node::new("dn", "Denoise");
+    for (k, v) in params {
+        dn = dn.with(k, v.clone());
+    }
+    let color = format!("{}.color", source.id);
+    Graph {
+        nodes: vec![
+            source,
+            Node::new("acc", "Accumulate"),
+            Node::new("gb", "GBuffer"),
+            dn,
+        ],
+        edges: vec![
+            Edge::new(color, "acc.color"),
+            Edge::new("acc.color", "dn.color"),
+            Edge::new("acc.variance", "dn.variance"),
+            Edge::new("gb.albedo", "dn.albedo"),
+            Edge::new("gb.normal", "dn.normal"),
+            Edge::new("gb.depth", "dn.depth"),
+        ],
+        origin: None,
+    }
+}

@@ -6,7 +6,7 @@ use crate::context::GpuContext;
 use crate::cpu::exposure_scale;
 use crate::error::Result;
 use crate::kernel::{Binding, Kernel, uniform_buffer};
-use crate::nodes::{FrameIo, NodeExec};
+use crate::nodes::{FrameIo, NodeExec, record_color_filter};
 use crate::timing::GpuTimer;
 
 pub(crate) struct Exposure {
@@ -48,15 +48,6 @@ impl NodeExec for Exposure {
         io: &FrameIo<'_>,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let input = io.input(pass, "color")?;
-        let Some(out) = pass.output("color") else {
-            return Ok(());
-        };
-        self.kernel
-            .pass(&pass.node)
-            .read(&input.view)
-            .write(&io.texture(out).view)
-            .uniform(&self.params)
-            .dispatch_2d(ctx, encoder, pass.extent, timer)
+        record_color_filter(&self.kernel, &self.params, ctx, encoder, pass, io, timer)
     }
 }

@@ -167,6 +167,31 @@ pub fn owned_memory(pass: &Pass) -> Option<(u64, String)> {
     }
 }
 
+/// Records the common post-processing pass: `color` in, `color` out, one uniform block.
+///
+/// # Errors
+/// When the input is not bound or the bindings do not match the kernel.
+pub(crate) fn record_color_filter(
+    kernel: &crate::kernel::Kernel,
+    params: &wgpu::Buffer,
+    ctx: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    pass: &Pass,
+    io: &FrameIo<'_>,
+    timer: Option<&mut GpuTimer>,
+) -> Result<()> {
+    let input = io.input(pass, "color")?;
+    let Some(out) = pass.output("color") else {
+        return Ok(());
+    };
+    kernel
+        .pass(&pass.node)
+        .read(&input.view)
+        .write(&io.texture(out).view)
+        .uniform(params)
+        .dispatch_2d(ctx, encoder, pass.extent, timer)
+}
+
 /// Creates the GPU side of the node a pass runs.
 ///
 /// # Errors

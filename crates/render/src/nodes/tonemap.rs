@@ -6,7 +6,7 @@ use lumagraph_graph::registry::TONEMAP_OPERATORS;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::kernel::{Binding, Kernel, uniform_buffer};
-use crate::nodes::{FrameIo, NodeExec};
+use crate::nodes::{FrameIo, NodeExec, record_color_filter};
 use crate::timing::GpuTimer;
 
 /// The shader's number for an operator name (its index in the registry).
@@ -61,15 +61,6 @@ impl NodeExec for Tonemap {
         io: &FrameIo<'_>,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let input = io.input(pass, "color")?;
-        let Some(out) = pass.output("color") else {
-            return Ok(());
-        };
-        self.kernel
-            .pass(&pass.node)
-            .read(&input.view)
-            .write(&io.texture(out).view)
-            .uniform(&self.params)
-            .dispatch_2d(ctx, encoder, pass.extent, timer)
+        record_color_filter(&self.kernel, &self.params, ctx, encoder, pass, io, timer)
     }
 }
