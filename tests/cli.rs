@@ -495,12 +495,29 @@ fn converge_writes_csv_and_plot() {
 
 #[test]
 fn plan_lists_shader_features_for_the_scene() {
-    let o = lumagraph(&["plan", "graphs/pathtrace.ron", "--scene", "assets/cornell.ron"]);
+    let o = lumagraph(&[
+        "plan",
+        "graphs/pathtrace.ron",
+        "--scene",
+        "assets/cornell.ron",
+    ]);
     let (stdout, stderr) = text(&o);
     assert!(o.status.success(), "{stderr}");
     let left_out = stdout.split("left out:\n").last().unwrap();
-    for f in ["BVH traversal", "environment", "metal lobe", "glass lobe", "first-hit AOVs"] {
-        assert!(left_out.contains(f), "{f} not listed as left out:\n{stdout}");
+    for f in [
+        "BVH traversal",
+        "environment",
+        "metal lobe",
+        "glass lobe",
+        "first-hit AOVs",
+    ] {
+        assert!(
+            left_out.contains(f),
+            "{f} not listed as left out:\n{stdout}"
+        );
     }
-    assert!(stdout.contains("compiled in:\n    inline intersection"), "{stdout}");
+    assert!(
+        stdout.contains("compiled in:\n    inline intersection"),
+        "{stdout}"
+    );
 }
