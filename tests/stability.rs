@@ -6,10 +6,11 @@
 //! - Roughness 1e-8 renders as roughness 0; IOR 1.0001 as 1.0 (vanishes); IOR 4.0 is finite
 //!   and still white in the furnace.
 //! - Camera rays grazing a white plane under the furnace: finite, and 1.0.
-//! - The Cornell box translated by 1e4 units: the same image as at the origin (no
-//!   self-intersection), 32×32 block means within 3 % at 256 spp (measured 0.9 %). Both
-//!   copies use the same geometry, quantized as f32 keeps it at 1e4, so the comparison sees
-//!   tracing precision only. At 1e5 the worst block still differs by 5 %: not yet solved.
+//! - The Cornell box translated by 1e5 units: the same image as at the origin (no
+//!   self-intersection, no light leaks), 32×32 block means within 3 % at 64 spp (measured
+//!   0.22 %, image mean ratio 1.0000; it was 5.2 % while rays leaving a triangle were offset
+//!   4 float steps, 1/32 of a unit at 1e5, which moved shadow edges). Both copies use the same
+//!   geometry, quantized as f32 keeps it at 1e5, so the comparison sees tracing precision only.
 //! - An environment map of constant 1, importance sampled and rotated: the furnace stays
 //!   white within 1 %.
 //! - One environment pixel of 1e7: finite, no sample dropped. A bright patch on a dim sky:
@@ -215,7 +216,7 @@ fn grazing_camera_over_a_white_plane() {
 }
 
 /// How far the far copy of the Cornell box is moved along x.
-const FAR: f32 = 1e4;
+const FAR: f32 = 1e5;
 
 fn translated_cornell(offset: f32) -> Scene {
     let text = std::fs::read_to_string(common::repo("assets/cornell.ron")).unwrap();
@@ -271,7 +272,7 @@ fn shift_x(text: &str, offset: f32) -> String {
 }
 
 #[test]
-fn cornell_1e4_from_the_origin_is_the_same_image() {
+fn cornell_1e5_from_the_origin_is_the_same_image() {
     let (near, far) = (translated_cornell(0.0), translated_cornell(FAR));
     assert!(
         (far.camera.position.x - FAR).abs() < 1.0,
@@ -292,7 +293,7 @@ fn cornell_1e4_from_the_origin_is_the_same_image() {
         .flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs() / x[c].max(1e-3)))
         .fold(0.0, f64::max);
     eprintln!(
-        "Cornell at {FAR} vs origin, 256 spp: worst 32x32 block mean difference {:.2} %",
+        "Cornell at {FAR} vs origin, 64 spp: worst 32x32 block mean difference {:.2} %",
         worst * 100.0
     );
     for (i, (x, y)) in ma.iter().zip(&mb).enumerate() {

@@ -67,9 +67,9 @@ fn mis_power(a: f32, b: f32) -> f32 {
 
 // Offsets a ray origin off a surface along the geometric normal by `steps` float steps of
 // the position's magnitude (Wächter and Binder, Ray Tracing Gems, ch. 6, who use 256). The
-// path tracer skips the triangle a ray leaves, so off triangles a few steps only have to
-// clear coplanar neighbours (256 steps are 2 units at 1e5, wider than a room); spheres,
-// which a ray can hit again from inside, keep the full 256.
+// path tracer uses it off spheres only, which a ray can hit again from inside: rays leave a
+// triangle from the hit itself (see `origin_n` in primitives.wgsl), since any offset is at
+// least a float step (1/128 at 1e5) and moves shadow edges.
 fn offset_ray(p: vec3f, n: vec3f, steps: f32) -> vec3f {
     let of_i = vec3i(steps * n);
     let pi = bitcast<vec3f>(bitcast<vec3i>(p) + select(of_i, -of_i, p < vec3f(0.0)));

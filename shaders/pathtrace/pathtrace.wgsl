@@ -63,11 +63,25 @@ struct Surface {
     ns: vec3f,
     material: u32,
     light: u32,
+    // Componentwise bound on the rounding error of `p` (triangles; 0 on spheres).
+    err: vec3f,
+}
+
+// Rounding error bounds of a point computed as v0 + u e1 + v e2 in f32: a float step of each
+// term (2^-23 relative) for the sum, plus 2^-20 of the edges for the error of the plane
+// distance Moller-Trumbore computes against a neighbouring triangle. At 1e5 this is 1.5 float
+// steps (0.012 units); at the origin of a unit-sized scene, about 4e-6.
+const POSITION_ERR: f32 = 1.1920929e-7;
+const EDGE_ERR: f32 = 9.536743e-7;
+
+fn barycentric_err(v0: vec3f, e1: vec3f, e2: vec3f, u: f32, v: f32) -> vec3f {
+    return POSITION_ERR * (abs(v0) + abs(u * e1) + abs(v * e2)) + EDGE_ERR * (abs(e1) + abs(e2));
 }
 
 fn surface_at(ray: Ray, hit: Hit) -> Surface {
     var s: Surface;
     s.p = ray.origin + hit.t * ray.dir;
+    s.err = vec3f(0.0);
     if (hit.prim & PRIM_SPHERE) != 0u {
         let sph = spheres[hit.prim & ~PRIM_SPHERE];
         s.ng = normalize(s.p - sph.center);
@@ -79,6 +93,7 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
         let sh = tri_shading[hit.prim];
         // Position from the barycentrics: more accurate than origin + t * dir far away.
         s.p = tri.v0 + hit.u * tri.e1 + hit.v * tri.e2;
+        s.err = barycentric_err(tri.v0, tri.e1, tri.e2, hit.u, hit.v);
         s.ng = normalize(cross(tri.e1, tri.e2));
         if (sh.flags & TRI_VERTEX_NORMALS) != 0u {
             let n = (1.0 - hit.u - hit.v) * sh.n0 + hit.u * sh.n1 + hit.v * sh.n2;
@@ -99,6 +114,10 @@ struct LightSample {
     radiance: vec3f,
     // Solid-angle pdf, light selection included; 0 when the sample is invalid.
     pdf: f32,
+    // How far the shadow ray stops short of `dist`, so that it does not reach the light (or
+    // what is coplanar with it): the sampled point's error off the light's plane over the
+    // cosine there, and a relative term for the error of t.
+    margin: f32,
 }
 
 fn env_map_on() -> bool {
@@ -167,6 +186,7 @@ fn sample_light(x: vec3f) -> LightSample {
         out.dist = dist;
         out.radiance = l.emission;
         out.pdf = light_select_pdf(l) / (TWO_PI * cone);
+        out.margin = 1e-4 * dist;
         return out;
     }
     let b = sample_triangle(u);
@@ -185,6 +205,8 @@ fn sample_light(x: vec3f) -> LightSample {
     out.dist = dist;
     out.radiance = l.emission;
     out.pdf = light_select_pdf(l) * dist2 / (l.area * abs(cos_y));
+    let err = barycentric_err(l.p0, l.e1, l.e2, b.x, b.y);
+    out.margin = dot(abs(ny), err) / abs(cos_y) + EDGE_ERR * dist;
     return out;
 }
 
@@ -210,6 +232,24 @@ fn camera_ray(pixel: vec2u, u: vec2f) -> Ray {
     return ray;
 }
 
+// The origin of a ray leaving `s` towards the side `n` faces, and its error for the
+// intersection routines (`origin_n`, `origin_err`, `origin_off`, `origin_slab`).
+fn leave(s: Surface, on_sphere: bool, n: vec3f, dir: vec3f) -> vec3f {
+    if on_sphere {
+        origin_n = vec3f(0.0);
+        origin_err = vec3f(0.0);
+        origin_off = 0.0;
+        origin_slab = 0.0;
+        return offset_ray(s.p, n, 256.0);
+    }
+    // The front of the plane left is the side the ray goes to.
+    origin_n = n;
+    origin_err = s.err;
+    origin_off = dot(abs(n), s.err);
+    origin_slab = origin_off / abs(dot(n, dir));
+    return s.p;
+}
+
 fn trace_path(pixel: vec2u) -> vec3f {
     var ray = camera_ray(pixel, rand2());
     var throughput = vec3f(1.0);
@@ -222,6 +262,10 @@ fn trace_path(pixel: vec2u) -> vec3f {
     let has_lights = HAS_LIGHTS && frame.header.num_lights > 0u;
     // The triangle the current ray leaves (never hit again); camera rays leave none.
     skip_prim = NO_HIT;
+    origin_n = vec3f(0.0);
+    origin_err = vec3f(0.0);
+    origin_off = 0.0;
+    origin_slab = 0.0;
     for (var bounce = 0u; ; bounce++) {
         let hit = intersect_scene(ray);
         ray_count += 1u;
@@ -242,11 +286,11 @@ fn trace_path(pixel: vec2u) -> vec3f {
             break;
         }
         let s = surface_at(ray, hit);
-        // Rays leaving this surface skip it if it is a triangle (spheres can be hit again
-        // from inside).
+        // Rays leaving a triangle skip it, start at the hit position itself and ignore what
+        // is within its error (see `leave`); rays leaving a sphere, which can hit it again
+        // from inside, start 256 float steps off it (Wachter and Binder).
         let on_sphere = (hit.prim & PRIM_SPHERE) != 0u;
         skip_prim = select(hit.prim, NO_HIT, on_sphere);
-        let offset_steps = select(4.0, 256.0, on_sphere);
         let mat = materials[s.material];
         let front = dot(s.ng, ray.dir) < 0.0;
         let two_sided = (mat.flags & MATERIAL_TWO_SIDED) != 0u;
@@ -286,9 +330,9 @@ fn trace_path(pixel: vec2u) -> vec3f {
             if ls.pdf > 0.0 && dot(ng, ls.wi) * select(-1.0, 1.0, front || flip) > 0.0 {
                 let e = eval_bsdf(mat, wo, to_local * ls.wi);
                 if e.pdf > 0.0 || any(e.f_cos > vec3f(0.0)) {
-                    let shadow = Ray(offset_ray(s.p, select(-ng, ng, dot(ng, ls.wi) > 0.0), offset_steps), ls.wi);
+                    let shadow = Ray(leave(s, on_sphere, select(-ng, ng, dot(ng, ls.wi) > 0.0), ls.wi), ls.wi);
                     ray_count += 1u;
-                    if !occluded(shadow, ls.dist * (1.0 - 1e-4)) {
+                    if !occluded(shadow, ls.dist - ls.margin) {
                         let w = mis_power(ls.pdf, e.pdf);
                         radiance += throughput * e.f_cos * ls.radiance * (w / ls.pdf);
                     }
@@ -306,7 +350,7 @@ fn trace_path(pixel: vec2u) -> vec3f {
         throughput *= bs.weight;
         bsdf_pdf = bs.pdf;
         prev_p = s.p;
-        ray = Ray(offset_ray(s.p, side, offset_steps), wi);
+        ray = Ray(leave(s, on_sphere, side, wi), wi);
 
         // Russian roulette.
         if bounce + 1u >= RR_START {
@@ -359,6 +403,10 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         // First hit through the pixel center: what a raster G-buffer sees.
         let ray = pinhole_ray(id.xy, vec2f(0.5));
         skip_prim = NO_HIT;
+        origin_n = vec3f(0.0);
+        origin_err = vec3f(0.0);
+        origin_off = 0.0;
+        origin_slab = 0.0;
         let hit = intersect_scene(ray);
         var albedo = vec3f(0.0);
         var normal = vec3f(0.0);

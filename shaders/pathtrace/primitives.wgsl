@@ -2,13 +2,30 @@
 
 // Ray/primitive tests shared by the BVH traversal (bvh.wgsl) and the scene-specialized
 // intersection code the renderer generates for small scenes. Mirrors
-// crates/scene/src/traverse.rs. Hits count for 0 < t < t_max.
+// crates/scene/src/traverse.rs. Hits count for 0 < t < t_max (and, for triangles, only
+// beyond `origin_err`, which the CPU mirror does not have: it is always 0 there).
 const F32_MAX: f32 = 3.40282347e38;
 
 // A triangle rays must not hit: the one they leave from. A flat triangle cannot be hit again
 // by a ray leaving it, so skipping it removes self-intersection whatever the coordinates'
 // magnitude, and the origin offset only has to clear coplanar neighbours.
 var<private> skip_prim: u32 = NO_HIT;
+// For rays leaving a triangle (camera rays and rays leaving a sphere have 0 for both): the
+// unit normal of the triangle left, and a componentwise bound on the rounding error of the
+// origin. Such rays start exactly at the computed hit, not offset: an offset of even one
+// float step is 1/128 at 1e5, which visibly moves shadow boundaries. Instead a triangle
+// parallel to the one left (within 2.6 degrees) whose plane passes within the origin's error
+// is not hit: the coplanar neighbours of the triangle left, whatever the coordinates'
+// magnitude. Other triangles (a wall meeting the floor at a corner) are hit as usual.
+var<private> origin_n: vec3<f32> = vec3<f32>(0.0);
+var<private> origin_err: vec3<f32> = vec3<f32>(0.0);
+// The origin's error off the plane it leaves, and that over the ray's cosine to it: the
+// distance along the ray within which it may still be behind that plane.
+var<private> origin_off: f32 = 0.0;
+var<private> origin_slab: f32 = 0.0;
+// cos^2 of 2.6 degrees: "parallel" above it.
+const PARALLEL_COS2: f32 = 0.998;
+
 // Far box distance scale, 1 + 2 gamma_3 (Ize, "Robust BVH ray traversal").
 const ROBUST_FAR: f32 = 1.0000004;
 // Direction components below this are replaced by it (with their sign) before inverting.
@@ -42,7 +59,25 @@ fn intersect_triangle(origin: vec3<f32>, dir: vec3<f32>, v0: vec3<f32>, e1: vec3
     let q = cross(s, e1);
     let v = dot(dir, q) * inv_det;
     let t = dot(e2, q) * inv_det;
-    let hit = u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < t_max;
+    let inside = u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t < t_max;
+    var hit = inside && t > 0.0;
+    // Rays leaving a triangle: near their origin, within its error, a hit may be an artefact
+    // of that error. Where the origin is within its error of this triangle's plane (|t det| is
+    // the distance to it times |n|), a parallel plane is the one left (a coplanar neighbour:
+    // never hit), and another one meets it at an edge: hit, at t ~ 0 whatever the sign of the
+    // computed t, only at a concave corner (a corner of this triangle is in front of the plane
+    // left, as a wall over a floor) by a ray crossing it towards its back (det > 0).
+    // Elsewhere, at a convex edge (as the top of a box seen from its side), a hit closer than
+    // `origin_slab` is one the origin, rounded to behind the plane it leaves, sees from inside.
+    let n = cross(e1, e2);
+    let on_plane = abs(t * det) <= dot(abs(n), origin_err);
+    if (inside && (on_plane || (t > 0.0 && t <= origin_slab))) {
+        let a0 = -dot(s, origin_n);
+        let concave = max(a0, a0 + max(dot(e1, origin_n), dot(e2, origin_n))) > origin_off;
+        let along = dot(n, origin_n);
+        let parallel = along * along > PARALLEL_COS2 * dot(n, n);
+        hit = select(concave, det > 0.0 && concave && !parallel, on_plane);
+    }
     return vec4<f32>(select(0.0, 1.0, hit), t, u, v);
 }
 
