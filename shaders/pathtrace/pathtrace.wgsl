@@ -323,7 +323,7 @@ fn trace_path(pixel: vec2u) -> vec3f {
             var ls: LightSample;
             if rand() < p_env {
                 let es = sample_env(rand(), rand2());
-                ls = LightSample(es.wi, F32_MAX, es.radiance, es.pdf * p_env);
+                ls = LightSample(es.wi, F32_MAX, es.radiance, es.pdf * p_env, 0.0);
             } else {
                 ls = sample_light(s.p);
             }
