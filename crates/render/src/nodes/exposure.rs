@@ -5,28 +5,17 @@ use lumagraph_graph::Pass;
 use crate::context::GpuContext;
 use crate::cpu::exposure_scale;
 use crate::error::Result;
-use crate::kernel::{Binding, Kernel, uniform_buffer};
-use crate::nodes::{FrameIo, NodeExec, record_color_filter};
+use crate::nodes::{ColorFilter, FrameIo, NodeExec};
 use crate::timing::GpuTimer;
 
 pub(crate) struct Exposure {
-    kernel: Kernel,
-    params: wgpu::Buffer,
+    filter: ColorFilter,
 }
 
 impl Exposure {
     pub(crate) fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
-        let kernel = Kernel::new(
-            ctx,
-            "post/exposure.wgsl",
-            &[
-                Binding::Texture,
-                Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
-                Binding::Uniform,
-            ],
-        )?;
-        let params = uniform_buffer(ctx, "exposure params", &[0; 16]);
-        let mut node = Self { kernel, params };
+        let filter = ColorFilter::new(ctx, "post/exposure.wgsl", wgpu::TextureFormat::Rgba32Float)?;
+        let mut node = Self { filter };
         node.update(ctx, pass)?;
         Ok(node)
     }
@@ -35,8 +24,9 @@ impl Exposure {
 impl NodeExec for Exposure {
     fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
         let scale = exposure_scale(pass.params.float("ev"));
-        ctx.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(&[scale, 0.0, 0.0, 0.0]));
+        let mut bytes = [0_u8; 16];
+        bytes[..4].copy_from_slice(&scale.to_le_bytes());
+        self.filter.set_params(ctx, &bytes);
         Ok(())
     }
 
@@ -48,6 +38,6 @@ impl NodeExec for Exposure {
         io: &FrameIo<'_>,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        record_color_filter(&self.kernel, &self.params, ctx, encoder, pass, io, timer)
+        self.filter.record(ctx, encoder, pass, io, timer)
     }
 }

@@ -167,29 +167,65 @@ pub fn owned_memory(pass: &Pass) -> Option<(u64, String)> {
     }
 }
 
-/// Records the common post-processing pass: `color` in, `color` out, one uniform block.
-///
-/// # Errors
-/// When the input is not bound or the bindings do not match the kernel.
-pub(crate) fn record_color_filter(
-    kernel: &crate::kernel::Kernel,
-    params: &wgpu::Buffer,
-    ctx: &GpuContext,
-    encoder: &mut wgpu::CommandEncoder,
-    pass: &Pass,
-    io: &FrameIo<'_>,
-    timer: Option<&mut GpuTimer>,
-) -> Result<()> {
-    let input = io.input(pass, "color")?;
-    let Some(out) = pass.output("color") else {
-        return Ok(());
-    };
-    kernel
-        .pass(&pass.node)
-        .read(&input.view)
-        .write(&io.texture(out).view)
-        .uniform(params)
-        .dispatch_2d(ctx, encoder, pass.extent, timer)
+/// The common shape of a post-processing node: `color` in, `color` out (in `out_format`),
+/// one 16-byte uniform block of params; the nodes differ only in their shader and params.
+pub(crate) struct ColorFilter {
+    kernel: crate::kernel::Kernel,
+    params: wgpu::Buffer,
+}
+
+impl ColorFilter {
+    /// Compiles `shader` (bindings: input texture, output storage texture, uniform).
+    ///
+    /// # Errors
+    /// When the shader does not compile.
+    pub(crate) fn new(
+        ctx: &GpuContext,
+        shader: &str,
+        out_format: wgpu::TextureFormat,
+    ) -> Result<Self> {
+        use crate::kernel::{Binding, Kernel, uniform_buffer};
+        let kernel = Kernel::new(
+            ctx,
+            shader,
+            &[
+                Binding::Texture,
+                Binding::StorageTexture(out_format),
+                Binding::Uniform,
+            ],
+        )?;
+        let params = uniform_buffer(ctx, shader, &[0; 16]);
+        Ok(Self { kernel, params })
+    }
+
+    /// Writes the params block.
+    pub(crate) fn set_params(&self, ctx: &GpuContext, bytes: &[u8; 16]) {
+        ctx.queue.write_buffer(&self.params, 0, bytes);
+    }
+
+    /// Records the pass over `pass`'s `color` ports.
+    ///
+    /// # Errors
+    /// When the input is not bound or the bindings do not match the kernel.
+    pub(crate) fn record(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: &Pass,
+        io: &FrameIo<'_>,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let input = io.input(pass, "color")?;
+        let Some(out) = pass.output("color") else {
+            return Ok(());
+        };
+        self.kernel
+            .pass(&pass.node)
+            .read(&input.view)
+            .write(&io.texture(out).view)
+            .uniform(&self.params)
+            .dispatch_2d(ctx, encoder, pass.extent, timer)
+    }
 }
 
 /// Creates the GPU side of the node a pass runs.

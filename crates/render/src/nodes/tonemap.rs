@@ -5,8 +5,7 @@ use lumagraph_graph::registry::TONEMAP_OPERATORS;
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::kernel::{Binding, Kernel, uniform_buffer};
-use crate::nodes::{FrameIo, NodeExec, record_color_filter};
+use crate::nodes::{ColorFilter, FrameIo, NodeExec};
 use crate::timing::GpuTimer;
 
 /// The shader's number for an operator name (its index in the registry).
@@ -19,23 +18,13 @@ pub(crate) fn operator_index(name: &str) -> u32 {
 }
 
 pub(crate) struct Tonemap {
-    kernel: Kernel,
-    params: wgpu::Buffer,
+    filter: ColorFilter,
 }
 
 impl Tonemap {
     pub(crate) fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
-        let kernel = Kernel::new(
-            ctx,
-            "post/tonemap.wgsl",
-            &[
-                Binding::Texture,
-                Binding::StorageTexture(wgpu::TextureFormat::Rgba8Unorm),
-                Binding::Uniform,
-            ],
-        )?;
-        let params = uniform_buffer(ctx, "tonemap params", &[0; 16]);
-        let mut node = Self { kernel, params };
+        let filter = ColorFilter::new(ctx, "post/tonemap.wgsl", wgpu::TextureFormat::Rgba8Unorm)?;
+        let mut node = Self { filter };
         node.update(ctx, pass)?;
         Ok(node)
     }
@@ -49,7 +38,7 @@ impl NodeExec for Tonemap {
         let mut bytes = [0_u8; 16];
         bytes[..4].copy_from_slice(&op.to_le_bytes());
         bytes[4..8].copy_from_slice(&white.to_le_bytes());
-        ctx.queue.write_buffer(&self.params, 0, &bytes);
+        self.filter.set_params(ctx, &bytes);
         Ok(())
     }
 
@@ -61,6 +50,6 @@ impl NodeExec for Tonemap {
         io: &FrameIo<'_>,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        record_color_filter(&self.kernel, &self.params, ctx, encoder, pass, io, timer)
+        self.filter.record(ctx, encoder, pass, io, timer)
     }
 }
