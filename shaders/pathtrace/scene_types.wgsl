@@ -69,7 +69,8 @@ struct Sphere {
     pad1: u32,
 }
 
-// Material, 64 bytes. Texture indices: 16 bits each, 0xffff = none.
+// Material, 80 bytes. Texture indices: 16 bits each, 0xffff = none; each texture
+// multiplies its factor (see textures.wgsl).
 struct Material {
     base_color: vec3<f32>,
     roughness: f32,
@@ -82,7 +83,23 @@ struct Material {
     tex_base_mr: u32,
     tex_emissive_normal: u32,
     flags: u32,
+    normal_scale: f32,
+    tex_transmission_specular: u32,
+    tex_specular_color: u32,
     pad0: u32,
+    pad1: u32,
+}
+
+// A triangle's tangents (xyz, w = handedness) and UVs at its corners, 80 bytes, same index as
+// TriPositions; only present when some material has a texture.
+struct TriTexcoords {
+    t0: vec4<f32>,
+    t1: vec4<f32>,
+    t2: vec4<f32>,
+    uv01: vec4<f32>,
+    uv2: vec2<f32>,
+    pad0: u32,
+    pad1: u32,
 }
 
 // Emissive triangle (p0, e1, e2) or sphere (center p0, radius e1.x), 64 bytes.

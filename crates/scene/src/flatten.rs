@@ -10,8 +10,8 @@ use crate::file::Environment;
 use crate::gpu::{
     ENV_CONSTANT, ENV_MAP, ENV_NONE, ENV_SHOW_BACKGROUND, FEATURE_ENVIRONMENT, FEATURE_LIGHTS,
     FEATURE_METAL, FEATURE_SPHERES, FEATURE_TEXTURES, FEATURE_TRANSMISSION, GpuAliasEntry,
-    GpuBvhNode, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere, GpuTriShading,
-    GpuTriangle, LIGHT_SPHERE, LIGHT_TWO_SIDED, MATERIAL_TWO_SIDED, NO_LIGHT, TRI_VERTEX_NORMALS,
+    GpuBvhNode, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere,
+    GpuTriShading, GpuTriTexcoords, GpuTriangle, LIGHT_SPHERE, LIGHT_TWO_SIDED, MATERIAL_TWO_SIDED, NO_LIGHT, TRI_VERTEX_NORMALS,
 };
 use crate::scene::{Material, NO_TEXTURE, Scene};
 
@@ -39,6 +39,12 @@ pub struct GpuScene {
     pub lights: Vec<GpuLight>,
     /// Alias table over `lights`, by power (buffer `light_alias`).
     pub light_alias: Vec<GpuAliasEntry>,
+    /// Texture coordinates and tangents per triangle, same order as `tri_positions`; empty
+    /// when no material has a texture (buffer `tri_texcoords`).
+    pub tri_texcoords: Vec<GpuTriTexcoords>,
+    /// Every texture a material uses, packed by [`crate::texture::pack_textures`]; empty
+    /// without textures (buffer `textures`).
+    pub textures: Vec<u32>,
     /// For each GPU triangle, its index in [`Scene::triangles`] (CPU side only).
     pub tri_source: Vec<u32>,
     /// For each GPU sphere, its index in [`Scene::spheres`] (CPU side only).
@@ -74,7 +80,12 @@ fn gpu_material(m: &Material) -> GpuMaterial {
         tex_base_mr: tex16(m.textures.base_color) | (tex16(m.textures.metallic_roughness) << 16),
         tex_emissive_normal: tex16(m.textures.emissive) | (tex16(m.textures.normal) << 16),
         flags: if m.two_sided { MATERIAL_TWO_SIDED } else { 0 },
+        normal_scale: m.normal_scale,
+        tex_transmission_specular: tex16(m.textures.transmission)
+            | (tex16(m.textures.specular) << 16),
+        tex_specular_color: tex16(m.textures.specular_color) | (0xFFFF << 16),
         pad0: 0,
+        pad1: 0,
     }
 }
 
@@ -163,6 +174,33 @@ impl GpuScene {
             },
             ..Self::default()
         };
+        let textured = scene.materials.iter().any(|m| m.textures.any());
+        if scene.textures.len() >= 0xFFFF {
+            return Err(SceneError::new(ErrorKind::BadValue {
+                field: "textures",
+                message: format!("{} textures; at most 65534", scene.textures.len()),
+            }));
+        }
+        for m in &scene.materials {
+            if let Some(&t) = m
+                .textures
+                .all()
+                .iter()
+                .find(|&&t| t != NO_TEXTURE && t as usize >= scene.textures.len())
+            {
+                return Err(SceneError::new(ErrorKind::BadValue {
+                    field: "textures",
+                    message: format!(
+                        "material \"{}\" uses texture {t} of {}",
+                        m.name,
+                        scene.textures.len()
+                    ),
+                }));
+            }
+        }
+        if textured {
+            out.textures = crate::texture::pack_textures(&scene.textures);
+        }
         let mut weights = Vec::new();
         for (i, &src) in out.tri_source.iter().enumerate() {
             let t = &scene.triangles[src as usize];
@@ -176,6 +214,20 @@ impl GpuScene {
             });
             let flat_n = e1.cross(e2).normalize();
             let ns = t.normals.unwrap_or([flat_n; 3]);
+            if textured {
+                let uv = t.uvs.unwrap_or([glam::Vec2::ZERO; 3]);
+                let tan = t.tangents.unwrap_or_else(|| {
+                    crate::texture::triangle_tangents(t.positions, ns, uv)
+                });
+                out.tri_texcoords.push(GpuTriTexcoords {
+                    t0: tan[0].to_array(),
+                    t1: tan[1].to_array(),
+                    t2: tan[2].to_array(),
+                    uv01: [uv[0].x, uv[0].y, uv[1].x, uv[1].y],
+                    uv2: uv[2].to_array(),
+                    ..GpuTriTexcoords::default()
+                });
+            }
             let m = &scene.materials[t.material as usize];
             let mut light = NO_LIGHT;
             if m.is_emissive() {

@@ -125,7 +125,9 @@ pub struct GpuSphere {
     pub pad1: u32,
 }
 
-/// A material, 64 bytes (four vec4s).
+/// A material, 80 bytes (five vec4s). Texture ids index the scene's textures (see
+/// [`crate::texture::pack_textures`]), 16 bits each, 0xFFFF = none; each texture multiplies
+/// its factor.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuMaterial {
@@ -153,8 +155,40 @@ pub struct GpuMaterial {
     pub tex_emissive_normal: u32,
     /// [`MATERIAL_TWO_SIDED`] (offset 56).
     pub flags: u32,
-    /// Padding (offset 60).
+    /// glTF `normalTexture.scale` (offset 60).
+    pub normal_scale: f32,
+    /// Transmission texture (low 16 bits, R) and specular texture (high 16 bits, A)
+    /// (offset 64).
+    pub tex_transmission_specular: u32,
+    /// Specular color texture (low 16 bits, RGB sRGB); the high 16 bits are 0xFFFF
+    /// (offset 68).
+    pub tex_specular_color: u32,
+    /// Padding (offset 72).
     pub pad0: u32,
+    /// Padding (offset 76).
+    pub pad1: u32,
+}
+
+/// A triangle's texture coordinates and tangents, 80 bytes, same index as its
+/// [`GpuTriangle`]; only filled when some material has a texture (else the buffer holds
+/// one zeroed entry).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuTriTexcoords {
+    /// Tangent at corner 0: xyz unit, w = ±1 handedness (offset 0).
+    pub t0: [f32; 4],
+    /// Tangent at corner 1 (offset 16).
+    pub t1: [f32; 4],
+    /// Tangent at corner 2 (offset 32).
+    pub t2: [f32; 4],
+    /// UV at corner 0 (xy) and corner 1 (zw) (offset 48).
+    pub uv01: [f32; 4],
+    /// UV at corner 2 (offset 64).
+    pub uv2: [f32; 2],
+    /// Padding (offset 72).
+    pub pad0: u32,
+    /// Padding (offset 76).
+    pub pad1: u32,
 }
 
 /// An emitter, 64 bytes: an emissive triangle or sphere.

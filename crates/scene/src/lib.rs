@@ -7,6 +7,8 @@
 //! - [`GpuScene`]: the scene flattened into `#[repr(C)]` arrays laid out as WGSL lays out
 //!   storage buffers ([`gpu`]), with a BVH built by obvhs ([`bvh`]), lights and an alias
 //!   table for picking them by power.
+//! - [`texture`]: decoded glTF textures, their packing for the GPU and a CPU sampler
+//!   that mirrors the shader's.
 //! - [`traverse`]: CPU ray queries over exactly that layout, mirrored by
 //!   `shaders/pathtrace/bvh.wgsl`.
 //!
@@ -21,6 +23,7 @@ pub mod gpu;
 pub mod import;
 mod load;
 mod scene;
+pub mod texture;
 pub mod traverse;
 
 pub use bvh::{BVH_STACK_SIZE, BvhOptions};
@@ -33,4 +36,5 @@ pub use scene::{
     Camera, LoadReport, Material, MaterialTextures, NO_TEXTURE, Scene, Sphere, Triangle,
     cube_quads, push_triangle, quad_triangles, rectangle_quad, transform_triangle,
 };
+pub use texture::{Texture, Wrap};
 pub use traverse::{Hit, Ray, intersect, intersect_within, occluded};

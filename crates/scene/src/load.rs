@@ -246,6 +246,7 @@ struct Builder<'a> {
     derived: HashMap<(u32, [u32; 3], bool), u32>,
     scene_triangles: Vec<crate::scene::Triangle>,
     spheres: Vec<Sphere>,
+    textures: Vec<crate::texture::Texture>,
     report: LoadReport,
     /// Cameras of each named `Mesh` shape.
     mesh_cameras: BTreeMap<String, Vec<Camera>>,
@@ -261,6 +262,7 @@ impl<'a> Builder<'a> {
             derived: HashMap::new(),
             scene_triangles: Vec::new(),
             spheres: Vec::new(),
+            textures: Vec::new(),
             report: LoadReport::default(),
             mesh_cameras: BTreeMap::new(),
         }
@@ -319,6 +321,7 @@ impl<'a> Builder<'a> {
             materials: self.materials,
             triangles: self.scene_triangles,
             spheres: self.spheres,
+            textures: self.textures,
             environment,
             settings: s,
             report: self.report,
@@ -436,10 +439,21 @@ impl<'a> Builder<'a> {
                 let mesh = import_mesh(&full, t)?;
                 let prefix = name.clone().unwrap_or_else(|| path.clone());
                 let mut ids = Vec::with_capacity(mesh.materials.len());
-                for m in mesh.materials {
+                // The file's textures follow the scene's; its materials' indices move along
+                // (an override material has none, so the file's textures are not kept).
+                let first_texture = self.textures.len() as u32;
+                if over.is_none() {
+                    self.textures.extend(mesh.textures);
+                }
+                for mut m in mesh.materials {
                     let id = if let Some(o) = over {
                         o
                     } else {
+                        for t in m.textures.all_mut() {
+                            if *t != crate::scene::NO_TEXTURE {
+                                *t += first_texture;
+                            }
+                        }
                         self.materials.push(Material {
                             name: format!("{prefix}/{}", m.name),
                             ..m

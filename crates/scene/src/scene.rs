@@ -2,15 +2,15 @@
 //! a camera, the environment and render settings. Loaders fill it in; [`crate::GpuScene`]
 //! flattens it for the GPU.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use crate::file::{Environment, RenderSettings};
 
 /// No texture.
 pub const NO_TEXTURE: u32 = u32::MAX;
 
-/// Texture indices of a material (into the source file's texture list), recorded for later
-/// texture support; [`NO_TEXTURE`] when absent.
+/// Texture indices of a material, into [`Scene::textures`] (an importer's own list before
+/// the scene merges them); [`NO_TEXTURE`] when absent.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MaterialTextures {
     /// glTF `baseColorTexture`.
@@ -21,6 +21,12 @@ pub struct MaterialTextures {
     pub emissive: u32,
     /// glTF `normalTexture`.
     pub normal: u32,
+    /// `KHR_materials_transmission` `transmissionTexture` (R).
+    pub transmission: u32,
+    /// `KHR_materials_specular` `specularTexture` (A).
+    pub specular: u32,
+    /// `KHR_materials_specular` `specularColorTexture` (RGB, sRGB).
+    pub specular_color: u32,
 }
 
 impl Default for MaterialTextures {
@@ -30,6 +36,9 @@ impl Default for MaterialTextures {
             metallic_roughness: NO_TEXTURE,
             emissive: NO_TEXTURE,
             normal: NO_TEXTURE,
+            transmission: NO_TEXTURE,
+            specular: NO_TEXTURE,
+            specular_color: NO_TEXTURE,
         }
     }
 }
@@ -37,14 +46,33 @@ impl Default for MaterialTextures {
 impl MaterialTextures {
     /// Whether any texture is set.
     pub fn any(&self) -> bool {
+        self.all().iter().any(|&t| t != NO_TEXTURE)
+    }
+
+    /// Every slot, in declaration order.
+    pub fn all(&self) -> [u32; 7] {
         [
             self.base_color,
             self.metallic_roughness,
             self.emissive,
             self.normal,
+            self.transmission,
+            self.specular,
+            self.specular_color,
         ]
-        .iter()
-        .any(|&t| t != NO_TEXTURE)
+    }
+
+    /// Every slot, mutably, in declaration order.
+    pub fn all_mut(&mut self) -> [&mut u32; 7] {
+        [
+            &mut self.base_color,
+            &mut self.metallic_roughness,
+            &mut self.emissive,
+            &mut self.normal,
+            &mut self.transmission,
+            &mut self.specular,
+            &mut self.specular_color,
+        ]
     }
 }
 
@@ -71,8 +99,11 @@ pub struct Material {
     pub ior: f32,
     /// Emission leaves both sides (default: front only).
     pub two_sided: bool,
-    /// Texture indices, recorded but not decoded yet.
+    /// Texture indices into [`Scene::textures`]; each texture multiplies its factor.
     pub textures: MaterialTextures,
+    /// glTF `normalTexture.scale`: the tangent-space x and y of the normal map are scaled
+    /// by it.
+    pub normal_scale: f32,
 }
 
 impl Material {
@@ -90,6 +121,7 @@ impl Material {
             ior: 1.5,
             two_sided: false,
             textures: MaterialTextures::default(),
+            normal_scale: 1.0,
         }
     }
 
@@ -137,6 +169,12 @@ pub struct Triangle {
     pub positions: [Vec3; 3],
     /// Unit shading normals at the corners, when the source had them.
     pub normals: Option<[Vec3; 3]>,
+    /// Texture coordinates (glTF `TEXCOORD_0`) at the corners, when the source had them.
+    pub uvs: Option<[Vec2; 3]>,
+    /// Tangents at the corners (glTF `TANGENT`: xyz along +U, w = ±1 the handedness of the
+    /// bitangent `w · normal × tangent`), when the source had them; else they are generated
+    /// when the scene is flattened (see [`crate::texture::triangle_tangents`]).
+    pub tangents: Option<[Vec4; 3]>,
     /// Index into [`Scene::materials`].
     pub material: u32,
 }
@@ -209,6 +247,8 @@ pub struct Scene {
     pub triangles: Vec<Triangle>,
     /// Analytic spheres.
     pub spheres: Vec<Sphere>,
+    /// Decoded textures; materials index into this.
+    pub textures: Vec<crate::texture::Texture>,
     /// What rays leaving the scene see.
     pub environment: Environment,
     /// Image size and sampling.
@@ -221,7 +261,8 @@ pub struct Scene {
 ///
 /// Dropped: any corner NaN or infinite; zero area (the corners are collinear to within
 /// 1e-10 of the edge lengths' product). Vertex normals that are not finite or zero are
-/// replaced by the flat normal; the others are normalized.
+/// replaced by the flat normal; the others are normalized. Texture coordinates or tangents
+/// that are not finite are dropped (tangents are then generated).
 pub fn push_triangle(out: &mut Vec<Triangle>, report: &mut LoadReport, mut tri: Triangle) {
     if !tri.positions.iter().all(|p| p.is_finite()) {
         report.non_finite_triangles += 1;
@@ -245,27 +286,53 @@ pub fn push_triangle(out: &mut Vec<Triangle>, report: &mut LoadReport, mut tri: 
             tri.normals = None;
         }
     }
+    if tri.uvs.is_some_and(|uvs| !uvs.iter().all(|uv| uv.is_finite())) {
+        tri.uvs = None;
+    }
+    if tri
+        .tangents
+        .is_some_and(|ts| !ts.iter().all(|t| t.is_finite() && t.truncate().length_squared() > 1e-20))
+    {
+        tri.tangents = None;
+    }
     out.push(tri);
 }
 
 /// Applies `m` to a triangle: positions as points, normals by the inverse transpose;
 /// swaps two corners when `m` mirrors (negative determinant) so the front side follows
-/// the transformed normals, as glTF and Mitsuba do.
+/// the transformed normals, as glTF and Mitsuba do. Tangents transform as vectors; a
+/// mirror flips their handedness.
 pub fn transform_triangle(m: &Mat4, tri: &Triangle) -> Triangle {
     let normal_m = m.inverse().transpose();
+    let mirror = m.determinant() < 0.0;
     let mut positions = tri.positions.map(|p| m.transform_point3(p));
     let mut normals = tri
         .normals
         .map(|ns| ns.map(|n| normal_m.transform_vector3(n)));
-    if m.determinant() < 0.0 {
+    let mut uvs = tri.uvs;
+    let mut tangents = tri.tangents.map(|ts| {
+        ts.map(|t| {
+            let w = if mirror { -t.w } else { t.w };
+            m.transform_vector3(t.truncate()).extend(w)
+        })
+    });
+    if mirror {
         positions.swap(1, 2);
         if let Some(ns) = normals.as_mut() {
             ns.swap(1, 2);
+        }
+        if let Some(uv) = uvs.as_mut() {
+            uv.swap(1, 2);
+        }
+        if let Some(ts) = tangents.as_mut() {
+            ts.swap(1, 2);
         }
     }
     Triangle {
         positions,
         normals,
+        uvs,
+        tangents,
         material: tri.material,
     }
 }
@@ -277,11 +344,15 @@ pub fn quad_triangles(corners: [Vec3; 4], material: u32) -> [Triangle; 2] {
         Triangle {
             positions: [a, b, c],
             normals: None,
+            uvs: None,
+            tangents: None,
             material,
         },
         Triangle {
             positions: [a, c, d],
             normals: None,
+            uvs: None,
+            tangents: None,
             material,
         },
     ]

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use lumagraph_scene::{
     GpuAliasEntry, GpuBvhNode, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere,
-    GpuTriShading, GpuTriangle,
+    GpuTriShading, GpuTriTexcoords, GpuTriangle,
 };
 
 /// Resolves `#import "<path relative to shaders/>"` lines by textual inclusion, each file
@@ -128,8 +128,17 @@ fn wgsl_layouts_match_rust() {
                 tex_base_mr,
                 tex_emissive_normal,
                 flags,
-                pad0
+                normal_scale,
+                tex_transmission_specular,
+                tex_specular_color,
+                pad0,
+                pad1
             ]
+        ),
+        layout!(
+            GpuTriTexcoords,
+            "TriTexcoords",
+            [t0, t1, t2, uv01, uv2, pad0, pad1]
         ),
         layout!(
             GpuLight,

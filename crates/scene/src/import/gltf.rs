@@ -1,17 +1,25 @@
 //! glTF 2.0 import: every mesh of the default scene through the whole node hierarchy,
-//! perspective cameras, metallic-roughness materials (factors; texture indices recorded
-//! but not decoded), `KHR_materials_emissive_strength`, `KHR_materials_ior` and
-//! `KHR_materials_transmission`.
+//! perspective cameras, metallic-roughness materials with their base color,
+//! metallic-roughness, normal and emissive textures, `KHR_materials_emissive_strength`,
+//! `KHR_materials_ior`, `KHR_materials_transmission` and `KHR_materials_specular` (factors
+//! and textures). Texture coordinates are `TEXCOORD_0`; tangents are the file's `TANGENT`
+//! when present (else generated when the scene is flattened).
+//!
+//! Only the textures some material uses are decoded (PNG or JPEG: embedded in a buffer view,
+//! a data URI or an external file); a missing or broken image is an error naming the
+//! material, the texture and the image.
 
+use std::collections::HashMap;
 use std::path::Path;
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::ImportedMesh;
-use crate::error::SceneError;
+use crate::error::{ErrorKind, SceneError};
 use crate::scene::{
     Camera, Material, MaterialTextures, NO_TEXTURE, Triangle, push_triangle, transform_triangle,
 };
+use crate::texture::{Texture, Wrap};
 
 /// Imports a `.gltf` (with embedded or external buffers) or `.glb` file.
 ///
@@ -21,10 +29,20 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
     let file = ::gltf::Gltf::open(path)?;
     let buffers = ::gltf::import_buffers(&file.document, path.parent(), file.blob.clone())?;
     let doc = &file.document;
-    let mut out = ImportedMesh {
-        materials: doc.materials().map(|m| material(&m)).collect(),
-        ..ImportedMesh::default()
+    let mut out = ImportedMesh::default();
+    let mut decoder = Decoder {
+        base: path.parent(),
+        file: path.file_name().map_or_else(String::new, |f| f.to_string_lossy().into_owned()),
+        buffers: &buffers,
+        used: HashMap::new(),
+        textures: Vec::new(),
     };
+    for m in doc.materials() {
+        let mat = material(&m, &mut decoder, &mut out.report.warnings)
+            .map_err(|e| e.about(format!("material \"{}\"", material_name(&m))))?;
+        out.materials.push(mat);
+    }
+    out.textures = decoder.textures;
     let mut default_material = None;
 
     let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
@@ -102,6 +120,15 @@ fn read_primitive(
         .read_normals()
         .map(|n| n.map(Vec3::from).collect())
         .filter(|n: &Vec<Vec3>| n.len() == positions.len());
+    let uvs: Option<Vec<Vec2>> = reader
+        .read_tex_coords(0)
+        .map(|t| t.into_f32().map(Vec2::from).collect())
+        .filter(|t: &Vec<Vec2>| t.len() == positions.len());
+    // Tangents only mean something with the normals they were made for.
+    let tangents: Option<Vec<Vec4>> = reader
+        .read_tangents()
+        .map(|t| t.map(Vec4::from).collect())
+        .filter(|t: &Vec<Vec4>| t.len() == positions.len() && normals.is_some());
     let indices: Vec<u32> = match reader.read_indices() {
         Some(i) => i.into_u32().collect(),
         None => (0..positions.len() as u32).collect(),
@@ -116,6 +143,13 @@ fn read_primitive(
         let tri = Triangle {
             positions: idx.map(|i| positions[i]),
             normals: normals.as_ref().map(|n| idx.map(|i| n[i])),
+            uvs: uvs.as_ref().map(|t| idx.map(|i| t[i])),
+            tangents: tangents.as_ref().map(|t| {
+                idx.map(|i| {
+                    let w = if t[i].w < 0.0 { -1.0 } else { 1.0 };
+                    t[i].truncate().extend(w)
+                })
+            }),
             material,
         };
         push_triangle(
@@ -132,30 +166,214 @@ fn read_primitive(
     }
 }
 
-fn material(m: &::gltf::Material<'_>) -> Material {
+fn material_name(m: &::gltf::Material<'_>) -> String {
+    m.name().map_or_else(
+        || format!("material{}", m.index().unwrap_or(usize::MAX)),
+        str::to_owned,
+    )
+}
+
+/// Decodes the textures materials use, each once.
+struct Decoder<'a> {
+    base: Option<&'a Path>,
+    /// The glTF file's name, for texture names.
+    file: String,
+    buffers: &'a [::gltf::buffer::Data],
+    /// glTF texture index → index in `textures`.
+    used: HashMap<usize, u32>,
+    textures: Vec<Texture>,
+}
+
+fn wrap(mode: ::gltf::texture::WrappingMode) -> Wrap {
+    match mode {
+        ::gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        ::gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        ::gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+    }
+}
+
+/// RGBA8 texels of decoded image data (16-bit channels keep their high byte; float
+/// channels are clamped to [0, 1]).
+fn rgba8(data: &::gltf::image::Data) -> Option<Vec<[u8; 4]>> {
+    use ::gltf::image::Format;
+    let p = &data.pixels;
+    let f32_at = |i: usize| {
+        let v = f32::from_le_bytes([p[i], p[i + 1], p[i + 2], p[i + 3]]);
+        (v.clamp(0.0, 1.0) * 255.0).round() as u8
+    };
+    let (channels, bytes) = match data.format {
+        Format::R8 => (1, 1),
+        Format::R8G8 => (2, 1),
+        Format::R8G8B8 => (3, 1),
+        Format::R8G8B8A8 => (4, 1),
+        Format::R16 => (1, 2),
+        Format::R16G16 => (2, 2),
+        Format::R16G16B16 => (3, 2),
+        Format::R16G16B16A16 => (4, 2),
+        Format::R32G32B32FLOAT => (3, 4),
+        Format::R32G32B32A32FLOAT => (4, 4),
+    };
+    let n = data.width as usize * data.height as usize;
+    if p.len() < n * channels * bytes {
+        return None;
+    }
+    let channel = |px: usize, c: usize| -> u8 {
+        let i = (px * channels + c) * bytes;
+        match bytes {
+            1 => p[i],
+            // 16-bit channels are little-endian in gltf's decoded data: keep the high byte.
+            2 => p[i + 1],
+            _ => f32_at(i),
+        }
+    };
+    Some(
+        (0..n)
+            .map(|px| match channels {
+                1 => {
+                    let v = channel(px, 0);
+                    [v, v, v, 255]
+                }
+                2 => {
+                    let v = channel(px, 0);
+                    [v, v, v, channel(px, 1)]
+                }
+                3 => [channel(px, 0), channel(px, 1), channel(px, 2), 255],
+                _ => [channel(px, 0), channel(px, 1), channel(px, 2), channel(px, 3)],
+            })
+            .collect(),
+    )
+}
+
+impl Decoder<'_> {
+    /// The index of `info`'s texture among the decoded ones, decoding it on first use.
+    fn texture(
+        &mut self,
+        info: Option<::gltf::texture::Texture<'_>>,
+        tex_coord: u32,
+        warnings: &mut Vec<String>,
+    ) -> Result<u32, SceneError> {
+        let Some(t) = info else {
+            return Ok(NO_TEXTURE);
+        };
+        if tex_coord != 0 {
+            warnings.push(format!(
+                "texture {} uses TEXCOORD_{tex_coord}; TEXCOORD_0 is used instead",
+                t.index()
+            ));
+        }
+        if let Some(&i) = self.used.get(&t.index()) {
+            return Ok(i);
+        }
+        let image = t.source();
+        let what = match image.source() {
+            ::gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => {
+                format!("\"{uri}\"")
+            }
+            ::gltf::image::Source::Uri { .. } => "data URI".to_owned(),
+            ::gltf::image::Source::View { .. } => "buffer view".to_owned(),
+        };
+        let label = format!("texture {} (image {}, {what})", t.index(), image.index());
+        let fail = |message: String| {
+            SceneError::new(ErrorKind::Texture {
+                texture: label.clone(),
+                message,
+            })
+        };
+        let data = ::gltf::image::Data::from_source(image.source(), self.base, self.buffers)
+            .map_err(|e| fail(format!("cannot read the image: {e}")))?;
+        if data.width == 0 || data.height == 0 {
+            return Err(fail("the image is empty".to_owned()));
+        }
+        let texels =
+            rgba8(&data).ok_or_else(|| fail("the image has fewer pixels than its size".into()))?;
+        let sampler = t.sampler();
+        let nearest = sampler.mag_filter() == Some(::gltf::texture::MagFilter::Nearest);
+        let index = self.textures.len() as u32;
+        self.textures.push(Texture {
+            name: format!("{} image {} ({what})", self.file, image.index()),
+            width: data.width,
+            height: data.height,
+            texels,
+            wrap: [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())],
+            nearest,
+        });
+        self.used.insert(t.index(), index);
+        Ok(index)
+    }
+}
+
+/// `KHR_materials_specular` (and `KHR_materials_ior`) on the material model's dielectric
+/// specular: glTF's F0 is `((ior − 1)/(ior + 1))² · specularColor · specular` and ours
+/// `0.08 · specular`, so `specular = 12.5 · ((ior − 1)/(ior + 1))² · specularFactor ·
+/// max(specularColorFactor)`; the color's hue is not kept (`specular_tint` tints towards
+/// the base color only). With neither extension and ior 1.5 this is the default 0.5.
+pub fn gltf_specular(ior: f32, specular_factor: f32, specular_color: [f32; 3]) -> f32 {
+    // Exactly 0.5 at the default ior, as before the extensions were read.
+    let layer = if ior == 1.5 {
+        0.5
+    } else {
+        12.5 * ((ior - 1.0) / (ior + 1.0)).powi(2)
+    };
+    let color = specular_color[0].max(specular_color[1]).max(specular_color[2]);
+    layer * specular_factor * color
+}
+
+fn material(
+    m: &::gltf::Material<'_>,
+    dec: &mut Decoder<'_>,
+    warnings: &mut Vec<String>,
+) -> Result<Material, SceneError> {
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, _] = pbr.base_color_factor();
     let strength = m.emissive_strength().unwrap_or(1.0);
-    let tex = |t: Option<::gltf::texture::Texture<'_>>| t.map_or(NO_TEXTURE, |t| t.index() as u32);
-    Material {
-        name: m.name().map_or_else(
-            || format!("material{}", m.index().unwrap_or(usize::MAX)),
-            str::to_owned,
-        ),
+    let mut tex = |i: Option<::gltf::texture::Info<'_>>| {
+        let coord = i.as_ref().map_or(0, ::gltf::texture::Info::tex_coord);
+        dec.texture(i.map(|i| i.texture()), coord, warnings)
+    };
+    let base_color = tex(pbr.base_color_texture())?;
+    let metallic_roughness = tex(pbr.metallic_roughness_texture())?;
+    let emissive = tex(m.emissive_texture())?;
+    let transmission_ext = m.transmission();
+    let transmission = tex(transmission_ext
+        .as_ref()
+        .and_then(::gltf::material::Transmission::transmission_texture))?;
+    let specular_ext = m.specular();
+    let specular_tex = tex(specular_ext
+        .as_ref()
+        .and_then(::gltf::material::Specular::specular_texture))?;
+    let specular_color = tex(specular_ext
+        .as_ref()
+        .and_then(::gltf::material::Specular::specular_color_texture))?;
+    let normal_info = m.normal_texture();
+    let normal = match &normal_info {
+        Some(n) => dec.texture(Some(n.texture()), n.tex_coord(), warnings)?,
+        None => NO_TEXTURE,
+    };
+    let ior = m.ior().unwrap_or(1.5);
+    let specular = specular_ext.as_ref().map_or_else(
+        || gltf_specular(ior, 1.0, [1.0; 3]),
+        |s| gltf_specular(ior, s.specular_factor(), s.specular_color_factor()),
+    );
+    Ok(Material {
+        name: material_name(m),
         base_color: Vec3::new(r, g, b),
         emission: Vec3::from(m.emissive_factor()) * strength,
         roughness: pbr.roughness_factor(),
         metallic: pbr.metallic_factor(),
-        specular: 0.5,
+        specular,
         specular_tint: 0.0,
-        transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
-        ior: m.ior().unwrap_or(1.5),
+        transmission: transmission_ext.map_or(0.0, |t| t.transmission_factor()),
+        ior,
         two_sided: m.double_sided(),
         textures: MaterialTextures {
-            base_color: tex(pbr.base_color_texture().map(|i| i.texture())),
-            metallic_roughness: tex(pbr.metallic_roughness_texture().map(|i| i.texture())),
-            emissive: tex(m.emissive_texture().map(|i| i.texture())),
-            normal: tex(m.normal_texture().map(|i| i.texture())),
+            base_color,
+            metallic_roughness,
+            emissive,
+            normal,
+            transmission,
+            specular: specular_tex,
+            specular_color,
         },
-    }
+        normal_scale: normal_info.map_or(1.0, |n| n.scale()),
+    })
 }

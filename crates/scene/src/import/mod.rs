@@ -22,6 +22,8 @@ pub struct ImportedMesh {
     pub triangles: Vec<Triangle>,
     /// The file's materials (plus a default one when some triangles had none).
     pub materials: Vec<Material>,
+    /// The textures the materials use, decoded; `Material::textures` index this.
+    pub textures: Vec<crate::texture::Texture>,
     /// The file's cameras, in node order (glTF only).
     pub cameras: Vec<Camera>,
     /// What was dropped or changed.

@@ -66,6 +66,8 @@ pub fn import_obj(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneErr
             let tri = Triangle {
                 positions: [p0, p1, p2],
                 normals,
+                uvs: None,
+                tangents: None,
                 material,
             };
             push_triangle(

@@ -1,0 +1,172 @@
+//! Decoded textures and their sampling, the exact CPU mirror of
+//! `shaders/pathtrace/textures.wgsl`.
+//!
+//! A texture is RGBA8 texels (row 0 at the top: glTF's UV (0, 0) is the image's top-left
+//! corner), a wrap mode per axis and a filter. Sampling is bilinear between the four texels
+//! around the point (texel centers at `(i + 0.5) / width`), after decoding each texel from
+//! sRGB when asked (as a GPU filters an sRGB texture), or the nearest texel when the glTF
+//! sampler's `magFilter` is `NEAREST`. There are no mipmaps: the path tracer averages many
+//! jittered samples per pixel, which filters minified textures.
+//!
+//! On the GPU all textures of a scene live in one storage buffer of `u32`s
+//! ([`pack_textures`]): [`TEXTURE_DESC_WORDS`] words of descriptor per texture, then the
+//! texels, one RGBA8 word each (R in the low byte, as `unpack4x8unorm` reads it).
+
+use glam::{Vec2, Vec3, Vec4};
+
+/// How coordinates outside [0, 1] map into the texture (glTF sampler `wrapS` / `wrapT`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Wrap {
+    /// The texture repeats (glTF's default).
+    #[default]
+    Repeat,
+    /// The edge texels extend.
+    ClampToEdge,
+    /// The texture repeats, mirrored every other time.
+    MirroredRepeat,
+}
+
+impl Wrap {
+    /// The code the shader reads (`TEX_WRAP_*`).
+    pub fn code(self) -> u32 {
+        match self {
+            Self::Repeat => 0,
+            Self::ClampToEdge => 1,
+            Self::MirroredRepeat => 2,
+        }
+    }
+
+    /// The texel index for integer coordinate `i` in a row of `n` texels.
+    pub fn index(self, i: i64, n: u32) -> u32 {
+        let n = i64::from(n);
+        let r = match self {
+            Self::Repeat => i.rem_euclid(n),
+            Self::ClampToEdge => i.clamp(0, n - 1),
+            Self::MirroredRepeat => {
+                let m = i.rem_euclid(2 * n);
+                if m >= n { 2 * n - 1 - m } else { m }
+            }
+        };
+        u32::try_from(r).unwrap_or(0)
+    }
+}
+
+/// A decoded texture.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    /// Where it came from, for messages (`"BoxTextured.gltf image 0 (CesiumLogoFlat.png)"`).
+    pub name: String,
+    /// Width in texels (≥ 1).
+    pub width: u32,
+    /// Height in texels (≥ 1).
+    pub height: u32,
+    /// RGBA8 texels, row by row from the top.
+    pub texels: Vec<[u8; 4]>,
+    /// Wrap along U (glTF `wrapS`) and V (`wrapT`).
+    pub wrap: [Wrap; 2],
+    /// Nearest-texel lookup (glTF `magFilter: NEAREST`) instead of bilinear.
+    pub nearest: bool,
+}
+
+/// Words of descriptor per texture in the packed buffer: texel offset (in words), width,
+/// height, flags (bits 0–1 wrap S, bits 2–3 wrap T, bit 4 nearest).
+pub const TEXTURE_DESC_WORDS: usize = 4;
+/// Descriptor flag: nearest-texel lookup.
+pub const TEX_NEAREST: u32 = 16;
+
+/// sRGB → linear, one channel in [0, 1] (the WGSL `srgb_decode`).
+pub fn srgb_decode(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+impl Texture {
+    /// The texel at integer coordinates, wrapped, as unorm floats (sRGB decoded in rgb when
+    /// `srgb`; alpha is always linear).
+    pub fn fetch(&self, x: i64, y: i64, srgb: bool) -> Vec4 {
+        let xi = self.wrap[0].index(x, self.width);
+        let yi = self.wrap[1].index(y, self.height);
+        let t = self.texels[(yi * self.width + xi) as usize];
+        let v = Vec4::from_array(t.map(|c| f32::from(c) / 255.0));
+        if srgb {
+            Vec4::new(srgb_decode(v.x), srgb_decode(v.y), srgb_decode(v.z), v.w)
+        } else {
+            v
+        }
+    }
+
+    /// The filtered value at `uv` (see the module documentation).
+    pub fn sample(&self, uv: Vec2, srgb: bool) -> Vec4 {
+        let size = Vec2::new(self.width as f32, self.height as f32);
+        let p = uv * size;
+        if self.nearest {
+            let f = p.floor();
+            return self.fetch(f.x as i64, f.y as i64, srgb);
+        }
+        let p = p - 0.5;
+        let f = p.floor();
+        let t = p - f;
+        let (x, y) = (f.x as i64, f.y as i64);
+        let a = self.fetch(x, y, srgb).lerp(self.fetch(x + 1, y, srgb), t.x);
+        let b = self
+            .fetch(x, y + 1, srgb)
+            .lerp(self.fetch(x + 1, y + 1, srgb), t.x);
+        a.lerp(b, t.y)
+    }
+
+    /// The descriptor flags word.
+    pub fn flags(&self) -> u32 {
+        self.wrap[0].code() | (self.wrap[1].code() << 2) | if self.nearest { TEX_NEAREST } else { 0 }
+    }
+}
+
+/// All textures in one `u32` array: descriptors first, then the texels of each texture.
+pub fn pack_textures(textures: &[Texture]) -> Vec<u32> {
+    let head = textures.len() * TEXTURE_DESC_WORDS;
+    let total = head + textures.iter().map(|t| t.texels.len()).sum::<usize>();
+    let mut out = Vec::with_capacity(total);
+    let mut offset = head as u32;
+    for t in textures {
+        out.extend_from_slice(&[offset, t.width, t.height, t.flags()]);
+        offset += t.texels.len() as u32;
+    }
+    for t in textures {
+        out.extend(t.texels.iter().map(|&c| u32::from_le_bytes(c)));
+    }
+    out
+}
+
+/// The tangents of a triangle at its corners (xyz unit and orthogonal to the corner's
+/// normal, w = ±1 the handedness), generated from the UV gradient when the source has none.
+///
+/// The triangle's tangent is dP/du (the direction in which U grows on its plane) and its
+/// bitangent dP/dv, solved from the edges and their UV differences; at each corner the
+/// tangent is made orthogonal to that corner's normal (Gram–Schmidt) and w is the sign that
+/// makes `w · normal × tangent` point along dP/dv. One tangent per triangle, not averaged
+/// over shared vertices (MikkTSpace would): a normal map baked against MikkTSpace tangents
+/// shades with a small difference across curved, unevenly mapped surfaces. Without usable
+/// UVs (zero UV area), any tangent orthogonal to the normal is returned, with w = 1.
+pub fn triangle_tangents(positions: [Vec3; 3], normals: [Vec3; 3], uvs: [Vec2; 3]) -> [Vec4; 3] {
+    let (e1, e2) = (positions[1] - positions[0], positions[2] - positions[0]);
+    let (d1, d2) = (uvs[1] - uvs[0], uvs[2] - uvs[0]);
+    let det = d1.x * d2.y - d2.x * d1.y;
+    let (dpdu, dpdv) = if det.abs() > 1e-20 {
+        ((e1 * d2.y - e2 * d1.y) / det, (e2 * d1.x - e1 * d2.x) / det)
+    } else {
+        (Vec3::ZERO, Vec3::ZERO)
+    };
+    normals.map(|n| {
+        let t = dpdu - n * n.dot(dpdu);
+        if t.is_finite() && t.length_squared() > 1e-12 * dpdu.length_squared() {
+            let t = t.normalize();
+            let w = if n.cross(t).dot(dpdv) < 0.0 { -1.0 } else { 1.0 };
+            t.extend(w)
+        } else {
+            n.any_orthonormal_vector().extend(1.0)
+        }
+    })
+}
