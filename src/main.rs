@@ -170,26 +170,14 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
     for w in &r.warnings {
         println!("scene warning: {w}");
     }
-    let textured: Vec<&str> = scene
-        .materials
-        .iter()
-        .filter(|m| m.textures.any())
-        .map(|m| m.name.as_str())
-        .collect();
-    if !textured.is_empty() {
-        println!(
-            "scene warning: materials {} have textures, which this build does not read yet \
-             (their factors are used)",
-            textured.join(", ")
-        );
-    }
     let gpu = GpuScene::build(&scene)?;
     println!(
-        "scene {}: {} triangles, {} spheres, {} lights, {} BVH nodes ({:.0} ms)",
+        "scene {}: {} triangles, {} spheres, {} lights, {} textures, {} BVH nodes ({:.0} ms)",
         path.display(),
         gpu.tri_positions.len(),
         gpu.spheres.len(),
         gpu.lights.len(),
+        scene.textures.len(),
         gpu.bvh_nodes.len(),
         start.elapsed().as_secs_f64() * 1e3
     );

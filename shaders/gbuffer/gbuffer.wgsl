@@ -11,9 +11,14 @@
 // as the ray hit). Spheres arrive as a circumscribed tessellation; each fragment intersects
 // the true sphere along its pixel-center ray, drops the fragment on a miss and writes the
 // exact normal and depth, so silhouettes and normals match the ray tracer's.
+// With textures (HAS_TEXTURES), fragments of textured materials take their albedo and normal
+// through the path tracer's own functions (pathtrace/textures.wgsl) at the interpolated UV.
 // Outputs: albedo (base color), shading normal, distance along the ray; 0 where nothing is hit.
+#import "pathtrace/scene_types.wgsl"
+#import "pathtrace/textures.wgsl"
+#import "gbuffer/options.wgsl"
 
-struct Camera {
+struct RasterCamera {
     position: vec3f,
     tan_half_fov: f32,
     right: vec3f,
@@ -26,7 +31,10 @@ struct Camera {
 
 const NEAR: f32 = 1e-4;
 
-@group(0) @binding(0) var<uniform> cam: Camera;
+@group(0) @binding(0) var<uniform> cam: RasterCamera;
+// Materials and every texture (one zeroed stand-in each without textures).
+@group(0) @binding(1) var<storage, read> materials: array<Material>;
+@group(0) @binding(2) var<storage, read> textures: array<u32>;
 
 struct VertexIn {
     @location(0) position: vec3f,
@@ -34,6 +42,10 @@ struct VertexIn {
     @location(2) albedo: vec3f,
     // Sphere center and radius; for a triangle, its unit geometric normal and 0.
     @location(3) sphere: vec4f,
+    @location(4) uv: vec2f,
+    // Tangent (xyz) and handedness (w, corner 0's on every corner).
+    @location(5) tangent: vec4f,
+    @location(6) material: u32,
 }
 
 struct VertexOut {
@@ -42,6 +54,9 @@ struct VertexOut {
     @location(1) normal: vec3f,
     @location(2) @interpolate(flat) albedo: vec3f,
     @location(3) @interpolate(flat) sphere: vec4f,
+    @location(4) uv: vec2f,
+    @location(5) tangent: vec4f,
+    @location(6) @interpolate(flat) material: u32,
 }
 
 @vertex
@@ -59,6 +74,9 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.normal = v.normal;
     out.albedo = v.albedo;
     out.sphere = v.sphere;
+    out.uv = v.uv;
+    out.tangent = v.tangent;
+    out.material = v.material;
     return out;
 }
 
@@ -105,7 +123,13 @@ fn fs_main(f: VertexOut) -> FragmentOut {
     } else {
         let n = f.normal;
         // A zero interpolated normal falls back to the geometric one, as in the path tracer.
-        out.normal = vec4f(select(f.sphere.xyz, normalize(n), dot(n, n) > 0.0), 1.0);
+        var ns = select(f.sphere.xyz, normalize(n), dot(n, n) > 0.0);
+        if HAS_TEXTURES {
+            let m = textured_material(materials[f.material], f.uv);
+            out.albedo = vec4f(m.base_color, 1.0);
+            ns = normal_mapped(m, ns, f.sphere.xyz, f.uv, f.tangent);
+        }
+        out.normal = vec4f(ns, 1.0);
         out.depth = vec4f(length(f.world - cam.position), 0.0, 0.0, 0.0);
         out.frag_depth = f.clip.z;
     }

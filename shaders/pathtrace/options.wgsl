@@ -15,3 +15,5 @@ const HAS_LIGHTS: bool = true;
 const HAS_ENVIRONMENT: bool = true;
 // The environment is an equirectangular map: its sampling is compiled in.
 const HAS_ENV_MAP: bool = true;
+// Some material has a texture: UVs, tangents and texture sampling compiled in.
+const HAS_TEXTURES: bool = true;

@@ -10,6 +10,7 @@
 #import "pathtrace/options.wgsl"
 #import "pathtrace/bsdf.wgsl"
 #import "pathtrace/env.wgsl"
+#import "pathtrace/textures.wgsl"
 
 struct Frame {
     settings: Settings,
@@ -47,6 +48,10 @@ struct Frame {
 // Environment map texels (rgb radiance, a = pixel probability) and their alias table.
 @group(0) @binding(14) var<storage, read> env_texels: array<vec4f>;
 @group(0) @binding(15) var<storage, read> env_alias: array<AliasEntry>;
+// Texture coordinates and tangents per triangle, and every texture (see textures.wgsl); one
+// zeroed entry each when no material has a texture (HAS_TEXTURES off).
+@group(0) @binding(16) var<storage, read> tri_texcoords: array<TriTexcoords>;
+@group(0) @binding(17) var<storage, read> textures: array<u32>;
 
 #import "pathtrace/intersect.wgsl"
 
@@ -65,6 +70,8 @@ struct Surface {
     light: u32,
     // Componentwise bound on the rounding error of `p` (triangles; 0 on spheres).
     err: vec3f,
+    // Texture coordinates (HAS_TEXTURES; 0 on spheres).
+    uv: vec2f,
 }
 
 // Rounding error bounds of a point computed as v0 + u e1 + v e2 in f32: a float step of each
@@ -82,6 +89,7 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
     var s: Surface;
     s.p = ray.origin + hit.t * ray.dir;
     s.err = vec3f(0.0);
+    s.uv = vec2f(0.0);
     if (hit.prim & PRIM_SPHERE) != 0u {
         let sph = spheres[hit.prim & ~PRIM_SPHERE];
         s.ng = normalize(s.p - sph.center);
@@ -103,6 +111,11 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
         }
         s.material = sh.material;
         s.light = sh.light;
+        if HAS_TEXTURES {
+            let tc = tri_texcoords[hit.prim];
+            s.uv = tri_uv(tc, hit.u, hit.v);
+            s.ns = normal_mapped(materials[sh.material], s.ns, s.ng, s.uv, tri_tangent(tc, hit.u, hit.v));
+        }
     }
     return s;
 }
@@ -204,6 +217,14 @@ fn sample_light(x: vec3f) -> LightSample {
     out.wi = wi;
     out.dist = dist;
     out.radiance = l.emission;
+    if HAS_TEXTURES {
+        // An emissive texture varies the emission over the triangle (selection stays by the
+        // factor's power).
+        let m = materials[tri_shading[l.prim].material];
+        if tex_lo(m.tex_emissive_normal) != NO_TEX {
+            out.radiance = textured_emission(m, tri_uv(tri_texcoords[l.prim], b.x, b.y));
+        }
+    }
     out.pdf = light_select_pdf(l) * dist2 / (l.area * abs(cos_y));
     let err = barycentric_err(l.p0, l.e1, l.e2, b.x, b.y);
     out.margin = dot(abs(ny), err) / abs(cos_y) + EDGE_ERR * dist;
@@ -291,7 +312,10 @@ fn trace_path(pixel: vec2u) -> vec3f {
         // from inside, start 256 float steps off it (Wachter and Binder).
         let on_sphere = (hit.prim & PRIM_SPHERE) != 0u;
         skip_prim = select(hit.prim, NO_HIT, on_sphere);
-        let mat = materials[s.material];
+        var mat = materials[s.material];
+        if HAS_TEXTURES {
+            mat = textured_material(mat, s.uv);
+        }
         let front = dot(s.ng, ray.dir) < 0.0;
         let two_sided = (mat.flags & MATERIAL_TWO_SIDED) != 0u;
         let glass = HAS_GLASS && mat.transmission > 0.0 && mat.metallic < 1.0;
@@ -413,7 +437,11 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         var depth = 0.0;
         if hit.prim != NO_HIT {
             let s = surface_at(ray, hit);
-            albedo = materials[s.material].base_color;
+            var m = materials[s.material];
+            if HAS_TEXTURES {
+                m = textured_material(m, s.uv);
+            }
+            albedo = m.base_color;
             normal = s.ns;
             depth = hit.t;
         }

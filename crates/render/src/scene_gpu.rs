@@ -23,6 +23,10 @@ pub struct SceneBuffers {
     pub lights: wgpu::Buffer,
     /// Alias table over the emitters.
     pub light_alias: wgpu::Buffer,
+    /// Texture coordinates and tangents per triangle (one zeroed entry without textures).
+    pub tri_texcoords: wgpu::Buffer,
+    /// Every texture, packed (a zeroed stand-in without textures).
+    pub textures: wgpu::Buffer,
     /// Bytes uploaded, for reports.
     pub bytes: u64,
 }
@@ -48,7 +52,14 @@ fn storage(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
 impl SceneBuffers {
     /// Uploads every array of `scene`.
     pub fn upload(ctx: &GpuContext, scene: &GpuScene) -> Self {
-        let parts: [(&str, &[u8]); 7] = [
+        // A runtime-sized array binding holds at least one element.
+        let one = [lumagraph_scene::GpuTriTexcoords::default()];
+        let texcoords = if scene.tri_texcoords.is_empty() {
+            &one[..]
+        } else {
+            &scene.tri_texcoords[..]
+        };
+        let parts: [(&str, &[u8]); 9] = [
             ("bvh_nodes", bytemuck::cast_slice(&scene.bvh_nodes)),
             ("tri_positions", bytemuck::cast_slice(&scene.tri_positions)),
             ("tri_shading", bytemuck::cast_slice(&scene.tri_shading)),
@@ -56,9 +67,17 @@ impl SceneBuffers {
             ("materials", bytemuck::cast_slice(&scene.materials)),
             ("lights", bytemuck::cast_slice(&scene.lights)),
             ("light_alias", bytemuck::cast_slice(&scene.light_alias)),
+            ("tri_texcoords", bytemuck::cast_slice(texcoords)),
+            ("textures", bytemuck::cast_slice(&scene.textures)),
         ];
-        let bytes = parts.iter().map(|(_, b)| b.len() as u64).sum();
-        let [b0, b1, b2, b3, b4, b5, b6] = parts.map(|(label, b)| storage(ctx, label, b));
+        let bytes = parts.iter().map(|(_, b)| b.len() as u64).sum::<u64>()
+            - if scene.tri_texcoords.is_empty() {
+                std::mem::size_of_val(&one) as u64
+            } else {
+                0
+            };
+        let [b0, b1, b2, b3, b4, b5, b6, b7, b8] =
+            parts.map(|(label, b)| storage(ctx, label, b));
         Self {
             bvh_nodes: b0,
             tri_positions: b1,
@@ -67,6 +86,8 @@ impl SceneBuffers {
             materials: b4,
             lights: b5,
             light_alias: b6,
+            tri_texcoords: b7,
+            textures: b8,
             bytes,
         }
     }

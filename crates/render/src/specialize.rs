@@ -115,6 +115,17 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
     let env = scene.settings.env_kind != lumagraph_scene::ENV_NONE;
     let env_map = scene.settings.env_kind == lumagraph_scene::ENV_MAP;
     let lights = scene.lights.len();
+    let textured = scene.header.features & lumagraph_scene::FEATURE_TEXTURES != 0;
+    let textured_materials = count(&|x| {
+        [
+            x.tex_base_mr,
+            x.tex_emissive_normal,
+            x.tex_transmission_specular,
+            x.tex_specular_color,
+        ]
+        .iter()
+        .any(|&t| t & 0xFFFF != 0xFFFF || t >> 16 != 0xFFFF)
+    });
     let why = |n: usize, what: &str| {
         if all {
             "general shader (specialization off)".to_owned()
@@ -182,7 +193,20 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
                 "nothing reads albedo, normal or depth"
             },
         ),
-        feature("textures", false, "not supported by this build yet"),
+        feature(
+            "material textures",
+            all || textured,
+            if all {
+                "general shader (specialization off)".to_owned()
+            } else if textured {
+                format!(
+                    "{textured_materials} textured materials, {} KiB of texels",
+                    scene.textures.len() * 4 / 1024
+                )
+            } else {
+                "no material has a texture".to_owned()
+            },
+        ),
     ]
 }
 
@@ -199,7 +223,7 @@ pub fn pathtrace_source(
     let consts = format!(
         "const WRITE_AOVS: bool = {};\nconst HAS_SPECULAR: bool = {};\nconst HAS_METAL: bool = {};\n\
          const HAS_GLASS: bool = {};\nconst HAS_LIGHTS: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
-         const HAS_ENV_MAP: bool = {};\n",
+         const HAS_ENV_MAP: bool = {};\nconst HAS_TEXTURES: bool = {};\n",
         on("first-hit AOVs"),
         on("dielectric specular lobe"),
         on("metal lobe"),
@@ -207,6 +231,7 @@ pub fn pathtrace_source(
         on("light sampling (NEE + MIS)"),
         on("environment"),
         on("environment map sampling"),
+        on("material textures"),
     );
     let mut overrides = vec![("pathtrace/options.wgsl", consts)];
     if on("inline intersection")

@@ -2,7 +2,8 @@
 //! writing first-hit albedo, shading normal and distance along the ray.
 //!
 //! The scene's triangles go to one non-indexed vertex buffer with their corner normals and
-//! material color; each sphere becomes a UV sphere circumscribing the true one, and the
+//! material color (and, with textures, UV, tangent and material id: the fragment shader
+//! applies the base color texture and the normal map as the path tracer does); each sphere becomes a UV sphere circumscribing the true one, and the
 //! fragment shader intersects the true sphere along the pixel-center ray (dropping misses,
 //! writing the exact normal and depth), so spheres agree with the ray tracer to the pixel.
 //! See `shaders/gbuffer/gbuffer.wgsl` for the projection (reversed, infinite depth).
@@ -11,7 +12,7 @@
 //! every attachment of a render pass must have the same size.
 
 use lumagraph_graph::{Extent, Pass, TexFormat};
-use lumagraph_scene::{GpuScene, TRI_VERTEX_NORMALS};
+use lumagraph_scene::{FEATURE_TEXTURES, GpuScene, TRI_VERTEX_NORMALS};
 use wgpu::util::DeviceExt as _;
 
 use crate::context::GpuContext;
@@ -21,8 +22,9 @@ use crate::nodes::{FrameIo, NodeExec, Resources};
 use crate::pool::{PooledTexture, create, wgpu_format};
 use crate::timing::GpuTimer;
 
-/// Floats per vertex: position, normal, albedo (3 each), sphere (4).
-const VERTEX_FLOATS: usize = 13;
+/// Floats per vertex: position, normal, albedo (3 each), sphere (4), uv (2), tangent (4),
+/// material id (the bits of a `u32`).
+const VERTEX_FLOATS: usize = 20;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const PORTS: [(&str, TexFormat); 3] = [
     ("albedo", TexFormat::Rgba32Float),
@@ -46,7 +48,14 @@ impl GBuffer {
             RenderError::Gpu("GBuffer needs a scene (lumagraph render --scene FILE)".into())
         })?;
         let device = &ctx.device;
-        let source = crate::shader::resolve("gbuffer/gbuffer.wgsl")?;
+        let textured = scene.header.features & FEATURE_TEXTURES != 0;
+        let source = crate::shader::resolve_with(
+            "gbuffer/gbuffer.wgsl",
+            &[(
+                "gbuffer/options.wgsl",
+                format!("const HAS_TEXTURES: bool = {textured};\n"),
+            )],
+        )?;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("gbuffer"),
@@ -54,16 +63,20 @@ impl GBuffer {
         });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gbuffer"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
                 },
-                count: None,
-            }],
+                storage_entry(1),
+                storage_entry(2),
+            ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("gbuffer"),
@@ -71,7 +84,8 @@ impl GBuffer {
             immediate_size: 0,
         });
         let attributes = wgpu::vertex_attr_array![
-            0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x4
+            0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x4,
+            4 => Float32x2, 5 => Float32x4, 6 => Uint32
         ];
         let target = |format| {
             Some(wgpu::ColorTargetState {
@@ -119,13 +133,38 @@ impl GBuffer {
             });
         }
         let camera = uniform_buffer(ctx, "gbuffer camera", &camera_bytes(&scene));
+        // Without textures the shader reads neither: zeroed stand-ins.
+        let storage = |label: &str, bytes: &[u8]| {
+            let zeros = [0_u8; 80];
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: if textured && !bytes.is_empty() {
+                    bytes
+                } else {
+                    &zeros
+                },
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let materials = storage("gbuffer materials", bytemuck::cast_slice(&scene.materials));
+        let textures = storage("gbuffer textures", bytemuck::cast_slice(&scene.textures));
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer"),
             layout: &layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: camera.as_entire_binding(),
-            }],
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: camera.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: materials.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: textures.as_entire_binding(),
+                },
+            ],
         });
         let mut node = Self {
             scene,
@@ -137,6 +176,19 @@ impl GBuffer {
         };
         node.update(ctx, pass)?;
         Ok(node)
+    }
+}
+
+fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
     }
 }
 
@@ -178,6 +230,14 @@ fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     ]
 }
 
+/// Texture attributes of a vertex.
+#[derive(Clone, Copy)]
+struct Tex {
+    uv: [f32; 2],
+    tangent: [f32; 4],
+    material: u32,
+}
+
 /// The vertex data of every triangle and tessellated sphere, `VERTEX_FLOATS` per vertex.
 pub(crate) fn vertices(scene: &GpuScene, segments: u32) -> Vec<f32> {
     let albedo = |m: u32| {
@@ -187,13 +247,26 @@ pub(crate) fn vertices(scene: &GpuScene, segments: u32) -> Vec<f32> {
             .map_or([0.0; 3], |m| m.base_color)
     };
     let mut out = Vec::new();
-    let mut push = |p: [f32; 3], n: [f32; 3], a: [f32; 3], s: [f32; 4]| {
+    let mut push = |p: [f32; 3], n: [f32; 3], a: [f32; 3], s: [f32; 4], tex: Tex| {
         out.extend_from_slice(&p);
         out.extend_from_slice(&n);
         out.extend_from_slice(&a);
         out.extend_from_slice(&s);
+        out.extend_from_slice(&tex.uv);
+        out.extend_from_slice(&tex.tangent);
+        out.push(f32::from_bits(tex.material));
     };
-    for (t, sh) in scene.tri_positions.iter().zip(&scene.tri_shading) {
+    let no_tex = |material: u32| Tex {
+        uv: [0.0; 2],
+        tangent: [0.0; 4],
+        material,
+    };
+    for (i, (t, sh)) in scene
+        .tri_positions
+        .iter()
+        .zip(&scene.tri_shading)
+        .enumerate()
+    {
         let corners = [t.v0, add(t.v0, t.e1), add(t.v0, t.e2)];
         let ng = normalize(cross(t.e1, t.e2));
         let normals = if sh.flags & TRI_VERTEX_NORMALS != 0 {
@@ -202,8 +275,18 @@ pub(crate) fn vertices(scene: &GpuScene, segments: u32) -> Vec<f32> {
             [sh.n0; 3]
         };
         let a = albedo(sh.material);
-        for i in 0..3 {
-            push(corners[i], normals[i], a, [ng[0], ng[1], ng[2], 0.0]);
+        let tc = scene.tri_texcoords.get(i);
+        for k in 0..3 {
+            let tex = tc.map_or(no_tex(sh.material), |tc| {
+                let [t0, t1, t2] = [tc.t0, tc.t1, tc.t2];
+                let tan = [t0, t1, t2][k];
+                Tex {
+                    uv: [[tc.uv01[0], tc.uv01[1]], [tc.uv01[2], tc.uv01[3]], tc.uv2][k],
+                    tangent: [tan[0], tan[1], tan[2], t0[3]],
+                    material: sh.material,
+                }
+            });
+            push(corners[k], normals[k], a, [ng[0], ng[1], ng[2], 0.0], tex);
         }
     }
     // UV spheres: `segments` around, `segments / 2` from pole to pole, with corners pushed
@@ -235,7 +318,8 @@ pub(crate) fn vertices(scene: &GpuScene, segments: u32) -> Vec<f32> {
                     point(i, j + 1),
                 ];
                 for k in [0, 1, 2, 0, 2, 3] {
-                    push(q[k], normalize(sub(q[k], s.center)), a, sphere);
+                    let tex = no_tex(s.material);
+                    push(q[k], normalize(sub(q[k], s.center)), a, sphere, tex);
                 }
             }
         }

@@ -79,6 +79,8 @@ impl PathTrace {
                 storage,
                 storage,
                 storage,
+                storage,
+                storage,
             ],
         )?;
         let env = match &scene.environment_map {
@@ -218,6 +220,8 @@ impl NodeExec for PathTrace {
             .buffer(&self.ggx_table)
             .buffer(&self.env.texels)
             .buffer(&self.env.alias)
+            .buffer(&b.tri_texcoords)
+            .buffer(&b.textures)
             .dispatch_2d(ctx, encoder, pass.extent, timer)
     }
 

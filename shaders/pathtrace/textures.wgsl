@@ -1,0 +1,145 @@
+// Texture sampling and textured materials, mirrored exactly by crates/scene/src/texture.rs.
+// The includer declares `textures: array<u32>` (every texture of the scene: 4 descriptor
+// words per texture, offset / width / height / flags, then RGBA8 texels, one word each) and
+// calls these only when HAS_TEXTURES.
+//
+// Sampling is bilinear between the four texels around the point (texel centers at
+// (i + 0.5) / size), each decoded from sRGB first when asked; or the nearest texel when the
+// glTF sampler says NEAREST. UV (0, 0) is the image's top-left corner.
+#import "pathtrace/scene_types.wgsl"
+#import "common/color.wgsl"
+
+const NO_TEX: u32 = 0xffffu;
+const TEX_WRAP_REPEAT: u32 = 0u;
+const TEX_WRAP_CLAMP: u32 = 1u;
+const TEX_WRAP_MIRROR: u32 = 2u;
+const TEX_NEAREST: u32 = 16u;
+
+fn tex_wrap(i: i32, n: i32, mode: u32) -> i32 {
+    if mode == TEX_WRAP_CLAMP {
+        return clamp(i, 0, n - 1);
+    }
+    if mode == TEX_WRAP_MIRROR {
+        let m = ((i % (2 * n)) + 2 * n) % (2 * n);
+        return select(m, 2 * n - 1 - m, m >= n);
+    }
+    return ((i % n) + n) % n;
+}
+
+fn tex_fetch(offset: u32, w: i32, h: i32, flags: u32, x: i32, y: i32, srgb: bool) -> vec4f {
+    let xi = tex_wrap(x, w, flags & 3u);
+    let yi = tex_wrap(y, h, (flags >> 2u) & 3u);
+    let c = unpack4x8unorm(textures[offset + u32(yi * w + xi)]);
+    if srgb {
+        return vec4f(srgb_decode(c.rgb), c.a);
+    }
+    return c;
+}
+
+// The filtered texel of texture `id` at `uv`.
+fn tex_sample(id: u32, uv: vec2f, srgb: bool) -> vec4f {
+    let d = 4u * id;
+    let offset = textures[d];
+    let w = i32(textures[d + 1u]);
+    let h = i32(textures[d + 2u]);
+    let flags = textures[d + 3u];
+    let p = uv * vec2f(f32(w), f32(h));
+    if (flags & TEX_NEAREST) != 0u {
+        let f = vec2i(floor(p));
+        return tex_fetch(offset, w, h, flags, f.x, f.y, srgb);
+    }
+    let q = p - 0.5;
+    let f = floor(q);
+    let t = q - f;
+    let i = vec2i(f);
+    let a = mix(tex_fetch(offset, w, h, flags, i.x, i.y, srgb),
+        tex_fetch(offset, w, h, flags, i.x + 1, i.y, srgb), t.x);
+    let b = mix(tex_fetch(offset, w, h, flags, i.x, i.y + 1, srgb),
+        tex_fetch(offset, w, h, flags, i.x + 1, i.y + 1, srgb), t.x);
+    return mix(a, b, t.y);
+}
+
+fn tex_lo(packed: u32) -> u32 {
+    return packed & 0xffffu;
+}
+
+fn tex_hi(packed: u32) -> u32 {
+    return packed >> 16u;
+}
+
+// The UV at barycentrics (u, v) of a triangle.
+fn tri_uv(tc: TriTexcoords, u: f32, v: f32) -> vec2f {
+    return (1.0 - u - v) * tc.uv01.xy + u * tc.uv01.zw + v * tc.uv2;
+}
+
+// Emission of `m` at `uv`: factor x texture (sRGB).
+fn textured_emission(m: Material, uv: vec2f) -> vec3f {
+    let id = tex_lo(m.tex_emissive_normal);
+    if id == NO_TEX {
+        return m.emission;
+    }
+    return m.emission * tex_sample(id, uv, true).rgb;
+}
+
+// `m` with its textures applied at `uv`: base color x texture (sRGB; alpha ignored),
+// roughness x G and metallic x B of the metallic-roughness texture, emission x texture
+// (sRGB), transmission x R of the transmission texture, specular x A of the specular texture
+// x max channel of the specular color texture (sRGB).
+fn textured_material(m_in: Material, uv: vec2f) -> Material {
+    var m = m_in;
+    let base = tex_lo(m.tex_base_mr);
+    if base != NO_TEX {
+        m.base_color *= tex_sample(base, uv, true).rgb;
+    }
+    let mr = tex_hi(m.tex_base_mr);
+    if mr != NO_TEX {
+        let t = tex_sample(mr, uv, false);
+        m.roughness *= t.g;
+        m.metallic *= t.b;
+    }
+    m.emission = textured_emission(m, uv);
+    let tr = tex_lo(m.tex_transmission_specular);
+    if tr != NO_TEX {
+        m.transmission *= tex_sample(tr, uv, false).r;
+    }
+    let sp = tex_hi(m.tex_transmission_specular);
+    if sp != NO_TEX {
+        m.specular *= tex_sample(sp, uv, false).a;
+    }
+    let sc = tex_lo(m.tex_specular_color);
+    if sc != NO_TEX {
+        let c = tex_sample(sc, uv, true).rgb;
+        m.specular *= max(c.x, max(c.y, c.z));
+    }
+    return m;
+}
+
+// The shading normal with `m`'s normal map applied at `uv`: the texel's xyz in [-1, 1],
+// x and y scaled by `normal_scale`, in the frame (tangent, bitangent, ns) where the tangent
+// is made orthogonal to ns and the bitangent is w * ns x tangent. Falls back to `ns` when the
+// result is degenerate or faces away from the geometric normal `ng` (front side).
+fn normal_mapped(m: Material, ns: vec3f, ng: vec3f, uv: vec2f, tangent: vec4f) -> vec3f {
+    let id = tex_hi(m.tex_emissive_normal);
+    if id == NO_TEX {
+        return ns;
+    }
+    let t = tex_sample(id, uv, false).xyz * 2.0 - 1.0;
+    let tn = vec3f(t.xy * m.normal_scale, t.z);
+    let tg = tangent.xyz - ns * dot(ns, tangent.xyz);
+    if !(dot(tg, tg) > 0.0) {
+        return ns;
+    }
+    let tu = normalize(tg);
+    let bt = select(1.0, -1.0, tangent.w < 0.0) * cross(ns, tu);
+    let n = tn.x * tu + tn.y * bt + tn.z * ns;
+    let len2 = dot(n, n);
+    if !(len2 > 0.0) || dot(n, ng) <= 0.0 {
+        return ns;
+    }
+    return n / sqrt(len2);
+}
+
+// The interpolated tangent at barycentrics (u, v).
+fn tri_tangent(tc: TriTexcoords, u: f32, v: f32) -> vec4f {
+    return vec4f((1.0 - u - v) * tc.t0.xyz + u * tc.t1.xyz + v * tc.t2.xyz, tc.t0.w);
+}
