@@ -76,8 +76,7 @@ impl SceneBuffers {
             } else {
                 0
             };
-        let [b0, b1, b2, b3, b4, b5, b6, b7, b8] =
-            parts.map(|(label, b)| storage(ctx, label, b));
+        let [b0, b1, b2, b3, b4, b5, b6, b7, b8] = parts.map(|(label, b)| storage(ctx, label, b));
         Self {
             bvh_nodes: b0,
             tri_positions: b1,

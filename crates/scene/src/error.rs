@@ -62,14 +62,10 @@ pub enum ErrorKind {
     /// An OBJ or MTL file could not be loaded.
     #[error("OBJ: {0}")]
     Obj(#[from] tobj::LoadError),
-    /// A texture's image could not be read or decoded.
-    #[error("{texture}: {message}")]
-    Texture {
-        /// The texture (`texture 0 (image 1, "wood.png")`).
-        texture: String,
-        /// What went wrong.
-        message: String,
-    },
+    /// A texture's image could not be read or decoded: the texture
+    /// (`texture 0 (image 1, "wood.png")`) and what went wrong.
+    #[error("{0}")]
+    Texture(String),
     /// A mesh file has an extension this build does not import.
     #[error("unsupported mesh file type \"{0}\" (use .gltf, .glb or .obj)")]
     MeshType(String),

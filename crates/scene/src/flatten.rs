@@ -10,8 +10,9 @@ use crate::file::Environment;
 use crate::gpu::{
     ENV_CONSTANT, ENV_MAP, ENV_NONE, ENV_SHOW_BACKGROUND, FEATURE_ENVIRONMENT, FEATURE_LIGHTS,
     FEATURE_METAL, FEATURE_SPHERES, FEATURE_TEXTURES, FEATURE_TRANSMISSION, GpuAliasEntry,
-    GpuBvhNode, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere,
-    GpuTriShading, GpuTriTexcoords, GpuTriangle, LIGHT_SPHERE, LIGHT_TWO_SIDED, MATERIAL_TWO_SIDED, NO_LIGHT, TRI_VERTEX_NORMALS,
+    GpuBvhNode, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere, GpuTriShading,
+    GpuTriTexcoords, GpuTriangle, LIGHT_SPHERE, LIGHT_TWO_SIDED, MATERIAL_TWO_SIDED, NO_LIGHT,
+    TRI_VERTEX_NORMALS,
 };
 use crate::scene::{Material, NO_TEXTURE, Scene};
 
@@ -216,9 +217,9 @@ impl GpuScene {
             let ns = t.normals.unwrap_or([flat_n; 3]);
             if textured {
                 let uv = t.uvs.unwrap_or([glam::Vec2::ZERO; 3]);
-                let tan = t.tangents.unwrap_or_else(|| {
-                    crate::texture::triangle_tangents(t.positions, ns, uv)
-                });
+                let tan = t
+                    .tangents
+                    .unwrap_or_else(|| crate::texture::triangle_tangents(t.positions, ns, uv));
                 out.tri_texcoords.push(GpuTriTexcoords {
                     t0: tan[0].to_array(),
                     t1: tan[1].to_array(),

@@ -286,13 +286,16 @@ pub fn push_triangle(out: &mut Vec<Triangle>, report: &mut LoadReport, mut tri: 
             tri.normals = None;
         }
     }
-    if tri.uvs.is_some_and(|uvs| !uvs.iter().all(|uv| uv.is_finite())) {
+    if tri
+        .uvs
+        .is_some_and(|uvs| !uvs.iter().all(|uv| uv.is_finite()))
+    {
         tri.uvs = None;
     }
-    if tri
-        .tangents
-        .is_some_and(|ts| !ts.iter().all(|t| t.is_finite() && t.truncate().length_squared() > 1e-20))
-    {
+    if tri.tangents.is_some_and(|ts| {
+        !ts.iter()
+            .all(|t| t.is_finite() && t.truncate().length_squared() > 1e-20)
+    }) {
         tri.tangents = None;
     }
     out.push(tri);

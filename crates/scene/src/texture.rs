@@ -120,7 +120,9 @@ impl Texture {
 
     /// The descriptor flags word.
     pub fn flags(&self) -> u32 {
-        self.wrap[0].code() | (self.wrap[1].code() << 2) | if self.nearest { TEX_NEAREST } else { 0 }
+        self.wrap[0].code()
+            | (self.wrap[1].code() << 2)
+            | if self.nearest { TEX_NEAREST } else { 0 }
     }
 }
 
@@ -147,7 +149,7 @@ pub fn pack_textures(textures: &[Texture]) -> Vec<u32> {
 /// bitangent dP/dv, solved from the edges and their UV differences; at each corner the
 /// tangent is made orthogonal to that corner's normal (Gram–Schmidt) and w is the sign that
 /// makes `w · normal × tangent` point along dP/dv. One tangent per triangle, not averaged
-/// over shared vertices (MikkTSpace would): a normal map baked against MikkTSpace tangents
+/// over shared vertices (`MikkTSpace` would): a normal map baked against `MikkTSpace` tangents
 /// shades with a small difference across curved, unevenly mapped surfaces. Without usable
 /// UVs (zero UV area), any tangent orthogonal to the normal is returned, with w = 1.
 pub fn triangle_tangents(positions: [Vec3; 3], normals: [Vec3; 3], uvs: [Vec2; 3]) -> [Vec4; 3] {
@@ -163,7 +165,11 @@ pub fn triangle_tangents(positions: [Vec3; 3], normals: [Vec3; 3], uvs: [Vec2; 3
         let t = dpdu - n * n.dot(dpdu);
         if t.is_finite() && t.length_squared() > 1e-12 * dpdu.length_squared() {
             let t = t.normalize();
-            let w = if n.cross(t).dot(dpdv) < 0.0 { -1.0 } else { 1.0 };
+            let w = if n.cross(t).dot(dpdv) < 0.0 {
+                -1.0
+            } else {
+                1.0
+            };
             t.extend(w)
         } else {
             n.any_orthonormal_vector().extend(1.0)

@@ -32,7 +32,9 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
     let mut out = ImportedMesh::default();
     let mut decoder = Decoder {
         base: path.parent(),
-        file: path.file_name().map_or_else(String::new, |f| f.to_string_lossy().into_owned()),
+        file: path
+            .file_name()
+            .map_or_else(String::new, |f| f.to_string_lossy().into_owned()),
         buffers: &buffers,
         used: HashMap::new(),
         textures: Vec::new(),
@@ -238,7 +240,12 @@ fn rgba8(data: &::gltf::image::Data) -> Option<Vec<[u8; 4]>> {
                     [v, v, v, channel(px, 1)]
                 }
                 3 => [channel(px, 0), channel(px, 1), channel(px, 2), 255],
-                _ => [channel(px, 0), channel(px, 1), channel(px, 2), channel(px, 3)],
+                _ => [
+                    channel(px, 0),
+                    channel(px, 1),
+                    channel(px, 2),
+                    channel(px, 3),
+                ],
             })
             .collect(),
     )
@@ -273,12 +280,8 @@ impl Decoder<'_> {
             ::gltf::image::Source::View { .. } => "buffer view".to_owned(),
         };
         let label = format!("texture {} (image {}, {what})", t.index(), image.index());
-        let fail = |message: String| {
-            SceneError::new(ErrorKind::Texture {
-                texture: label.clone(),
-                message,
-            })
-        };
+        let fail =
+            |message: String| SceneError::new(ErrorKind::Texture(format!("{label}: {message}")));
         let data = ::gltf::image::Data::from_source(image.source(), self.base, self.buffers)
             .map_err(|e| fail(format!("cannot read the image: {e}")))?;
         if data.width == 0 || data.height == 0 {
@@ -314,7 +317,9 @@ pub fn gltf_specular(ior: f32, specular_factor: f32, specular_color: [f32; 3]) -
     } else {
         12.5 * ((ior - 1.0) / (ior + 1.0)).powi(2)
     };
-    let color = specular_color[0].max(specular_color[1]).max(specular_color[2]);
+    let color = specular_color[0]
+        .max(specular_color[1])
+        .max(specular_color[2]);
     layer * specular_factor * color
 }
 

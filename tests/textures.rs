@@ -1,0 +1,799 @@
+//! glTF textures: decoding, tangents, extensions (CPU) and their use by the path tracer and
+//! the G-buffer (GPU). Scenes are generated here: small glTF files whose buffers and PNGs are
+//! data URIs, buffer views or files next to them, written into a temporary folder.
+//!
+//! GPU checks compare the first-hit AOVs (through pixel centers) with the CPU mirror of the
+//! shader's sampling (`lumagraph_scene::texture`) at the UV of a CPU ray cast over the same
+//! flattened scene; the tolerances and what was measured are stated at each test.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3, Vec4};
+use lumagraph::graph::{Graph, Node, ParamValue};
+use lumagraph::render::cpu::Image;
+use lumagraph::render::{Executor, Resources, compile};
+use lumagraph::scene::texture::{Texture, srgb_decode, triangle_tangents};
+use lumagraph::scene::{GpuScene, NO_TEXTURE, Ray, Scene, Wrap};
+
+// ---------------------------------------------------------------- glTF generation
+
+fn base64(bytes: &[u8]) -> String {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for c in bytes.chunks(3) {
+        let n = (u32::from(c[0]) << 16)
+            | (u32::from(*c.get(1).unwrap_or(&0)) << 8)
+            | u32::from(*c.get(2).unwrap_or(&0));
+        for i in 0..4 {
+            if i <= c.len() {
+                out.push(A[(n >> (18 - 6 * i) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+fn png(w: u32, h: u32, px: &[[u8; 4]]) -> Vec<u8> {
+    let img = image::RgbaImage::from_raw(w, h, px.concat()).unwrap();
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+    out.into_inner()
+}
+
+/// How an image is stored.
+#[derive(Clone, Copy, PartialEq)]
+enum Embed {
+    DataUri,
+    File,
+    View,
+}
+
+struct Img {
+    w: u32,
+    h: u32,
+    px: Vec<[u8; 4]>,
+    embed: Embed,
+    /// glTF wrap codes (S, T) and whether magFilter is NEAREST.
+    wrap: (u32, u32),
+    nearest: bool,
+}
+
+impl Img {
+    fn new(w: u32, h: u32, px: Vec<[u8; 4]>) -> Self {
+        Self {
+            w,
+            h,
+            px,
+            embed: Embed::DataUri,
+            wrap: (10497, 10497),
+            nearest: false,
+        }
+    }
+
+    fn constant(c: [u8; 4]) -> Self {
+        Self::new(2, 2, vec![c; 4])
+    }
+}
+
+/// A unit quad in the z = 0 plane with its lower-left corner at `origin`, facing +z; U grows
+/// along +x from `uv0.x` to `uv1.x`, V grows along −y (image rows go down) from `uv0.y` at
+/// the top edge to `uv1.y` at the bottom.
+#[derive(Clone, Copy)]
+struct Quad {
+    origin: Vec2,
+    z: f32,
+    size: f32,
+    uv0: Vec2,
+    uv1: Vec2,
+    material: usize,
+    tangent: Option<Vec4>,
+}
+
+impl Quad {
+    fn at(x: f32, y: f32, material: usize) -> Self {
+        Self {
+            origin: Vec2::new(x, y),
+            z: 0.0,
+            size: 1.0,
+            uv0: Vec2::ZERO,
+            uv1: Vec2::ONE,
+            material,
+            tangent: None,
+        }
+    }
+}
+
+#[derive(Default)]
+struct Gltf {
+    images: Vec<Img>,
+    /// Material JSON objects; texture `i` is image `i` with its own sampler.
+    materials: Vec<String>,
+    quads: Vec<Quad>,
+}
+
+impl Gltf {
+    /// Writes `name.gltf` (and its external files) into `dir`.
+    fn write(&self, dir: &Path, name: &str) -> PathBuf {
+        let mut bin: Vec<u8> = Vec::new();
+        let mut views = Vec::new();
+        let mut accessors = Vec::new();
+        let mut push_view = |bin: &mut Vec<u8>, data: &[u8]| {
+            while !bin.len().is_multiple_of(4) {
+                bin.push(0);
+            }
+            views.push(format!(
+                r#"{{"buffer":0,"byteOffset":{},"byteLength":{}}}"#,
+                bin.len(),
+                data.len()
+            ));
+            bin.extend_from_slice(data);
+            views.len() - 1
+        };
+        let f32s = |v: &[f32]| -> Vec<u8> { v.iter().flat_map(|x| x.to_le_bytes()).collect() };
+        let mut meshes = Vec::new();
+        for q in &self.quads {
+            let (o, s, z) = (q.origin, q.size, q.z);
+            let pos = [
+                [o.x, o.y + s, z],
+                [o.x + s, o.y + s, z],
+                [o.x + s, o.y, z],
+                [o.x, o.y, z],
+            ];
+            let uv = [
+                [q.uv0.x, q.uv0.y],
+                [q.uv1.x, q.uv0.y],
+                [q.uv1.x, q.uv1.y],
+                [q.uv0.x, q.uv1.y],
+            ];
+            let normals = [[0.0, 0.0, 1.0_f32]; 4];
+            let mut attrs = Vec::new();
+            let mut acc = |view: usize, count: usize, ty: &str, comp: u32, extra: &str| {
+                accessors.push(format!(
+                    r#"{{"bufferView":{view},"componentType":{comp},"count":{count},"type":"{ty}"{extra}}}"#
+                ));
+                accessors.len() - 1
+            };
+            let v = push_view(&mut bin, &f32s(&pos.concat()));
+            let extra = format!(
+                r#","min":[{},{},{z}],"max":[{},{},{z}]"#,
+                o.x,
+                o.y,
+                o.x + s,
+                o.y + s
+            );
+            attrs.push(format!(r#""POSITION":{}"#, acc(v, 4, "VEC3", 5126, &extra)));
+            let v = push_view(&mut bin, &f32s(&normals.concat()));
+            attrs.push(format!(r#""NORMAL":{}"#, acc(v, 4, "VEC3", 5126, "")));
+            let v = push_view(&mut bin, &f32s(&uv.concat()));
+            attrs.push(format!(r#""TEXCOORD_0":{}"#, acc(v, 4, "VEC2", 5126, "")));
+            if let Some(t) = q.tangent {
+                let v = push_view(&mut bin, &f32s(&[t.to_array(); 4].concat()));
+                attrs.push(format!(r#""TANGENT":{}"#, acc(v, 4, "VEC4", 5126, "")));
+            }
+            // Counter-clockwise seen from +z.
+            let idx: Vec<u8> = [3u16, 2, 1, 3, 1, 0]
+                .iter()
+                .flat_map(|i| i.to_le_bytes())
+                .collect();
+            let v = push_view(&mut bin, &idx);
+            let indices = acc(v, 6, "SCALAR", 5123, "");
+            meshes.push(format!(
+                r#"{{"primitives":[{{"attributes":{{{}}},"indices":{indices},"material":{}}}]}}"#,
+                attrs.join(","),
+                q.material
+            ));
+        }
+        let mut images = Vec::new();
+        let mut samplers = Vec::new();
+        let mut textures = Vec::new();
+        for (i, img) in self.images.iter().enumerate() {
+            let data = png(img.w, img.h, &img.px);
+            images.push(match img.embed {
+                Embed::DataUri => format!(r#"{{"uri":"data:image/png;base64,{}"}}"#, base64(&data)),
+                Embed::File => {
+                    let file = format!("{name}_image{i}.png");
+                    std::fs::write(dir.join(&file), &data).unwrap();
+                    format!(r#"{{"uri":"{file}"}}"#)
+                }
+                Embed::View => {
+                    let v = push_view(&mut bin, &data);
+                    format!(r#"{{"bufferView":{v},"mimeType":"image/png"}}"#)
+                }
+            });
+            let mag = if img.nearest { 9728 } else { 9729 };
+            samplers.push(format!(
+                r#"{{"magFilter":{mag},"wrapS":{},"wrapT":{}}}"#,
+                img.wrap.0, img.wrap.1
+            ));
+            textures.push(format!(r#"{{"sampler":{i},"source":{i}}}"#));
+        }
+        let nodes: Vec<String> = (0..self.quads.len())
+            .map(|i| format!(r#"{{"mesh":{i}}}"#))
+            .collect();
+        let list = |v: &[String]| v.join(",");
+        let json = format!(
+            r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["KHR_materials_transmission","KHR_materials_ior","KHR_materials_specular","KHR_materials_emissive_strength"],
+"scene":0,"scenes":[{{"nodes":[{}]}}],"nodes":[{}],"meshes":[{}],"materials":[{}],
+"textures":[{}],"images":[{}],"samplers":[{}],"accessors":[{}],"bufferViews":[{}],
+"buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{}"}}]}}"#,
+            (0..self.quads.len())
+                .map(|i| i.to_string())
+                .collect::<Vec<_>>()
+                .join(","),
+            list(&nodes),
+            list(&meshes),
+            list(&self.materials),
+            list(&textures),
+            list(&images),
+            list(&samplers),
+            list(&accessors),
+            list(&views),
+            bin.len(),
+            base64(&bin)
+        );
+        let path = dir.join(format!("{name}.gltf"));
+        std::fs::write(&path, json).unwrap();
+        path
+    }
+}
+
+/// A scene file around `gltf`: camera at `eye` looking at `target`, black environment
+/// unless `env` is given.
+fn scene_file(
+    dir: &Path,
+    gltf: &Path,
+    eye: Vec3,
+    target: Vec3,
+    size: (u32, u32),
+    extra: &str,
+) -> PathBuf {
+    let text = format!(
+        "(version: 1,
+  camera: Perspective(position: ({:?}, {:?}, {:?}), target: ({:?}, {:?}, {:?}), up: (0.0, 1.0, 0.0), fov_y: 40.0),
+  shapes: [Mesh(name: \"m\", path: \"{}\"){extra}],
+  render: (width: {}, height: {}, max_bounces: 2, spp: 1, seed: 7),
+)",
+        eye.x,
+        eye.y,
+        eye.z,
+        target.x,
+        target.y,
+        target.z,
+        gltf.file_name().unwrap().to_string_lossy(),
+        size.0,
+        size.1
+    );
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+// ---------------------------------------------------------------- GPU helpers
+
+/// `PathTrace` (color, albedo, normal) and `GBuffer` (albedo, normal) of `scene`.
+fn render(scene: &Arc<GpuScene>, spp: i64) -> Option<[Image; 5]> {
+    let ctx = common::gpu()?;
+    let graph = Graph {
+        nodes: vec![
+            Node::new("gb", "GBuffer"),
+            Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(spp)),
+        ],
+        edges: Vec::new(),
+        origin: None,
+    };
+    let ports = [
+        "pt.color",
+        "pt.albedo",
+        "pt.normal",
+        "gb.albedo",
+        "gb.normal",
+    ];
+    let keep: Vec<String> = ports.iter().map(|p| (*p).to_owned()).collect();
+    let plan = compile(&graph, &keep, Some(scene)).unwrap();
+    let resources = Resources {
+        scene: Some(Arc::clone(scene)),
+        ..Resources::default()
+    };
+    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    exec.run_frame().unwrap();
+    Some(ports.map(|p| exec.read_port(p).unwrap()))
+}
+
+/// The pinhole ray through the center of pixel `(x, y)`, as the shader makes it.
+fn pixel_ray(g: &GpuScene, x: u32, y: u32) -> Ray {
+    let c = &g.camera;
+    let (w, h) = (g.settings.width as f32, g.settings.height as f32);
+    let u = (x as f32 + 0.5) / w;
+    let v = (y as f32 + 0.5) / h;
+    let dir = Vec3::from(c.forward)
+        + (2.0 * u - 1.0) * c.tan_half_fov * c.aspect * Vec3::from(c.right)
+        - (2.0 * v - 1.0) * c.tan_half_fov * Vec3::from(c.up);
+    Ray {
+        origin: Vec3::from(c.position),
+        dir: dir.normalize(),
+    }
+}
+
+/// Per pixel: the material and UV the CPU ray cast finds through its center.
+fn hits(g: &GpuScene) -> Vec<Option<(u32, Vec2)>> {
+    let (w, h) = (g.settings.width, g.settings.height);
+    (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let hit = lumagraph::scene::intersect(g, &pixel_ray(g, x, y))?;
+            let tc = g.tri_texcoords[hit.prim as usize];
+            let (a, b) = (hit.u, hit.v);
+            let uv = (1.0 - a - b) * Vec2::new(tc.uv01[0], tc.uv01[1])
+                + a * Vec2::new(tc.uv01[2], tc.uv01[3])
+                + b * Vec2::from(tc.uv2);
+            Some((g.tri_shading[hit.prim as usize].material, uv))
+        })
+        .collect()
+}
+
+fn temp() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+// ---------------------------------------------------------------- CPU tests
+
+#[test]
+fn wrap_modes_index_as_gltf_defines_them() {
+    let n = 4;
+    let idx = |w: Wrap| (-5..9).map(|i| w.index(i, n)).collect::<Vec<_>>();
+    assert_eq!(
+        idx(Wrap::Repeat),
+        [3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0]
+    );
+    assert_eq!(
+        idx(Wrap::ClampToEdge),
+        [0, 0, 0, 0, 0, 0, 1, 2, 3, 3, 3, 3, 3, 3]
+    );
+    assert_eq!(
+        idx(Wrap::MirroredRepeat),
+        [3, 3, 2, 1, 0, 0, 1, 2, 3, 3, 2, 1, 0, 0]
+    );
+}
+
+#[test]
+fn bilinear_sampling_interpolates_decoded_texels() {
+    let t = Texture {
+        name: "t".into(),
+        width: 2,
+        height: 1,
+        texels: vec![[0, 0, 0, 255], [255, 128, 64, 0]],
+        wrap: [Wrap::ClampToEdge; 2],
+        nearest: false,
+    };
+    // At the texel centers: the texels themselves; half-way: the mean of the decoded values.
+    let a = t.sample(Vec2::new(0.25, 0.5), true);
+    let b = t.sample(Vec2::new(0.75, 0.5), true);
+    assert_eq!(a, Vec4::new(0.0, 0.0, 0.0, 1.0));
+    assert!(
+        (b - Vec4::new(
+            1.0,
+            srgb_decode(128.0 / 255.0),
+            srgb_decode(64.0 / 255.0),
+            0.0
+        ))
+        .abs()
+        .max_element()
+            < 1e-7
+    );
+    let m = t.sample(Vec2::new(0.5, 0.5), true);
+    assert!((m - 0.5 * (a + b)).abs().max_element() < 1e-6, "{m}");
+    // Linear (not sRGB): the raw unorm values.
+    let l = t.sample(Vec2::new(0.75, 0.5), false);
+    assert!((l.y - 128.0 / 255.0).abs() < 1e-7);
+}
+
+#[test]
+fn generated_tangents_are_orthonormal_and_follow_u() {
+    // Pseudo-random triangles, UVs and vertex normals tilted up to ~35° off the face normal.
+    let mut seed = 12345_u32;
+    let mut rnd = || {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (seed >> 8) as f32 / (1u32 << 24) as f32 * 2.0 - 1.0
+    };
+    let mut worst = (0.0_f32, 0.0_f32);
+    for _ in 0..1000 {
+        let p = [0; 3].map(|_| Vec3::new(rnd(), rnd(), rnd()) * 3.0);
+        let uv = [0; 3].map(|_| Vec2::new(rnd(), rnd()) * 2.0);
+        let face = (p[1] - p[0]).cross(p[2] - p[0]);
+        let uv_area = (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]);
+        if face.length() < 1e-2 || uv_area.abs() < 1e-2 {
+            continue;
+        }
+        let n =
+            [0; 3].map(|_| (face.normalize() + 0.5 * Vec3::new(rnd(), rnd(), rnd())).normalize());
+        let t = triangle_tangents(p, n, uv);
+        // dP/du and dP/dv of the triangle, solved independently.
+        let m = glam::Mat2::from_cols(uv[1] - uv[0], uv[2] - uv[0]).inverse();
+        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+        let dpdu = e1 * m.col(0).x + e2 * m.col(0).y;
+        let dpdv = e1 * m.col(1).x + e2 * m.col(1).y;
+        for k in 0..3 {
+            let tk = t[k].truncate();
+            worst.0 = worst
+                .0
+                .max(tk.dot(n[k]).abs())
+                .max((tk.length() - 1.0).abs());
+            // Along +U: the tangent is dP/du's part orthogonal to the normal.
+            let want = (dpdu - n[k] * n[k].dot(dpdu)).normalize();
+            worst.1 = worst.1.max((tk - want).length());
+            assert!(t[k].w == 1.0 || t[k].w == -1.0);
+            assert!(t[k].w * n[k].cross(tk).dot(dpdv) > 0.0, "handedness");
+        }
+    }
+    println!(
+        "orthonormality error {:.2e}, distance to +U {:.2e}",
+        worst.0, worst.1
+    );
+    assert!(worst.0 < 1e-5 && worst.1 < 1e-3, "{worst:?}");
+}
+
+#[test]
+fn khr_transmission_ior_specular_and_emissive_strength_are_read() {
+    let dir = temp();
+    let gltf = Gltf {
+        images: vec![
+            Img::constant([255, 255, 255, 255]),
+            Img::constant([200, 100, 50, 255]),
+        ],
+        materials: vec![
+            r#"{"name":"glassy","emissiveFactor":[1,0.5,0.25],
+            "extensions":{"KHR_materials_transmission":{"transmissionFactor":0.7,"transmissionTexture":{"index":0}},
+            "KHR_materials_ior":{"ior":1.33},
+            "KHR_materials_specular":{"specularFactor":0.5,"specularColorFactor":[0.2,0.4,0.8],
+              "specularTexture":{"index":0},"specularColorTexture":{"index":1}},
+            "KHR_materials_emissive_strength":{"emissiveStrength":3}}}"#
+                .into(),
+        ],
+        quads: vec![Quad::at(0.0, 0.0, 0)],
+    }
+    .write(dir.path(), "khr");
+    let scene = Scene::load(&scene_file(
+        dir.path(),
+        &gltf,
+        Vec3::Z * 3.0,
+        Vec3::ZERO,
+        (8, 8),
+        "",
+    ))
+    .unwrap();
+    let m = &scene.materials[0];
+    assert_eq!(m.transmission, 0.7);
+    assert_eq!(m.ior, 1.33);
+    let f0 = ((1.33_f32 - 1.0) / (1.33 + 1.0)).powi(2);
+    let want = 12.5 * f0 * 0.5 * 0.8;
+    assert!((m.specular - want).abs() < 1e-6, "{} vs {want}", m.specular);
+    assert_eq!(m.emission, Vec3::new(3.0, 1.5, 0.75));
+    let t = m.textures;
+    assert_eq!((t.transmission, t.specular, t.specular_color), (0, 0, 1));
+    assert_eq!((t.base_color, t.normal), (NO_TEXTURE, NO_TEXTURE));
+    // Two textures decoded, each once.
+    assert_eq!(scene.textures.len(), 2);
+    assert_eq!(scene.textures[1].texels[0], [200, 100, 50, 255]);
+}
+
+#[test]
+fn missing_or_broken_images_name_the_material_and_image() {
+    let dir = temp();
+    let mut g = Gltf {
+        images: vec![Img {
+            embed: Embed::File,
+            ..Img::constant([1, 2, 3, 255])
+        }],
+        materials: vec![
+            r#"{"name":"painted","pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}"#.into(),
+        ],
+        quads: vec![Quad::at(0.0, 0.0, 0)],
+    };
+    let path = g.write(dir.path(), "broken");
+    std::fs::remove_file(dir.path().join("broken_image0.png")).unwrap();
+    let scene = scene_file(dir.path(), &path, Vec3::Z * 3.0, Vec3::ZERO, (8, 8), "");
+    let e = Scene::load(&scene).unwrap_err().to_string();
+    println!("{e}");
+    for want in [
+        "broken.gltf",
+        "material \"painted\"",
+        "broken_image0.png",
+        "cannot read",
+    ] {
+        assert!(e.contains(want), "{want:?} not in: {e}");
+    }
+    // Not a PNG at all.
+    std::fs::write(dir.path().join("broken_image0.png"), b"not an image").unwrap();
+    let e = Scene::load(&scene).unwrap_err().to_string();
+    println!("{e}");
+    assert!(
+        e.contains("material \"painted\"") && e.contains("broken_image0.png"),
+        "{e}"
+    );
+    // A data URI that does not decode.
+    g.images[0].embed = Embed::DataUri;
+    let path = g.write(dir.path(), "broken");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let i = text.find("data:image/png;base64,").unwrap() + 22;
+    std::fs::write(&path, format!("{}AAAA{}", &text[..i], &text[i + 8..])).unwrap();
+    let e = Scene::load(&scene).unwrap_err().to_string();
+    println!("{e}");
+    assert!(
+        e.contains("material \"painted\"") && e.contains("data URI"),
+        "{e}"
+    );
+}
+
+#[test]
+fn plan_lists_textures_for_textured_scenes_only() {
+    use lumagraph::render::specialize::{PathTraceOptions, features};
+    let opts = PathTraceOptions {
+        specialize: true,
+        aovs: false,
+    };
+    let on = |path: &Path| {
+        let scene = GpuScene::build(&Scene::load(path).unwrap()).unwrap();
+        let f = features(&scene, opts);
+        let t = f.iter().find(|f| f.name == "material textures").unwrap();
+        println!("{}: {} ({})", path.display(), t.included, t.reason);
+        (t.included, scene.tri_texcoords.len(), scene.textures.len())
+    };
+    let (inc, tc, words) = on(&common::repo("assets/boxtextured.ron"));
+    assert!(inc && tc == 12 && words > 4, "{inc} {tc} {words}");
+    // Untextured: left out, and no texcoords or texels uploaded.
+    assert_eq!(on(&common::repo("assets/cornell.ron")), (false, 0, 0));
+}
+
+// ---------------------------------------------------------------- GPU tests
+
+/// Albedo AOVs of 24 quads, each with its own texture (sizes 1×1 to 7×5; data URIs, buffer
+/// views and files; all three wrap modes with UVs outside [0, 1]; one NEAREST), against the
+/// CPU sampler at the CPU ray cast's UV.
+///
+/// Tolerance: `PathTrace`'s AOV and the CPU agree but for the f32 rounding of the two
+/// intersection routines' barycentrics; 2e-3 per channel holds that with room (measured max
+/// 6.0e-6 over 5 100 pixels). The G-buffer interpolates UVs in the rasterizer: against the
+/// path tracer, ≥ 99 % of pixels within 1/255 (measured 100 %).
+#[test]
+fn albedo_of_many_textures_matches_cpu_sampling() {
+    let dir = temp();
+    let mut g = Gltf::default();
+    let wraps = [
+        (10497, 10497),
+        (33071, 33071),
+        (33648, 33648),
+        (10497, 33648),
+    ];
+    for i in 0..24_usize {
+        let (w, h) = (1 + (i as u32 * 3) % 7, 1 + (i as u32 * 2) % 5);
+        let px = (0..w * h)
+            .map(|k| {
+                let k = k as usize + 7 * i;
+                [
+                    (k * 37 % 256) as u8,
+                    (k * 91 % 256) as u8,
+                    (k * 53 % 256) as u8,
+                    255,
+                ]
+            })
+            .collect();
+        g.images.push(Img {
+            embed: [Embed::DataUri, Embed::View, Embed::File][i % 3],
+            wrap: wraps[i % 4],
+            nearest: i == 5,
+            ..Img::new(w, h, px)
+        });
+        g.materials.push(format!(
+            r#"{{"pbrMetallicRoughness":{{"baseColorFactor":[0.9,0.8,1.0,1.0],"baseColorTexture":{{"index":{i}}}}}}}"#
+        ));
+        let mut q = Quad::at((i % 6) as f32 * 1.1 - 3.3, (i / 6) as f32 * 1.1 - 2.2, i);
+        if i % 2 == 1 {
+            q.uv0 = Vec2::new(-0.7, -0.4);
+            q.uv1 = Vec2::new(1.8, 1.3);
+        }
+        g.quads.push(q);
+    }
+    let path = g.write(dir.path(), "many");
+    let scene = Scene::load(&scene_file(
+        dir.path(),
+        &path,
+        Vec3::new(-0.05, -0.05, 9.0),
+        Vec3::new(-0.05, -0.05, 0.0),
+        (144, 96),
+        "",
+    ))
+    .unwrap();
+    assert_eq!(scene.textures.len(), 24);
+    let gpu = Arc::new(GpuScene::build(&scene).unwrap());
+    let Some([_, pt_albedo, _, gb_albedo, _]) = render(&gpu, 1) else {
+        return;
+    };
+    let mut per_material = [0_usize; 24];
+    let mut worst = 0.0_f32;
+    let mut gb_ok = 0_u32;
+    let mut covered = 0_u32;
+    for (i, hit) in hits(&gpu).iter().enumerate() {
+        let pt = Vec4::from(pt_albedo.pixels[i]).truncate();
+        let gb = Vec4::from(gb_albedo.pixels[i]).truncate();
+        let Some((m, uv)) = *hit else {
+            assert_eq!(pt, Vec3::ZERO, "pixel {i}: no hit on the CPU");
+            continue;
+        };
+        let tex = &scene.textures[m as usize];
+        if tex.nearest {
+            // Skip pixels within 1e-3 texel of a texel edge, where rounding picks either side.
+            let p = uv * Vec2::new(tex.width as f32, tex.height as f32);
+            let edge = (p - p.round()).abs().min_element();
+            if edge < 1e-3 {
+                continue;
+            }
+        }
+        let want = Vec3::new(0.9, 0.8, 1.0) * tex.sample(uv, true).truncate();
+        worst = worst.max((pt - want).abs().max_element());
+        per_material[m as usize] += 1;
+        covered += 1;
+        if (gb - pt).abs().max_element() <= 1.0 / 255.0 {
+            gb_ok += 1;
+        }
+    }
+    let gb_frac = f64::from(gb_ok) / f64::from(covered);
+    println!(
+        "PathTrace albedo vs CPU: max error {worst:.2e} over {covered} pixels; GBuffer within 1/255 of PathTrace: {:.2} %",
+        100.0 * gb_frac
+    );
+    assert!(per_material.iter().all(|&n| n >= 50), "{per_material:?}");
+    assert!(worst < 2e-3, "max albedo error {worst}");
+    assert!(gb_frac >= 0.99, "GBuffer albedo agrees on {gb_frac}");
+}
+
+/// A constant normal map tilting the normal 30° towards +U (and 30° towards −V with the
+/// file's own TANGENT rotated by 90°) gives that normal in both AOVs. Expected: the decoded
+/// texel, `normal_scale` applied, in the frame (T, w·N×T, N). Tolerance 0.05° for f32
+/// rounding (measured: 0.0000° in both AOVs).
+#[test]
+fn normal_map_tilts_the_aov_normal() {
+    let dir = temp();
+    let s = 30_f32.to_radians().sin();
+    let c = 30_f32.to_radians().cos();
+    let enc = |x: f32| ((x + 1.0) * 0.5 * 255.0).round() as u8;
+    let texel = [enc(s), enc(0.0), enc(c), 255];
+    let mut g = Gltf {
+        images: vec![Img::constant(texel)],
+        materials: vec![
+            r#"{"normalTexture":{"index":0}}"#.into(),
+            r#"{"normalTexture":{"index":0,"scale":0.5}}"#.into(),
+        ],
+        quads: vec![Quad::at(-1.05, -0.5, 0), Quad::at(0.05, -0.5, 1)],
+    };
+    let dec = |b: u8| f32::from(b) / 255.0 * 2.0 - 1.0;
+    let t = Vec3::new(dec(texel[0]), dec(texel[1]), dec(texel[2]));
+    // Generated tangents: T = +x (U grows along +x), B = dP/dv = −y, w = −1.
+    let want = [
+        (t.x * Vec3::X + t.y * Vec3::NEG_Y + t.z * Vec3::Z).normalize(),
+        (0.5 * t.x * Vec3::X + 0.5 * t.y * Vec3::NEG_Y + t.z * Vec3::Z).normalize(),
+    ];
+    let check = |g: &Gltf, want: [Vec3; 2], name: &str| {
+        let path = g.write(dir.path(), name);
+        let scene = Scene::load(&scene_file(
+            dir.path(),
+            &path,
+            Vec3::new(0.0, 0.0, 2.5),
+            Vec3::ZERO,
+            (48, 24),
+            "",
+        ))
+        .unwrap();
+        let gpu = Arc::new(GpuScene::build(&scene).unwrap());
+        let Some([_, _, pt_normal, _, gb_normal]) = render(&gpu, 1) else {
+            return;
+        };
+        let mut worst = [0.0_f32; 2];
+        let mut n = 0;
+        for (i, hit) in hits(&gpu).iter().enumerate() {
+            let Some((m, _)) = *hit else { continue };
+            for (k, img) in [&pt_normal, &gb_normal].iter().enumerate() {
+                let got = Vec4::from(img.pixels[i]).truncate();
+                let angle = got.angle_between(want[m as usize]).to_degrees();
+                worst[k] = worst[k].max(angle);
+            }
+            n += 1;
+        }
+        println!(
+            "{name}: worst angle PathTrace {:.4}°, GBuffer {:.4}° over {n} pixels",
+            worst[0], worst[1]
+        );
+        assert!(n > 300, "{n}");
+        assert!(worst[0] < 0.05 && worst[1] < 0.05, "{worst:?}");
+    };
+    check(&g, want, "generated");
+    // The file's tangent along +y with w = 1: B = N × T = −x.
+    for q in &mut g.quads {
+        q.tangent = Some(Vec4::new(0.0, 1.0, 0.0, 1.0));
+    }
+    let want_file = [
+        (t.x * Vec3::Y + t.y * Vec3::NEG_X + t.z * Vec3::Z).normalize(),
+        (0.5 * t.x * Vec3::Y + 0.5 * t.y * Vec3::NEG_X + t.z * Vec3::Z).normalize(),
+    ];
+    check(&g, want_file, "file_tangents");
+}
+
+/// Constant metallic-roughness and emissive textures render the image of the equivalent
+/// factors (same seed, 4 spp, max 2 bounces so Russian roulette never runs): the factor
+/// scene's values are the CPU decode of the same texels. Difference allowed: 1e-4 relative
+/// per channel (f32 `pow` and unorm rounding of the GPU against the CPU; measured 3.4e-7).
+#[test]
+fn constant_textures_render_like_factors() {
+    let dir = temp();
+    // Floor with metallic-roughness (G = roughness 0.6, B = metallic 0.4) and an emitter
+    // above it with an emissive texture (sRGB 200, 150, 90).
+    let mr = [0, 153, 102, 255];
+    let em = [200, 150, 90, 255];
+    let mut floor = Quad::at(-1.0, -1.0, 0);
+    floor.size = 2.0;
+    let mut light = Quad::at(-0.4, -0.4, 1);
+    light.size = 0.8;
+    light.z = 0.6;
+    let textured = Gltf {
+        images: vec![Img::constant(mr), Img::constant(em)],
+        materials: vec![
+            r#"{"pbrMetallicRoughness":{"baseColorFactor":[0.8,0.6,0.5,1],"metallicRoughnessTexture":{"index":0}}}"#.into(),
+            r#"{"emissiveFactor":[1,1,1],"emissiveTexture":{"index":1},"extensions":{"KHR_materials_emissive_strength":{"emissiveStrength":4}},"doubleSided":true}"#.into(),
+        ],
+        quads: vec![floor, light],
+    };
+    let u = |b: u8| f32::from(b) / 255.0;
+    let e = [em[0], em[1], em[2]].map(|b| 4.0 * srgb_decode(u(b)));
+    let factors = Gltf {
+        images: Vec::new(),
+        materials: vec![
+            format!(
+                r#"{{"pbrMetallicRoughness":{{"baseColorFactor":[0.8,0.6,0.5,1],"roughnessFactor":{:?},"metallicFactor":{:?}}}}}"#,
+                u(mr[1]),
+                u(mr[2])
+            ),
+            format!(
+                r#"{{"emissiveFactor":[{:?},{:?},{:?}],"doubleSided":true}}"#,
+                e[0], e[1], e[2]
+            ),
+        ],
+        quads: textured.quads.clone(),
+    };
+    let mut images = Vec::new();
+    for (name, g) in [("textured", &textured), ("factors", &factors)] {
+        let sub = dir.path().join(name);
+        std::fs::create_dir_all(&sub).unwrap();
+        let path = g.write(&sub, name);
+        let scene = Scene::load(&scene_file(
+            &sub,
+            &path,
+            Vec3::new(0.0, -2.5, 1.6),
+            Vec3::new(0.0, 0.0, 0.0),
+            (32, 32),
+            "",
+        ))
+        .unwrap();
+        let gpu = Arc::new(GpuScene::build(&scene).unwrap());
+        let Some([color, ..]) = render(&gpu, 4) else {
+            return;
+        };
+        images.push(color);
+    }
+    let (a, b) = (&images[0], &images[1]);
+    let mut worst = 0.0_f32;
+    let mut sum = 0.0_f64;
+    for (p, q) in a.pixels.iter().zip(&b.pixels) {
+        for ch in 0..3 {
+            let d = (p[ch] - q[ch]).abs() / q[ch].abs().max(1e-3);
+            worst = worst.max(d);
+            sum += f64::from(q[ch]);
+        }
+    }
+    println!("textured vs factors: max relative difference {worst:.2e} (image sum {sum:.1})");
+    assert!(sum > 10.0, "the image is lit");
+    assert!(worst < 1e-4, "{worst}");
+}
