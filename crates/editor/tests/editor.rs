@@ -581,3 +581,73 @@ fn a_file_picked_in_the_dialog_sets_the_path_param() {
         ParamValue::Str(first)
     );
 }
+
+/// Drags with simulated pointer events from `from` to `to`, a few frames apart, as a
+/// hand would.
+fn drag(
+    h: &mut egui_kittest::Harness<'_, lumagraph_editor::Editor>,
+    from: egui::Pos2,
+    to: egui::Pos2,
+) {
+    h.hover_at(from);
+    h.run_ok();
+    h.event(egui::Event::PointerButton {
+        pos: from,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    h.step();
+    for i in 1..=8 {
+        let t = i as f32 / 8.0;
+        h.event(egui::Event::PointerMoved(from + (to - from) * t));
+        h.step();
+    }
+    h.event(egui::Event::PointerButton {
+        pos: to,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    h.step();
+    h.run_ok();
+}
+
+/// Wires drawn on the canvas with the pointer: from an output pin to an input pin makes
+/// the edge (one undo step); between incompatible ports it is refused with the reason.
+#[test]
+fn dragging_from_an_output_pin_to_an_input_pin_connects_them() {
+    let Some(mut ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    assert!(ed.doc.disconnect("input.color", "exposure.color"));
+    ed.doc.end_gesture();
+    let mut h = harness(ed);
+    // Where the pins are drawn at the default zoom (see the snapshot): input's output
+    // pin, exposure's input pin, tonemap's output pin.
+    let input_out = egui::pos2(195.0, 339.0);
+    let exposure_in = egui::pos2(276.0, 339.0);
+    let tonemap_out = egui::pos2(552.0, 339.0);
+    drag(&mut h, input_out, exposure_in);
+    let ed = h.state_mut();
+    assert!(
+        ed.doc
+            .graph
+            .edges
+            .iter()
+            .any(|e| e.from == "input.color" && e.to == "exposure.color"),
+        "{:?}",
+        ed.doc.graph.edges
+    );
+    assert!(ed.errors.is_empty(), "{:?}", ed.errors);
+    let connected = ed.doc.graph.clone();
+    // ldr_color into an hdr_color input: refused, the graph unchanged.
+    drag(&mut h, tonemap_out, exposure_in);
+    let ed = h.state_mut();
+    assert_eq!(ed.doc.graph, connected);
+    let (msg, is_err) = ed.message.clone().expect("a refusal");
+    assert!(is_err && msg.contains("produces ldr_color"), "{msg}");
+    // The wire was one edit.
+    assert!(ed.doc.undo());
+    assert!(!ed.doc.graph.edges.iter().any(|e| e.to == "exposure.color"));
+}
