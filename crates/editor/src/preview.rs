@@ -129,24 +129,29 @@ pub fn preview_graph(graph: &Graph) -> Graph {
     g
 }
 
-/// The outputs the preview keeps alive: `port` and every output read by an edge between
-/// nodes upstream of it, so that none shares texture memory with a later one and a param
-/// edit can re-run only what is downstream of it.
+/// The outputs the preview keeps alive: `port` and every output an edge reads from a
+/// node that feeds a sink or `port` (sinks included, though the preview leaves them out).
+/// So the preview runs what `lumagraph render` runs, no two of those outputs share
+/// texture memory (a param edit can re-run only what is downstream of it), and previewing
+/// another of them is not a structural change (accumulation goes on).
 pub fn preview_keep(graph: &Graph, port: &str) -> Vec<String> {
+    let reg = Registry::builtin();
+    let node_of = |p: &str| lumagraph_graph::split_port_ref(p).map(|(n, _)| n.to_owned());
     let mut upstream = BTreeSet::new();
-    let mut stack: Vec<&str> = lumagraph_graph::split_port_ref(port)
-        .map(|(n, _)| n)
-        .into_iter()
+    let mut stack: Vec<String> = graph
+        .nodes
+        .iter()
+        .filter(|n| reg.get(&n.kind).is_some_and(|k| k.sink))
+        .map(|n| n.id.clone())
+        .chain(node_of(port))
         .collect();
     while let Some(n) = stack.pop() {
-        if !upstream.insert(n.to_owned()) {
+        if !upstream.insert(n.clone()) {
             continue;
         }
         for e in &graph.edges {
-            if let (Some((from, _)), Some((to, _))) = (
-                lumagraph_graph::split_port_ref(&e.from),
-                lumagraph_graph::split_port_ref(&e.to),
-            ) && to == n
+            if node_of(&e.to).as_deref() == Some(n.as_str())
+                && let Some(from) = node_of(&e.from)
             {
                 stack.push(from);
             }
@@ -154,9 +159,7 @@ pub fn preview_keep(graph: &Graph, port: &str) -> Vec<String> {
     }
     let mut keep = vec![port.to_owned()];
     for e in &graph.edges {
-        if lumagraph_graph::split_port_ref(&e.from).is_some_and(|(n, _)| upstream.contains(n))
-            && !keep.contains(&e.from)
-        {
+        if node_of(&e.from).is_some_and(|n| upstream.contains(&n)) && !keep.contains(&e.from) {
             keep.push(e.from.clone());
         }
     }
@@ -176,7 +179,7 @@ pub fn compile_preview(
 ) -> Result<Plan, String> {
     let g = preview_graph(graph);
     let extent = |node: &Node, params: &Params| source_extent(base, scene, node, params);
-    let keep = preview_keep(&g, port);
+    let keep = preview_keep(graph, port);
     lumagraph_graph::compile(
         &g,
         Registry::builtin(),
@@ -310,7 +313,7 @@ impl Preview {
             None => false,
         };
         let report = if updated {
-            self.stats.param_updates += 1;
+            self.stats.param_updates += u64::from(!changed.is_empty());
             let before = self.samples;
             let exec = self.exec.as_mut().ok_or("no executor")?;
             let report = exec.rerun(&changed).map_err(|e| e.to_string());

@@ -487,6 +487,20 @@ fn accumulation_continues_through_a_post_edit() {
     assert!(later > after, "samples stuck at {after}");
     eprintln!("spp: {before} before the edit, {after} after it, {later} two frames later");
 
+    // Selecting another node previews its output without restarting either.
+    h.state_mut().select(vec!["denoise".into()]);
+    h.step();
+    assert_eq!(h.state().preview.stats.last_update, Vec::<String>::new());
+    h.step();
+    let ed = h.state();
+    assert_eq!(ed.preview.image.as_ref().unwrap().port, "denoise.color");
+    assert_eq!(
+        ed.preview.stats.restarts, restarts,
+        "accumulation restarted"
+    );
+    assert_eq!(ed.preview.stats.rebuilds, 1);
+    assert!(ed.preview.samples.unwrap() > later);
+
     // A path tracer param feeds the accumulation: it restarts.
     h.state_mut()
         .doc
