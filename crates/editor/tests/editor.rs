@@ -577,7 +577,17 @@ fn a_file_picked_in_the_dialog_sets_the_path_param() {
     h.run_ok();
     let pick = h.state().file_dialog.as_ref().map(|(p, _)| p.clone());
     assert_eq!(pick, Some(Pick::Param("input".into(), "path".into())));
-    // The dialog opens in the folder of the current file: pick the other one.
+    // The dialog opens in the folder of the current file and lists it on a thread of its
+    // own: wait for the listing (at most 10 s), then pick the other file.
+    let start = std::time::Instant::now();
+    while h.query_by_label_contains("second.exr").is_none() {
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(10),
+            "the dialog never listed the folder"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        h.step();
+    }
     h.get_by_label_contains("second.exr").click();
     h.run_ok();
     h.get_by_role_and_label(Role::Button, "🗀  Open").click();
