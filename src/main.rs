@@ -96,11 +96,20 @@ enum Command {
         #[arg(long, default_value_t = 3)]
         runs: u32,
     },
-    /// Open the node editor, optionally on a graph file.
-    #[command(after_help = "Example:\n  lumagraph edit graphs/post_tonemap.ron")]
+    /// Open the node editor, optionally on a graph file and a scene.
+    #[command(
+        after_help = "Examples:\n  lumagraph edit graphs/post_tonemap.ron\n  lumagraph edit graphs/pathtrace_denoise.ron --scene assets/cornell.ron"
+    )]
     Edit {
         /// The graph file (RON) to open.
         graph: Option<PathBuf>,
+        /// Scene file for nodes that render a scene (also: Scene → Open scene… in the
+        /// editor).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// The preview renders scenes with their longer side at most this many pixels.
+        #[arg(long, default_value_t = lumagraph_editor::DEFAULT_PREVIEW_MAX)]
+        preview_size: u32,
     },
     /// Error against run time: render progressively at 1, 2, 4… spp and score the raw
     /// accumulation and every Denoise output against a reference (RMSE, relMSE, SSIM);
@@ -424,7 +433,18 @@ fn run(cli: Cli) -> Result<()> {
             let loaded = load_scene(Some(&scene))?.context("no scene")?;
             bench::run(&loaded.gpu, spp, runs)
         }
-        Command::Edit { graph } => Ok(lumagraph_editor::run(graph)?),
+        Command::Edit {
+            graph,
+            scene,
+            preview_size,
+        } => Ok(lumagraph_editor::run(
+            graph,
+            lumagraph_editor::EditorConfig {
+                scene,
+                preview_max: preview_size,
+                ..Default::default()
+            },
+        )?),
         Command::Converge {
             graph,
             scene,

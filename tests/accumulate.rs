@@ -162,3 +162,69 @@ fn variance_of_the_mean_matches_cpu_and_keeps_the_mean_exact() {
     }
     assert!(worst < 1e-3, "variance off by {worst} (relative)");
 }
+
+/// A param edit downstream of the accumulation re-runs only the passes downstream of the
+/// edited node, over the accumulation as it is (no frame added, no restart), and gives
+/// the same pixels as a fresh executor run with the new params; an edit upstream of it
+/// restarts accumulation and runs the whole frame.
+#[test]
+fn rerun_after_a_post_edit_runs_only_downstream_passes() {
+    let Some(ctx) = common::gpu() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("ramp.exr");
+    let mut image = Image::filled(8, 4, [0.0, 0.0, 0.0, 1.0]);
+    for (i, p) in image.pixels.iter_mut().enumerate() {
+        let x = i as f32 * 0.11 + 0.02;
+        *p = [x, 0.5 * x, 0.25, 1.0];
+    }
+    std::fs::write(&input, image_io::encode_exr(&image, false).unwrap()).unwrap();
+    let graph = |ev: f64| {
+        let mut g = acc_graph(&input);
+        g.nodes
+            .push(Node::new("exposure", "Exposure").with("ev", ParamValue::Float(ev)));
+        g.nodes.push(Node::new("tonemap", "Tonemap"));
+        g.edges.push(Edge::new("acc.color", "exposure.color"));
+        g.edges.push(Edge::new("exposure.color", "tonemap.color"));
+        g
+    };
+    // Every upstream output kept alive, as the editor's preview compiles.
+    let keep: Vec<String> = [
+        "input.color",
+        "acc.color",
+        "exposure.color",
+        "tonemap.color",
+    ]
+    .map(str::to_owned)
+    .into();
+    let mut exec = Executor::new(
+        ctx,
+        compile(&graph(0.0), &keep, None).unwrap(),
+        &Resources::default(),
+    )
+    .unwrap();
+    exec.run_frames(3, true).unwrap();
+    assert!(
+        exec.update_params(compile(&graph(1.5), &keep, None).unwrap())
+            .unwrap()
+    );
+    let report = exec.rerun(&["exposure".to_owned()]).unwrap();
+    assert_eq!(report.executed, ["exposure", "tonemap"]);
+    assert_eq!(exec.frames(), 3, "a rerun adds no frame");
+    let edited = exec.read_port("tonemap.color").unwrap();
+    let mut fresh = Executor::new(
+        ctx,
+        compile(&graph(1.5), &keep, None).unwrap(),
+        &Resources::default(),
+    )
+    .unwrap();
+    fresh.run_frames(3, true).unwrap();
+    assert_eq!(
+        edited.pixels,
+        fresh.read_port("tonemap.color").unwrap().pixels
+    );
+
+    // The input feeds the accumulation: editing it restarts it with a whole frame.
+    let report = exec.rerun(&["input".to_owned()]).unwrap();
+    assert_eq!(report.executed, ["input", "acc", "exposure", "tonemap"]);
+    assert_eq!(exec.frames(), 4);
+}

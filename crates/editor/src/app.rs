@@ -6,6 +6,7 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use egui::{Color32, Key, Modifiers, Ui, ViewportCommand};
 use lumagraph_graph::{CompileOptions, Graph, Node, Params, Registry, split_port_ref};
@@ -14,23 +15,64 @@ use lumagraph_render::{GpuContext, source_extent};
 use crate::canvas::{Canvas, CanvasEvent, NodeInfo};
 use crate::document::Document;
 use crate::files::{self, Recent};
-use crate::preview::Preview;
+use crate::preview::{Preview, PreviewScene};
 use crate::{EditorError, inspector};
 
 mod menus;
 
+/// The largest preview side, in pixels, for nodes that render a scene, unless
+/// [`EditorConfig::preview_max`] says otherwise.
+pub const DEFAULT_PREVIEW_MAX: u32 = 256;
+
 /// Settings that differ between the real window and the tests.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct EditorConfig {
     /// Where the recent-files list lives; `None` keeps it in memory only.
     pub recent_store: Option<PathBuf>,
+    /// The scene to open with the graph, if any.
+    pub scene: Option<PathBuf>,
+    /// The preview renders scenes with their longer side at most this many pixels (the
+    /// scene's aspect kept); `lumagraph render` uses the scene's full resolution.
+    pub preview_max: u32,
+}
+
+impl Default for EditorConfig {
+    fn default() -> Self {
+        Self {
+            recent_store: None,
+            scene: None,
+            preview_max: DEFAULT_PREVIEW_MAX,
+        }
+    }
+}
+
+/// A scene loaded in the editor.
+#[derive(Clone, Debug)]
+pub struct EditorScene {
+    /// Its file.
+    pub path: PathBuf,
+    /// The resolution the scene file asks for.
+    pub full: (u32, u32),
+    /// The scene as the preview renders it (resolution capped).
+    pub preview: PreviewScene,
+}
+
+/// What a file picked in the file dialog is for.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Pick {
+    /// A graph to open.
+    OpenGraph,
+    /// Where to save the graph.
+    SaveGraph,
+    /// A scene to render.
+    Scene,
+    /// A path param: node id and param name.
+    Param(String, String),
 }
 
 /// A question waiting in a modal dialog.
 #[derive(Clone, Debug, PartialEq)]
 enum Dialog {
-    Open,
-    SaveAs,
     /// Unsaved changes: save, discard or cancel before `then`.
     Unsaved(Then),
 }
@@ -58,7 +100,7 @@ pub struct Editor {
     pub errors: BTreeMap<String, Vec<String>>,
     /// Compile errors not tied to a node.
     pub graph_errors: Vec<String>,
-    errors_for: Option<Graph>,
+    errors_for: Option<(Graph, u64)>,
     /// The last status message and whether it is an error.
     pub message: Option<(String, bool)>,
     message_time: f64,
@@ -66,11 +108,18 @@ pub struct Editor {
     pub recent: Recent,
     clipboard: Option<Graph>,
     dialog: Option<Dialog>,
-    path_input: String,
     /// Set when the window may close even with unsaved changes.
     pub quit_confirmed: bool,
     /// Set when the editor asked the window to close.
     pub wants_close: bool,
+    /// The scene nodes such as `PathTrace` render, when one is loaded.
+    pub scene: Option<EditorScene>,
+    /// Why the last scene could not be loaded.
+    pub scene_error: Option<String>,
+    scene_generation: u64,
+    preview_max: u32,
+    /// The open file dialog and what its pick is for.
+    pub file_dialog: Option<(Pick, egui_file_dialog::FileDialog)>,
 }
 
 impl std::fmt::Debug for Editor {
@@ -100,14 +149,198 @@ impl Editor {
             recent: Recent::load(config.recent_store.clone()),
             clipboard: None,
             dialog: None,
-            path_input: String::new(),
             quit_confirmed: false,
             wants_close: false,
+            scene: None,
+            scene_error: None,
+            scene_generation: 0,
+            preview_max: config.preview_max.max(1),
+            file_dialog: None,
         };
         if let Some(p) = graph {
             editor.open(p);
         }
+        if let Some(s) = &config.scene {
+            editor.load_scene(s);
+        }
         editor
+    }
+
+    /// Loads the scene that `PathTrace` and `GBuffer` nodes render, restarting the
+    /// preview. A scene that cannot be loaded leaves the current one (if any) and the
+    /// error in the status line and the side panel. Returns whether it loaded.
+    pub fn load_scene(&mut self, path: &Path) -> bool {
+        let loaded = lumagraph_scene::Scene::load(path)
+            .and_then(|scene| lumagraph_scene::GpuScene::build(&scene));
+        match loaded {
+            Ok(mut gpu) => {
+                let full = (gpu.settings.width, gpu.settings.height);
+                let longest = full.0.max(full.1).max(1);
+                if longest > self.preview_max {
+                    let scale = |x: u32| {
+                        u32::try_from(
+                            u64::from(x) * u64::from(self.preview_max) / u64::from(longest),
+                        )
+                        .unwrap_or(1)
+                        .max(1)
+                    };
+                    gpu.settings.width = scale(full.0);
+                    gpu.settings.height = scale(full.1);
+                }
+                self.scene_generation += 1;
+                self.scene = Some(EditorScene {
+                    path: path.to_owned(),
+                    full,
+                    preview: PreviewScene {
+                        gpu: Arc::new(gpu),
+                        generation: self.scene_generation,
+                    },
+                });
+                self.scene_error = None;
+                self.errors_for = None;
+                self.say(format!("scene {}", path.display()), false);
+                true
+            }
+            Err(e) => {
+                let text = format!("cannot load the scene: {e}");
+                self.scene_error = Some(text.clone());
+                self.say(text, true);
+                false
+            }
+        }
+    }
+
+    /// Removes the scene; nodes that render one then show an error.
+    pub fn close_scene(&mut self) {
+        self.scene = None;
+        self.scene_error = None;
+        self.errors_for = None;
+        self.scene_generation += 1;
+    }
+
+    /// Opens the file dialog for `pick`, starting in the folder that fits it.
+    pub fn open_file_dialog(&mut self, pick: Pick) {
+        use egui_file_dialog::FileDialog;
+        let base = self.doc.base_dir();
+        let start = |p: Option<&Path>| {
+            p.and_then(Path::parent)
+                .filter(|d| !d.as_os_str().is_empty())
+                .map_or_else(|| base.clone(), Path::to_path_buf)
+        };
+        let (title, dir, extensions): (&str, PathBuf, Vec<&'static str>) = match &pick {
+            Pick::OpenGraph => ("Open graph", start(self.doc.path.as_deref()), vec!["ron"]),
+            Pick::SaveGraph => (
+                "Save graph as",
+                start(self.doc.path.as_deref()),
+                vec!["ron"],
+            ),
+            Pick::Scene => (
+                "Open scene",
+                start(self.scene.as_ref().map(|s| s.path.as_path())),
+                vec!["ron"],
+            ),
+            Pick::Param(node, param) => {
+                let extensions = self
+                    .doc
+                    .graph
+                    .node(node)
+                    .and_then(|n| Registry::builtin().get(&n.kind))
+                    .and_then(|k| k.params.iter().find(|d| d.name == param))
+                    .and_then(|d| match &d.ty {
+                        lumagraph_graph::ParamType::Path { extensions, .. } => {
+                            Some(extensions.to_vec())
+                        }
+                        _ => None,
+                    })
+                    .unwrap_or_default();
+                let current = self
+                    .doc
+                    .graph
+                    .node(node)
+                    .and_then(|n| n.params.get(param.as_str()))
+                    .and_then(|v| match v {
+                        lumagraph_graph::ParamValue::Str(s) => Some(base.join(s)),
+                        _ => None,
+                    });
+                ("Pick a file", start(current.as_deref()), extensions)
+            }
+        };
+        let dir = std::path::absolute(&dir).unwrap_or(dir);
+        let name = extensions
+            .iter()
+            .map(|e| format!(".{e}"))
+            .collect::<Vec<_>>()
+            .join(" ");
+        let mut dialog = FileDialog::new()
+            .title(title)
+            .id(egui::Id::new("file_dialog"))
+            .initial_directory(dir);
+        if !extensions.is_empty() {
+            dialog = dialog
+                .add_file_filter_extensions(&name, extensions.clone())
+                .default_file_filter(&name);
+        }
+        if pick == Pick::SaveGraph {
+            dialog = dialog
+                .add_save_extension("graph", "ron")
+                .default_save_extension("graph")
+                .default_file_name(
+                    &self
+                        .doc
+                        .path
+                        .as_deref()
+                        .and_then(Path::file_name)
+                        .map_or_else(
+                            || "untitled.ron".to_owned(),
+                            |n| n.to_string_lossy().into_owned(),
+                        ),
+                );
+            dialog.save_file();
+        } else {
+            dialog.pick_file();
+        }
+        self.file_dialog = Some((pick, dialog));
+    }
+
+    /// Applies a path picked in the file dialog for `pick`: opens, saves, loads the scene,
+    /// or sets the param (an undoable edit, relative to the graph's folder when inside it).
+    pub fn apply_pick(&mut self, pick: &Pick, path: &Path) {
+        match pick {
+            Pick::OpenGraph => self.ask(Then::Open(path.to_owned())),
+            Pick::SaveGraph => {
+                if let Err(e) = self.save_as(path) {
+                    self.say(e.to_string(), true);
+                }
+            }
+            Pick::Scene => {
+                self.load_scene(path);
+            }
+            Pick::Param(node, param) => {
+                let base = std::path::absolute(self.doc.base_dir()).unwrap_or_default();
+                let value = path
+                    .strip_prefix(&base)
+                    .map_or_else(|_| path.display().to_string(), |p| p.display().to_string());
+                self.doc
+                    .set_param(node, param, lumagraph_graph::ParamValue::Str(value));
+                self.doc.end_gesture();
+            }
+        }
+    }
+
+    fn file_dialog_ui(&mut self, ctx: &egui::Context) {
+        let Some((pick, dialog)) = &mut self.file_dialog else {
+            return;
+        };
+        dialog.update(ctx);
+        match dialog.state() {
+            egui_file_dialog::DialogState::Picked(path) => {
+                let (pick, path) = (pick.clone(), path.clone());
+                self.file_dialog = None;
+                self.apply_pick(&pick, &path);
+            }
+            egui_file_dialog::DialogState::Open => {}
+            _ => self.file_dialog = None,
+        }
     }
 
     fn say(&mut self, text: impl Into<String>, error: bool) {
@@ -268,15 +501,18 @@ impl Editor {
         for n in &mut key.nodes {
             n.pos = None;
         }
+        // Another scene changes what nodes that render one can do.
+        let key = (key, self.scene_generation);
         if self.errors_for.as_ref() == Some(&key) {
             return;
         }
         self.errors.clear();
         self.graph_errors.clear();
         let base = self.doc.base_dir();
-        let extent = |node: &Node, params: &Params| source_extent(&base, None, node, params);
+        let scene = self.scene.as_ref().map(|s| &*s.preview.gpu);
+        let extent = |node: &Node, params: &Params| source_extent(&base, scene, node, params);
         let result = lumagraph_graph::compile(
-            &key,
+            &key.0,
             Registry::builtin(),
             &CompileOptions {
                 source_extent: &extent,
@@ -345,8 +581,7 @@ impl Editor {
                 self.say(e.to_string(), true);
             }
         } else {
-            self.path_input = "untitled.ron".into();
-            self.dialog = Some(Dialog::SaveAs);
+            self.open_file_dialog(Pick::SaveGraph);
         }
     }
 
@@ -369,10 +604,7 @@ impl Editor {
                 self.doc.replace(Graph::new(), None);
                 self.selected.clear();
             }
-            Then::Open(p) if p.as_os_str().is_empty() => {
-                self.path_input = self.doc.base_dir().join("").display().to_string();
-                self.dialog = Some(Dialog::Open);
-            }
+            Then::Open(p) if p.as_os_str().is_empty() => self.open_file_dialog(Pick::OpenGraph),
             Then::Open(p) => self.open(&p),
         }
     }
@@ -390,7 +622,19 @@ impl Editor {
         self.refresh_errors();
         let port = self.effective_port();
         let base = self.doc.base_dir();
-        self.preview.update(&self.doc.graph, &base, port.as_deref());
+        let scene = self.scene.as_ref().map(|s| &s.preview);
+        let ran = self
+            .preview
+            .update(&self.doc.graph, &base, port.as_deref(), scene);
+        if let Some(p) = port.as_deref()
+            && !ran
+            && self.preview.wants_frames()
+        {
+            let _ = self.preview.step(p);
+        }
+        if self.preview.wants_frames() {
+            ui.ctx().request_repaint();
+        }
 
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
@@ -421,6 +665,7 @@ impl Editor {
         });
         self.refusal_tooltip(ui, now);
         self.dialogs(ui);
+        self.file_dialog_ui(&ui.ctx().clone());
     }
 
     fn refusal_tooltip(&self, ui: &Ui, now: f64) {
@@ -463,14 +708,16 @@ impl Editor {
             }
             let s = &self.preview.stats;
             ui.weak(format!(
-                "preview: frame {:.1} ms, readback {:.1} ms · {} rebuilds, {} param updates",
-                s.frame_ms, s.readback_ms, s.rebuilds, s.param_updates
+                "preview: frame {:.1} ms, readback {:.1} ms · {} rebuilds, {} param updates, \
+                 {} accumulation restarts",
+                s.frame_ms, s.readback_ms, s.rebuilds, s.param_updates, s.restarts
             ));
         });
     }
 
     fn side_panel(&mut self, ui: &mut Ui, port: Option<&str>) {
         ui.heading("Preview");
+        self.scene_line(ui);
         match port {
             Some(p) => ui.weak(p),
             None => ui.weak("nothing to preview"),
@@ -483,9 +730,37 @@ impl Editor {
             let w = ui.available_width().min(size.x.max(1.0) * 2.0);
             let h = w * size.y / size.x.max(1.0);
             ui.add(egui::Image::new((tex.id(), egui::vec2(w, h))));
-            if let Some(img) = &self.preview.image {
-                ui.weak(format!("{}×{}", img.width, img.height));
-            }
+            let size = self
+                .preview
+                .image
+                .as_ref()
+                .map(|img| format!("{}×{}", img.width, img.height));
+            ui.horizontal(|ui| {
+                if let Some(size) = size {
+                    ui.weak(size);
+                }
+                if let Some(n) = self.preview.samples {
+                    ui.label(format!("{n} spp"))
+                        .on_hover_text("samples per pixel accumulated so far");
+                }
+                if self.preview.progressive {
+                    let label = if self.preview.paused {
+                        "▶ resume"
+                    } else {
+                        "⏸ pause"
+                    };
+                    if ui.button(label).clicked() {
+                        self.preview.paused = !self.preview.paused;
+                    }
+                    if self
+                        .preview
+                        .samples
+                        .is_some_and(|s| s >= self.preview.target_spp)
+                    {
+                        ui.weak(format!("done (scene spp {})", self.preview.target_spp));
+                    }
+                }
+            });
         }
         ui.separator();
         ui.heading("Inspector");
@@ -496,12 +771,49 @@ impl Editor {
             [one] => {
                 let id = one.clone();
                 let errs = self.errors.get(&id).cloned();
-                inspector::show(ui, &mut self.doc, &id, errs.as_ref());
+                if let Some(inspector::Request::PickFile(param)) =
+                    inspector::show(ui, &mut self.doc, &id, errs.as_ref())
+                {
+                    self.open_file_dialog(Pick::Param(id, param));
+                }
             }
             many => {
                 ui.label(format!("{} nodes selected", many.len()));
             }
         });
+    }
+
+    fn scene_line(&mut self, ui: &mut Ui) {
+        ui.horizontal_wrapped(|ui| {
+            match &self.scene {
+                Some(s) => {
+                    let name = s.path.file_name().map_or_else(
+                        || s.path.display().to_string(),
+                        |n| n.to_string_lossy().into_owned(),
+                    );
+                    let g = &s.preview.gpu.settings;
+                    ui.label(format!("scene {name}"))
+                        .on_hover_text(s.path.display().to_string());
+                    ui.weak(format!(
+                        "{}×{}, previewed at {}×{}",
+                        s.full.0, s.full.1, g.width, g.height
+                    ));
+                }
+                None => {
+                    ui.weak("no scene");
+                }
+            }
+            if ui
+                .button("Open scene…")
+                .on_hover_text("the scene PathTrace and GBuffer nodes render")
+                .clicked()
+            {
+                self.open_file_dialog(Pick::Scene);
+            }
+        });
+        if let Some(e) = &self.scene_error {
+            ui.colored_label(Color32::from_rgb(240, 90, 90), e);
+        }
     }
 
     /// Handles a close request from the window: returns whether to let it close.

@@ -1,8 +1,9 @@
 //! The inspector: one widget per param of the selected node, chosen by the param's type
 //! in the registry: sliders over the declared range (logarithmic for wide positive
 //! ranges), combo boxes for enums, checkboxes for bools, and a path field that checks the
-//! extension (and, for inputs, that the file exists) with a picker listing the matching
-//! files of the graph's folder. Every param's doc is its tooltip.
+//! extension (and, for inputs, that the file exists), a `…` button opening the file
+//! dialog, and a `▾` menu listing the matching files near the graph. Every param's doc is
+//! its tooltip.
 
 use std::path::Path;
 
@@ -12,11 +13,23 @@ use lumagraph_graph::{ParamType, ParamValue, Registry};
 
 use crate::document::Document;
 
+/// What the inspector asks of the editor.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Request {
+    /// Open the file dialog for the path param with this name.
+    PickFile(String),
+}
+
 /// Shows the inspector for node `id`.
-pub fn show(ui: &mut Ui, doc: &mut Document, id: &str, errors: Option<&Vec<String>>) {
+pub fn show(
+    ui: &mut Ui,
+    doc: &mut Document,
+    id: &str,
+    errors: Option<&Vec<String>>,
+) -> Option<Request> {
     let Some(node) = doc.graph.node(id).cloned() else {
         ui.weak("no node selected");
-        return;
+        return None;
     };
     ui.heading(&node.id);
     let Some(kind) = Registry::builtin().get(&node.kind) else {
@@ -24,7 +37,7 @@ pub fn show(ui: &mut Ui, doc: &mut Document, id: &str, errors: Option<&Vec<Strin
             Color32::from_rgb(230, 60, 60),
             format!("unknown node kind \"{}\"", node.kind),
         );
-        return;
+        return None;
     };
     ui.label(RichText::new(kind.name).strong())
         .on_hover_text(kind.doc);
@@ -39,6 +52,7 @@ pub fn show(ui: &mut Ui, doc: &mut Document, id: &str, errors: Option<&Vec<Strin
         ui.weak("no params");
     }
     let base = doc.base_dir();
+    let mut request = None;
     egui::Grid::new("params")
         .num_columns(2)
         .spacing([8.0, 6.0])
@@ -50,12 +64,23 @@ pub fn show(ui: &mut Ui, doc: &mut Document, id: &str, errors: Option<&Vec<Strin
                     .cloned()
                     .unwrap_or_else(|| def.ty.default_value());
                 let label = ui.label(def.name).on_hover_text(tooltip(def)).id;
-                if let Some(v) = param_widget(ui, def, &current, &base, kind.sink, label) {
-                    doc.set_param(id, def.name, v);
+                match param_widget(ui, def, &current, &base, kind.sink, label) {
+                    Some(Change::Set(v)) => doc.set_param(id, def.name, v),
+                    Some(Change::Pick) => request = Some(Request::PickFile(def.name.to_owned())),
+                    None => {}
                 }
                 ui.end_row();
             }
         });
+    request
+}
+
+/// What a param widget did.
+enum Change {
+    /// The user set a new value.
+    Set(ParamValue),
+    /// The user asked for the file dialog.
+    Pick,
 }
 
 fn tooltip(def: &ParamDef) -> String {
@@ -84,6 +109,18 @@ fn param_widget(
     current: &ParamValue,
     base: &Path,
     sink: bool,
+    label: egui::Id,
+) -> Option<Change> {
+    if let ParamType::Path { extensions, .. } = &def.ty {
+        return path_widget(ui, def, current, base, sink, extensions, label);
+    }
+    value_widget(ui, def, current, label).map(Change::Set)
+}
+
+fn value_widget(
+    ui: &mut Ui,
+    def: &ParamDef,
+    current: &ParamValue,
     label: egui::Id,
 ) -> Option<ParamValue> {
     let tip = tooltip(def);
@@ -145,9 +182,6 @@ fn param_widget(
                 .labelled_by(label);
             picked
         }
-        ParamType::Path { extensions, .. } => {
-            path_widget(ui, def, current, base, sink, extensions, label)
-        }
         _ => {
             ui.weak(current.to_string());
             None
@@ -186,7 +220,7 @@ fn path_widget(
     sink: bool,
     extensions: &[&str],
     label: egui::Id,
-) -> Option<ParamValue> {
+) -> Option<Change> {
     let value = match current {
         ParamValue::Str(s) => s.clone(),
         other => other.to_string(),
@@ -205,11 +239,19 @@ fn path_widget(
                 ui.data_mut(|d| d.insert_temp(id, text.clone()));
             }
             if (r.lost_focus() || !r.has_focus()) && problem.is_none() && text != value {
-                out = Some(ParamValue::Str(text.clone()));
+                out = Some(Change::Set(ParamValue::Str(text.clone())));
                 ui.data_mut(|d| d.remove::<String>(id));
             }
+            if ui
+                .button("…")
+                .on_hover_text("choose a file in the file dialog")
+                .clicked()
+            {
+                ui.data_mut(|d| d.remove::<String>(id));
+                out = Some(Change::Pick);
+            }
             if !sink {
-                ui.menu_button("…", |ui| {
+                ui.menu_button("▾", |ui| {
                     let files = list_files(base, extensions);
                     if files.is_empty() {
                         ui.weak(format!(
@@ -220,7 +262,7 @@ fn path_widget(
                     }
                     for f in files {
                         if ui.button(&f).clicked() {
-                            out = Some(ParamValue::Str(f.clone()));
+                            out = Some(Change::Set(ParamValue::Str(f.clone())));
                             ui.data_mut(|d| d.remove::<String>(id));
                             ui.close();
                         }

@@ -24,7 +24,7 @@ pub mod undo;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-pub use app::{Editor, EditorApp, EditorConfig};
+pub use app::{DEFAULT_PREVIEW_MAX, Editor, EditorApp, EditorConfig, EditorScene, Pick};
 use lumagraph_render::GpuContext;
 
 /// What can go wrong in the editor.
@@ -59,11 +59,12 @@ pub fn wgpu_setup() -> egui_wgpu::WgpuSetup {
     egui_wgpu::WgpuSetup::CreateNew(setup)
 }
 
-/// Opens the editor window, with `graph` loaded when given; returns when it closes.
+/// Opens the editor window, with `graph` loaded when given and the scene and preview size
+/// of `config`; returns when it closes.
 ///
 /// # Errors
 /// When the window or its GPU device cannot be created.
-pub fn run(graph: Option<PathBuf>) -> Result<(), EditorError> {
+pub fn run(graph: Option<PathBuf>, config: EditorConfig) -> Result<(), EditorError> {
     let options = eframe::NativeOptions {
         renderer: eframe::Renderer::Wgpu,
         viewport: egui::ViewportBuilder::default()
@@ -76,7 +77,8 @@ pub fn run(graph: Option<PathBuf>) -> Result<(), EditorError> {
         ..Default::default()
     };
     let config = EditorConfig {
-        recent_store: files::default_recent_path(),
+        recent_store: config.recent_store.or_else(files::default_recent_path),
+        ..config
     };
     eframe::run_native(
         "lumagraph editor",

@@ -12,18 +12,35 @@
 //! node's PNG path exactly (display-encoded data as is, linear data sRGB-encoded and
 //! clipped), so the preview shows the pixels `lumagraph render` writes to a PNG.
 //!
-//! Progressive sources: a future `PathTrace` node keeps its accumulation inside its own
-//! `NodeExec`. Because a param edit downstream only calls `update` on the nodes whose
-//! params changed, the executor (and the accumulation) survives; the editor then only has
-//! to keep calling [`Preview::run_frame`] while a node reports it is still converging.
+//! Scenes and progressive sources: with a scene (see [`PreviewScene`]), `PathTrace` and
+//! `GBuffer` nodes render it, at a resolution capped for responsiveness. When the plan has
+//! a node with history (`Accumulate`), the editor keeps calling [`Preview::step`], one
+//! frame (one more sample per pixel per `samples_per_frame`) per UI frame, until the
+//! scene's `spp` is reached. The preview compiles with every output upstream of the
+//! previewed port kept alive, so no two of them share texture memory: a param edit then
+//! re-runs only the edited node and what is downstream of it ([`Executor::rerun`]) over
+//! the accumulation as it is. Editing a node that feeds the accumulation (`PathTrace`,
+//! `GBuffer` when it feeds one), the scene, or the graph's structure restarts it.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use lumagraph_graph::{CompileOptions, Graph, Node, Params, Plan, PortType, Registry};
 use lumagraph_render::cpu::{srgb_encode, to_u8};
-use lumagraph_render::{Executor, GpuContext, Resources, source_extent};
+use lumagraph_render::{Executor, FrameReport, GpuContext, Resources, source_extent};
+use lumagraph_scene::GpuScene;
+
+/// The scene the preview renders, already at the preview's resolution.
+#[derive(Clone, Debug)]
+pub struct PreviewScene {
+    /// The flattened scene.
+    pub gpu: Arc<GpuScene>,
+    /// Changes whenever another scene (or the same file again) is loaded, so the preview
+    /// restarts.
+    pub generation: u64,
+}
 
 /// A preview image: 8-bit RGBA as a PNG written by an Output node would hold it.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -51,13 +68,27 @@ pub struct PreviewStats {
     pub frame_ms: f64,
     /// Wall time of the last readback and conversion, ms.
     pub readback_ms: f64,
+    /// Times progressive accumulation restarted (a new executor, or an edit upstream of
+    /// the accumulation).
+    pub restarts: u64,
+    /// Nodes the last param update re-ran, in order.
+    pub last_update: Vec<String>,
 }
 
 /// The preview state.
 pub struct Preview {
     gpu: GpuContext,
     exec: Option<Executor>,
-    key: Option<(Graph, String, PathBuf)>,
+    key: Option<(Graph, String, PathBuf, u64)>,
+    scene: Option<Arc<GpuScene>>,
+    /// Samples per pixel accumulated so far, when the plan path-traces.
+    pub samples: Option<u64>,
+    /// Whether the plan has a node with history, so frames keep coming.
+    pub progressive: bool,
+    /// Accumulation stops at this many samples per pixel (the scene's `spp`).
+    pub target_spp: u64,
+    /// Set to stop adding frames.
+    pub paused: bool,
     /// The last image.
     pub image: Option<PreviewImage>,
     texture: Option<egui::TextureHandle>,
@@ -98,14 +129,57 @@ pub fn preview_graph(graph: &Graph) -> Graph {
     g
 }
 
-/// Compiles the preview graph of `graph`, keeping `port`.
+/// The outputs the preview keeps alive: `port` and every output an edge reads from a
+/// node that feeds a sink or `port` (sinks included, though the preview leaves them out).
+/// So the preview runs what `lumagraph render` runs, no two of those outputs share
+/// texture memory (a param edit can re-run only what is downstream of it), and previewing
+/// another of them is not a structural change (accumulation goes on).
+pub fn preview_keep(graph: &Graph, port: &str) -> Vec<String> {
+    let reg = Registry::builtin();
+    let node_of = |p: &str| lumagraph_graph::split_port_ref(p).map(|(n, _)| n.to_owned());
+    let mut upstream = BTreeSet::new();
+    let mut stack: Vec<String> = graph
+        .nodes
+        .iter()
+        .filter(|n| reg.get(&n.kind).is_some_and(|k| k.sink))
+        .map(|n| n.id.clone())
+        .chain(node_of(port))
+        .collect();
+    while let Some(n) = stack.pop() {
+        if !upstream.insert(n.clone()) {
+            continue;
+        }
+        for e in &graph.edges {
+            if node_of(&e.to).as_deref() == Some(n.as_str())
+                && let Some(from) = node_of(&e.from)
+            {
+                stack.push(from);
+            }
+        }
+    }
+    let mut keep = vec![port.to_owned()];
+    for e in &graph.edges {
+        if node_of(&e.from).is_some_and(|n| upstream.contains(&n)) && !keep.contains(&e.from) {
+            keep.push(e.from.clone());
+        }
+    }
+    keep
+}
+
+/// Compiles the preview graph of `graph`, keeping `port` (and the outputs upstream of it,
+/// see [`preview_keep`]), with `scene` for the nodes that render one.
 ///
 /// # Errors
 /// The compiler's messages, one a line.
-pub fn compile_preview(graph: &Graph, base: &Path, port: &str) -> Result<Plan, String> {
+pub fn compile_preview(
+    graph: &Graph,
+    base: &Path,
+    port: &str,
+    scene: Option<&GpuScene>,
+) -> Result<Plan, String> {
     let g = preview_graph(graph);
-    let extent = |node: &Node, params: &Params| source_extent(base, None, node, params);
-    let keep = [port.to_owned()];
+    let extent = |node: &Node, params: &Params| source_extent(base, scene, node, params);
+    let keep = preview_keep(graph, port);
     lumagraph_graph::compile(
         &g,
         Registry::builtin(),
@@ -150,6 +224,11 @@ impl Preview {
             gpu,
             exec: None,
             key: None,
+            scene: None,
+            samples: None,
+            progressive: false,
+            target_spp: 0,
+            paused: false,
             image: None,
             texture: None,
             texture_stale: false,
@@ -164,20 +243,34 @@ impl Preview {
         &self.gpu
     }
 
-    /// Brings the preview up to date with `graph` showing `port`; does nothing when
-    /// neither changed (node positions do not count). Returns whether a frame ran.
-    pub fn update(&mut self, graph: &Graph, base: &Path, port: Option<&str>) -> bool {
+    /// Brings the preview up to date with `graph` showing `port`, rendering `scene` when
+    /// given; does nothing when none of them changed (node positions do not count).
+    /// Returns whether a frame ran.
+    pub fn update(
+        &mut self,
+        graph: &Graph,
+        base: &Path,
+        port: Option<&str>,
+        scene: Option<&PreviewScene>,
+    ) -> bool {
         let Some(port) = port else {
             self.clear(Some("select a node with an output to preview it".into()));
             return false;
         };
         let mut g = preview_graph(graph);
         g.origin = None;
-        let key = (g, port.to_owned(), base.to_owned());
+        let generation = scene.map_or(0, |s| s.generation);
+        let key = (g, port.to_owned(), base.to_owned(), generation);
         if self.key.as_ref() == Some(&key) {
             return false;
         }
+        let scene_changed = self.key.as_ref().is_none_or(|k| k.3 != generation);
         self.key = Some(key);
+        if scene_changed {
+            // Another scene: nothing of the old executor (buffers, accumulation) applies.
+            self.exec = None;
+            self.scene = scene.map(|s| Arc::clone(&s.gpu));
+        }
         match self.render(graph, base, port) {
             Ok(()) => {
                 self.error = None;
@@ -195,31 +288,98 @@ impl Preview {
         self.image = None;
         self.texture = None;
         self.pass_ms.clear();
+        self.samples = None;
+        self.progressive = false;
         self.error = error;
     }
 
     fn render(&mut self, graph: &Graph, base: &Path, port: &str) -> Result<(), String> {
-        let plan = compile_preview(graph, base, port)?;
+        let plan = compile_preview(graph, base, port, self.scene.as_deref())?;
+        let changed: Vec<String> = match &self.exec {
+            Some(exec) => exec
+                .plan()
+                .passes
+                .iter()
+                .zip(&plan.passes)
+                .filter(|(a, b)| a.params != b.params)
+                .map(|(a, _)| a.node.clone())
+                .collect(),
+            None => Vec::new(),
+        };
         let updated = match &mut self.exec {
             Some(exec) => exec
                 .update_params(plan.clone())
                 .map_err(|e| e.to_string())?,
             None => false,
         };
-        if updated {
-            self.stats.param_updates += 1;
+        let report = if updated {
+            self.stats.param_updates += u64::from(!changed.is_empty());
+            let before = self.samples;
+            let exec = self.exec.as_mut().ok_or("no executor")?;
+            let report = exec.rerun(&changed).map_err(|e| e.to_string());
+            self.stats.last_update = report
+                .as_ref()
+                .map(|r| r.executed.clone())
+                .unwrap_or_default();
+            let report = report?;
+            self.read_samples()?;
+            if self.samples < before {
+                self.stats.restarts += 1;
+            }
+            report
         } else {
             self.exec = None;
             let paths = Resources {
                 base_dir: base.to_owned(),
                 out_dir: base.to_owned(),
+                scene: self.scene.clone(),
                 ..Resources::default()
             };
             let exec = Executor::new(&self.gpu, plan, &paths).map_err(|e| e.to_string())?;
+            self.progressive = exec
+                .plan()
+                .passes
+                .iter()
+                .any(|p| Registry::builtin().get(p.kind).is_some_and(|k| k.history));
+            self.target_spp = self
+                .scene
+                .as_ref()
+                .filter(|_| self.progressive)
+                .map_or(0, |s| u64::from(s.settings.spp));
             self.exec = Some(exec);
             self.stats.rebuilds += 1;
+            self.stats.restarts += u64::from(self.progressive);
+            let report = self.frame()?;
+            self.read_samples()?;
+            report
+        };
+        self.show(&report, port)
+    }
+
+    /// Whether the preview wants another frame: the plan accumulates, it is not paused,
+    /// and the scene's sample count is not reached yet.
+    pub fn wants_frames(&self) -> bool {
+        self.exec.is_some()
+            && self.error.is_none()
+            && self.progressive
+            && !self.paused
+            && self.samples.is_none_or(|s| s < self.target_spp)
+    }
+
+    /// Runs one more frame (one more sample per pixel for a path tracer) and reads `port`
+    /// back.
+    ///
+    /// # Errors
+    /// When the frame or the readback fails.
+    pub fn step(&mut self, port: &str) -> Result<(), String> {
+        let result = self.frame().and_then(|report| {
+            self.read_samples()?;
+            self.show(&report, port)
+        });
+        if let Err(e) = &result {
+            self.error = Some(e.clone());
         }
-        self.run_frame(port)
+        result
     }
 
     /// Runs one frame of the current executor and reads `port` back.
@@ -227,39 +387,64 @@ impl Preview {
     /// # Errors
     /// When the frame or the readback fails.
     pub fn run_frame(&mut self, port: &str) -> Result<(), String> {
+        let report = self.frame()?;
+        self.read_samples()?;
+        self.show(&report, port)
+    }
+
+    fn frame(&mut self) -> Result<FrameReport, String> {
+        let exec = self.exec.as_mut().ok_or("nothing to run")?;
+        exec.run_frame().map_err(|e| {
+            // A failed frame leaves the executor in an unknown state: rebuild next time.
+            self.exec = None;
+            self.key = None;
+            e.to_string()
+        })
+    }
+
+    /// Reads the path tracer's sample count (a small readback) when the plan has one.
+    fn read_samples(&mut self) -> Result<(), String> {
         let Some(exec) = &mut self.exec else {
-            return Err("nothing to run".into());
+            return Ok(());
         };
-        let result = (|| {
-            let report = exec.run_frame().map_err(|e| e.to_string())?;
-            let t = Instant::now();
-            let ty = exec
-                .plan()
-                .textures
-                .iter()
-                .find(|t| t.name == port)
-                .map(|t| t.ty)
-                .ok_or_else(|| format!("{port} is not computed"))?;
-            let image = exec.read_port(port).map_err(|e| e.to_string())?;
-            let rgba = encode_rgba8(&image, ty);
-            Ok::<_, String>((report, image.width, image.height, rgba, t.elapsed()))
-        })();
-        let (report, width, height, rgba, readback) = match result {
-            Ok(r) => r,
-            Err(e) => {
-                // A failed frame leaves the executor in an unknown state: rebuild next time.
-                self.exec = None;
-                return Err(e);
-            }
-        };
+        if !exec.plan().passes.iter().any(|p| p.kind == "PathTrace") {
+            self.samples = None;
+            return Ok(());
+        }
+        let counters = exec.counters().map_err(|e| e.to_string())?;
+        self.samples = counters
+            .iter()
+            .find(|(_, c)| c.name == "samples_per_pixel")
+            .map(|(_, c)| c.value);
+        Ok(())
+    }
+
+    /// Reads `port` back after `report`'s frame and keeps it as the image to show.
+    fn show(&mut self, report: &FrameReport, port: &str) -> Result<(), String> {
+        let exec = self.exec.as_ref().ok_or("nothing to run")?;
+        let t = Instant::now();
+        let ty = exec
+            .plan()
+            .textures
+            .iter()
+            .find(|t| t.name == port)
+            .map(|t| t.ty)
+            .ok_or_else(|| format!("{port} is not computed"))?;
+        let image = exec.read_port(port).map_err(|e| e.to_string())?;
+        let rgba = encode_rgba8(&image, ty);
         self.stats.frames += 1;
         self.stats.frame_ms = report.wall.as_secs_f64() * 1e3;
-        self.stats.readback_ms = readback.as_secs_f64() * 1e3;
-        self.pass_ms = report.pass_ms.unwrap_or_default().into_iter().collect();
+        self.stats.readback_ms = t.elapsed().as_secs_f64() * 1e3;
+        self.pass_ms = report
+            .pass_ms
+            .clone()
+            .unwrap_or_default()
+            .into_iter()
+            .collect();
         self.image = Some(PreviewImage {
             port: port.to_owned(),
-            width,
-            height,
+            width: image.width,
+            height: image.height,
             rgba,
         });
         self.texture_stale = true;

@@ -9,7 +9,8 @@ use egui_kittest::kittest::Queryable as _;
 use lumagraph_graph::{Graph, ParamValue};
 use lumagraph_render::{Executor, Resources, compile};
 
-use common::{editor, harness, repo, snapshot_options};
+use common::{editor, harness, repo, snapshot_options, with_config};
+use lumagraph_editor::{EditorConfig, Pick};
 
 fn post_tonemap() -> std::path::PathBuf {
     repo("graphs/post_tonemap.ron")
@@ -394,14 +395,14 @@ fn param_edits_are_cheaper_than_rebuilds() {
     let base = ed.doc.base_dir();
     let port = Some("tonemap.color");
     let t = std::time::Instant::now();
-    ed.preview.update(&ed.doc.graph, &base, port);
+    ed.preview.update(&ed.doc.graph, &base, port, None);
     let first = t.elapsed();
     let n: u32 = 10;
     let t = std::time::Instant::now();
     for i in 0..n {
         ed.doc
             .set_param("exposure", "ev", ParamValue::Float(f64::from(i + 1) * 0.1));
-        assert!(ed.preview.update(&ed.doc.graph, &base, port));
+        assert!(ed.preview.update(&ed.doc.graph, &base, port, None));
     }
     let per_edit = t.elapsed() / n;
     let s = &ed.preview.stats;
@@ -417,4 +418,260 @@ fn param_edits_are_cheaper_than_rebuilds() {
     );
     assert_eq!(s.rebuilds, 1);
     assert_eq!(s.param_updates, u64::from(n));
+}
+
+/// The path-traced graph with the Cornell box at a tiny preview size.
+fn pathtrace_editor() -> Option<lumagraph_editor::Editor> {
+    with_config(
+        Some(&repo("graphs/pathtrace_denoise.ron")),
+        &EditorConfig {
+            scene: Some(repo("assets/cornell.ron")),
+            preview_max: 24,
+            ..EditorConfig::default()
+        },
+    )
+}
+
+/// With a scene, the path tracer's preview keeps accumulating while the editor runs; an
+/// exposure edit through the inspector re-runs only exposure and tonemap over the
+/// accumulation (no restart), which keeps growing; a `PathTrace` edit restarts it.
+#[test]
+fn accumulation_continues_through_a_post_edit() {
+    let Some(mut ed) = pathtrace_editor() else {
+        return;
+    };
+    assert!(ed.scene_error.is_none(), "{:?}", ed.scene_error);
+    ed.select(vec!["exposure".into()]);
+    let mut h = harness(ed);
+    // As a click on tonemap's output pin label would: preview the end of the chain.
+    h.state_mut().preview_port = Some("tonemap.color".into());
+    for _ in 0..3 {
+        h.step();
+    }
+    let ed = h.state();
+    assert!(ed.errors.is_empty(), "{:?}", ed.errors);
+    assert!(ed.preview.progressive);
+    let img = ed.preview.image.as_ref().expect("a preview");
+    assert_eq!((img.width, img.height), (24, 24), "capped preview size");
+    assert_eq!(img.port, "tonemap.color");
+    let before = ed.preview.samples.expect("a sample count");
+    assert!(before >= 3, "{before} spp after the first frames");
+    let restarts = ed.preview.stats.restarts;
+    let updates = ed.preview.stats.param_updates;
+    let picture = img.rgba.clone();
+
+    // Click three quarters along the ev slider.
+    let rect = h.get_by_role_and_label(Role::Slider, "ev").rect();
+    click_at(
+        &mut h,
+        egui::pos2(rect.left() + rect.width() * 0.75, rect.center().y),
+    );
+    let ed = h.state();
+    let ev = ed.doc.graph.node("exposure").unwrap().params["ev"]
+        .as_f64()
+        .unwrap();
+    assert!(ev > 1.0, "ev {ev}");
+    assert_eq!(ed.preview.stats.param_updates, updates + 1);
+    assert_eq!(ed.preview.stats.last_update, ["exposure", "tonemap"]);
+    assert_eq!(
+        ed.preview.stats.restarts, restarts,
+        "accumulation restarted"
+    );
+    let after = ed.preview.samples.unwrap();
+    assert!(after >= before, "samples went from {before} to {after}");
+    assert_ne!(ed.preview.image.as_ref().unwrap().rgba, picture);
+    for _ in 0..2 {
+        h.step();
+    }
+    let later = h.state().preview.samples.unwrap();
+    assert!(later > after, "samples stuck at {after}");
+    eprintln!("spp: {before} before the edit, {after} after it, {later} two frames later");
+
+    // Selecting another node previews its output without restarting either.
+    h.state_mut().select(vec!["denoise".into()]);
+    h.step();
+    assert_eq!(h.state().preview.stats.last_update, Vec::<String>::new());
+    h.step();
+    let ed = h.state();
+    assert_eq!(ed.preview.image.as_ref().unwrap().port, "denoise.color");
+    assert_eq!(
+        ed.preview.stats.restarts, restarts,
+        "accumulation restarted"
+    );
+    assert_eq!(ed.preview.stats.rebuilds, 1);
+    assert!(ed.preview.samples.unwrap() > later);
+
+    // A path tracer param feeds the accumulation: it restarts.
+    h.state_mut()
+        .doc
+        .set_param("pathtrace", "samples_per_frame", ParamValue::Int(2));
+    h.step();
+    let ed = h.state();
+    assert_eq!(ed.preview.stats.restarts, restarts + 1);
+    assert!(
+        ed.preview.samples.unwrap() <= 4,
+        "{:?} spp after a restart",
+        ed.preview.samples
+    );
+}
+
+/// A scene that cannot be loaded is an error in the UI, never a panic; without a scene,
+/// the nodes that render one say so.
+#[test]
+fn scene_errors_are_shown() {
+    let Some(_) = common::gpu() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("broken_scene.ron");
+    std::fs::write(&bad, "(version: 1, camera: ").unwrap();
+    let ed = with_config(
+        Some(&repo("graphs/pathtrace_denoise.ron")),
+        &EditorConfig {
+            scene: Some(bad),
+            preview_max: 16,
+            ..EditorConfig::default()
+        },
+    )
+    .unwrap();
+    let mut h = harness(ed);
+    let ed = h.state();
+    let err = ed.scene_error.clone().expect("a scene error");
+    assert!(err.contains("broken_scene.ron"), "{err}");
+    assert!(
+        ed.errors["pathtrace"][0].contains("none was given"),
+        "{:?}",
+        ed.errors
+    );
+    // In the side panel and the status line.
+    assert_eq!(
+        h.query_all_by_label_contains("cannot load the scene")
+            .count(),
+        2
+    );
+    // Loading a good one clears the errors.
+    assert!(h.state_mut().load_scene(&repo("assets/cornell.ron")));
+    h.step();
+    let ed = h.state();
+    assert!(ed.errors.is_empty(), "{:?}", ed.errors);
+    assert!(ed.scene_error.is_none());
+}
+
+/// The `…` button of a path param opens the file dialog; a file picked in it sets the
+/// param as one undoable edit.
+#[test]
+fn a_file_picked_in_the_dialog_sets_the_path_param() {
+    let Some(mut ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path().canonicalize().unwrap();
+    for name in ["first.exr", "second.exr"] {
+        std::fs::copy(repo("assets/test_chart.exr"), dir.join(name)).unwrap();
+    }
+    let first = dir.join("first.exr").display().to_string();
+    ed.doc
+        .set_param("input", "path", ParamValue::Str(first.clone()));
+    ed.doc.end_gesture();
+    ed.select(vec!["input".into()]);
+    let mut h = harness(ed);
+    h.get_by_role_and_label(Role::Button, "…").click();
+    h.run_ok();
+    let pick = h.state().file_dialog.as_ref().map(|(p, _)| p.clone());
+    assert_eq!(pick, Some(Pick::Param("input".into(), "path".into())));
+    // The dialog opens in the folder of the current file and lists it on a thread of its
+    // own: wait for the listing (at most 10 s), then pick the other file.
+    let start = std::time::Instant::now();
+    while h.query_by_label_contains("second.exr").is_none() {
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(10),
+            "the dialog never listed the folder"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        h.step();
+    }
+    h.get_by_label_contains("second.exr").click();
+    h.run_ok();
+    h.get_by_role_and_label(Role::Button, "🗀  Open").click();
+    h.run_ok();
+    let ed = h.state_mut();
+    assert!(ed.file_dialog.is_none());
+    let second = dir.join("second.exr").display().to_string();
+    assert_eq!(
+        ed.doc.graph.node("input").unwrap().params["path"],
+        ParamValue::Str(second)
+    );
+    assert!(ed.doc.undo());
+    assert_eq!(
+        ed.doc.graph.node("input").unwrap().params["path"],
+        ParamValue::Str(first)
+    );
+}
+
+/// Drags with simulated pointer events from `from` to `to`, a few frames apart, as a
+/// hand would.
+fn drag(
+    h: &mut egui_kittest::Harness<'_, lumagraph_editor::Editor>,
+    from: egui::Pos2,
+    to: egui::Pos2,
+) {
+    h.hover_at(from);
+    h.run_ok();
+    h.event(egui::Event::PointerButton {
+        pos: from,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    h.step();
+    for i in 1..=8 {
+        let t = i as f32 / 8.0;
+        h.event(egui::Event::PointerMoved(from + (to - from) * t));
+        h.step();
+    }
+    h.event(egui::Event::PointerButton {
+        pos: to,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    h.step();
+    h.run_ok();
+}
+
+/// Wires drawn on the canvas with the pointer: from an output pin to an input pin makes
+/// the edge (one undo step); between incompatible ports it is refused with the reason.
+#[test]
+fn dragging_from_an_output_pin_to_an_input_pin_connects_them() {
+    let Some(mut ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    assert!(ed.doc.disconnect("input.color", "exposure.color"));
+    ed.doc.end_gesture();
+    let mut h = harness(ed);
+    // Where the pins are drawn at the default zoom (see the snapshot): input's output
+    // pin, exposure's input pin, tonemap's output pin.
+    let input_out = egui::pos2(195.0, 339.0);
+    let exposure_in = egui::pos2(276.0, 339.0);
+    let tonemap_out = egui::pos2(552.0, 339.0);
+    drag(&mut h, input_out, exposure_in);
+    let ed = h.state_mut();
+    assert!(
+        ed.doc
+            .graph
+            .edges
+            .iter()
+            .any(|e| e.from == "input.color" && e.to == "exposure.color"),
+        "{:?}",
+        ed.doc.graph.edges
+    );
+    assert!(ed.errors.is_empty(), "{:?}", ed.errors);
+    let connected = ed.doc.graph.clone();
+    // ldr_color into an hdr_color input: refused, the graph unchanged.
+    drag(&mut h, tonemap_out, exposure_in);
+    let ed = h.state_mut();
+    assert_eq!(ed.doc.graph, connected);
+    let (msg, is_err) = ed.message.clone().expect("a refusal");
+    assert!(is_err && msg.contains("produces ldr_color"), "{msg}");
+    // The wire was one edit.
+    assert!(ed.doc.undo());
+    assert!(!ed.doc.graph.edges.iter().any(|e| e.to == "exposure.color"));
 }

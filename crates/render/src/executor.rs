@@ -72,6 +72,9 @@ enum Mode {
     WarmUp,
     /// Only the passes that do not run every frame, timed; sinks write. No frame is added.
     Tail,
+    /// Only the passes marked in `Executor::only`, timed; their sinks write. No frame is
+    /// added.
+    Only,
 }
 
 /// What one frame did.
@@ -98,6 +101,8 @@ pub struct Executor {
     frames: u64,
     /// Per pass: whether it feeds (or is) a node with history, and so runs every frame.
     every_frame: Vec<bool>,
+    /// Per pass: whether a [`Mode::Only`] run records it.
+    only: Vec<bool>,
 }
 
 impl std::fmt::Debug for Executor {
@@ -138,6 +143,7 @@ impl Executor {
             timer,
             frames: 0,
             every_frame,
+            only: Vec::new(),
         })
     }
 
@@ -231,6 +237,61 @@ impl Executor {
         self.run(1, Mode::Tail)
     }
 
+    /// After a param edit ([`Executor::update_params`]), runs only the passes of `changed`
+    /// and those downstream of them, reading the other passes' outputs as the last frame
+    /// left them, without adding a frame: a tone-mapping or exposure edit re-runs the post
+    /// chain over the accumulation as it is.
+    ///
+    /// When a changed node is progressive (it keeps history or feeds a node that does, such
+    /// as a `PathTrace` before an `Accumulate`), its history no longer matches its params:
+    /// accumulation restarts ([`Executor::reset_history`]) and a whole frame runs. A whole
+    /// frame also runs, without a restart, when an output the partial run would read may
+    /// have been overwritten because its texture shares memory with a later one (keep the
+    /// upstream outputs alive with [`lumagraph_graph::CompileOptions::keep`] to avoid it),
+    /// or before the first frame. [`FrameReport::executed`] tells which passes ran.
+    ///
+    /// # Errors
+    /// When a node fails; the error names the node.
+    pub fn rerun(&mut self, changed: &[String]) -> Result<FrameReport> {
+        let plan = &self.plan;
+        let mut only: Vec<bool> = plan
+            .passes
+            .iter()
+            .map(|p| changed.contains(&p.node))
+            .collect();
+        for (p, pass) in plan.passes.iter().enumerate() {
+            if pass
+                .inputs
+                .iter()
+                .any(|(_, t)| only[plan.textures[t.0].first])
+            {
+                only[p] = true;
+            }
+        }
+        if only.iter().zip(&self.every_frame).any(|(&o, &e)| o && e) {
+            self.reset_history();
+            return self.run(1, Mode::Finish);
+        }
+        // Every texture read by a rerun pass but written by a pass that does not rerun
+        // must still hold what that pass wrote: no later texture may share its slot.
+        let stale = plan.passes.iter().enumerate().any(|(p, pass)| {
+            only[p]
+                && pass.inputs.iter().any(|(_, t)| {
+                    let desc = &plan.textures[t.0];
+                    !only[desc.first]
+                        && plan.slots[desc.slot]
+                            .textures
+                            .iter()
+                            .any(|u| plan.textures[u.0].first > desc.first)
+                })
+        });
+        if stale || self.frames == 0 {
+            return self.run(1, Mode::Finish);
+        }
+        self.only = only;
+        self.run(1, Mode::Only)
+    }
+
     /// Records every pass once without writing files or keeping history, so drivers that
     /// compile pipelines at their first dispatch do it here rather than in a timed frame.
     ///
@@ -265,10 +326,13 @@ impl Executor {
         for frame in 0..n {
             let last = mode != Mode::Progress && frame + 1 == n;
             for (p, (pass, node)) in self.plan.passes.iter().zip(&mut self.nodes).enumerate() {
-                if (!last && !self.every_frame[p]) || (mode == Mode::Tail && self.every_frame[p]) {
+                if (!last && !self.every_frame[p])
+                    || (mode == Mode::Tail && self.every_frame[p])
+                    || (mode == Mode::Only && !self.only[p])
+                {
                     continue;
                 }
-                let timer = if last && matches!(mode, Mode::Finish | Mode::Tail) {
+                let timer = if last && matches!(mode, Mode::Finish | Mode::Tail | Mode::Only) {
                     self.timer.as_mut()
                 } else {
                     None
@@ -293,8 +357,11 @@ impl Executor {
         }
         self.ctx.wait()?;
         let mut written = Vec::new();
-        if matches!(mode, Mode::Finish | Mode::Tail) {
-            for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
+        if matches!(mode, Mode::Finish | Mode::Tail | Mode::Only) {
+            for (p, (pass, node)) in self.plan.passes.iter().zip(&mut self.nodes).enumerate() {
+                if mode == Mode::Only && !self.only[p] {
+                    continue;
+                }
                 written.extend(
                     node.finish(&self.ctx, pass)
                         .map_err(|e| e.in_node(&pass.node))?,
@@ -302,10 +369,12 @@ impl Executor {
             }
         }
         let pass_ms = match &self.timer {
-            Some(t) if matches!(mode, Mode::Finish | Mode::Tail) => Some(t.read(&self.ctx)?),
+            Some(t) if matches!(mode, Mode::Finish | Mode::Tail | Mode::Only) => {
+                Some(t.read(&self.ctx)?)
+            }
             _ => None,
         };
-        if mode != Mode::Tail {
+        if !matches!(mode, Mode::Tail | Mode::Only) {
             self.frames += u64::from(n);
         }
         Ok(FrameReport {

@@ -1,12 +1,12 @@
-//! The menu bar and the modal dialogs (open, save as, unsaved changes). File paths are
-//! typed in a text field with validation (no native file dialog: `rfd` would pull a
-//! D-Bus/GTK stack into the build for little gain here).
+//! The menu bar and the modal dialog for unsaved changes. Files are picked with
+//! `egui-file-dialog`, drawn by egui itself (a native dialog through `rfd` would pull a
+//! D-Bus/GTK stack into the build).
 
 use std::path::PathBuf;
 
-use egui::{Color32, RichText, Ui};
+use egui::Ui;
 
-use super::{Dialog, Editor, Then};
+use super::{Dialog, Editor, Pick, Then};
 use crate::canvas::add_node_menu;
 
 impl Editor {
@@ -33,12 +33,7 @@ impl Editor {
                     self.save_or_ask();
                 }
                 if ui.button("Save as…").clicked() {
-                    self.path_input = self
-                        .doc
-                        .path
-                        .as_ref()
-                        .map_or_else(|| "untitled.ron".into(), |p| p.display().to_string());
-                    self.dialog = Some(Dialog::SaveAs);
+                    self.open_file_dialog(Pick::SaveGraph);
                 }
                 ui.separator();
                 if ui.button("Quit").clicked() {
@@ -73,6 +68,25 @@ impl Editor {
                     self.delete_selection();
                 }
             });
+            ui.menu_button("Scene", |ui| {
+                if ui.button("Open scene…").clicked() {
+                    self.open_file_dialog(Pick::Scene);
+                }
+                let path = self.scene.as_ref().map(|s| s.path.clone());
+                if ui
+                    .add_enabled(path.is_some(), egui::Button::new("Reload scene"))
+                    .clicked()
+                    && let Some(p) = path
+                {
+                    self.load_scene(&p);
+                }
+                if ui
+                    .add_enabled(self.scene.is_some(), egui::Button::new("Close scene"))
+                    .clicked()
+                {
+                    self.close_scene();
+                }
+            });
             ui.menu_button("Add node", |ui| {
                 if let Some(kind) = add_node_menu(ui, &mut self.canvas.search) {
                     match self.doc.add_node(kind, None) {
@@ -92,88 +106,12 @@ impl Editor {
         let mut close = false;
         let modal = egui::Modal::new(egui::Id::new("dialog")).show(&ctx, |ui| {
             ui.set_width(420.0);
-            match &dialog {
-                Dialog::Open => close = self.open_dialog(ui),
-                Dialog::SaveAs => close = self.save_as_dialog(ui),
-                Dialog::Unsaved(then) => close = self.unsaved_dialog(ui, then),
-            }
+            let Dialog::Unsaved(then) = &dialog;
+            close = self.unsaved_dialog(ui, then);
         });
         if (close || modal.should_close()) && self.dialog.as_ref() == Some(&dialog) {
             self.dialog = None;
         }
-    }
-
-    fn open_dialog(&mut self, ui: &mut Ui) -> bool {
-        ui.heading("Open graph");
-        ui.text_edit_singleline(&mut self.path_input);
-        let path = PathBuf::from(self.path_input.trim());
-        let problem = if !path.is_file() {
-            Some("no such file")
-        } else if path.extension().is_none_or(|e| e != "ron") {
-            Some("graph files end in .ron")
-        } else {
-            None
-        };
-        if let Some(p) = problem {
-            ui.colored_label(Color32::from_rgb(240, 90, 90), p);
-        }
-        let mut close = false;
-        for f in self.recent.files.clone() {
-            if ui
-                .button(RichText::new(f.display().to_string()).weak())
-                .clicked()
-            {
-                self.path_input = f.display().to_string();
-            }
-        }
-        ui.horizontal(|ui| {
-            if ui
-                .add_enabled(problem.is_none(), egui::Button::new("Open"))
-                .clicked()
-            {
-                self.open(&path);
-                close = true;
-            }
-            if ui.button("Cancel").clicked() {
-                close = true;
-            }
-        });
-        close
-    }
-
-    fn save_as_dialog(&mut self, ui: &mut Ui) -> bool {
-        ui.heading("Save graph as");
-        ui.text_edit_singleline(&mut self.path_input);
-        let path = PathBuf::from(self.path_input.trim());
-        let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
-        let problem = if path.extension().is_none_or(|e| e != "ron") {
-            Some("graph files end in .ron")
-        } else if dir.is_some_and(|d| !d.is_dir()) {
-            Some("the folder does not exist")
-        } else {
-            None
-        };
-        if let Some(p) = problem {
-            ui.colored_label(Color32::from_rgb(240, 90, 90), p);
-        } else if path.exists() {
-            ui.weak("the file exists and will be replaced");
-        }
-        let mut close = false;
-        ui.horizontal(|ui| {
-            if ui
-                .add_enabled(problem.is_none(), egui::Button::new("Save"))
-                .clicked()
-            {
-                match self.save_as(&path) {
-                    Ok(()) => close = true,
-                    Err(e) => self.say(e.to_string(), true),
-                }
-            }
-            if ui.button("Cancel").clicked() {
-                close = true;
-            }
-        });
-        close
     }
 
     fn unsaved_dialog(&mut self, ui: &mut Ui, then: &Then) -> bool {
@@ -197,8 +135,8 @@ impl Editor {
                         Err(e) => self.say(e.to_string(), true),
                     }
                 } else {
-                    self.path_input = "untitled.ron".into();
-                    self.dialog = Some(Dialog::SaveAs);
+                    close = true;
+                    self.open_file_dialog(Pick::SaveGraph);
                 }
             }
             if ui.button("Discard").clicked() {

@@ -90,14 +90,19 @@ pub fn repo(rel: &str) -> PathBuf {
 
 /// An editor on the shared device, with the recent-files list in `recent`.
 pub fn editor(graph: Option<&Path>, recent: Option<PathBuf>) -> Option<Editor> {
-    let gpu = gpu()?;
-    Some(Editor::new(
-        gpu,
+    with_config(
         graph,
         &EditorConfig {
             recent_store: recent,
+            ..EditorConfig::default()
         },
-    ))
+    )
+}
+
+/// An editor on the shared device with `config`.
+pub fn with_config(graph: Option<&Path>, config: &EditorConfig) -> Option<Editor> {
+    let gpu = gpu()?;
+    Some(Editor::new(gpu, graph, config))
 }
 
 /// A headless harness drawing `editor` with egui's wgpu renderer on the shared device.
