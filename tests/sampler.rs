@@ -235,7 +235,6 @@ fn sobol_beats_independent_on_edges_and_defocus() {
             }
         }
     }
-    // Limit from measurements: see the figures above (docs/pathtracer.md).
     let worst = ratios.iter().copied().fold(f64::INFINITY, f64::min);
     assert!(
         worst >= LIMIT_16SPP,
@@ -243,7 +242,11 @@ fn sobol_beats_independent_on_edges_and_defocus() {
     );
 }
 
-const LIMIT_16SPP: f64 = 1.0;
+/// Smallest independent/Sobol RMSE ratio at 16 spp, over seeds 0, 1, 2. Measured 1.78, 1.66
+/// and 1.84 on lavapipe (1.45–1.54 at 4 spp, 1.86–1.96 at 64 spp); 1.4 leaves room for seed
+/// to seed spread while failing if the Sobol points lose their stratification (that gives
+/// a ratio near 1).
+const LIMIT_16SPP: f64 = 1.4;
 
 #[test]
 fn frames_continue_the_sequence() {

@@ -2,34 +2,9 @@
 // the sample index is shuffled by a hash-based Owen scramble, the Sobol point of the shuffled
 // index is computed from the direction vectors, and a second, per-dimension Owen scramble
 // randomizes its digits. Bit for bit the `sobol_burley` crate's `sample(index, dimension,
-// seed)` (Kuo-Joe direction numbers, Laine-Karras-style hash with the crate's constants) for
+// seed)` (Joe and Kuo direction numbers, Laine-Karras-style hash with the crate's constants) for
 // index < 2^16 and the first four dimensions; `tests/sampler.rs` checks it on the GPU.
 // `_rev` values have their bits reversed, as in the crate.
-
-// Direction vectors of dimensions 0..3, 16 per dimension, bit-reversed (the 16 bits of a
-// sample index reach the 16 most significant bits of the point).
-const SOBOL_REV_DIRECTIONS = array<u32, 64>(
-    // dimension 0 (van der Corput)
-    0x00000001u, 0x00000002u, 0x00000004u, 0x00000008u,
-    0x00000010u, 0x00000020u, 0x00000040u, 0x00000080u,
-    0x00000100u, 0x00000200u, 0x00000400u, 0x00000800u,
-    0x00001000u, 0x00002000u, 0x00004000u, 0x00008000u,
-    // dimension 1
-    0x00000001u, 0x00000003u, 0x00000005u, 0x0000000fu,
-    0x00000011u, 0x00000033u, 0x00000055u, 0x000000ffu,
-    0x00000101u, 0x00000303u, 0x00000505u, 0x00000f0fu,
-    0x00001111u, 0x00003333u, 0x00005555u, 0x0000ffffu,
-    // dimension 2
-    0x00000001u, 0x00000003u, 0x00000006u, 0x00000009u,
-    0x00000017u, 0x0000003au, 0x00000071u, 0x000000a3u,
-    0x00000116u, 0x00000339u, 0x00000677u, 0x000009aau,
-    0x00001601u, 0x00003903u, 0x00007706u, 0x0000aa09u,
-    // dimension 3
-    0x00000001u, 0x00000003u, 0x00000004u, 0x0000000au,
-    0x0000001fu, 0x0000002eu, 0x00000045u, 0x000000c9u,
-    0x0000011bu, 0x000002a4u, 0x0000079au, 0x00000b67u,
-    0x0000101eu, 0x0000302du, 0x00004041u, 0x0000a0c3u,
-);
 
 const SOBOL_DIMENSIONS: u32 = 4u;
 
@@ -55,15 +30,40 @@ fn owen_scramble_rev(x_rev: u32, scramble: u32) -> u32 {
     return n;
 }
 
-// The Sobol point of dimension `dim` for the index whose reversed bits are `index_rev`
-// (its 16 least significant bits), bit-reversed.
+// The Sobol point of dimension `dim` (< 4) for the index whose reversed bits are
+// `index_rev` (its 16 least significant bits), bit-reversed. The direction vectors come from
+// their recurrences (Joe and Kuo's numbers, as the crate builds them), bit-reversed:
+// dimension 0 is the van der Corput sequence; 1 is x + 1 (m = 1); 2 is x^2 + x + 1
+// (m = 1, 3); 3 is x^3 + x + 1 (m = 1, 3, 1). Dimension d > 0 has degree d, so its first d
+// vectors are the m values. (A table indexed at run time compiled to a copy of the whole
+// table per lookup on Mesa: 30x slower.)
 fn sobol_rev(index_rev: u32, dim: u32) -> u32 {
     let index = reverseBits(index_rev) & 0xffffu;
+    if dim == 0u {
+        return index;
+    }
     var sobol = 0u;
-    for (var k = 0u; k < 16u; k++) {
-        if ((index >> k) & 1u) != 0u {
-            sobol ^= SOBOL_REV_DIRECTIONS[dim * 16u + k];
+    // The previous three direction vectors.
+    var h1 = 0u;
+    var h2 = 0u;
+    var h3 = 0u;
+    for (var k = 0u; (index >> k) != 0u; k++) {
+        var v: u32;
+        if k < dim {
+            v = select(select(4u, 3u, k == 1u), 1u, k == 0u);
+        } else if dim == 1u {
+            v = h1 ^ (h1 << 1u);
+        } else if dim == 2u {
+            v = h2 ^ (h2 << 2u) ^ h1;
+        } else {
+            v = h3 ^ (h3 << 3u) ^ h2;
         }
+        if ((index >> k) & 1u) != 0u {
+            sobol ^= v;
+        }
+        h3 = h2;
+        h2 = h1;
+        h1 = v;
     }
     return sobol;
 }
