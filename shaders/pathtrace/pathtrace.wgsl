@@ -5,7 +5,7 @@
 // (Mitsuba 3's conventions, so the references match). Samples that are not finite never
 // reach the output: they are dropped and counted in `stats[0]`.
 #import "pathtrace/scene_types.wgsl"
-#import "common/rng.wgsl"
+#import "pathtrace/sampler.wgsl"
 #import "common/sampling.wgsl"
 #import "pathtrace/options.wgsl"
 #import "pathtrace/bsdf.wgsl"
@@ -24,7 +24,8 @@ struct Frame {
     env_height: u32,
     // Largest channel value one sample may contribute (0: no clamp).
     firefly_clamp: f32,
-    pad0: u32,
+    // SAMPLER_SOBOL or SAMPLER_INDEPENDENT (sampler.wgsl).
+    sampler: u32,
     pad1: u32,
     pad2: u32,
 }
@@ -171,11 +172,12 @@ fn pick_light(u: f32) -> u32 {
     return select(e.other, i, scaled - f32(i) < e.prob);
 }
 
-fn sample_light(x: vec3f) -> LightSample {
+// A light sample seen from `x`; `bounce` picks the point's random numbers (sampler.wgsl).
+fn sample_light(x: vec3f, bounce: u32) -> LightSample {
     var out: LightSample;
     out.pdf = 0.0;
     let l = lights[pick_light(rand())];
-    let u = rand2();
+    let u = sample_2d_at(PAIR_LIGHT, bounce);
     if (l.flags & LIGHT_SPHERE) != 0u {
         // Uniform direction in the cone the sphere subtends.
         let r = l.e1.x;
@@ -245,7 +247,7 @@ fn camera_ray(pixel: vec2u, u: vec2f) -> Ray {
     let cam = frame.camera;
     var ray = pinhole_ray(pixel, u);
     if cam.aperture_radius > 0.0 {
-        let lens = cam.aperture_radius * sample_disk(rand2());
+        let lens = cam.aperture_radius * sample_disk(sample_2d(PAIR_LENS));
         let focus = cam.position + ray.dir * (cam.focus_distance / dot(ray.dir, cam.forward));
         ray.origin = cam.position + lens.x * cam.right + lens.y * cam.up;
         ray.dir = normalize(focus - ray.origin);
@@ -272,7 +274,7 @@ fn leave(s: Surface, on_sphere: bool, n: vec3f, dir: vec3f) -> vec3f {
 }
 
 fn trace_path(pixel: vec2u) -> vec3f {
-    var ray = camera_ray(pixel, rand2());
+    var ray = camera_ray(pixel, sample_2d(PAIR_PIXEL));
     var throughput = vec3f(1.0);
     var radiance = vec3f(0.0);
     // Solid-angle pdf of the BSDF sample that made `ray` (0: a mirror, interface or camera
@@ -349,7 +351,7 @@ fn trace_path(pixel: vec2u) -> vec3f {
                 let es = sample_env(rand(), rand2());
                 ls = LightSample(es.wi, F32_MAX, es.radiance, es.pdf * p_env, 0.0);
             } else {
-                ls = sample_light(s.p);
+                ls = sample_light(s.p, bounce);
             }
             if ls.pdf > 0.0 && dot(ng, ls.wi) * select(-1.0, 1.0, front || flip) > 0.0 {
                 let e = eval_bsdf(mat, wo, to_local * ls.wi);
@@ -364,7 +366,9 @@ fn trace_path(pixel: vec2u) -> vec3f {
             }
         }
 
-        let bs = sample_bsdf(mat, wo, rand(), vec3f(rand2(), rand()));
+        let u_lobe = rand();
+        let u_dir = sample_2d_at(PAIR_BSDF, bounce);
+        let bs = sample_bsdf(mat, wo, u_lobe, vec3f(u_dir, rand()));
         if !bs.valid {
             break;
         }
@@ -401,7 +405,7 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     ray_count = 0u;
     let n = frame.samples_per_frame;
     for (var i = 0u; i < n; i++) {
-        rng_init(pixel_index, frame.sample_offset + i, frame.settings.seed);
+        sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler);
         var l = trace_path(id.xy);
         if frame.firefly_clamp > 0.0 {
             let peak = max(l.x, max(l.y, l.z));

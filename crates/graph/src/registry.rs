@@ -252,6 +252,25 @@ fn builtin_kinds() -> Vec<NodeKind> {
                     },
                     doc: "how light sampling draws directions from an environment map",
                 },
+                ParamDef {
+                    name: "sampler",
+                    ty: ParamType::Enum {
+                        default: "sobol",
+                        options: &[
+                            (
+                                "sobol",
+                                "Owen-scrambled Sobol points for the pixel, lens, and first-hit \
+                                 light and BSDF samples; the other dimensions independent",
+                            ),
+                            (
+                                "independent",
+                                "every dimension from a PCG hash stream (a baseline for \
+                                 comparisons)",
+                            ),
+                        ],
+                    },
+                    doc: "how the random numbers of a path are drawn (docs/pathtracer.md)",
+                },
             ],
             sink: false,
             history: false,

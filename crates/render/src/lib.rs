@@ -22,6 +22,7 @@ pub mod nodes;
 mod pool;
 pub mod raycast;
 pub mod readback;
+pub mod sampler;
 mod scene_gpu;
 pub mod shader;
 pub mod specialize;

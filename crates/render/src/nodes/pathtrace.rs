@@ -42,6 +42,8 @@ pub(crate) struct PathTrace {
     env: crate::env_map::EnvMap,
     /// Largest channel value a sample may contribute; 0 is off.
     firefly_clamp: f32,
+    /// `SAMPLER_SOBOL` (0) or `SAMPLER_INDEPENDENT` (1) in `pathtrace/sampler.wgsl`.
+    sampler: u32,
 }
 
 impl PathTrace {
@@ -138,6 +140,7 @@ impl PathTrace {
             ggx_table,
             env,
             firefly_clamp: 0.0,
+            sampler: 0,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -158,7 +161,8 @@ impl PathTrace {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
         bytes.extend_from_slice(&self.firefly_clamp.to_le_bytes());
-        bytes.extend_from_slice(&[0; 12]);
+        bytes.extend_from_slice(&self.sampler.to_le_bytes());
+        bytes.extend_from_slice(&[0; 8]);
         bytes
     }
 }
@@ -169,6 +173,7 @@ impl NodeExec for PathTrace {
         #[expect(clippy::cast_possible_truncation, reason = "GPU math is f32")]
         let clamp = pass.params.float("firefly_clamp") as f32;
         self.firefly_clamp = clamp;
+        self.sampler = u32::from(pass.params.str("sampler") == "independent");
         Ok(())
     }
 
