@@ -163,6 +163,9 @@ impl Canvas {
         };
         let style = SnarlStyle {
             collapsible: Some(false),
+            // Pins on the frame's edge: with the default (inside the frame) the pin of
+            // every output row after the first is drawn over its label.
+            pin_placement: Some(egui_snarl::ui::PinPlacement::Edge),
             ..SnarlStyle::new()
         };
         let canvas_rect = ui.max_rect();

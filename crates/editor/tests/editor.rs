@@ -649,9 +649,9 @@ fn dragging_from_an_output_pin_to_an_input_pin_connects_them() {
     let mut h = harness(ed);
     // Where the pins are drawn at the default zoom (see the snapshot): input's output
     // pin, exposure's input pin, tonemap's output pin.
-    let input_out = egui::pos2(195.0, 339.0);
-    let exposure_in = egui::pos2(276.0, 339.0);
-    let tonemap_out = egui::pos2(552.0, 339.0);
+    let input_out = egui::pos2(204.0, 339.0);
+    let exposure_in = egui::pos2(267.0, 339.0);
+    let tonemap_out = egui::pos2(562.0, 339.0);
     drag(&mut h, input_out, exposure_in);
     let ed = h.state_mut();
     assert!(
@@ -674,4 +674,23 @@ fn dragging_from_an_output_pin_to_an_input_pin_connects_them() {
     // The wire was one edit.
     assert!(ed.doc.undo());
     assert!(!ed.doc.graph.edges.iter().any(|e| e.to == "exposure.color"));
+}
+
+/// The default graph on the Cornell box, paused after its first frame: nodes with several
+/// outputs show every pin label in full.
+#[test]
+fn snapshot_of_the_path_traced_graph() {
+    let Some(mut ed) = pathtrace_editor() else {
+        return;
+    };
+    ed.select(vec!["denoise".into()]);
+    ed.preview.paused = true;
+    let mut h = harness(ed);
+    h.run_ok();
+    // Timings vary from run to run; hide them.
+    h.state_mut().preview.pass_ms.clear();
+    h.state_mut().preview.stats = Default::default();
+    h.state_mut().message = None;
+    h.run_ok();
+    h.snapshot_options("editor_pathtrace_denoise", &snapshot_options());
 }
