@@ -220,8 +220,8 @@ fn sample_light(x: vec3f, bounce: u32) -> LightSample {
     out.dist = dist;
     out.radiance = l.emission;
     if HAS_TEXTURES {
-        // An emissive texture varies the emission over the triangle (selection stays by the
-        // factor's power).
+        // An emissive texture varies the emission over the triangle (selection goes by its
+        // mean over the triangle: `GpuLight::power`).
         let m = materials[tri_shading[l.prim].material];
         if tex_lo(m.tex_emissive_normal) != NO_TEX {
             out.radiance = textured_emission(m, tri_uv(tri_texcoords[l.prim], b.x, b.y));

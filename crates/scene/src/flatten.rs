@@ -1,5 +1,6 @@
 //! Flattening a [`Scene`] into a [`GpuScene`]: BVH, reordered primitives, materials,
-//! lights with a power-proportional alias table, camera and settings.
+//! lights with a power-proportional alias table (an emissive texture scales a triangle's
+//! power by its mean over the triangle), camera and settings.
 
 use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
@@ -87,6 +88,33 @@ fn gpu_material(m: &Material) -> GpuMaterial {
         tex_specular_color: tex16(m.textures.specular_color) | (0xFFFF << 16),
         pad0: 0,
         pad1: 0,
+    }
+}
+
+/// Smallest share of its factor's power an emitter with an emissive texture keeps for light
+/// selection, so that a footprint whose samples all fall on black texels stays selectable.
+pub const MIN_TEXTURED_POWER_SCALE: f32 = 1e-2;
+
+/// How much of the emissive factor's luminance the emissive texture of `m` leaves over a
+/// triangle with texture coordinates `uv`: the mean of the textured emission over the
+/// triangle ([`crate::texture::Texture::triangle_mean`]) over the factor's luminance, at
+/// least [`MIN_TEXTURED_POWER_SCALE`]. Only the selection probability uses it; the light's
+/// radiance is still read from the texture at the sampled point, so the estimate stays
+/// unbiased whatever the scale.
+fn textured_emission_scale(scene: &Scene, m: &Material, uv: [glam::Vec2; 3]) -> f32 {
+    let factor = luminance(m.emission);
+    let Some(tex) = scene.textures.get(m.textures.emissive as usize) else {
+        return 1.0;
+    };
+    if factor <= 0.0 {
+        return 1.0;
+    }
+    let mean = tex.triangle_mean(uv, true).truncate();
+    let scale = luminance(m.emission * mean) / factor;
+    if scale.is_finite() {
+        scale.clamp(MIN_TEXTURED_POWER_SCALE, 1.0)
+    } else {
+        1.0
     }
 }
 
@@ -235,7 +263,11 @@ impl GpuScene {
                 light = out.lights.len() as u32;
                 let area = t.area();
                 let sides = if m.two_sided { 2.0 } else { 1.0 };
-                let power = luminance(m.emission) * area * std::f32::consts::PI * sides;
+                let mut power = luminance(m.emission) * area * std::f32::consts::PI * sides;
+                if textured && m.textures.emissive != NO_TEXTURE {
+                    let uv = t.uvs.unwrap_or([glam::Vec2::ZERO; 3]);
+                    power *= textured_emission_scale(scene, m, uv);
+                }
                 weights.push(power);
                 out.lights.push(GpuLight {
                     p0: p0.to_array(),

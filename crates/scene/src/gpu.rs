@@ -209,8 +209,9 @@ pub struct GpuLight {
     pub area: f32,
     /// Emitted radiance, linear RGB (offset 48).
     pub emission: [f32; 3],
-    /// Power used for selection: luminance(emission) × area × π (× 2 if two-sided)
-    /// (offset 60). Selection probability = power / `GpuHeader::total_light_power`.
+    /// Power used for selection: luminance(emission) × area × π (× 2 if two-sided), × the
+    /// emissive texture's mean over the triangle when it has one (offset 60). Selection
+    /// probability = power / `GpuHeader::total_light_power`.
     pub power: f32,
 }
 

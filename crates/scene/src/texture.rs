@@ -73,6 +73,8 @@ pub struct Texture {
 pub const TEXTURE_DESC_WORDS: usize = 4;
 /// Descriptor flag: nearest-texel lookup.
 pub const TEX_NEAREST: u32 = 16;
+/// The finest subdivision [`Texture::triangle_mean`] uses: at most 64² = 4096 samples.
+pub const TRIANGLE_MEAN_MAX_SPLIT: u32 = 64;
 
 /// sRGB → linear, one channel in [0, 1] (the WGSL `srgb_decode`).
 pub fn srgb_decode(c: f32) -> f32 {
@@ -116,6 +118,34 @@ impl Texture {
             .fetch(x, y + 1, srgb)
             .lerp(self.fetch(x + 1, y + 1, srgb), t.x);
         a.lerp(b, t.y)
+    }
+
+    /// The mean of the filtered value over the triangle with corners `uvs` in texture space
+    /// (what [`Texture::sample`] returns, averaged over the triangle's area): the samples are
+    /// the centroids of the n² congruent sub-triangles of an n-fold subdivision, n chosen so
+    /// that there are about 16 per texel (4 ≤ n ≤ [`TRIANGLE_MEAN_MAX_SPLIT`]: fewer on
+    /// footprints over 256 texels). Exact for a constant texture.
+    pub fn triangle_mean(&self, uvs: [Vec2; 3], srgb: bool) -> Vec4 {
+        let (d1, d2) = (uvs[1] - uvs[0], uvs[2] - uvs[0]);
+        let texels = 0.5 * d1.perp_dot(d2).abs() * self.width as f32 * self.height as f32;
+        let n = if texels.is_finite() {
+            ((4.0 * texels.sqrt()).ceil() as u32).clamp(4, TRIANGLE_MEAN_MAX_SPLIT)
+        } else {
+            4
+        };
+        let at = |a: f32, b: f32| self.sample(uvs[0] + a * d1 + b * d2, srgb);
+        let inv = 1.0 / n as f32;
+        let mut sum = Vec4::ZERO;
+        for i in 0..n {
+            for j in 0..n - i {
+                // The upright sub-triangle at (i, j), and the inverted one beside it.
+                sum += at((i as f32 + 1.0 / 3.0) * inv, (j as f32 + 1.0 / 3.0) * inv);
+                if i + j + 1 < n {
+                    sum += at((i as f32 + 2.0 / 3.0) * inv, (j as f32 + 2.0 / 3.0) * inv);
+                }
+            }
+        }
+        sum / (n * n) as f32
     }
 
     /// The descriptor flags word.
