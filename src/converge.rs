@@ -163,6 +163,7 @@ pub fn run(args: &Args<'_>) -> Result<()> {
     let mut rows = Vec::new();
     let mut render_secs = 0.0;
     let mut spp = 1;
+    let mut clock;
     let last_tail_ms = loop {
         let t = Instant::now();
         let frames = spp - u32::try_from(exec.frames()).unwrap_or(spp);
@@ -170,6 +171,7 @@ pub fn run(args: &Args<'_>) -> Result<()> {
         render_secs += t.elapsed().as_secs_f64();
         let tail = exec.run_tail()?;
         let tail_secs = tail.wall.as_secs_f64();
+        clock = tail.pass_clock;
         let pass_ms = tail.pass_ms.unwrap_or_default();
         for (port, denoised) in &ports {
             let image = exec.read_port(port)?;
@@ -194,7 +196,10 @@ pub fn run(args: &Args<'_>) -> Result<()> {
     };
 
     print_table(&rows);
-    println!("GPU time per pass of the part run after rendering (last checkpoint):");
+    println!(
+        "time per pass of the part run after rendering (last checkpoint; {}):",
+        clock.describe()
+    );
     if last_tail_ms.is_empty() {
         println!("  not available (adapter has no timestamp queries)");
     }

@@ -319,7 +319,10 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
     };
     match &report.pass_ms {
         Some(times) => {
-            println!("GPU time per pass (last frame):");
+            println!(
+                "time per pass (last frame; {}):",
+                report.pass_clock.describe()
+            );
             for (name, ms) in times {
                 println!("  {name:<16} {ms:>9.3} ms");
             }

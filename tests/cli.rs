@@ -387,6 +387,39 @@ fn path_traced_render_reports_its_figures() {
     let exr = lumagraph::render::image_io::load(&out.path().join("render.exr")).unwrap();
     assert_eq!((exr.width, exr.height), (256, 256));
     assert!(out.path().join("render.png").is_file());
+
+    // Per-pass times: the path tracer is the cost of a frame. On a CPU adapter they are
+    // wall times of each pass alone (lavapipe's timestamps reported ~0.01 ms for a 250 ms
+    // path-tracing dispatch); there it must account for a good part of a frame (2 frames
+    // of 4 spp here; measured ~90 %, 25 % leaves room for a loaded machine).
+    let pass_ms = |name: &str| -> f64 {
+        let line = stdout
+            .lines()
+            .find(|l| l.trim_start().starts_with(&format!("{name} ")))
+            .unwrap_or_else(|| panic!("no time for {name} in:\n{stdout}"));
+        line.split_whitespace().nth(1).unwrap().parse().unwrap()
+    };
+    let trace = pass_ms("pathtrace");
+    for other in ["accumulate", "exposure", "tonemap"] {
+        assert!(
+            trace > pass_ms(other),
+            "pathtrace not the largest:\n{stdout}"
+        );
+    }
+    if stdout.contains("wall time of each pass") {
+        let seconds: f64 = stdout
+            .lines()
+            .find(|l| l.starts_with("rendered "))
+            .and_then(|l| l.split(" in ").nth(1))
+            .and_then(|t| t.split(' ').next())
+            .and_then(|t| t.parse().ok())
+            .unwrap_or_else(|| panic!("no render time in:\n{stdout}"));
+        let frame_ms = seconds * 1e3 / 2.0;
+        assert!(
+            trace > 0.25 * frame_ms,
+            "pathtrace {trace} ms of a {frame_ms} ms frame:\n{stdout}"
+        );
+    }
 }
 
 #[test]

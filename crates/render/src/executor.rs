@@ -77,11 +77,36 @@ enum Mode {
     Only,
 }
 
+/// How [`FrameReport::pass_ms`] was measured.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PassClock {
+    /// Timestamp queries written at the beginning and end of each pass.
+    #[default]
+    Timestamps,
+    /// Wall time of each pass submitted alone and waited for. Used on CPU adapters, whose
+    /// timestamps do not wait for a dispatch to finish (lavapipe reports ~0.01 ms for a
+    /// path-tracing dispatch of 250 ms and charges it to a later pass).
+    Wall,
+}
+
+impl PassClock {
+    /// How the times were measured, for reports.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Timestamps => "GPU timestamps",
+            Self::Wall => "wall time of each pass submitted alone (CPU adapter)",
+        }
+    }
+}
+
 /// What one frame did.
 #[derive(Clone, Debug, Default)]
 pub struct FrameReport {
-    /// GPU milliseconds per pass, when the adapter has timestamp queries.
+    /// Milliseconds per pass (summed by node) in the timed frame; `None` when the adapter
+    /// cannot time passes. [`FrameReport::pass_clock`] says how they were measured.
     pub pass_ms: Option<Vec<(String, f64)>>,
+    /// How `pass_ms` was measured.
+    pub pass_clock: PassClock,
     /// Wall time from recording to the last file written.
     pub wall: Duration,
     /// Files written by sinks.
@@ -98,6 +123,8 @@ pub struct Executor {
     slots: Vec<PooledTexture>,
     pool: TexturePool,
     timer: Option<GpuTimer>,
+    /// Time passes by wall clock (CPU adapters) instead of `timer`.
+    wall_clock: bool,
     frames: u64,
     /// Per pass: whether it feeds (or is) a node with history, and so runs every frame.
     every_frame: Vec<bool>,
@@ -132,7 +159,12 @@ impl Executor {
         let capacity = u32::try_from(plan.passes.len() * 8)
             .unwrap_or(u32::MAX)
             .max(8);
-        let timer = GpuTimer::new(ctx, capacity);
+        let wall_clock = ctx.is_cpu();
+        let timer = if wall_clock {
+            None
+        } else {
+            GpuTimer::new(ctx, capacity)
+        };
         let every_frame = every_frame(&plan);
         Ok(Self {
             ctx: ctx.clone(),
@@ -141,6 +173,7 @@ impl Executor {
             slots,
             pool,
             timer,
+            wall_clock,
             frames: 0,
             every_frame,
             only: Vec::new(),
@@ -308,12 +341,7 @@ impl Executor {
 
     fn run(&mut self, n: u32, mode: Mode) -> Result<FrameReport> {
         let start = Instant::now();
-        let mut encoder = self
-            .ctx
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("frame"),
-            });
+        let mut encoder = new_encoder(&self.ctx);
         if let Some(t) = &mut self.timer {
             t.begin_frame();
         }
@@ -322,6 +350,8 @@ impl Executor {
             slots: &self.slots,
         };
         let mut executed = Vec::with_capacity(self.plan.passes.len());
+        let timed = matches!(mode, Mode::Finish | Mode::Tail | Mode::Only);
+        let mut wall_ms: Vec<(String, f64)> = Vec::new();
         let n = n.max(1);
         for frame in 0..n {
             let last = mode != Mode::Progress && frame + 1 == n;
@@ -332,13 +362,29 @@ impl Executor {
                 {
                     continue;
                 }
-                let timer = if last && matches!(mode, Mode::Finish | Mode::Tail | Mode::Only) {
+                let timer = if last && timed {
                     self.timer.as_mut()
                 } else {
                     None
                 };
-                node.record(&self.ctx, &mut encoder, pass, &io, timer)
-                    .map_err(|e| e.in_node(&pass.node))?;
+                if last && timed && self.wall_clock {
+                    // Everything before this pass finishes first; then the pass alone.
+                    let before = std::mem::replace(&mut encoder, new_encoder(&self.ctx));
+                    submit_and_wait(&self.ctx, before)?;
+                    let t = Instant::now();
+                    node.record(&self.ctx, &mut encoder, pass, &io, None)
+                        .map_err(|e| e.in_node(&pass.node))?;
+                    let this = std::mem::replace(&mut encoder, new_encoder(&self.ctx));
+                    submit_and_wait(&self.ctx, this).map_err(|e| e.in_node(&pass.node))?;
+                    let ms = t.elapsed().as_secs_f64() * 1e3;
+                    match wall_ms.iter_mut().find(|(l, _)| *l == pass.node) {
+                        Some((_, total)) => *total += ms,
+                        None => wall_ms.push((pass.node.clone(), ms)),
+                    }
+                } else {
+                    node.record(&self.ctx, &mut encoder, pass, &io, timer)
+                        .map_err(|e| e.in_node(&pass.node))?;
+                }
                 if last {
                     executed.push(pass.node.clone());
                 }
@@ -347,15 +393,7 @@ impl Executor {
         if let Some(t) = &self.timer {
             t.resolve(&mut encoder);
         }
-        let scope = self
-            .ctx
-            .device
-            .push_error_scope(wgpu::ErrorFilter::Validation);
-        self.ctx.queue.submit([encoder.finish()]);
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Gpu(e.to_string()));
-        }
-        self.ctx.wait()?;
+        submit_and_wait(&self.ctx, encoder)?;
         let mut written = Vec::new();
         if matches!(mode, Mode::Finish | Mode::Tail | Mode::Only) {
             for (p, (pass, node)) in self.plan.passes.iter().zip(&mut self.nodes).enumerate() {
@@ -369,9 +407,8 @@ impl Executor {
             }
         }
         let pass_ms = match &self.timer {
-            Some(t) if matches!(mode, Mode::Finish | Mode::Tail | Mode::Only) => {
-                Some(t.read(&self.ctx)?)
-            }
+            _ if timed && self.wall_clock => Some(wall_ms),
+            Some(t) if timed => Some(t.read(&self.ctx)?),
             _ => None,
         };
         if !matches!(mode, Mode::Tail | Mode::Only) {
@@ -379,6 +416,11 @@ impl Executor {
         }
         Ok(FrameReport {
             pass_ms,
+            pass_clock: if self.wall_clock {
+                PassClock::Wall
+            } else {
+                PassClock::Timestamps
+            },
             wall: start.elapsed(),
             written,
             executed,
@@ -485,4 +527,22 @@ fn same_structure(a: &Plan, b: &Plan) -> bool {
             .zip(&b.slots)
             .all(|(s, t)| s.format == t.format && s.extent == t.extent && s.textures == t.textures);
     passes && textures && slots
+}
+
+fn new_encoder(ctx: &GpuContext) -> wgpu::CommandEncoder {
+    ctx.device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("frame"),
+        })
+}
+
+/// Submits `encoder`, turning validation errors into [`RenderError::Gpu`], and waits for
+/// the queue.
+fn submit_and_wait(ctx: &GpuContext, encoder: wgpu::CommandEncoder) -> Result<()> {
+    let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+    ctx.queue.submit([encoder.finish()]);
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(RenderError::Gpu(e.to_string()));
+    }
+    ctx.wait()
 }
