@@ -108,6 +108,9 @@ pub struct Editor {
     pub recent: Recent,
     clipboard: Option<Graph>,
     dialog: Option<Dialog>,
+    /// What to do once the graph is saved through the file dialog (Save in the
+    /// unsaved-changes prompt of an untitled graph).
+    after_save: Option<Then>,
     /// Set when the window may close even with unsaved changes.
     pub quit_confirmed: bool,
     /// Set when the editor asked the window to close.
@@ -156,6 +159,7 @@ impl Editor {
             scene_generation: 0,
             preview_max: config.preview_max.max(1),
             file_dialog: None,
+            after_save: None,
         };
         if let Some(p) = graph {
             editor.open(p);
@@ -307,11 +311,17 @@ impl Editor {
     pub fn apply_pick(&mut self, pick: &Pick, path: &Path) {
         match pick {
             Pick::OpenGraph => self.ask(Then::Open(path.to_owned())),
-            Pick::SaveGraph => {
-                if let Err(e) = self.save_as(path) {
+            Pick::SaveGraph => match self.save_as(path) {
+                Ok(()) => {
+                    if let Some(then) = self.after_save.take() {
+                        self.proceed(then);
+                    }
+                }
+                Err(e) => {
+                    self.after_save = None;
                     self.say(e.to_string(), true);
                 }
-            }
+            },
             Pick::Scene => {
                 self.load_scene(path);
             }
@@ -339,7 +349,11 @@ impl Editor {
                 self.apply_pick(&pick, &path);
             }
             egui_file_dialog::DialogState::Open => {}
-            _ => self.file_dialog = None,
+            _ => {
+                // Cancelled: whatever waited for a save does not happen.
+                self.file_dialog = None;
+                self.after_save = None;
+            }
         }
     }
 

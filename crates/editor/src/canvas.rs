@@ -253,7 +253,7 @@ impl Canvas {
 pub struct NodeInfo<'a> {
     /// Compile errors per node id.
     pub errors: &'a BTreeMap<String, Vec<String>>,
-    /// GPU ms per node id, from the last preview frame.
+    /// Milliseconds per node id, from the last preview frame.
     pub pass_ms: &'a BTreeMap<String, f64>,
     /// The previewed port.
     pub preview: Option<&'a str>,
@@ -470,8 +470,10 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
         snarl: &mut Snarl<String>,
     ) {
         if let Some(ms) = self.info.pass_ms.get(&snarl[node]) {
-            ui.weak(format!("GPU {ms:.2} ms"))
-                .on_hover_text("GPU time of this node's passes in the last preview frame");
+            ui.weak(format!("{ms:.2} ms")).on_hover_text(
+                "time of this node's passes in the last preview frame: GPU timestamps, or on \
+                 a CPU adapter the wall time of each pass submitted alone",
+            );
         }
     }
 

@@ -93,7 +93,8 @@ pub struct Preview {
     pub image: Option<PreviewImage>,
     texture: Option<egui::TextureHandle>,
     texture_stale: bool,
-    /// GPU ms per node of the last frame (empty without timestamp queries).
+    /// Milliseconds per node of the last frame (see `FrameReport::pass_clock`; empty when
+    /// the adapter cannot time passes).
     pub pass_ms: BTreeMap<String, f64>,
     /// Why there is no preview, when there is none.
     pub error: Option<String>,

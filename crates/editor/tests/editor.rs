@@ -385,6 +385,38 @@ fn closing_with_unsaved_changes_asks_first() {
     assert!(h.state().quit_confirmed && h.state().wants_close);
 }
 
+/// Save in the unsaved-changes prompt of an untitled graph opens Save as; once the file is
+/// written the quit goes on (and the file holds the graph).
+#[test]
+fn saving_an_untitled_graph_from_the_quit_prompt_then_quits() {
+    let Some(mut ed) = editor(None, None) else {
+        return;
+    };
+    ed.doc
+        .add_node("Exposure", Some((0.0, 0.0)))
+        .expect("an Exposure node");
+    ed.doc.end_gesture();
+    assert!(!ed.on_close_requested());
+    let mut h = harness(ed);
+    h.get_by_label("Unsaved changes");
+    h.get_by_label("Save").click();
+    h.run_ok();
+    let pick = h.state().file_dialog.as_ref().map(|(p, _)| p.clone());
+    assert_eq!(pick, Some(Pick::SaveGraph));
+    assert!(!h.state().wants_close, "quit before the graph was saved");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("untitled.ron");
+    // What the dialog hands over when a file name is typed and confirmed.
+    h.state_mut().file_dialog = None;
+    h.state_mut().apply_pick(&Pick::SaveGraph, &path);
+    h.run_ok();
+    let ed = h.state();
+    assert!(ed.quit_confirmed && ed.wants_close);
+    let saved = Graph::load(&path).expect("the saved graph");
+    assert_eq!(saved.nodes.len(), 1);
+    assert_eq!(saved.nodes[0].kind, "Exposure");
+}
+
 /// Time of a param edit (compile, `update_params`, frame, readback) against a rebuild,
 /// printed for the docs; asserts only that a param edit does not rebuild.
 #[test]

@@ -135,7 +135,9 @@ impl Editor {
                         Err(e) => self.say(e.to_string(), true),
                     }
                 } else {
+                    // Save as first; the quit, new or open goes on once it is saved.
                     close = true;
+                    self.after_save = Some(then.clone());
                     self.open_file_dialog(Pick::SaveGraph);
                 }
             }
