@@ -13,7 +13,9 @@
 // exact normal and depth, so silhouettes and normals match the ray tracer's.
 // With textures (HAS_TEXTURES), fragments of textured materials take their albedo and normal
 // through the path tracer's own functions (pathtrace/textures.wgsl) at the interpolated UV.
-// Outputs: albedo (base color), shading normal, distance along the ray; 0 where nothing is hit.
+// Outputs: albedo (base color; alpha 2 on emissive materials, 1 on others, which Denoise uses
+// to keep lights and lit surfaces apart), shading normal, distance along the ray; 0 where
+// nothing is hit.
 #import "pathtrace/scene_types.wgsl"
 #import "pathtrace/textures.wgsl"
 #import "gbuffer/options.wgsl"
@@ -98,7 +100,8 @@ fn pixel_ray(xy: vec2f) -> vec3f {
 fn fs_main(f: VertexOut) -> FragmentOut {
     let dir = pixel_ray(f.clip.xy);
     var out: FragmentOut;
-    out.albedo = vec4f(f.albedo, 1.0);
+    let flag = select(1.0, 2.0, any(materials[f.material].emission > vec3f(0.0)));
+    out.albedo = vec4f(f.albedo, flag);
     if f.sphere.w > 0.0 {
         // The ray-sphere hit nearest the camera in front of it (the path tracer's test).
         let oc = cam.position - f.sphere.xyz;
@@ -126,7 +129,7 @@ fn fs_main(f: VertexOut) -> FragmentOut {
         var ns = select(f.sphere.xyz, normalize(n), dot(n, n) > 0.0);
         if HAS_TEXTURES {
             let m = textured_material(materials[f.material], f.uv);
-            out.albedo = vec4f(m.base_color, 1.0);
+            out.albedo = vec4f(m.base_color, flag);
             ns = normal_mapped(m, ns, f.sphere.xyz, f.uv, f.tangent);
         }
         out.normal = vec4f(ns, 1.0);

@@ -16,6 +16,10 @@
 //         s = sqrt(3×3 Gaussian of the variance) when variance-guided, else 2^-pass
 //   w_n = exp(-max(1 - dot(n_p, n_q), 0) / max(sigma_normal, 1e-6))
 //   w_z = exp(-|z_p - z_q| / (sigma_depth * |grad z · offset| + 1e-3 z_p + 1e-6))
+// and 0 when one of p and q is an emitter and the other is not (GBuffer writes albedo alpha
+// 2 on emitters, 1 elsewhere): a light beside a ceiling of the same normal, depth and albedo
+// is told apart only by luminance, which a large variance at the light's edge pixels
+// disarms, so without this the light bleeds into the dark strip around it.
 // Every input is loaded through `finite`, so NaN or Inf anywhere becomes 0, never output.
 
 struct Params {
@@ -47,6 +51,12 @@ const KERNEL = array<f32, 3>(0.375, 0.25, 0.0625);
 fn finite(v: vec4f) -> vec4f {
     let e = bitcast<vec4u>(v) & vec4u(0x7f800000u);
     return select(vec4f(0.0), v, e != vec4u(0x7f800000u));
+}
+
+// Whether the G-buffer marks `p` as an emitter (albedo alpha 2; 1 on other surfaces, 0 where
+// nothing is hit or the albedo comes from elsewhere).
+fn emitter_at(p: vec2i) -> bool {
+    return finite(textureLoad(albedo, p, 0)).a > 1.5;
 }
 
 fn albedo_at(p: vec2i) -> vec3f {
@@ -128,6 +138,7 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     let l_p = dot(center.rgb, LUMA);
     let n_p = finite(textureLoad(normal, p, 0)).xyz;
     let z_p = depth_at(p);
+    let e_p = emitter_at(p);
     let grad = depth_gradient(p, size, z_p);
 
     var s = params.scale;
@@ -160,7 +171,8 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
             let w_n = max(1.0 - dot(n_p, n_q), 0.0) / n_denom;
             let z_scale = params.sigma_depth * abs(dot(grad, vec2f(offset))) + z_eps;
             let w_z = abs(z_p - z_q) / z_scale;
-            let w = h * exp(-(w_l + w_n + w_z));
+            let same = e_p == emitter_at(q);
+            let w = select(0.0, h * exp(-(w_l + w_n + w_z)), same);
             color += w * c.rgb;
             var_sum += w * w * c.a;
             wsum += w;

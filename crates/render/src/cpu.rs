@@ -237,7 +237,8 @@ fn finite4(p: [f32; 4]) -> [f32; 4] {
 }
 
 /// The à-trous filter of `shaders/post/denoise.wgsl`, mirrored: demodulation, then
-/// `iterations` passes, then remodulation. Depth is read from channel 0 of `depth`.
+/// `iterations` passes, then remodulation. Depth is read from channel 0 of `depth`; an albedo
+/// alpha above 1.5 marks an emitter, which shares no taps with other pixels.
 ///
 /// # Panics
 /// When the images differ in size.
@@ -260,6 +261,7 @@ pub fn denoise(
     let alb = |i: usize| map3(rgb(finite4(albedo.pixels[i])), |v| v.max(EPS));
     let z = |i: usize| finite4(depth.pixels[i])[0];
     let nrm = |i: usize| rgb(finite4(normal.pixels[i]));
+    let emitter = |i: usize| finite4(albedo.pixels[i])[3] > 1.5;
     let dot3 = |a: V3, b: V3| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     // Demodulation.
     let mut cur: Vec<[f32; 4]> = (0..color.pixels.len())
@@ -333,6 +335,9 @@ pub fn denoise(
                             continue;
                         }
                         let q = idx(qx, qy);
+                        if emitter(q) != emitter(i) {
+                            continue;
+                        }
                         let c = finite4(cur[q]);
                         let hk =
                             KERNEL[dx.unsigned_abs() as usize] * KERNEL[dy.unsigned_abs() as usize];

@@ -133,8 +133,9 @@ impl GBuffer {
             });
         }
         let camera = uniform_buffer(ctx, "gbuffer camera", &camera_bytes(&scene));
-        // Without textures the shader reads neither: zeroed stand-ins.
-        let storage = |label: &str, bytes: &[u8]| {
+        // The materials are always read (their emission marks emitters); the textures only
+        // with textures: without, a zeroed stand-in.
+        let storage = |label: &str, bytes: &[u8], textured: bool| {
             let zeros = [0_u8; 80];
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
@@ -146,8 +147,16 @@ impl GBuffer {
                 usage: wgpu::BufferUsages::STORAGE,
             })
         };
-        let materials = storage("gbuffer materials", bytemuck::cast_slice(&scene.materials));
-        let textures = storage("gbuffer textures", bytemuck::cast_slice(&scene.textures));
+        let materials = storage(
+            "gbuffer materials",
+            bytemuck::cast_slice(&scene.materials),
+            true,
+        );
+        let textures = storage(
+            "gbuffer textures",
+            bytemuck::cast_slice(&scene.textures),
+            textured,
+        );
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer"),
             layout: &layout,
