@@ -439,9 +439,13 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         var albedo = vec3f(0.0);
         var normal = vec3f(0.0);
         var depth = 0.0;
+        // As GBuffer: alpha 2 on emitters, 1 on other surfaces, 0 where nothing is hit (Denoise
+        // never mixes emitters with the rest).
+        var flag = 0.0;
         if hit.prim != NO_HIT {
             let s = surface_at(ray, hit);
             var m = materials[s.material];
+            flag = select(1.0, 2.0, any(m.emission > vec3f(0.0)));
             if HAS_TEXTURES {
                 m = textured_material(m, s.uv);
             }
@@ -449,7 +453,7 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
             normal = s.ns;
             depth = hit.t;
         }
-        textureStore(out_albedo, id.xy, vec4f(albedo, 1.0));
+        textureStore(out_albedo, id.xy, vec4f(albedo, flag));
         textureStore(out_normal, id.xy, vec4f(normal, 1.0));
         textureStore(out_depth, id.xy, vec4f(depth, 0.0, 0.0, 0.0));
     }

@@ -206,7 +206,8 @@ fn builtin_kinds() -> Vec<NodeKind> {
                 OutputDef {
                     name: "albedo",
                     ty: PortType::Albedo,
-                    doc: "base color at the first hit through the pixel center (0 on a miss)",
+                    doc: "base color at the first hit through the pixel center; alpha 2 on emitters, 1 \
+                          elsewhere (0 on a miss)",
                 },
                 OutputDef {
                     name: "normal",
@@ -318,7 +319,8 @@ fn builtin_kinds() -> Vec<NodeKind> {
                 OutputDef {
                     name: "albedo",
                     ty: PortType::Albedo,
-                    doc: "material base color (0 where nothing is hit)",
+                    doc: "material base color; alpha 2 on emitters, 1 elsewhere (0 where nothing is \
+                          hit)",
                 },
                 OutputDef {
                     name: "normal",
