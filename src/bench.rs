@@ -1,5 +1,6 @@
 //! `lumagraph bench`: path tracing throughput on the current adapter, with the
-//! scene-specialized shader and the general (BVH) one side by side.
+//! scene-specialized shader (with its scene data inlined, then read from buffers) and the
+//! general (BVH) one side by side.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -14,6 +15,7 @@ fn measure(
     ctx: &GpuContext,
     scene: &Arc<GpuScene>,
     general: bool,
+    data_in_buffers: bool,
     spp: u32,
     runs: u32,
 ) -> Result<(f64, String)> {
@@ -31,6 +33,7 @@ fn measure(
     let resources = Resources {
         scene: Some(Arc::clone(scene)),
         general_shaders: general,
+        scene_data_in_buffers: data_in_buffers,
         ..Resources::default()
     };
     let mut exec = Executor::new(ctx, plan, &resources)?;
@@ -61,16 +64,30 @@ pub fn run(scene: &Arc<GpuScene>, spp: u32, runs: u32) -> Result<()> {
         "{}x{}, {} bounces, {spp} spp per run, best of {runs}:",
         scene.settings.width, scene.settings.height, scene.settings.max_bounces
     );
-    let (special, how_s) = measure(&ctx, scene, false, spp, runs)?;
+    let (special, how_s) = measure(&ctx, scene, false, false, spp, runs)?;
     println!(
         "  specialized  {:>8.3} M paths/s   ({how_s})",
         special / 1e6
     );
-    let (general, how_g) = measure(&ctx, scene, true, spp, runs)?;
+    let inlined = how_s.contains("materials and lights inlined");
+    let buffers = if inlined {
+        let (buffers, how_b) = measure(&ctx, scene, false, true, spp, runs)?;
+        println!(
+            "  buffers      {:>8.3} M paths/s   ({how_b})",
+            buffers / 1e6
+        );
+        Some(buffers)
+    } else {
+        None
+    };
+    let (general, how_g) = measure(&ctx, scene, true, false, spp, runs)?;
     println!(
         "  general      {:>8.3} M paths/s   ({how_g})",
         general / 1e6
     );
+    if let Some(buffers) = buffers {
+        println!("  specialized / buffers: {:.2}x", special / buffers);
+    }
     println!("  specialized / general: {:.2}x", special / general);
     Ok(())
 }

@@ -294,6 +294,7 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
         out_dir: args.out.to_owned(),
         scene: scene.as_ref().map(|s| Arc::clone(&s.gpu)),
         general_shaders: false,
+        scene_data_in_buffers: false,
     };
     let left_out = plan.left_out.clone();
     let mut exec = Executor::new(&ctx, plan, &resources)?;
@@ -346,6 +347,7 @@ fn print_features(plan: &lumagraph::graph::Plan, scene: &GpuScene) {
             aovs: ["albedo", "normal", "depth"]
                 .iter()
                 .any(|port| pass.output(port).is_some()),
+            data_in_buffers: false,
         };
         let features = lumagraph::render::specialize::features(scene, options);
         println!("shader features of {} for this scene:", pass.node);

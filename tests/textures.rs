@@ -576,6 +576,7 @@ fn plan_lists_textures_for_textured_scenes_only() {
     let opts = PathTraceOptions {
         specialize: true,
         aovs: false,
+        data_in_buffers: false,
     };
     let on = |path: &Path| {
         let scene = GpuScene::build(&Scene::load(path).unwrap()).unwrap();

@@ -55,6 +55,7 @@ struct Frame {
 @group(0) @binding(17) var<storage, read> textures: array<u32>;
 
 #import "pathtrace/intersect.wgsl"
+#import "pathtrace/scene_data.wgsl"
 
 const RR_START: u32 = 5u;
 
@@ -92,14 +93,14 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
     s.err = vec3f(0.0);
     s.uv = vec2f(0.0);
     if (hit.prim & PRIM_SPHERE) != 0u {
-        let sph = spheres[hit.prim & ~PRIM_SPHERE];
+        let sph = scene_sphere(hit.prim & ~PRIM_SPHERE);
         s.ng = normalize(s.p - sph.center);
         s.ns = s.ng;
         s.material = sph.material;
         s.light = sph.light;
     } else {
-        let tri = tri_positions[hit.prim];
-        let sh = tri_shading[hit.prim];
+        let tri = scene_tri_positions(hit.prim);
+        let sh = scene_tri_shading(hit.prim);
         // Position from the barycentrics: more accurate than origin + t * dir far away.
         s.p = tri.v0 + hit.u * tri.e1 + hit.v * tri.e2;
         s.err = barycentric_err(tri.v0, tri.e1, tri.e2, hit.u, hit.v);
@@ -115,7 +116,7 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
         if HAS_TEXTURES {
             let tc = tri_texcoords[hit.prim];
             s.uv = tri_uv(tc, hit.u, hit.v);
-            s.ns = normal_mapped(materials[sh.material], s.ns, s.ng, s.uv, tri_tangent(tc, hit.u, hit.v));
+            s.ns = normal_mapped(scene_material(sh.material), s.ns, s.ng, s.uv, tri_tangent(tc, hit.u, hit.v));
         }
     }
     return s;
@@ -168,7 +169,7 @@ fn pick_light(u: f32) -> u32 {
     let n = frame.header.num_lights;
     let scaled = u * f32(n);
     let i = min(u32(scaled), n - 1u);
-    let e = light_alias[i];
+    let e = scene_light_alias(i);
     return select(e.other, i, scaled - f32(i) < e.prob);
 }
 
@@ -176,7 +177,7 @@ fn pick_light(u: f32) -> u32 {
 fn sample_light(x: vec3f, bounce: u32) -> LightSample {
     var out: LightSample;
     out.pdf = 0.0;
-    let l = lights[pick_light(rand())];
+    let l = scene_light(pick_light(rand()));
     let u = sample_2d_at(PAIR_LIGHT, bounce);
     if (l.flags & LIGHT_SPHERE) != 0u {
         // Uniform direction in the cone the sphere subtends.
@@ -222,7 +223,7 @@ fn sample_light(x: vec3f, bounce: u32) -> LightSample {
     if HAS_TEXTURES {
         // An emissive texture varies the emission over the triangle (selection goes by its
         // mean over the triangle: `GpuLight::power`).
-        let m = materials[tri_shading[l.prim].material];
+        let m = scene_material(scene_tri_shading(l.prim).material);
         if tex_lo(m.tex_emissive_normal) != NO_TEX {
             out.radiance = textured_emission(m, tri_uv(tri_texcoords[l.prim], b.x, b.y));
         }
@@ -314,7 +315,7 @@ fn trace_path(pixel: vec2u) -> vec3f {
         // from inside, start 256 float steps off it (Wachter and Binder).
         let on_sphere = (hit.prim & PRIM_SPHERE) != 0u;
         skip_prim = select(hit.prim, NO_HIT, on_sphere);
-        var mat = materials[s.material];
+        var mat = scene_material(s.material);
         if HAS_TEXTURES {
             mat = textured_material(mat, s.uv);
         }
@@ -326,7 +327,7 @@ fn trace_path(pixel: vec2u) -> vec3f {
         if s.light != NO_LIGHT && (front || two_sided) {
             var w = 1.0;
             if bsdf_pdf > 0.0 {
-                w = mis_power(bsdf_pdf, light_pdf(lights[s.light], prev_p, s.p, s.ng));
+                w = mis_power(bsdf_pdf, light_pdf(scene_light(s.light), prev_p, s.p, s.ng));
             }
             radiance += throughput * mat.emission * w;
         }
@@ -444,7 +445,7 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         var flag = 0.0;
         if hit.prim != NO_HIT {
             let s = surface_at(ray, hit);
-            var m = materials[s.material];
+            var m = scene_material(s.material);
             flag = select(1.0, 2.0, any(m.emission > vec3f(0.0)));
             if HAS_TEXTURES {
                 m = textured_material(m, s.uv);

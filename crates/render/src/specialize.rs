@@ -4,7 +4,10 @@
 //! constants written into the shader are nearly free; on GPUs, tiny scenes gain too. So a
 //! scene with few primitives gets an intersection routine that tests every primitive with
 //! its coordinates written into the code, replacing `pathtrace/intersect.wgsl` (the BVH
-//! traversal over storage buffers) through the import resolver's overrides.
+//! traversal over storage buffers) through the import resolver's overrides. Such a scene,
+//! unless textured, also gets its materials, lights, light alias table and per-primitive
+//! shading data written into the code (`pathtrace/scene_data.wgsl` replaced), so no bounce
+//! reads them from memory; the images are bit-identical to reading the buffers.
 
 use std::fmt::Write as _;
 
@@ -73,6 +76,222 @@ fn occluded(ray: Ray, t_max: f32) -> bool {{
     ))
 }
 
+/// Scenes with at most this many materials (and [`INLINE_MAX_PRIMITIVES`] primitives) get
+/// their materials, lights and per-primitive shading data written into the shader.
+pub const INLINE_MAX_MATERIALS: usize = 64;
+
+/// WGSL literals for scene values; remembers whether one was not finite (WGSL has no
+/// literal for it).
+#[derive(Default)]
+struct Literals {
+    not_finite: std::cell::Cell<bool>,
+}
+
+impl Literals {
+    /// An f32 literal that parses back to exactly `x` (the shortest round-trip decimal).
+    fn f(&self, x: f32) -> String {
+        if !x.is_finite() {
+            self.not_finite.set(true);
+        }
+        format!("{x:?}f")
+    }
+
+    fn v3(&self, v: [f32; 3]) -> String {
+        format!(
+            "vec3f({}, {}, {})",
+            self.f(v[0]),
+            self.f(v[1]),
+            self.f(v[2])
+        )
+    }
+}
+
+fn u(x: u32) -> String {
+    format!("{x}u")
+}
+
+/// WGSL functions returning row `i` of a table as a `ty` struct with fields of `types`:
+/// one function per field, which compares `i` with the start of each run of equal values
+/// and assigns (a select once compiled: no branch, no memory), so a field equal in every row
+/// is a constant. A `const` array indexed at run time would instead be copied to scratch
+/// memory per lookup on some drivers (Mesa's was 30x slower); a `switch` over the ids was
+/// measured slower than these comparisons on lavapipe.
+fn table_fns(name: &str, ty: &str, types: &[&str], rows: &[Vec<String>]) -> String {
+    let mut out = String::new();
+    let mut args = Vec::new();
+    for (k, field_ty) in types.iter().enumerate() {
+        let _ = writeln!(out, "fn {name}_{k}(i: u32) -> {field_ty} {{");
+        match rows.first() {
+            None => {
+                let _ = writeln!(out, "    return {field_ty}();");
+            }
+            Some(first) => {
+                let _ = writeln!(out, "    var r = {};", first[k]);
+                for (j, row) in rows.iter().enumerate().skip(1) {
+                    if row[k] != rows[j - 1][k] {
+                        let _ = writeln!(out, "    if i >= {j}u {{ r = {}; }}", row[k]);
+                    }
+                }
+                out.push_str("    return r;\n");
+            }
+        }
+        out.push_str("}\n\n");
+        args.push(format!("{name}_{k}(i)"));
+    }
+    let _ = writeln!(
+        out,
+        "fn {name}(i: u32) -> {ty} {{\n    return {ty}({});\n}}\n",
+        args.join(", ")
+    );
+    out
+}
+
+/// Generated replacement for `pathtrace/scene_data.wgsl`: materials, lights, the light
+/// alias table and every primitive's position and shading data written into the code and
+/// returned by id, or `None` when the scene is too large ([`INLINE_MAX_PRIMITIVES`],
+/// [`INLINE_MAX_MATERIALS`]), textured (texture lookups read their buffers anyway), or holds
+/// a value that is not finite.
+pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
+    if scene.tri_positions.len() + scene.spheres.len() > INLINE_MAX_PRIMITIVES
+        || scene.materials.len() > INLINE_MAX_MATERIALS
+        || scene.header.features & lumagraph_scene::FEATURE_TEXTURES != 0
+    {
+        return None;
+    }
+    let l = Literals::default();
+    let (f3, f1, u1) = ("vec3f", "f32", "u32");
+    let materials: Vec<Vec<String>> = scene
+        .materials
+        .iter()
+        .map(|m| {
+            vec![
+                l.v3(m.base_color),
+                l.f(m.roughness),
+                l.v3(m.emission),
+                l.f(m.metallic),
+                l.f(m.specular),
+                l.f(m.specular_tint),
+                l.f(m.transmission),
+                l.f(m.ior),
+                u(m.tex_base_mr),
+                u(m.tex_emissive_normal),
+                u(m.flags),
+                l.f(m.normal_scale),
+                u(m.tex_transmission_specular),
+                u(m.tex_specular_color),
+                u(0),
+                u(0),
+            ]
+        })
+        .collect();
+    let lights: Vec<Vec<String>> = scene
+        .lights
+        .iter()
+        .map(|x| {
+            vec![
+                l.v3(x.p0),
+                u(x.flags),
+                l.v3(x.e1),
+                u(x.prim),
+                l.v3(x.e2),
+                l.f(x.area),
+                l.v3(x.emission),
+                l.f(x.power),
+            ]
+        })
+        .collect();
+    let alias: Vec<Vec<String>> = scene
+        .light_alias
+        .iter()
+        .map(|a| vec![l.f(a.prob), u(a.other)])
+        .collect();
+    let positions: Vec<Vec<String>> = scene
+        .tri_positions
+        .iter()
+        .map(|t| vec![l.v3(t.v0), u(0), l.v3(t.e1), u(0), l.v3(t.e2), u(0)])
+        .collect();
+    // Normals are read only with TRI_VERTEX_NORMALS: without, zeros (longer runs).
+    let shading: Vec<Vec<String>> = scene
+        .tri_shading
+        .iter()
+        .map(|t| {
+            let smooth = t.flags & lumagraph_scene::TRI_VERTEX_NORMALS != 0;
+            let n = |v: [f32; 3]| {
+                if smooth {
+                    l.v3(v)
+                } else {
+                    "vec3f()".to_owned()
+                }
+            };
+            vec![
+                n(t.n0),
+                u(t.material),
+                n(t.n1),
+                u(t.light),
+                n(t.n2),
+                u(t.flags),
+            ]
+        })
+        .collect();
+    let spheres: Vec<Vec<String>> = scene
+        .spheres
+        .iter()
+        .map(|s| {
+            vec![
+                l.v3(s.center),
+                l.f(s.radius),
+                u(s.material),
+                u(s.light),
+                u(0),
+                u(0),
+            ]
+        })
+        .collect();
+    if l.not_finite.get() {
+        return None;
+    }
+    let material_types = [
+        f3, f1, f3, f1, f1, f1, f1, f1, u1, u1, u1, f1, u1, u1, u1, u1,
+    ];
+    Some(format!(
+        "// Generated for this scene: {} materials, {} lights, {} triangles and {} spheres,
+// returned by id with their values in the code (no material, light or shading buffer read).
+#import \"pathtrace/scene_types.wgsl\"
+
+{}{}{}{}{}{}",
+        materials.len(),
+        lights.len(),
+        positions.len(),
+        spheres.len(),
+        table_fns("scene_material", "Material", &material_types, &materials),
+        table_fns(
+            "scene_light",
+            "Light",
+            &[f3, u1, f3, u1, f3, f1, f3, f1],
+            &lights
+        ),
+        table_fns("scene_light_alias", "AliasEntry", &[f1, u1], &alias),
+        table_fns(
+            "scene_tri_positions",
+            "TriPositions",
+            &[f3, u1, f3, u1, f3, u1],
+            &positions
+        ),
+        table_fns(
+            "scene_tri_shading",
+            "TriShading",
+            &[f3, u1, f3, u1, f3, u1],
+            &shading
+        ),
+        table_fns(
+            "scene_sphere",
+            "Sphere",
+            &[f3, f1, u1, u1, u1, u1],
+            &spheres
+        ),
+    ))
+}
+
 /// What the graph needs of the path tracer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PathTraceOptions {
@@ -80,6 +299,10 @@ pub struct PathTraceOptions {
     pub specialize: bool,
     /// Write the first-hit AOVs (albedo, normal, depth): something reads them.
     pub aovs: bool,
+    /// With `specialize`, keep materials, lights and shading data in their storage buffers
+    /// even where the scene is small enough to write them into the shader (tests and
+    /// benchmarks compare the two; images are bit-identical).
+    pub data_in_buffers: bool,
 }
 
 /// One feature of the path tracer, compiled in or left out for a scene, and why.
@@ -116,6 +339,11 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
     let env_map = scene.settings.env_kind == lumagraph_scene::ENV_MAP;
     let lights = scene.lights.len();
     let textured = scene.header.features & lumagraph_scene::FEATURE_TEXTURES != 0;
+    let inline_data = inline
+        && !options.data_in_buffers
+        && !textured
+        && m.len() <= INLINE_MAX_MATERIALS
+        && inline_scene_data(scene).is_some();
     let textured_materials = count(&|x| {
         [
             x.tex_base_mr,
@@ -146,6 +374,31 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
             },
         ),
         feature("inline intersection", inline, format!("{prims} primitives")),
+        feature(
+            "inline materials and lights",
+            inline_data,
+            if inline_data {
+                format!(
+                    "{} materials, {lights} lights, {prims} primitives' shading data",
+                    m.len()
+                )
+            } else if all {
+                "general shader (specialization off)".to_owned()
+            } else if !inline {
+                format!("{prims} primitives > {INLINE_MAX_PRIMITIVES}: read from buffers")
+            } else if options.data_in_buffers {
+                "forced off: read from buffers".to_owned()
+            } else if textured {
+                "textured materials: read from buffers".to_owned()
+            } else if m.len() > INLINE_MAX_MATERIALS {
+                format!(
+                    "{} materials > {INLINE_MAX_MATERIALS}: read from buffers",
+                    m.len()
+                )
+            } else {
+                "a value is not finite: read from buffers".to_owned()
+            },
+        ),
         feature(
             "light sampling (NEE + MIS)",
             all || lights > 0,
@@ -239,6 +492,11 @@ pub fn pathtrace_source(
     {
         overrides.push(("pathtrace/intersect.wgsl", code));
     }
+    if on("inline materials and lights")
+        && let Some(code) = inline_scene_data(scene)
+    {
+        overrides.push(("pathtrace/scene_data.wgsl", code));
+    }
     let left_out: Vec<&str> = features
         .iter()
         .filter(|f| !f.included)
@@ -246,7 +504,9 @@ pub fn pathtrace_source(
         .collect();
     let how = format!(
         "{}; left out: {}",
-        if on("inline intersection") {
+        if on("inline materials and lights") {
+            "intersection inlined, materials and lights inlined"
+        } else if on("inline intersection") {
             "intersection inlined"
         } else {
             "BVH traversal"

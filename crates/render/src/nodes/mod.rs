@@ -30,6 +30,9 @@ pub struct Resources {
     pub scene: Option<Arc<lumagraph_scene::GpuScene>>,
     /// Use the general shaders even where a scene-specialized one exists (benchmarks).
     pub general_shaders: bool,
+    /// In the specialized shader, keep materials, lights and shading data in their storage
+    /// buffers even where they could be written into the code (tests and benchmarks).
+    pub scene_data_in_buffers: bool,
 }
 
 /// A named count a node keeps (samples, rays, dropped samples), since its last reset.

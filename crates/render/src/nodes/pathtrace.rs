@@ -57,6 +57,7 @@ impl PathTrace {
             .any(|p| pass.output(p).is_some());
         let options = crate::specialize::PathTraceOptions {
             specialize: !resources.general_shaders,
+            data_in_buffers: resources.scene_data_in_buffers,
             aovs,
         };
         let (source, how) = crate::specialize::pathtrace_source(&scene, options)?;
