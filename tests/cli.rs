@@ -553,6 +553,12 @@ fn plan_lists_shader_features_for_the_scene() {
         stdout.contains("compiled in:\n    inline intersection"),
         "{stdout}"
     );
+    assert!(
+        stdout.contains(
+            "    inline materials and lights  4 materials, 2 lights, 36 primitives' shading data"
+        ),
+        "{stdout}"
+    );
 }
 
 #[test]

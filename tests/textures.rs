@@ -589,6 +589,18 @@ fn plan_lists_textures_for_textured_scenes_only() {
     assert!(inc && tc == 12 && words > 4, "{inc} {tc} {words}");
     // Untextured: left out, and no texcoords or texels uploaded.
     assert_eq!(on(&common::repo("assets/cornell.ron")), (false, 0, 0));
+    // Textured scenes keep materials and lights in their buffers, however small.
+    let scene =
+        GpuScene::build(&Scene::load(&common::repo("assets/boxtextured.ron")).unwrap()).unwrap();
+    let f = features(&scene, opts);
+    let inline = f
+        .iter()
+        .find(|f| f.name == "inline materials and lights")
+        .unwrap();
+    assert!(
+        !inline.included && inline.reason.contains("textured"),
+        "{inline:?}"
+    );
 }
 
 /// `Texture::triangle_mean` against a dense grid over the same triangles (the mean of the
