@@ -8,7 +8,7 @@
 //! - Same seed and spp: bit-identical images; no NaN/Inf sample dropped.
 //! - Materials, lights and shading data written into the specialized shader or read from
 //!   their buffers: bit-identical color and first-hit AOVs (Cornell; spheres of every lobe
-//!   under an environment), 64×64 at 8 spp.
+//!   under an environment; Cornell with 28 spheres of 28 materials), 64×64 at 8 spp.
 
 mod common;
 
@@ -269,8 +269,13 @@ fn render_small(name: &str, spp: u32, in_buffers: bool) -> Option<(Vec<Image>, S
 #[test]
 fn inlined_scene_data_renders_bit_identical_images() {
     // Cornell: triangles, an area light (NEE + MIS); the material furnace: spheres, every
-    // lobe, a constant environment. Same math, only where the data comes from differs.
-    for name in ["cornell.ron", "furnace_materials.ron"] {
+    // lobe, a constant environment; Cornell with 28 spheres of 28 materials: the largest
+    // scene inlined (64 primitives). Same math, only where the data comes from differs.
+    for name in [
+        "cornell.ron",
+        "furnace_materials.ron",
+        "cornell_spheres.ron",
+    ] {
         let Some((inline, how_inline)) = render_small(name, 8, false) else {
             return;
         };
