@@ -9,7 +9,7 @@ use wgpu::util::DeviceExt as _;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::kernel::{Binding, Kernel, uniform_buffer};
-use crate::readback::map_read;
+use crate::readback::{compute_and_read, groups_1d};
 use crate::scene_gpu::SceneBuffers;
 
 /// One ray: origin, direction (any length) and the largest `t` that counts.
@@ -85,51 +85,26 @@ impl Raycaster {
                 contents: bytemuck::cast_slice(rays),
                 usage: wgpu::BufferUsages::STORAGE,
             });
-        let size = rays.len() as u64 * 16;
-        let hits = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("raycast hits"),
-            size,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("raycast readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = ctx
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("raycast"),
-            });
-        let groups = count.div_ceil(64);
-        self.kernel
-            .pass("raycast")
-            .uniform(&params)
-            .buffer(&queries)
-            .buffer(&hits)
-            .buffer(&scene.bvh_nodes)
-            .buffer(&scene.tri_positions)
-            .buffer(&scene.spheres)
-            .dispatch(
-                ctx,
-                &mut encoder,
-                [groups.min(65535), groups.div_ceil(65535), 1],
-                None,
-            )?;
-        encoder.copy_buffer_to_buffer(&hits, 0, &readback, 0, size);
-        ctx.queue.submit([encoder.finish()]);
-        map_read(ctx, &readback, size, |bytes| {
-            bytemuck::pod_collect_to_vec::<u8, GpuHit>(bytes)
-                .into_iter()
-                .map(|h| Hit {
-                    prim: h.prim,
-                    t: h.t,
-                    u: h.u,
-                    v: h.v,
-                })
-                .collect()
-        })
+        let hits =
+            compute_and_read::<GpuHit>(ctx, "raycast hits", rays.len(), |encoder, output| {
+                self.kernel
+                    .pass("raycast")
+                    .uniform(&params)
+                    .buffer(&queries)
+                    .buffer(output)
+                    .buffer(&scene.bvh_nodes)
+                    .buffer(&scene.tri_positions)
+                    .buffer(&scene.spheres)
+                    .dispatch(ctx, encoder, groups_1d(count, 64), None)
+            })?;
+        Ok(hits
+            .into_iter()
+            .map(|h| Hit {
+                prim: h.prim,
+                t: h.t,
+                u: h.u,
+                v: h.v,
+            })
+            .collect())
     }
 }

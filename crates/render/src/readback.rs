@@ -36,6 +36,49 @@ pub fn map_read<T>(
     Ok(out)
 }
 
+/// Runs a compute job that writes `count` values of `T` into a storage buffer and reads them
+/// back: `record` gets a fresh encoder and the output buffer (`STORAGE | COPY_SRC`) and
+/// records the dispatch; the copy, the submission and the wait follow.
+///
+/// # Errors
+/// What `record` returns, or when mapping fails or the GPU does not finish.
+pub fn compute_and_read<T: bytemuck::Pod>(
+    ctx: &GpuContext,
+    label: &str,
+    count: usize,
+    record: impl FnOnce(&mut wgpu::CommandEncoder, &wgpu::Buffer) -> Result<()>,
+) -> Result<Vec<T>> {
+    let size = (count * std::mem::size_of::<T>()) as u64;
+    let output = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("compute readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = ctx
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    record(&mut encoder, &output)?;
+    encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, size);
+    ctx.queue.submit([encoder.finish()]);
+    map_read(ctx, &readback, size, |bytes| {
+        bytemuck::pod_collect_to_vec::<u8, T>(bytes)
+    })
+}
+
+/// Workgroup counts for `count` invocations of a 1D kernel of `size` lanes, folded into a
+/// second dimension past the 65 535-group limit.
+pub fn groups_1d(count: u32, size: u32) -> [u32; 3] {
+    let groups = count.div_ceil(size);
+    [groups.min(65535), groups.div_ceil(65535), 1]
+}
+
 /// Reads a whole texture back as tightly packed rows of texels.
 ///
 /// # Errors

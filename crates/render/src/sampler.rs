@@ -7,7 +7,7 @@ use wgpu::util::DeviceExt as _;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::kernel::{Binding, Kernel, uniform_buffer};
-use crate::readback::map_read;
+use crate::readback::{compute_and_read, groups_1d};
 
 /// What a query asks for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -107,40 +107,13 @@ impl SamplerCheck {
                 contents: bytemuck::cast_slice(&words),
                 usage: wgpu::BufferUsages::STORAGE,
             });
-        let size = queries.len() as u64 * 8;
-        let output = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("sampler points"),
-            size,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("sampler readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = ctx
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("sampler"),
-            });
-        let groups = count.div_ceil(64);
-        self.kernel
-            .pass("sampler")
-            .uniform(&params)
-            .buffer(&input)
-            .buffer(&output)
-            .dispatch(
-                ctx,
-                &mut encoder,
-                [groups.min(65535), groups.div_ceil(65535), 1],
-                None,
-            )?;
-        encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, size);
-        ctx.queue.submit([encoder.finish()]);
-        map_read(ctx, &readback, size, |bytes| {
-            bytemuck::pod_collect_to_vec::<u8, [f32; 2]>(bytes)
+        compute_and_read::<[f32; 2]>(ctx, "sampler points", queries.len(), |encoder, output| {
+            self.kernel
+                .pass("sampler")
+                .uniform(&params)
+                .buffer(&input)
+                .buffer(output)
+                .dispatch(ctx, encoder, groups_1d(count, 64), None)
         })
     }
 }
