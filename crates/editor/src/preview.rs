@@ -28,7 +28,6 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use lumagraph_graph::{CompileOptions, Graph, Node, Params, Plan, PortType, Registry};
-use lumagraph_render::cpu::{srgb_encode, to_u8};
 use lumagraph_render::{Executor, FrameReport, GpuContext, Resources, source_extent};
 use lumagraph_scene::GpuScene;
 
@@ -202,20 +201,7 @@ pub fn compile_preview(
 
 /// Converts read-back texels to 8-bit RGBA the way the Output node writes a PNG.
 pub fn encode_rgba8(image: &lumagraph_render::cpu::Image, ty: PortType) -> Vec<u8> {
-    let linear = ty != PortType::LdrColor;
-    let encode = |x: f32| if linear { srgb_encode(x) } else { x };
-    image
-        .pixels
-        .iter()
-        .flat_map(|p| {
-            [
-                to_u8(encode(p[0])),
-                to_u8(encode(p[1])),
-                to_u8(encode(p[2])),
-                to_u8(p[3]),
-            ]
-        })
-        .collect()
+    lumagraph_render::image_io::to_rgba8(image, ty != PortType::LdrColor)
 }
 
 impl Preview {

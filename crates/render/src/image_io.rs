@@ -208,6 +208,24 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<(
     write(path, &encode_png(width, height, rgba8)?)
 }
 
+/// 8-bit RGBA texels as a PNG stores them: color sRGB-encoded first when `linear` is set,
+/// then every channel clipped to [0, 1] and rounded; alpha as it is.
+pub fn to_rgba8(image: &Image, linear: bool) -> Vec<u8> {
+    let encode = |x: f32| if linear { srgb_encode(x) } else { x };
+    image
+        .pixels
+        .iter()
+        .flat_map(|p| {
+            [
+                to_u8(encode(p[0])),
+                to_u8(encode(p[1])),
+                to_u8(encode(p[2])),
+                to_u8(p[3]),
+            ]
+        })
+        .collect()
+}
+
 /// Writes an image to a file chosen by extension, atomically: `.exr` as 32-bit float RGBA
 /// as it is; `.png` as 8-bit, sRGB-encoding the values first when `linear` is set.
 ///
@@ -216,22 +234,7 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<(
 pub fn save(path: &Path, image: &Image, linear: bool) -> Result<()> {
     match extension(path).as_str() {
         "exr" => write(path, &encode_exr(image, false)?),
-        "png" => {
-            let encode = |x: f32| if linear { srgb_encode(x) } else { x };
-            let bytes: Vec<u8> = image
-                .pixels
-                .iter()
-                .flat_map(|p| {
-                    [
-                        to_u8(encode(p[0])),
-                        to_u8(encode(p[1])),
-                        to_u8(encode(p[2])),
-                        to_u8(p[3]),
-                    ]
-                })
-                .collect();
-            write_png(path, image.width, image.height, &bytes)
-        }
+        "png" => write_png(path, image.width, image.height, &to_rgba8(image, linear)),
         other => Err(RenderError::image(
             path,
             format!("unsupported output extension \".{other}\" (use .png or .exr)"),
