@@ -143,6 +143,17 @@ enum Command {
         #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
         overrides: Vec<String>,
     },
+    /// Write the resolved scene for other renderers: scene.json (camera, materials, spheres,
+    /// lights, environment, settings) and OBJ files of its triangles; scripts/references/
+    /// builds Mitsuba 3 scenes from it.
+    #[command(after_help = "Example:\n  lumagraph export assets/cornell.ron --out cornell_export")]
+    Export {
+        /// Scene file.
+        scene: PathBuf,
+        /// Folder to write into (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Write the generated HDR test chart (the source of `assets/test_chart.exr`).
     #[command(hide = true)]
     TestChart {
@@ -469,6 +480,13 @@ fn run(cli: Cli) -> Result<()> {
             out: &out,
             overrides: &overrides,
         }),
+        Command::Export { scene, out } => {
+            let loaded = load_scene(Some(&scene))?.context("no scene")?;
+            for path in lumagraph::scene::export::export(&loaded.scene, &loaded.gpu, &out)? {
+                println!("wrote {}", path.display());
+            }
+            Ok(())
+        }
         Command::TestChart { out } => {
             let chart = image_io::test_chart();
             let bytes = image_io::encode_exr(&chart, true)?;

@@ -64,16 +64,3 @@ fn mis_power(a: f32, b: f32) -> f32 {
     let b2 = b * b;
     return select(0.0, a2 / (a2 + b2), a2 + b2 > 0.0);
 }
-
-// Offsets a ray origin off a surface along the geometric normal by `steps` float steps of
-// the position's magnitude (Wächter and Binder, Ray Tracing Gems, ch. 6, who use 256). The
-// path tracer uses it off spheres only, which a ray can hit again from inside: rays leave a
-// triangle from the hit itself (see `origin_n` in primitives.wgsl), since any offset is at
-// least a float step (1/128 at 1e5) and moves shadow edges.
-fn offset_ray(p: vec3f, n: vec3f, steps: f32) -> vec3f {
-    let of_i = vec3i(steps * n);
-    let pi = bitcast<vec3f>(bitcast<vec3i>(p) + select(of_i, -of_i, p < vec3f(0.0)));
-    let origin = 1.0 / 32.0;
-    let float_scale = 1.0 / 65536.0;
-    return select(pi, p + float_scale * n, abs(p) < vec3f(origin));
-}

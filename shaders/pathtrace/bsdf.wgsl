@@ -2,10 +2,15 @@
 //   dielectric layer  (1 - metallic)(1 - transmission): GGX specular with Schlick Fresnel
 //                     (F0 = 0.08 specular, tinted by specular_tint) over a Lambertian base
 //                     that receives exactly the energy the specular does not reflect;
-//   metal             metallic: GGX with Schlick Fresnel on base_color, plus Kulla-Conty
-//                     multiple-scattering compensation;
+//   metal             metallic: GGX with Schlick Fresnel on base_color, or the exact
+//                     conductor Fresnel of a complex index eta + i k (MATERIAL_CONDUCTOR),
+//                     plus Kulla-Conty multiple-scattering compensation;
 //   glass             (1 - metallic) transmission: dielectric interface (exact Fresnel with
 //                     ior), reflection or refraction chosen by Fresnel, rough by GGX.
+// MATERIAL_SINGLE_SCATTER leaves out what stands in for multiple scattering (the metal's
+// Kulla-Conty term; rough glass's reflections into the surface, sent back out, and its
+// missing shadowing of the outgoing direction), as Mitsuba's roughconductor and
+// roughdielectric do.
 // The GGX albedo tables (`ggx_table`, computed by crates/render/src/bsdf_tables.rs and
 // declared by the includer) make the white furnace white at every roughness.
 // Vectors are in the shading frame (normal = +z); wo points to the viewer.
@@ -85,6 +90,49 @@ fn lobe_albedo(f0: vec3f, t: vec2f) -> vec3f {
     return f0 * t.x + schlick_f90(f0) * t.y;
 }
 
+// Unpolarized Fresnel reflectance of a conductor of complex index eta + i k (per channel) at
+// incidence cosine cos_i; mirrors crates/scene/src/conductor.rs.
+fn fresnel_conductor(cos_i: f32, eta: vec3f, k: vec3f) -> vec3f {
+    let c2 = clamp(cos_i * cos_i, 0.0, 1.0);
+    let s2 = 1.0 - c2;
+    let t0 = eta * eta - k * k - s2;
+    let a2b2 = sqrt(max(t0 * t0 + 4.0 * eta * eta * k * k, vec3f(0.0)));
+    let t1 = a2b2 + c2;
+    let a = sqrt(max(0.5 * (a2b2 + t0), vec3f(0.0)));
+    let t2 = 2.0 * abs(cos_i) * a;
+    let rs = (t1 - t2) / max(t1 + t2, vec3f(1e-30));
+    let t3 = c2 * a2b2 + s2 * s2;
+    let t4 = t2 * s2;
+    let rp = rs * (t3 - t4) / max(t3 + t4, vec3f(1e-30));
+    return clamp(0.5 * (rs + rp), vec3f(0.0), vec3f(1.0));
+}
+
+fn is_conductor(m: Material) -> bool {
+    return (m.flags & MATERIAL_CONDUCTOR) != 0u;
+}
+
+fn multiscatter(m: Material) -> bool {
+    return (m.flags & MATERIAL_SINGLE_SCATTER) == 0u;
+}
+
+// The metal lobe's Fresnel reflectance at microfacet cosine c.
+fn metal_fresnel(m: Material, c: f32) -> vec3f {
+    if is_conductor(m) {
+        return fresnel_conductor(c, m.eta, m.k);
+    }
+    return schlick(m.base_color, c);
+}
+
+// Its cosine-weighted hemispherical average (Schlick's in closed form; a conductor's is
+// integrated on the CPU).
+fn metal_fresnel_avg(m: Material) -> vec3f {
+    if is_conductor(m) {
+        return m.f_avg;
+    }
+    let f0 = m.base_color;
+    return f0 + (schlick_f90(f0) - f0) / 21.0;
+}
+
 // Unpolarized Fresnel reflectance of a dielectric interface; eta = eta_t / eta_i.
 fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
@@ -118,7 +166,8 @@ fn layer_spec_prob(m: Material, es_o: vec3f) -> f32 {
     return clamp(s / max(s + d, 1e-6), 0.1, 0.9);
 }
 
-// Probability of sampling the single-scattering part of the metal lobe.
+// Probability of sampling the single-scattering part of the metal lobe (the rest is
+// cosine-sampled for the multiple-scattering term).
 fn metal_ss_prob(e_o: f32) -> f32 {
     return clamp(e_o, 0.25, 1.0);
 }
@@ -133,6 +182,11 @@ fn lobe_params(m: Material) -> LobeParams {
     let r = clamp(m.roughness, 0.0, 1.0);
     let alpha = r * r;
     return LobeParams(r, alpha * alpha, alpha < ALPHA_MIN);
+}
+
+// `metal_ss_prob`, or 1 where there is no multiple-scattering term to sample.
+fn metal_ss_sample_prob(m: Material, lp: LobeParams, e_o: f32) -> f32 {
+    return select(metal_ss_prob(e_o), 1.0, lp.is_smooth || !multiscatter(m));
 }
 
 // The non-delta, non-glass part of the BSDF: f * cos(wi) and the solid-angle pdf with which
@@ -181,15 +235,17 @@ fn eval_bsdf(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
         out.pdf += w.x * (ps * vndf_pdf + (1.0 - ps) * cos_pdf);
     }
     if HAS_METAL && w.y > 0.0 {
-        let f0 = m.base_color;
         let e_o = to.x + to.y;
-        let e_i = ti.x + ti.y;
-        let e_avg = ta.x + ta.y;
-        let f_avg = f0 + (schlick_f90(f0) - f0) / 21.0;
-        let f_ms = f_avg * f_avg * e_avg / (1.0 - f_avg * (1.0 - e_avg));
-        let ms = f_ms * (1.0 - e_o) * (1.0 - e_i) / (PI * max(1.0 - e_avg, 1e-4)) * wi.z;
-        let ss = g2_over * schlick(f0, dot(wo, h));
-        let q = select(metal_ss_prob(e_o), 1.0, lp.is_smooth);
+        let ss = g2_over * metal_fresnel(m, dot(wo, h));
+        var ms = vec3f(0.0);
+        if multiscatter(m) {
+            let e_i = ti.x + ti.y;
+            let e_avg = ta.x + ta.y;
+            let f_avg = metal_fresnel_avg(m);
+            let f_ms = f_avg * f_avg * e_avg / (1.0 - f_avg * (1.0 - e_avg));
+            ms = f_ms * (1.0 - e_o) * (1.0 - e_i) / (PI * max(1.0 - e_avg, 1e-4)) * wi.z;
+        }
+        let q = metal_ss_sample_prob(m, lp, e_o);
         out.f_cos += w.y * (ss + ms);
         out.pdf += w.y * (q * vndf_pdf + (1.0 - q) * cos_pdf);
     }
@@ -218,16 +274,30 @@ fn sample_glass(m: Material, lp: LobeParams, wo: vec3f, u: vec3f) -> BsdfSample 
     let f = fresnel_dielectric(c, eta);
     var wi: vec3f;
     var weight = vec3f(1.0);
+    let single = !lp.is_smooth && !multiscatter(m);
     if u.z < f {
         wi = 2.0 * c * mh - wo_l;
         // A reflection into the surface would scatter again on the microsurface; send it
-        // out mirrored instead, which keeps the energy (a multiple-scattering stand-in).
+        // out mirrored instead, which keeps the energy (a multiple-scattering stand-in), or
+        // lose it (single scattering).
+        if single && wi.z <= 0.0 {
+            return BsdfSample(vec3f(0.0, 0.0, 1.0), vec3f(0.0), 0.0, false);
+        }
         wi.z = abs(wi.z);
     } else {
         wi = refract(-wo_l, mh, 1.0 / eta);
+        if single && wi.z >= 0.0 {
+            return BsdfSample(vec3f(0.0, 0.0, 1.0), vec3f(0.0), 0.0, false);
+        }
         wi.z = -abs(wi.z);
         // Radiance is compressed into a smaller solid angle entering a denser medium.
         weight = m.base_color / (eta * eta);
+    }
+    if single {
+        // f cos / pdf of a visible-normal sample of a single-scattering microfacet
+        // interface: the shadowing of wi, G2(wo, wi) / G1(wo).
+        let zi = abs(wi.z);
+        weight *= smith_g2(wo_l.z, zi, lp.a2) / smith_g1(wo_l.z, lp.a2);
     }
     return BsdfSample(normalize(vec3f(wi.xy, wi.z * s)), weight, 0.0, true);
 }
@@ -255,19 +325,21 @@ fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     var p_mirror: f32;
     var fresnel_f0: vec3f;
     let v = (u_lobe - w.z) / max(1.0 - w.z, 1e-6);
-    if v * (w.x + w.y) < w.x {
+    let layer = v * (w.x + w.y) < w.x;
+    if layer {
         fresnel_f0 = dielectric_f0(m);
         p_mirror = w.x * layer_spec_prob(m, lobe_albedo(fresnel_f0, to));
     } else {
         fresnel_f0 = m.base_color;
-        p_mirror = w.y * select(metal_ss_prob(to.x + to.y), 1.0, lp.is_smooth);
+        p_mirror = w.y * metal_ss_sample_prob(m, lp, to.x + to.y);
     }
-    let p_lobe = select(w.y, w.x, v * (w.x + w.y) < w.x);
+    let p_lobe = select(w.y, w.x, layer);
     let mirror = u.z * p_lobe < p_mirror;
     if mirror && lp.is_smooth {
         // Perfect mirror: a delta lobe, weighted by its Fresnel over its probability.
         out.wi = vec3f(-wo.xy, wo.z);
-        out.weight = p_lobe * schlick(fresnel_f0, wo.z) / p_mirror;
+        let fresnel = select(metal_fresnel(m, wo.z), schlick(fresnel_f0, wo.z), layer);
+        out.weight = p_lobe * fresnel / p_mirror;
         out.valid = true;
         return out;
     }

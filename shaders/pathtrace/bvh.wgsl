@@ -48,7 +48,7 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
             } else {
                 for (var i = first; i < first + count; i = i + 1u) {
                     let s = spheres[i];
-                    let t = intersect_sphere(ray.origin, ray.dir, s.center, s.radius, hit.t);
+                    let t = intersect_sphere_from(i | PRIM_SPHERE, ray.origin, ray.dir, s.center, s.radius, hit.t);
                     if (t > 0.0) {
                         hit = Hit(i | PRIM_SPHERE, t, 0.0, 0.0);
                         if (any_hit) {

@@ -7,12 +7,13 @@
 #import "pathtrace/scene_types.wgsl"
 #import "common/sampling.wgsl"
 
-// World direction to the map's frame: undo the azimuth (about y), then the elevation
-// (about x).
+// The map is placed as Mitsuba's `envmap` with to_world = R_y(azimuth) R_x(elevation)
+// (right-handed rotations). World direction to the map's frame: undo the azimuth, then the
+// elevation.
 fn env_to_map(d: vec3f) -> vec3f {
     let az = frame.settings.env_azimuth;
     let el = frame.settings.env_elevation;
-    let a = vec3f(cos(az) * d.x + sin(az) * d.z, d.y, -sin(az) * d.x + cos(az) * d.z);
+    let a = vec3f(cos(az) * d.x - sin(az) * d.z, d.y, sin(az) * d.x + cos(az) * d.z);
     return vec3f(a.x, cos(el) * a.y + sin(el) * a.z, -sin(el) * a.y + cos(el) * a.z);
 }
 
@@ -20,18 +21,20 @@ fn env_from_map(m: vec3f) -> vec3f {
     let az = frame.settings.env_azimuth;
     let el = frame.settings.env_elevation;
     let a = vec3f(m.x, cos(el) * m.y - sin(el) * m.z, sin(el) * m.y + cos(el) * m.z);
-    return vec3f(cos(az) * a.x - sin(az) * a.z, a.y, sin(az) * a.x + cos(az) * a.z);
+    return vec3f(cos(az) * a.x + sin(az) * a.z, a.y, -sin(az) * a.x + cos(az) * a.z);
 }
 
-// u grows with the azimuth from -z towards +x; v from +y (top row) down.
+// Mitsuba's equirectangular mapping: u = atan2(x, -z) / 2pi (mod 1), so the image's left edge
+// is seen along -z, its centre column along +z and u = 1/4 along +x; v grows from +y (top
+// row) down.
 fn env_uv(m: vec3f) -> vec2f {
-    let u = 0.5 + atan2(m.x, -m.z) * (0.5 * INV_PI);
+    let u = fract(atan2(m.x, -m.z) * (0.5 * INV_PI) + 1.0);
     let v = acos(clamp(m.y, -1.0, 1.0)) * INV_PI;
     return vec2f(u, v);
 }
 
 fn env_dir(uv: vec2f) -> vec3f {
-    let phi = (uv.x - 0.5) * TWO_PI;
+    let phi = uv.x * TWO_PI;
     let theta = uv.y * PI;
     let s = sin(theta);
     return vec3f(s * sin(phi), cos(theta), -s * cos(phi));

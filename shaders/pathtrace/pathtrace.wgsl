@@ -1,6 +1,7 @@
 // Path tracer megakernel: one invocation per pixel traces `samples_per_frame` paths and
 // writes their mean radiance. Unidirectional path tracing with next-event estimation and
-// multiple importance sampling (power heuristic) for emissive triangles and spheres,
+// multiple importance sampling (power heuristic) for emissive triangles and spheres and the
+// environment map, next-event estimation alone for point, spot and directional lights,
 // Russian roulette from the fifth bounce, one-sided Lambertian materials and emitters
 // (Mitsuba 3's conventions, so the references match). Samples that are not finite never
 // reach the output: they are dropped and counted in `stats[0]`.
@@ -26,8 +27,27 @@ struct Frame {
     firefly_clamp: f32,
     // SAMPLER_SOBOL or SAMPLER_INDEPENDENT (sampler.wgsl).
     sampler: u32,
-    pad1: u32,
+    // STRATEGY_MIS, STRATEGY_LIGHT or STRATEGY_BSDF: how direct light is estimated.
+    strategy: u32,
     pad2: u32,
+}
+
+const STRATEGY_MIS: u32 = 0u;
+const STRATEGY_LIGHT: u32 = 1u;
+const STRATEGY_BSDF: u32 = 2u;
+
+// Weight of emission that a BSDF-sampled ray (solid-angle pdf `bsdf_pdf`, 0 after a mirror,
+// an interface or from the camera) finds where light sampling has pdf `light_pdf`.
+fn hit_weight(bsdf_pdf: f32, light_pdf: f32) -> f32 {
+    if bsdf_pdf == 0.0 || frame.strategy == STRATEGY_BSDF {
+        return 1.0;
+    }
+    return select(mis_power(bsdf_pdf, light_pdf), 0.0, frame.strategy == STRATEGY_LIGHT);
+}
+
+// Weight of a light sample of pdf `light_pdf` where BSDF sampling has pdf `bsdf_pdf`.
+fn light_weight(light_pdf: f32, bsdf_pdf: f32) -> f32 {
+    return select(mis_power(light_pdf, bsdf_pdf), 1.0, frame.strategy == STRATEGY_LIGHT);
 }
 
 @group(0) @binding(0) var output: texture_storage_2d<rgba32float, write>;
@@ -133,6 +153,9 @@ struct LightSample {
     // what is coplanar with it): the sampled point's error off the light's plane over the
     // cosine there, and a relative term for the error of t.
     margin: f32,
+    // A point, spot or directional light: `pdf` is only its selection probability, and no
+    // BSDF-sampled ray can reach it (no MIS).
+    delta: bool,
 }
 
 fn env_map_on() -> bool {
@@ -177,8 +200,34 @@ fn pick_light(u: f32) -> u32 {
 fn sample_light(x: vec3f, bounce: u32) -> LightSample {
     var out: LightSample;
     out.pdf = 0.0;
+    out.delta = false;
     let l = scene_light(pick_light(rand()));
     let u = sample_2d_at(PAIR_LIGHT, bounce);
+    if (l.flags & LIGHT_DELTA) != 0u {
+        out.delta = true;
+        out.pdf = light_select_pdf(l);
+        if (l.flags & LIGHT_DIRECTIONAL) != 0u {
+            out.wi = -l.e1;
+            out.dist = F32_MAX;
+            out.radiance = l.emission;
+            out.margin = 0.0;
+            return out;
+        }
+        let d = l.p0 - x;
+        let dist2 = dot(d, d);
+        let dist = sqrt(dist2);
+        out.wi = d / dist;
+        out.dist = dist;
+        out.margin = EDGE_ERR * dist;
+        var falloff = 1.0;
+        if (l.flags & LIGHT_SPOT) != 0u {
+            // Full within the beam width e2.y, linear in angle to 0 at the cutoff e2.x.
+            let theta = acos(clamp(dot(-out.wi, l.e1), -1.0, 1.0));
+            falloff = clamp((l.e2.x - theta) / max(l.e2.x - l.e2.y, 1e-12), 0.0, 1.0);
+        }
+        out.radiance = l.emission * (falloff / dist2);
+        return out;
+    }
     if (l.flags & LIGHT_SPHERE) != 0u {
         // Uniform direction in the cone the sphere subtends.
         let r = l.e1.x;
@@ -257,14 +306,16 @@ fn camera_ray(pixel: vec2u, u: vec2f) -> Ray {
 }
 
 // The origin of a ray leaving `s` towards the side `n` faces, and its error for the
-// intersection routines (`origin_n`, `origin_err`, `origin_off`, `origin_slab`).
+// intersection routines (`origin_n`, `origin_err`, `origin_off`, `origin_slab`,
+// `skip_inward`). Rays start at the hit itself, never offset (`skip_prim`).
 fn leave(s: Surface, on_sphere: bool, n: vec3f, dir: vec3f) -> vec3f {
     if on_sphere {
         origin_n = vec3f(0.0);
         origin_err = vec3f(0.0);
         origin_off = 0.0;
         origin_slab = 0.0;
-        return offset_ray(s.p, n, 256.0);
+        skip_inward = dot(dir, s.ng) < 0.0;
+        return s.p;
     }
     // The front of the plane left is the side the ray goes to.
     origin_n = n;
@@ -301,20 +352,16 @@ fn trace_path(pixel: vec2u) -> vec3f {
             }
             if visible && env_map_on() {
                 let e = env_eval(ray.dir);
-                var w = 1.0;
-                if bsdf_pdf > 0.0 {
-                    w = mis_power(bsdf_pdf, e.a * env_select_prob());
-                }
-                radiance += throughput * e.rgb * w;
+                radiance += throughput * e.rgb * hit_weight(bsdf_pdf, e.a * env_select_prob());
             }
             break;
         }
         let s = surface_at(ray, hit);
-        // Rays leaving a triangle skip it, start at the hit position itself and ignore what
-        // is within its error (see `leave`); rays leaving a sphere, which can hit it again
-        // from inside, start 256 float steps off it (Wachter and Binder).
+        // Rays leaving a surface start at the hit position itself and skip the primitive
+        // left: a triangle ignores what is within the position's error (see `leave`), a
+        // sphere is met again only by a ray going into it, at its far side.
         let on_sphere = (hit.prim & PRIM_SPHERE) != 0u;
-        skip_prim = select(hit.prim, NO_HIT, on_sphere);
+        skip_prim = hit.prim;
         var mat = scene_material(s.material);
         if HAS_TEXTURES {
             mat = textured_material(mat, s.uv);
@@ -327,7 +374,7 @@ fn trace_path(pixel: vec2u) -> vec3f {
         if s.light != NO_LIGHT && (front || two_sided) {
             var w = 1.0;
             if bsdf_pdf > 0.0 {
-                w = mis_power(bsdf_pdf, light_pdf(scene_light(s.light), prev_p, s.p, s.ng));
+                w = hit_weight(bsdf_pdf, light_pdf(scene_light(s.light), prev_p, s.p, s.ng));
             }
             radiance += throughput * mat.emission * w;
         }
@@ -346,21 +393,23 @@ fn trace_path(pixel: vec2u) -> vec3f {
 
         // Next-event estimation through the non-delta lobes.
         let p_env = env_select_prob();
+        // (BSDF sampling only: point, spot and directional lights, which no ray can hit.)
         if (has_lights || p_env > 0.0) && wo.z > 0.0 {
             var ls: LightSample;
             if rand() < p_env {
                 let es = sample_env(rand(), rand2());
-                ls = LightSample(es.wi, F32_MAX, es.radiance, es.pdf * p_env, 0.0);
+                ls = LightSample(es.wi, F32_MAX, es.radiance, es.pdf * p_env, 0.0, false);
             } else {
                 ls = sample_light(s.p, bounce);
             }
-            if ls.pdf > 0.0 && dot(ng, ls.wi) * select(-1.0, 1.0, front || flip) > 0.0 {
+            let wanted = ls.delta || frame.strategy != STRATEGY_BSDF;
+            if wanted && ls.pdf > 0.0 && dot(ng, ls.wi) * select(-1.0, 1.0, front || flip) > 0.0 {
                 let e = eval_bsdf(mat, wo, to_local * ls.wi);
                 if e.pdf > 0.0 || any(e.f_cos > vec3f(0.0)) {
                     let shadow = Ray(leave(s, on_sphere, select(-ng, ng, dot(ng, ls.wi) > 0.0), ls.wi), ls.wi);
                     ray_count += 1u;
                     if !occluded(shadow, ls.dist - ls.margin) {
-                        let w = mis_power(ls.pdf, e.pdf);
+                        let w = select(light_weight(ls.pdf, e.pdf), 1.0, ls.delta);
                         radiance += throughput * e.f_cos * ls.radiance * (w / ls.pdf);
                     }
                 }

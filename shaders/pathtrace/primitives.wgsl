@@ -6,10 +6,13 @@
 // beyond `origin_err`, which the CPU mirror does not have: it is always 0 there).
 const F32_MAX: f32 = 3.40282347e38;
 
-// A triangle rays must not hit: the one they leave from. A flat triangle cannot be hit again
-// by a ray leaving it, so skipping it removes self-intersection whatever the coordinates'
-// magnitude, and the origin offset only has to clear coplanar neighbours.
+// The primitive a ray leaves from (a triangle's index, or a sphere's | PRIM_SPHERE). A flat
+// triangle cannot be hit again by a ray leaving it, nor a sphere by a ray leaving it outwards,
+// so skipping it removes self-intersection whatever the coordinates' magnitude, with no
+// offset of the origin; for triangles the origin's error only has to clear coplanar
+// neighbours (below). A ray entering a sphere (`skip_inward`) meets it at its far side.
 var<private> skip_prim: u32 = NO_HIT;
+var<private> skip_inward: bool = false;
 // For rays leaving a triangle (camera rays and rays leaving a sphere have 0 for both): the
 // unit normal of the triangle left, and a componentwise bound on the rounding error of the
 // origin. Such rays start exactly at the computed hit, not offset: an offset of even one
@@ -81,27 +84,44 @@ fn intersect_triangle(origin: vec3<f32>, dir: vec3<f32>, v0: vec3<f32>, e1: vec3
     return vec4<f32>(select(0.0, 1.0, hit), t, u, v);
 }
 
-// Robust ray/sphere (Ray Tracing Gems, ch. 7). Returns the nearest t in (0, t_max), or -1.
-fn intersect_sphere(origin: vec3<f32>, dir: vec3<f32>, center: vec3<f32>, radius: f32, t_max: f32) -> f32 {
+// Both roots (near, far) of ray/sphere in the robust form of Ray Tracing Gems, ch. 7; (-1, -1)
+// when the ray misses.
+fn sphere_roots(origin: vec3<f32>, dir: vec3<f32>, center: vec3<f32>, radius: f32) -> vec2<f32> {
     let f = origin - center;
     let a = dot(dir, dir);
     let b = -dot(f, dir);
     let l = f + (b / a) * dir;
     let disc = a * (radius * radius - dot(l, l));
     if (!(disc >= 0.0)) {
-        return -1.0;
+        return vec2<f32>(-1.0);
     }
     let c = dot(f, f) - radius * radius;
     let root = sqrt(disc);
     let q = b + select(root, -root, b < 0.0);
     let t0 = c / q;
     let t1 = q / a;
-    let near = min(t0, t1);
-    let far = max(t0, t1);
-    if (near > 0.0 && near < t_max) {
-        return near;
-    } else if (far > 0.0 && far < t_max) {
-        return far;
+    return vec2<f32>(min(t0, t1), max(t0, t1));
+}
+
+// The nearest ray/sphere t in (0, t_max), or -1.
+fn intersect_sphere(origin: vec3<f32>, dir: vec3<f32>, center: vec3<f32>, radius: f32, t_max: f32) -> f32 {
+    let r = sphere_roots(origin, dir, center, radius);
+    if (r.x > 0.0 && r.x < t_max) {
+        return r.x;
+    } else if (r.y > 0.0 && r.y < t_max) {
+        return r.y;
     }
     return -1.0;
+}
+
+// `intersect_sphere` for sphere `prim` (its index | PRIM_SPHERE) by a ray that may be the one
+// leaving it (`skip_prim`, from its surface, not offset): going out, it cannot meet that
+// convex sphere again; going in (`skip_inward`), only at the far root, the near one being its
+// own origin whichever side of the surface rounding put that.
+fn intersect_sphere_from(prim: u32, origin: vec3<f32>, dir: vec3<f32>, center: vec3<f32>, radius: f32, t_max: f32) -> f32 {
+    if (prim != skip_prim) {
+        return intersect_sphere(origin, dir, center, radius, t_max);
+    }
+    let r = sphere_roots(origin, dir, center, radius);
+    return select(-1.0, r.y, skip_inward && r.y > 0.0 && r.y < t_max);
 }

@@ -11,8 +11,15 @@ const NO_LIGHT: u32 = 0xffffffffu;
 
 const TRI_VERTEX_NORMALS: u32 = 1u;
 const MATERIAL_TWO_SIDED: u32 = 1u;
+const MATERIAL_CONDUCTOR: u32 = 2u;
+const MATERIAL_SINGLE_SCATTER: u32 = 4u;
 const LIGHT_SPHERE: u32 = 1u;
 const LIGHT_TWO_SIDED: u32 = 2u;
+const LIGHT_POINT: u32 = 4u;
+const LIGHT_SPOT: u32 = 8u;
+const LIGHT_DIRECTIONAL: u32 = 16u;
+// Point, spot and directional lights: no area, never hit, sampled with a delta pdf.
+const LIGHT_DELTA: u32 = 28u;
 const ENV_NONE: u32 = 0u;
 const ENV_CONSTANT: u32 = 1u;
 const ENV_MAP: u32 = 2u;
@@ -88,6 +95,14 @@ struct Material {
     tex_specular_color: u32,
     pad0: u32,
     pad1: u32,
+    // Complex index of refraction of a conductor (MATERIAL_CONDUCTOR), and its metal
+    // lobe's cosine-weighted average Fresnel reflectance.
+    eta: vec3<f32>,
+    pad2: u32,
+    k: vec3<f32>,
+    pad3: u32,
+    f_avg: vec3<f32>,
+    pad4: u32,
 }
 
 // A triangle's tangents (xyz, w = handedness) and UVs at its corners, 80 bytes, same index as
@@ -102,7 +117,10 @@ struct TriTexcoords {
     pad1: u32,
 }
 
-// Emissive triangle (p0, e1, e2) or sphere (center p0, radius e1.x), 64 bytes.
+// Emissive triangle (p0, e1, e2) or sphere (center p0, radius e1.x), 64 bytes, or a light
+// without area: point (position p0, intensity in `emission`), spot (also unit axis e1,
+// e2 = (cutoff, beam width) half-angles in radians), directional (unit travel direction e1,
+// irradiance in `emission`).
 // Selection probability = power / SceneHeader.total_light_power.
 struct Light {
     p0: vec3<f32>,

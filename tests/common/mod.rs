@@ -82,3 +82,134 @@ pub fn denoise_graph(
         origin: None,
     }
 }
+
+/// A scene file under the repository root, flattened; `size` overrides its image size
+/// (square), for tests that need fewer pixels than the scene's references.
+pub fn gpu_scene(rel: &str, size: Option<u32>) -> std::sync::Arc<lumagraph::scene::GpuScene> {
+    let mut scene = lumagraph::scene::Scene::load(&repo(rel)).unwrap();
+    if let Some(s) = size {
+        scene.settings.width = s;
+        scene.settings.height = s;
+    }
+    std::sync::Arc::new(lumagraph::scene::GpuScene::build(&scene).unwrap())
+}
+
+/// `frames` independent estimates of `scene`'s image with random seed `seed`, each the
+/// mean of `spp` samples per pixel from `PathTrace` with the independent sampler (so frames
+/// are independent, and so are runs with different seeds) and `params`.
+pub fn independent_frames(
+    scene: &lumagraph::scene::GpuScene,
+    seed: u32,
+    params: &[(&str, lumagraph::graph::ParamValue)],
+    frames: u32,
+    spp: i64,
+) -> Option<Vec<lumagraph::render::cpu::Image>> {
+    use lumagraph::graph::{Graph, Node, ParamValue};
+    use lumagraph::render::{Executor, Resources, compile};
+    let ctx = gpu()?;
+    let mut scene = scene.clone();
+    scene.settings.seed = seed;
+    let scene = std::sync::Arc::new(scene);
+    let mut pt = Node::new("pt", "PathTrace")
+        .with("samples_per_frame", ParamValue::Int(spp))
+        .with("sampler", ParamValue::Str("independent".into()));
+    for (k, v) in params {
+        pt = pt.with(k, v.clone());
+    }
+    let graph = Graph {
+        nodes: vec![pt],
+        edges: Vec::new(),
+        origin: None,
+    };
+    let plan = compile(&graph, &["pt.color".into()], Some(&scene)).unwrap();
+    let resources = Resources {
+        scene: Some(scene),
+        ..Resources::default()
+    };
+    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    Some(
+        (0..frames)
+            .map(|_| {
+                exec.run_frames(1, true).unwrap();
+                exec.read_port("pt.color").unwrap()
+            })
+            .collect(),
+    )
+}
+
+/// Per-block, per-channel mean and standard error of the mean over independent frames:
+/// `(mean, standard error)` for each `block`×`block` block and RGB channel.
+pub fn block_stats(frames: &[lumagraph::render::cpu::Image], block: u32) -> Vec<[(f64, f64); 3]> {
+    let per_frame: Vec<Vec<[f64; 3]>> = frames
+        .iter()
+        .map(|f| lumagraph::render::metrics::block_means(f, block))
+        .collect();
+    let n = per_frame.len() as f64;
+    (0..per_frame[0].len())
+        .map(|b| {
+            std::array::from_fn(|c| {
+                let mean = per_frame.iter().map(|f| f[b][c]).sum::<f64>() / n;
+                let var = per_frame
+                    .iter()
+                    .map(|f| (f[b][c] - mean).powi(2))
+                    .sum::<f64>()
+                    / (n - 1.0);
+                (mean, (var / n).sqrt())
+            })
+        })
+        .collect()
+}
+
+/// Two-sided critical value of Student's t with `df` degrees of freedom at significance
+/// `alpha`.
+pub fn t_critical(alpha: f64, df: f64) -> f64 {
+    // P(|T| > t) = I_{df/(df+t^2)}(df/2, 1/2).
+    let x = puruspe::invbetai(alpha, 0.5 * df, 0.5);
+    (df * (1.0 - x) / x).sqrt()
+}
+
+/// Whether two sets of independent frames have the same expected block means: Welch's
+/// t-test on every block and channel whose mean is at least `floor`, at overall significance
+/// `alpha` (Bonferroni over the tests). Returns the number of tests and the largest |t| over
+/// its critical value, or an error naming the worst block.
+pub fn same_means(
+    a: &[lumagraph::render::cpu::Image],
+    b: &[lumagraph::render::cpu::Image],
+    block: u32,
+    floor: f64,
+    alpha: f64,
+) -> Result<(usize, f64), String> {
+    let (sa, sb) = (block_stats(a, block), block_stats(b, block));
+    let df = (a.len().min(b.len()) - 1) as f64;
+    let mut tests = Vec::new();
+    for (i, (x, y)) in sa.iter().zip(&sb).enumerate() {
+        for c in 0..3 {
+            let ((ma, ea), (mb, eb)) = (x[c], y[c]);
+            if ma.max(mb) < floor {
+                continue;
+            }
+            let t = (ma - mb) / (ea * ea + eb * eb).sqrt().max(1e-12);
+            tests.push((i, c, ma, mb, t));
+        }
+    }
+    // Welch's degrees of freedom are at least the smaller sample's; using that is
+    // conservative.
+    let crit = t_critical(alpha / tests.len() as f64, df);
+    let worst = tests
+        .iter()
+        .max_by(|p, q| p.4.abs().total_cmp(&q.4.abs()))
+        .copied()
+        .ok_or("no block above the floor")?;
+    if worst.4.abs() > crit {
+        return Err(format!(
+            "block {} channel {}: {:.5} vs {:.5}, t = {:.2} > {crit:.2} ({} tests, alpha {alpha})",
+            worst.0,
+            worst.1,
+            worst.2,
+            worst.3,
+            worst.4,
+            tests.len()
+        ));
+    }
+    Ok((tests.len(), worst.4.abs() / crit))
+}

@@ -272,6 +272,33 @@ fn builtin_kinds() -> Vec<NodeKind> {
                     },
                     doc: "how the random numbers of a path are drawn (docs/pathtracer.md)",
                 },
+                ParamDef {
+                    name: "strategy",
+                    ty: ParamType::Enum {
+                        default: "mis",
+                        options: &[
+                            (
+                                "mis",
+                                "light sampling and BSDF sampling, weighted by the power \
+                                 heuristic",
+                            ),
+                            (
+                                "light",
+                                "light sampling only: emitters a BSDF-sampled ray hits count \
+                                 only after mirrors and interfaces (a check, noisy on glossy \
+                                 surfaces)",
+                            ),
+                            (
+                                "bsdf",
+                                "BSDF sampling only: emitters count when hit; shadow rays only \
+                                 to point, spot and directional lights, which no ray can hit \
+                                 (a check, noisy for small lights)",
+                            ),
+                        ],
+                    },
+                    doc: "how direct light is estimated; every strategy converges to the same \
+                          image (docs/pathtracer.md)",
+                },
             ],
             sink: false,
             history: false,

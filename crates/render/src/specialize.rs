@@ -44,11 +44,11 @@ pub fn inline_intersection(scene: &GpuScene) -> Option<String> {
         let args = format!("{}, {:?}", v3(s.center), s.radius);
         let _ = writeln!(
             closest,
-            "    t = intersect_sphere(ray.origin, ray.dir, {args}, hit.t);\n    if (t > 0.0) {{ hit = Hit({i}u | PRIM_SPHERE, t, 0.0, 0.0); }}"
+            "    t = intersect_sphere_from({i}u | PRIM_SPHERE, ray.origin, ray.dir, {args}, hit.t);\n    if (t > 0.0) {{ hit = Hit({i}u | PRIM_SPHERE, t, 0.0, 0.0); }}"
         );
         let _ = writeln!(
             any,
-            "    if (intersect_sphere(ray.origin, ray.dir, {args}, t_max) > 0.0) {{ return true; }}"
+            "    if (intersect_sphere_from({i}u | PRIM_SPHERE, ray.origin, ray.dir, {args}, t_max) > 0.0) {{ return true; }}"
         );
     }
     Some(format!(
@@ -181,6 +181,12 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
                 u(m.tex_specular_color),
                 u(0),
                 u(0),
+                l.v3(m.eta),
+                u(0),
+                l.v3(m.k),
+                u(0),
+                l.v3(m.f_avg),
+                u(0),
             ]
         })
         .collect();
@@ -251,7 +257,7 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
         return None;
     }
     let material_types = [
-        f3, f1, f3, f1, f1, f1, f1, f1, u1, u1, u1, f1, u1, u1, u1, u1,
+        f3, f1, f3, f1, f1, f1, f1, f1, u1, u1, u1, f1, u1, u1, u1, u1, f3, u1, f3, u1, f3, u1,
     ];
     Some(format!(
         "// Generated for this scene: {} materials, {} lights, {} triangles and {} spheres,

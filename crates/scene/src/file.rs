@@ -1,8 +1,8 @@
-//! The scene file format (RON, `version: 1`), as written by hand.
+//! The scene file format (RON, `version: 2`), as written by hand.
 //!
 //! ```ron
 //! (
-//!     version: 1,
+//!     version: 2,
 //!     camera: Perspective(position: (0, 0, 3.9), target: (0, 0, 0), up: (0, 1, 0), fov_y: 39.3077),
 //!     materials: { "white": (base_color: (0.8, 0.8, 0.8)) },
 //!     shapes: [
@@ -11,10 +11,16 @@
 //!              emission: (10, 10, 10)),
 //!         Mesh(name: "box", path: "CornellBox/CornellBox.gltf", transform: (scale: (2, 2, 2))),
 //!     ],
+//!     lights: [Point(position: (0, 0.9, 0), intensity: (2, 2, 2))],
 //!     environment: Constant((1, 1, 1)),
 //!     render: (width: 256, height: 256, spp: 16),
 //! )
 //! ```
+//!
+//! Version 2 changed the orientation of environment maps to Mitsuba's (the map's centre
+//! column is seen looking along +z; `azimuth` and `elevation` rotate as Mitsuba's
+//! `rotate`). Version 1 files are still read: their maps are turned so they light the
+//! scene as before (see [`Environment::Map`]).
 //!
 //! Optional fields are written without `Some(…)` (ron's `implicit_some` is on). Every
 //! struct refuses unknown fields. Vectors are tuples `(x, y, z)`. Angles are in
@@ -28,8 +34,8 @@ use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
-/// The scene file version this build reads and writes.
-pub const VERSION: u32 = 1;
+/// The scene file version this build writes; it also reads version 1 (see the module docs).
+pub const VERSION: u32 = 2;
 
 /// A 3-vector written `(x, y, z)`.
 pub type V3 = [f32; 3];
@@ -38,7 +44,7 @@ pub type V3 = [f32; 3];
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
-    /// Always [`VERSION`].
+    /// [`VERSION`], or 1.
     pub version: u32,
     /// The camera.
     pub camera: CameraDesc,
@@ -47,6 +53,9 @@ pub struct SceneFile {
     pub materials: BTreeMap<String, MaterialDesc>,
     /// The shapes, each triangulated or kept as an analytic sphere.
     pub shapes: Vec<ShapeDesc>,
+    /// Point, spot and directional lights.
+    #[serde(default)]
+    pub lights: Vec<LightDesc>,
     /// What rays that leave the scene see.
     #[serde(default)]
     pub environment: Environment,
@@ -114,8 +123,22 @@ pub struct MaterialDesc {
     pub emission: V3,
     /// Perceptual roughness in [0, 1] (α = roughness²). Default 0.5.
     pub roughness: f32,
-    /// 0 dielectric, 1 metal. Default 0.
-    pub metallic: f32,
+    /// 0 dielectric, 1 metal. Default 0, or 1 with `conductor`, `eta` or `k`.
+    pub metallic: Option<f32>,
+    /// A measured conductor by name (`"Au"`, `"Ag"`, `"Al"`, `"Cu"`, …; see
+    /// [`crate::conductor::PRESETS`]): the metal lobe uses the exact conductor Fresnel
+    /// with its complex index of refraction instead of Schlick's on `base_color`.
+    pub conductor: Option<String>,
+    /// Real part of a conductor's index of refraction (RGB); with `k`, instead of a named
+    /// `conductor`.
+    pub eta: Option<V3>,
+    /// Imaginary part (extinction coefficient) of a conductor's index of refraction (RGB).
+    pub k: Option<V3>,
+    /// Compensate the energy that single-scattering microfacet lobes lose (metal:
+    /// Kulla–Conty; rough glass: reflections into the surface sent back out). Default
+    /// true; false matches renderers without it (Mitsuba's `roughconductor`,
+    /// `roughdielectric`).
+    pub multiscatter: bool,
     /// Dielectric specular strength; 0.5 means F0 = 0.04. Default 0.5. Use 0 for a pure
     /// Lambertian surface.
     pub specular: f32,
@@ -135,7 +158,11 @@ impl Default for MaterialDesc {
             base_color: [0.8, 0.8, 0.8],
             emission: [0.0; 3],
             roughness: 0.5,
-            metallic: 0.0,
+            metallic: None,
+            conductor: None,
+            eta: None,
+            k: None,
+            multiscatter: true,
             specular: 0.5,
             specular_tint: 0.0,
             transmission: 0.0,
@@ -322,6 +349,78 @@ impl ShapeDesc {
     }
 }
 
+/// A light that is not a surface: a point, a spot or a direction. None of them is seen by
+/// rays (they have no area); they light the scene through light sampling only.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[non_exhaustive]
+pub enum LightDesc {
+    /// Light from one point, the same in every direction (Mitsuba `point`).
+    Point {
+        /// Name for messages.
+        #[serde(default)]
+        name: Option<String>,
+        /// Where it is, world space.
+        position: V3,
+        /// Radiant intensity, W/sr (linear RGB).
+        intensity: V3,
+    },
+    /// A point light emitting into a cone (Mitsuba `spot`): full `intensity` within
+    /// `beam_width` of its axis, falling linearly in angle to 0 at `cutoff_angle`.
+    Spot {
+        /// Name for messages.
+        #[serde(default)]
+        name: Option<String>,
+        /// Where it is, world space.
+        position: V3,
+        /// A point on its axis.
+        target: V3,
+        /// Radiant intensity on the axis, W/sr (linear RGB).
+        intensity: V3,
+        /// Half-angle of the cone outside which it is black, degrees, in (0, 90]. Default 20.
+        #[serde(default = "default_cutoff")]
+        cutoff_angle: f32,
+        /// Half-angle of the cone of full intensity, degrees, in [0, `cutoff_angle`].
+        /// Default ¾ of `cutoff_angle`.
+        #[serde(default)]
+        beam_width: Option<f32>,
+    },
+    /// Parallel light from infinitely far away, as the sun (Mitsuba `directional`).
+    Directional {
+        /// Name for messages.
+        #[serde(default)]
+        name: Option<String>,
+        /// The direction the light travels in (from the light towards the scene).
+        direction: V3,
+        /// Irradiance on a surface facing the light, W/m² (linear RGB).
+        irradiance: V3,
+    },
+}
+
+impl LightDesc {
+    /// The light's name, if it has one.
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            Self::Point { name, .. } | Self::Spot { name, .. } | Self::Directional { name, .. } => {
+                name.as_deref()
+            }
+        }
+    }
+
+    /// The kind, as written in the file.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Point { .. } => "Point",
+            Self::Spot { .. } => "Spot",
+            Self::Directional { .. } => "Directional",
+        }
+    }
+}
+
+fn default_cutoff() -> f32 {
+    20.0
+}
+
 /// What rays that leave the scene see.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize)]
 #[non_exhaustive]
@@ -331,17 +430,25 @@ pub enum Environment {
     None,
     /// The same radiance (linear RGB) from every direction.
     Constant(V3),
-    /// An equirectangular image (Radiance `.hdr` or `.exr`, linear), importance sampled.
+    /// An equirectangular image (Radiance `.hdr` or `.exr`, linear), importance sampled,
+    /// in Mitsuba's orientation: looking along +z one sees the image's centre column, along
+    /// +x the column a quarter from its left edge, along +y its top row. The map is turned
+    /// by `elevation` about +x, then by `azimuth` about +y (counter-clockwise seen from
+    /// above: Mitsuba's `to_world = rotate(y, azimuth) · rotate(x, elevation)`).
+    ///
+    /// Version 1 files saw the centre column along −z and turned the other way; they are
+    /// read as `azimuth' = −(azimuth + 180)`, `elevation' = −elevation`, which lights the
+    /// scene exactly as before.
     Map {
         /// The image, relative to the scene file (made absolute on load).
         path: String,
         /// Radiance scale.
         #[serde(default = "one")]
         intensity: f32,
-        /// Rotation about the up (y) axis, degrees.
+        /// Rotation about the up (+y) axis, degrees, counter-clockwise seen from above.
         #[serde(default)]
         azimuth: f32,
-        /// Tilt of the map's horizon, degrees (rotation about x).
+        /// Tilt of the map's horizon, degrees (rotation about +x, before the azimuth).
         #[serde(default)]
         elevation: f32,
         /// Whether camera rays that miss see the map (else black); lighting is unchanged.

@@ -1,6 +1,7 @@
 //! Flattening a [`Scene`] into a [`GpuScene`]: BVH, reordered primitives, materials,
 //! lights with a power-proportional alias table (an emissive texture scales a triangle's
-//! power by its mean over the triangle), camera and settings.
+//! power by its mean over the triangle; point, spot and directional lights join with their
+//! emitted power), camera and settings.
 
 use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
@@ -12,10 +13,11 @@ use crate::gpu::{
     ENV_CONSTANT, ENV_MAP, ENV_NONE, ENV_SHOW_BACKGROUND, FEATURE_ENVIRONMENT, FEATURE_LIGHTS,
     FEATURE_METAL, FEATURE_SPHERES, FEATURE_TEXTURES, FEATURE_TRANSMISSION, GpuAliasEntry,
     GpuBvhNode, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere, GpuTriShading,
-    GpuTriTexcoords, GpuTriangle, LIGHT_SPHERE, LIGHT_TWO_SIDED, MATERIAL_TWO_SIDED, NO_LIGHT,
+    GpuTriTexcoords, GpuTriangle, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPHERE, LIGHT_SPOT,
+    LIGHT_TWO_SIDED, MATERIAL_CONDUCTOR, MATERIAL_SINGLE_SCATTER, MATERIAL_TWO_SIDED, NO_LIGHT,
     TRI_VERTEX_NORMALS,
 };
-use crate::scene::{Material, NO_TEXTURE, Scene};
+use crate::scene::{Material, NO_TEXTURE, PunctualLight, Scene};
 
 /// Everything the render crate uploads: one `Vec` per storage buffer, plus small blocks.
 /// Arrays may be empty (no spheres, no lights); the uploader pads empty buffers.
@@ -70,6 +72,20 @@ fn tex16(t: u32) -> u32 {
 }
 
 fn gpu_material(m: &Material) -> GpuMaterial {
+    let mut flags = if m.two_sided { MATERIAL_TWO_SIDED } else { 0 };
+    if m.conductor.is_some() {
+        flags |= MATERIAL_CONDUCTOR;
+    }
+    if !m.multiscatter {
+        flags |= MATERIAL_SINGLE_SCATTER;
+    }
+    let (eta, k, f_avg) = m.conductor.map_or(([0.0; 3], [0.0; 3], [0.0; 3]), |c| {
+        (
+            c.eta.to_array(),
+            c.k.to_array(),
+            c.average_reflectance().to_array(),
+        )
+    });
     GpuMaterial {
         base_color: m.base_color.to_array(),
         roughness: m.roughness,
@@ -81,14 +97,72 @@ fn gpu_material(m: &Material) -> GpuMaterial {
         ior: m.ior,
         tex_base_mr: tex16(m.textures.base_color) | (tex16(m.textures.metallic_roughness) << 16),
         tex_emissive_normal: tex16(m.textures.emissive) | (tex16(m.textures.normal) << 16),
-        flags: if m.two_sided { MATERIAL_TWO_SIDED } else { 0 },
+        flags,
         normal_scale: m.normal_scale,
         tex_transmission_specular: tex16(m.textures.transmission)
             | (tex16(m.textures.specular) << 16),
         tex_specular_color: tex16(m.textures.specular_color) | (0xFFFF << 16),
-        pad0: 0,
-        pad1: 0,
+        eta,
+        k,
+        f_avg,
+        ..GpuMaterial::default()
     }
+}
+
+/// The light-table entry of a point, spot or directional light and its emitted power (for
+/// selection): 4π I for a point, ∫ falloff over the sphere × I for a spot (2π (1 − cos)
+/// over the full cone, plus the linear ramp's share), and for a directional light its
+/// irradiance over the disk of the scene's bounding sphere (`radius`).
+fn punctual_light(l: &PunctualLight, radius: f32) -> (GpuLight, f32) {
+    use std::f32::consts::PI;
+    let mut g = GpuLight::default();
+    let power = match *l {
+        PunctualLight::Point {
+            position,
+            intensity,
+        } => {
+            g.flags = LIGHT_POINT;
+            g.p0 = position.to_array();
+            g.emission = intensity.to_array();
+            4.0 * PI * luminance(intensity)
+        }
+        PunctualLight::Spot {
+            position,
+            axis,
+            intensity,
+            cutoff,
+            beam,
+        } => {
+            g.flags = LIGHT_SPOT;
+            g.p0 = position.to_array();
+            g.e1 = axis.to_array();
+            g.e2 = [cutoff, beam, 0.0];
+            g.emission = intensity.to_array();
+            // The falloff's solid angle, by midpoint rule in θ over [beam, cutoff].
+            let full = 2.0 * PI * (1.0 - beam.cos());
+            let steps = 64;
+            let dt = (cutoff - beam) / steps as f32;
+            let ramp: f32 = (0..steps)
+                .map(|i| {
+                    let t = beam + (i as f32 + 0.5) * dt;
+                    2.0 * PI * t.sin() * (cutoff - t) / (cutoff - beam).max(1e-12) * dt
+                })
+                .sum();
+            (full + ramp) * luminance(intensity)
+        }
+        PunctualLight::Directional {
+            direction,
+            irradiance,
+        } => {
+            g.flags = LIGHT_DIRECTIONAL;
+            g.e1 = direction.to_array();
+            g.emission = irradiance.to_array();
+            PI * radius * radius * luminance(irradiance)
+        }
+    };
+    g.prim = NO_LIGHT;
+    g.power = power;
+    (g, power)
 }
 
 /// Smallest share of its factor's power an emitter with an emissive texture keeps for light
@@ -320,6 +394,14 @@ impl GpuScene {
                 light,
                 ..GpuSphere::default()
             });
+        }
+        let radius = out.bvh_nodes.first().map_or(1.0, |root| {
+            0.5 * (Vec3::from(root.aabb_max) - Vec3::from(root.aabb_min)).length()
+        });
+        for l in &scene.lights {
+            let (light, power) = punctual_light(l, radius);
+            weights.push(power);
+            out.lights.push(light);
         }
         out.light_alias = alias_table(&weights);
         out.header = header(scene, &out, flat.depth, weights.iter().sum());

@@ -26,10 +26,24 @@ pub const NO_LIGHT: u32 = u32::MAX;
 pub const TRI_VERTEX_NORMALS: u32 = 1;
 /// [`GpuMaterial::flags`]: emission leaves both sides.
 pub const MATERIAL_TWO_SIDED: u32 = 1;
+/// [`GpuMaterial::flags`]: the metal lobe's Fresnel is the exact conductor one with
+/// `eta` and `k` (else Schlick's on `base_color`).
+pub const MATERIAL_CONDUCTOR: u32 = 2;
+/// [`GpuMaterial::flags`]: no multiple-scattering compensation (the metal lobe's
+/// Kulla–Conty term, rough glass's reflections into the surface sent back out).
+pub const MATERIAL_SINGLE_SCATTER: u32 = 4;
 /// [`GpuLight::flags`]: the light is a sphere (else a triangle).
 pub const LIGHT_SPHERE: u32 = 1;
 /// [`GpuLight::flags`]: emission leaves both sides of the triangle.
 pub const LIGHT_TWO_SIDED: u32 = 2;
+/// [`GpuLight::flags`]: a point light at `p0` of radiant intensity `emission`.
+pub const LIGHT_POINT: u32 = 4;
+/// [`GpuLight::flags`]: a spot light at `p0`, unit axis `e1`, `e2` = (cutoff, beam width)
+/// half-angles in radians, radiant intensity `emission` on the axis.
+pub const LIGHT_SPOT: u32 = 8;
+/// [`GpuLight::flags`]: a directional light travelling along unit `e1`, irradiance
+/// `emission`.
+pub const LIGHT_DIRECTIONAL: u32 = 16;
 
 /// [`GpuSettings::env_kind`]: black environment.
 pub const ENV_NONE: u32 = 0;
@@ -125,7 +139,7 @@ pub struct GpuSphere {
     pub pad1: u32,
 }
 
-/// A material, 80 bytes (five vec4s). Texture ids index the scene's textures (see
+/// A material, 128 bytes (eight vec4s). Texture ids index the scene's textures (see
 /// [`crate::texture::pack_textures`]), 16 bits each, 0xFFFF = none; each texture multiplies
 /// its factor.
 #[repr(C)]
@@ -167,6 +181,19 @@ pub struct GpuMaterial {
     pub pad0: u32,
     /// Padding (offset 76).
     pub pad1: u32,
+    /// A conductor's index of refraction, real part ([`MATERIAL_CONDUCTOR`]; offset 80).
+    pub eta: [f32; 3],
+    /// Padding (offset 92).
+    pub pad2: u32,
+    /// A conductor's extinction coefficient (offset 96).
+    pub k: [f32; 3],
+    /// Padding (offset 108).
+    pub pad3: u32,
+    /// A conductor's cosine-weighted average Fresnel reflectance, for the metal lobe's
+    /// multiple-scattering term (offset 112).
+    pub f_avg: [f32; 3],
+    /// Padding (offset 124).
+    pub pad4: u32,
 }
 
 /// A triangle's texture coordinates and tangents, 80 bytes, same index as its
@@ -191,7 +218,8 @@ pub struct GpuTriTexcoords {
     pub pad1: u32,
 }
 
-/// An emitter, 64 bytes: an emissive triangle or sphere.
+/// An emitter, 64 bytes: an emissive triangle or sphere, or a point, spot or directional
+/// light ([`LIGHT_POINT`], [`LIGHT_SPOT`], [`LIGHT_DIRECTIONAL`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuLight {

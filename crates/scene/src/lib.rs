@@ -1,9 +1,12 @@
 //! lumagraph scenes, with no GPU in sight.
 //!
-//! - [`file`]: the RON scene format (`version: 1`): camera, named materials, shapes
-//!   (meshes, spheres, Mitsuba-style rectangles and boxes, quads), environment, render
-//!   settings. [`Scene::load`] reads it into a [`Scene`] with world-space triangles.
-//! - [`import`]: glTF 2.0 and OBJ + MTL meshes, cameras and materials.
+//! - [`file`]: the RON scene format (`version: 2`): camera, named materials, shapes
+//!   (meshes, spheres, Mitsuba-style rectangles and boxes, quads), point, spot and
+//!   directional lights, environment, render settings. [`Scene::load`] reads it into a [`Scene`] with world-space triangles.
+//! - [`import`]: glTF 2.0 and OBJ + MTL meshes, cameras, materials and
+//!   (`KHR_lights_punctual`) lights.
+//! - [`conductor`]: measured metals (complex index of refraction) and their Fresnel.
+//! - [`export`]: the resolved scene as JSON + OBJ for other renderers (Mitsuba references).
 //! - [`GpuScene`]: the scene flattened into `#[repr(C)]` arrays laid out as WGSL lays out
 //!   storage buffers ([`gpu`]), with a BVH built by obvhs ([`bvh`]), lights and an alias
 //!   table for picking them by power.
@@ -16,7 +19,9 @@
 //! the shape or material; broken triangles are dropped and counted in a [`LoadReport`].
 
 pub mod bvh;
+pub mod conductor;
 mod error;
+pub mod export;
 pub mod file;
 mod flatten;
 pub mod gpu;
@@ -28,13 +33,13 @@ pub mod traverse;
 
 pub use bvh::{BVH_STACK_SIZE, BvhOptions};
 pub use error::{ErrorKind, Pos, SceneError};
-pub use file::{Environment, RenderSettings, VERSION};
+pub use file::{Environment, LightDesc, RenderSettings, VERSION};
 pub use flatten::{GpuScene, alias_table, luminance};
 pub use gpu::*;
 pub use load::transform_matrix;
 pub use scene::{
-    Camera, LoadReport, Material, MaterialTextures, NO_TEXTURE, Scene, Sphere, Triangle,
-    cube_quads, push_triangle, quad_triangles, rectangle_quad, transform_triangle,
+    Camera, LoadReport, Material, MaterialTextures, NO_TEXTURE, PunctualLight, Scene, Sphere,
+    Triangle, cube_quads, push_triangle, quad_triangles, rectangle_quad, transform_triangle,
 };
 pub use texture::{Texture, Wrap};
 pub use traverse::{Hit, Ray, intersect, intersect_within, occluded};

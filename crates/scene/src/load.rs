@@ -9,14 +9,16 @@ use glam::{Mat4, Quat, Vec3};
 use ron::extensions::Extensions;
 use serde::Deserialize;
 
+use crate::conductor::Conductor;
 use crate::error::{ErrorKind, Pos, SceneError};
 use crate::file::{
-    CameraDesc, Environment, MaterialDesc, SceneFile, ShapeDesc, TransformDesc, V3, VERSION,
+    CameraDesc, Environment, LightDesc, MaterialDesc, SceneFile, ShapeDesc, TransformDesc, V3,
+    VERSION,
 };
 use crate::import::import_mesh;
 use crate::scene::{
-    Camera, LoadReport, Material, Scene, Sphere, cube_quads, push_triangle, quad_triangles,
-    rectangle_quad, transform_triangle,
+    Camera, LoadReport, Material, PunctualLight, Scene, Sphere, cube_quads, push_triangle,
+    quad_triangles, rectangle_quad, transform_triangle,
 };
 
 #[derive(Deserialize)]
@@ -35,10 +37,13 @@ impl<'a> Locator<'a> {
     fn new(text: &'a str) -> Self {
         let kinds = ["Mesh", "Sphere", "Rectangle", "Box", "Quad"];
         let start = text.find("shapes").unwrap_or(0);
+        let end = text[start..]
+            .find("lights:")
+            .map_or(text.len(), |o| start + o);
         let mut shape_starts = Vec::new();
         let bytes = text.as_bytes();
         let mut i = start;
-        while i < text.len() {
+        while i < end {
             let rest = &text[i..];
             let before_ok =
                 i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_');
@@ -92,6 +97,33 @@ impl<'a> Locator<'a> {
 
     fn find(&self, needle: &str) -> Option<Pos> {
         self.text.find(needle).map(|o| self.pos(o))
+    }
+
+    /// Where `needle` first appears in light `index` of the `lights` list (lights are
+    /// found by their kind's name followed by `(`), or where that light starts.
+    fn in_light(&self, index: usize, needle: &str) -> Option<Pos> {
+        let list = self.text.find("lights:")?;
+        let kinds = ["Point", "Spot", "Directional"];
+        let mut starts = Vec::new();
+        let mut i = list;
+        while i < self.text.len() {
+            let rest = &self.text[i..];
+            if let Some(k) = kinds
+                .iter()
+                .find(|k| rest.starts_with(**k) && rest[k.len()..].trim_start().starts_with('('))
+            {
+                starts.push(i);
+                i += k.len();
+                continue;
+            }
+            i += rest.chars().next().map_or(1, char::len_utf8);
+        }
+        let start = *starts.get(index)?;
+        let end = starts.get(index + 1).copied().unwrap_or(self.text.len());
+        let found = self.text[start..end]
+            .find(needle)
+            .map_or(start, |o| start + o);
+        Some(self.pos(found))
     }
 }
 
@@ -173,24 +205,159 @@ pub fn transform_matrix(t: &TransformDesc) -> Result<Mat4, SceneError> {
     Ok(m)
 }
 
+/// The conductor a material description names or gives, if any.
+fn conductor_from_desc(d: &MaterialDesc) -> Result<Option<Conductor>, SceneError> {
+    match (&d.conductor, d.eta, d.k) {
+        (None, None, None) => Ok(None),
+        (Some(name), None, None) => crate::conductor::preset(name).map(Some).ok_or_else(|| {
+            let known: Vec<&str> = crate::conductor::PRESETS.iter().map(|p| p.0).collect();
+            bad(
+                "conductor",
+                format!("no conductor \"{name}\" (known: {})", known.join(", ")),
+            )
+        }),
+        (Some(_), _, _) => Err(bad(
+            "conductor",
+            "give either a named `conductor` or `eta` and `k`, not both",
+        )),
+        (None, Some(eta), Some(k)) => {
+            let eta = finite3("eta", eta)?;
+            let k = non_negative3("k", k)?;
+            if eta.min_element() <= 0.0 {
+                return Err(bad("eta", format!("{eta} must be positive")));
+            }
+            Ok(Some(Conductor::new(eta, k)))
+        }
+        (None, Some(_), None) => Err(bad("eta", "`eta` needs `k` (the extinction coefficient)")),
+        (None, None, Some(_)) => Err(bad("k", "`k` needs `eta` (the real part of the index)")),
+    }
+}
+
 fn material_from_desc(name: &str, d: &MaterialDesc) -> Result<Material, SceneError> {
     let ior = d.ior;
     if !(ior > 0.0 && ior.is_finite()) {
         return Err(bad("ior", format!("{ior} must be a positive number")));
     }
+    let conductor = conductor_from_desc(d)?;
+    let metallic = d
+        .metallic
+        .unwrap_or(if conductor.is_some() { 1.0 } else { 0.0 });
+    if conductor.is_some() && metallic == 0.0 {
+        return Err(bad(
+            "metallic",
+            "a conductor needs `metallic` > 0 (it is the metal lobe's Fresnel)",
+        ));
+    }
+    // A conductor's colour is its reflectance at normal incidence (albedo outputs and the
+    // denoiser read it); `base_color` is not used by its Fresnel.
+    let base_color = match conductor {
+        Some(c) => c.normal_reflectance(),
+        None => non_negative3("base_color", d.base_color)?,
+    };
     Ok(Material {
         name: name.to_owned(),
-        base_color: non_negative3("base_color", d.base_color)?,
+        base_color,
         emission: non_negative3("emission", d.emission)?,
         roughness: unit_range("roughness", d.roughness)?,
-        metallic: unit_range("metallic", d.metallic)?,
+        metallic: unit_range("metallic", metallic)?,
         specular: unit_range("specular", d.specular)?,
         specular_tint: unit_range("specular_tint", d.specular_tint)?,
         transmission: unit_range("transmission", d.transmission)?,
         ior,
         two_sided: d.two_sided,
+        conductor,
+        multiscatter: d.multiscatter,
         ..Material::named(name)
     })
+}
+
+fn angle(field: &'static str, degrees: f32, max: f32) -> Result<f32, SceneError> {
+    if degrees.is_finite() && (0.0..=max).contains(&degrees) {
+        Ok(degrees.to_radians())
+    } else {
+        Err(bad(
+            field,
+            format!("{degrees} must be in [0, {max}] degrees"),
+        ))
+    }
+}
+
+fn light_from_desc(d: &LightDesc) -> Result<PunctualLight, SceneError> {
+    Ok(match d {
+        LightDesc::Point {
+            position,
+            intensity,
+            ..
+        } => PunctualLight::Point {
+            position: finite3("position", *position)?,
+            intensity: non_negative3("intensity", *intensity)?,
+        },
+        LightDesc::Spot {
+            position,
+            target,
+            intensity,
+            cutoff_angle,
+            beam_width,
+            ..
+        } => {
+            let position = finite3("position", *position)?;
+            let axis = finite3("target", *target)? - position;
+            if axis.length_squared() == 0.0 {
+                return Err(bad("target", "the target must differ from the position"));
+            }
+            let cutoff = angle("cutoff_angle", *cutoff_angle, 90.0)?;
+            if cutoff == 0.0 {
+                return Err(bad("cutoff_angle", "0 degrees lights nothing"));
+            }
+            let beam = match beam_width {
+                Some(b) => angle("beam_width", *b, *cutoff_angle)?,
+                None => 0.75 * cutoff,
+            };
+            PunctualLight::Spot {
+                position,
+                axis: axis.normalize(),
+                intensity: non_negative3("intensity", *intensity)?,
+                cutoff,
+                beam,
+            }
+        }
+        LightDesc::Directional {
+            direction,
+            irradiance,
+            ..
+        } => {
+            let direction = finite3("direction", *direction)?;
+            if direction.length_squared() == 0.0 {
+                return Err(bad("direction", "the direction must not be zero"));
+            }
+            PunctualLight::Directional {
+                direction: direction.normalize(),
+                irradiance: non_negative3("irradiance", *irradiance)?,
+            }
+        }
+    })
+}
+
+/// A version 1 environment map in version 2's (Mitsuba's) orientation, lighting the scene
+/// the same: version 1 saw the map's centre column along −z, i.e. turned by 180° about y
+/// from Mitsuba's, and rotated by the opposite angles.
+fn environment_from_v1(env: Environment) -> Environment {
+    match env {
+        Environment::Map {
+            path,
+            intensity,
+            azimuth,
+            elevation,
+            show_background,
+        } => Environment::Map {
+            path,
+            intensity,
+            azimuth: -(azimuth + 180.0),
+            elevation: -elevation,
+            show_background,
+        },
+        other => other,
+    }
 }
 
 impl Scene {
@@ -224,7 +391,7 @@ impl Scene {
         };
         let options = ron::Options::default().with_default_extension(Extensions::IMPLICIT_SOME);
         let probe: VersionProbe = options.from_str(text).map_err(syntax)?;
-        if probe.version != VERSION {
+        if !(1..=VERSION).contains(&probe.version) {
             let loc = Locator::new(text);
             return Err(SceneError::new(ErrorKind::Version {
                 found: probe.version,
@@ -232,7 +399,10 @@ impl Scene {
             })
             .at(loc.find("version")));
         }
-        let file: SceneFile = options.from_str(text).map_err(syntax)?;
+        let mut file: SceneFile = options.from_str(text).map_err(syntax)?;
+        if file.version == 1 {
+            file.environment = environment_from_v1(file.environment);
+        }
         Builder::new(text, base_dir).build(&file)
     }
 }
@@ -246,6 +416,7 @@ struct Builder<'a> {
     derived: HashMap<(u32, [u32; 3], bool), u32>,
     scene_triangles: Vec<crate::scene::Triangle>,
     spheres: Vec<Sphere>,
+    lights: Vec<PunctualLight>,
     textures: Vec<crate::texture::Texture>,
     report: LoadReport,
     /// Cameras of each named `Mesh` shape.
@@ -262,6 +433,7 @@ impl<'a> Builder<'a> {
             derived: HashMap::new(),
             scene_triangles: Vec::new(),
             spheres: Vec::new(),
+            lights: Vec::new(),
             textures: Vec::new(),
             report: LoadReport::default(),
             mesh_cameras: BTreeMap::new(),
@@ -296,6 +468,20 @@ impl<'a> Builder<'a> {
                 e.about(label).at(self.loc.in_shape(i, &needle))
             })?;
         }
+        for (i, light) in file.lights.iter().enumerate() {
+            let l = light_from_desc(light).map_err(|e| {
+                let label = match light.name() {
+                    Some(n) => format!("light \"{n}\""),
+                    None => format!("light {i} ({})", light.kind()),
+                };
+                let needle = match &e.kind {
+                    ErrorKind::BadValue { field, .. } => *field,
+                    _ => "",
+                };
+                e.about(label).at(self.loc.in_light(i, needle))
+            })?;
+            self.lights.push(l);
+        }
         let camera = self
             .camera(&file.camera)
             .map_err(|e| e.about("camera").at(self.loc.find("camera")))?;
@@ -321,6 +507,7 @@ impl<'a> Builder<'a> {
             materials: self.materials,
             triangles: self.scene_triangles,
             spheres: self.spheres,
+            lights: self.lights,
             textures: self.textures,
             environment,
             settings: s,
@@ -468,6 +655,7 @@ impl<'a> Builder<'a> {
                         t
                     }));
                 self.report.merge(mesh.report);
+                self.lights.extend(mesh.lights);
                 if let Some(n) = name {
                     self.mesh_cameras.insert(n.clone(), mesh.cameras);
                 }

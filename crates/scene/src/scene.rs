@@ -104,6 +104,12 @@ pub struct Material {
     /// glTF `normalTexture.scale`: the tangent-space x and y of the normal map are scaled
     /// by it.
     pub normal_scale: f32,
+    /// A conductor's complex index of refraction: the metal lobe's Fresnel is the exact
+    /// conductor one instead of Schlick's on `base_color` (which then holds its
+    /// normal-incidence reflectance, for albedo outputs).
+    pub conductor: Option<crate::conductor::Conductor>,
+    /// Compensate the energy single-scattering microfacet lobes lose (default true).
+    pub multiscatter: bool,
 }
 
 impl Material {
@@ -122,6 +128,8 @@ impl Material {
             two_sided: false,
             textures: MaterialTextures::default(),
             normal_scale: 1.0,
+            conductor: None,
+            multiscatter: true,
         }
     }
 
@@ -208,6 +216,39 @@ pub struct Sphere {
     pub material: u32,
 }
 
+/// A light without area: it lights the scene through light sampling only and is never hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PunctualLight {
+    /// Light from one point, the same in every direction.
+    Point {
+        /// Position.
+        position: Vec3,
+        /// Radiant intensity, W/sr.
+        intensity: Vec3,
+    },
+    /// Light from one point into a cone about `axis`: full `intensity` within `beam` of
+    /// the axis, falling linearly in angle to 0 at `cutoff` (Mitsuba's `spot`).
+    Spot {
+        /// Position.
+        position: Vec3,
+        /// Unit axis, the direction light leaves along.
+        axis: Vec3,
+        /// Radiant intensity on the axis, W/sr.
+        intensity: Vec3,
+        /// Half-angle outside which it is black, radians.
+        cutoff: f32,
+        /// Half-angle of full intensity, radians, at most `cutoff`.
+        beam: f32,
+    },
+    /// Parallel light from infinitely far away.
+    Directional {
+        /// Unit direction the light travels in.
+        direction: Vec3,
+        /// Irradiance on a surface facing the light, W/m².
+        irradiance: Vec3,
+    },
+}
+
 /// What loading left out or changed, never fatal.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct LoadReport {
@@ -247,6 +288,8 @@ pub struct Scene {
     pub triangles: Vec<Triangle>,
     /// Analytic spheres.
     pub spheres: Vec<Sphere>,
+    /// Point, spot and directional lights.
+    pub lights: Vec<PunctualLight>,
     /// Decoded textures; materials index into this.
     pub textures: Vec<crate::texture::Texture>,
     /// What rays leaving the scene see.

@@ -48,6 +48,7 @@ fn sphere_grid_scene() -> Scene {
         },
         materials,
         triangles: mesh.triangles,
+        lights: Vec::new(),
         textures: Vec::new(),
         spheres,
         environment: Environment::None,

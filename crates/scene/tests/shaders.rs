@@ -132,7 +132,13 @@ fn wgsl_layouts_match_rust() {
                 tex_transmission_specular,
                 tex_specular_color,
                 pad0,
-                pad1
+                pad1,
+                eta,
+                pad2,
+                k,
+                pad3,
+                f_avg,
+                pad4
             ]
         ),
         layout!(

@@ -44,6 +44,9 @@ pub(crate) struct PathTrace {
     firefly_clamp: f32,
     /// `SAMPLER_SOBOL` (0) or `SAMPLER_INDEPENDENT` (1) in `pathtrace/sampler.wgsl`.
     sampler: u32,
+    /// `STRATEGY_MIS` (0), `STRATEGY_LIGHT` (1) or `STRATEGY_BSDF` (2) in
+    /// `pathtrace/pathtrace.wgsl`.
+    strategy: u32,
 }
 
 impl PathTrace {
@@ -142,6 +145,7 @@ impl PathTrace {
             env,
             firefly_clamp: 0.0,
             sampler: 0,
+            strategy: 0,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -163,7 +167,8 @@ impl PathTrace {
         }
         bytes.extend_from_slice(&self.firefly_clamp.to_le_bytes());
         bytes.extend_from_slice(&self.sampler.to_le_bytes());
-        bytes.extend_from_slice(&[0; 8]);
+        bytes.extend_from_slice(&self.strategy.to_le_bytes());
+        bytes.extend_from_slice(&[0; 4]);
         bytes
     }
 }
@@ -175,6 +180,11 @@ impl NodeExec for PathTrace {
         let clamp = pass.params.float("firefly_clamp") as f32;
         self.firefly_clamp = clamp;
         self.sampler = u32::from(pass.params.str("sampler") == "independent");
+        self.strategy = match pass.params.str("strategy") {
+            "light" => 1,
+            "bsdf" => 2,
+            _ => 0,
+        };
         Ok(())
     }
 

@@ -5,6 +5,13 @@
 //! and textures). Texture coordinates are `TEXCOORD_0`; tangents are the file's `TANGENT`
 //! when present (else generated when the scene is flattened).
 //!
+//! `KHR_lights_punctual` lights become [`PunctualLight`]s, converted as Blender's importer
+//! does in its default ("Standard") mode: a point or spot light's intensity in candela
+//! (lm/sr) over 683 lm/W is its radiant intensity in W/sr, a directional light's lux over
+//! 683 its irradiance in W/m². A spot's outer cone angle is the cutoff and its inner one
+//! the beam width, with the falloff linear in angle between them (Mitsuba's; glTF only
+//! recommends a curve). `range` is not read (lights are physical: no cut-off distance).
+//!
 //! Only the textures some material uses are decoded (PNG or JPEG: embedded in a buffer view,
 //! a data URI or an external file); a missing or broken image is an error naming the
 //! material, the texture and the image.
@@ -17,7 +24,8 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use super::ImportedMesh;
 use crate::error::{ErrorKind, SceneError};
 use crate::scene::{
-    Camera, Material, MaterialTextures, NO_TEXTURE, Triangle, push_triangle, transform_triangle,
+    Camera, Material, MaterialTextures, NO_TEXTURE, PunctualLight, Triangle, push_triangle,
+    transform_triangle,
 };
 use crate::texture::{Texture, Wrap};
 
@@ -75,6 +83,16 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
                 ));
             }
         }
+        if let Some(light) = node.light() {
+            match punctual_light(&light, &world) {
+                Ok(l) => out.lights.push(l),
+                Err(why) => out.report.warnings.push(format!(
+                    "light {} ({}): {why}; skipped",
+                    light.index(),
+                    light.name().unwrap_or("unnamed")
+                )),
+            }
+        }
         if let Some(mesh) = node.mesh() {
             for prim in mesh.primitives() {
                 if prim.mode() != ::gltf::mesh::Mode::Triangles {
@@ -101,6 +119,50 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
         stack.extend(children.into_iter().rev().map(|c| (c, world)));
     }
     Ok(out)
+}
+
+/// Luminous efficacy of 555 nm light, lm/W: photometric glTF units to radiometric ones.
+pub const LUMENS_PER_WATT: f32 = 683.0;
+
+/// A `KHR_lights_punctual` light placed by its node's world matrix (it shines along the
+/// node's −z).
+fn punctual_light(
+    light: &::gltf::khr_lights_punctual::Light<'_>,
+    world: &Mat4,
+) -> Result<PunctualLight, String> {
+    use ::gltf::khr_lights_punctual::Kind;
+    let power = Vec3::from(light.color()) * (light.intensity() / LUMENS_PER_WATT);
+    if !power.is_finite() || power.min_element() < 0.0 {
+        return Err(format!("color × intensity {power} is not finite and >= 0"));
+    }
+    let position = world.transform_point3(Vec3::ZERO);
+    let axis = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+    if !position.is_finite() || axis == Vec3::ZERO {
+        return Err("its node's transform is singular".to_owned());
+    }
+    Ok(match light.kind() {
+        Kind::Point => PunctualLight::Point {
+            position,
+            intensity: power,
+        },
+        Kind::Directional => PunctualLight::Directional {
+            direction: axis,
+            irradiance: power,
+        },
+        Kind::Spot {
+            inner_cone_angle,
+            outer_cone_angle,
+        } => {
+            let cutoff = outer_cone_angle.clamp(1e-4, std::f32::consts::FRAC_PI_2);
+            PunctualLight::Spot {
+                position,
+                axis,
+                intensity: power,
+                cutoff,
+                beam: inner_cone_angle.clamp(0.0, cutoff),
+            }
+        }
+    })
 }
 
 fn read_primitive(
@@ -380,5 +442,7 @@ fn material(
             specular_color,
         },
         normal_scale: normal_info.map_or(1.0, |n| n.scale()),
+        conductor: None,
+        multiscatter: true,
     })
 }

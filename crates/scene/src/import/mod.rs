@@ -1,7 +1,8 @@
 //! Mesh import: glTF 2.0 ([`gltf`]) and OBJ + MTL ([`obj`]).
 //!
 //! An importer returns world-space triangles (the file's node hierarchy and the caller's
-//! transform applied), its materials with indices local to the file, and its cameras.
+//! transform applied), its materials with indices local to the file, its cameras and its
+//! lights.
 //! Broken triangles (NaN or infinite corners, zero area) are dropped and counted in the
 //! [`LoadReport`], never a panic.
 
@@ -13,7 +14,7 @@ use std::path::Path;
 use glam::Mat4;
 
 use crate::error::{ErrorKind, SceneError};
-use crate::scene::{Camera, LoadReport, Material, Triangle};
+use crate::scene::{Camera, LoadReport, Material, PunctualLight, Triangle};
 
 /// What a mesh file holds, placed in the world.
 #[derive(Clone, Debug, Default)]
@@ -26,6 +27,8 @@ pub struct ImportedMesh {
     pub textures: Vec<crate::texture::Texture>,
     /// The file's cameras, in node order (glTF only).
     pub cameras: Vec<Camera>,
+    /// The file's point, spot and directional lights, placed (glTF `KHR_lights_punctual`).
+    pub lights: Vec<PunctualLight>,
     /// What was dropped or changed.
     pub report: LoadReport,
 }
