@@ -1,7 +1,8 @@
 // Environment lighting from an equirectangular map, importance sampled by pixel: each
 // pixel's probability is proportional to its luminance times sin(theta) (its solid angle),
-// drawn with an alias table; radiance and pdf are constant over a pixel, so evaluation and
-// sampling agree exactly. The includer declares `env_texels: array<vec4f>` (rgb radiance,
+// drawn with an alias table, and the pdf is constant over a pixel. The radiance is Mitsuba's
+// `envmap` lookup: bilinear between texel values placed at u = (x + 1/2) / W (wrapping
+// around) and v = y / (H - 1), so renders compare with Mitsuba's pixel for pixel. The includer declares `env_texels: array<vec4f>` (rgb radiance,
 // a = pixel probability), `env_alias: array<AliasEntry>` and `frame` (map size, rotation,
 // scale in `frame.settings`).
 #import "pathtrace/scene_types.wgsl"
@@ -40,6 +41,24 @@ fn env_dir(uv: vec2f) -> vec3f {
     return vec3f(s * sin(phi), cos(theta), -s * cos(phi));
 }
 
+// Radiance of the map (unscaled) at `uv`: Mitsuba's bilinear lookup (see above).
+fn env_radiance(uv: vec2f) -> vec3f {
+    let w = frame.env_width;
+    let h = frame.env_height;
+    let x = uv.x * f32(w) - 0.5;
+    let y = uv.y * f32(max(h, 2u) - 1u);
+    let xf = floor(x);
+    let fx = x - xf;
+    let x0 = u32(i32(xf) + i32(w)) % w;
+    let x1 = (x0 + 1u) % w;
+    let y0 = min(u32(max(floor(y), 0.0)), h - 1u);
+    let fy = clamp(y - f32(y0), 0.0, 1.0);
+    let y1 = min(y0 + 1u, h - 1u);
+    let top = mix(env_texels[y0 * w + x0].rgb, env_texels[y0 * w + x1].rgb, fx);
+    let bottom = mix(env_texels[y1 * w + x0].rgb, env_texels[y1 * w + x1].rgb, fx);
+    return mix(top, bottom, fy);
+}
+
 fn env_texel(uv: vec2f) -> u32 {
     let w = frame.env_width;
     let h = frame.env_height;
@@ -57,9 +76,10 @@ fn env_pixel_pdf(p: f32, sin_theta: f32) -> f32 {
 // Radiance (rgb) and solid-angle pdf (a) of the map in world direction d.
 fn env_eval(d: vec3f) -> vec4f {
     let m = env_to_map(d);
-    let t = env_texels[env_texel(env_uv(m))];
+    let uv = env_uv(m);
+    let p = env_texels[env_texel(uv)].a;
     let sin_theta = sqrt(max(0.0, 1.0 - m.y * m.y));
-    return vec4f(t.rgb * frame.settings.env_radiance, env_pixel_pdf(t.a, sin_theta));
+    return vec4f(env_radiance(uv) * frame.settings.env_radiance, env_pixel_pdf(p, sin_theta));
 }
 
 struct EnvSample {
@@ -77,7 +97,6 @@ fn sample_env(u_pick: f32, u: vec2f) -> EnvSample {
     let x = idx % frame.env_width;
     let y = idx / frame.env_width;
     let uv = vec2f((f32(x) + u.x) / f32(frame.env_width), (f32(y) + u.y) / f32(frame.env_height));
-    let t = env_texels[idx];
-    let pdf = env_pixel_pdf(t.a, sin(uv.y * PI));
-    return EnvSample(env_from_map(env_dir(uv)), t.rgb * frame.settings.env_radiance, pdf);
+    let pdf = env_pixel_pdf(env_texels[idx].a, sin(uv.y * PI));
+    return EnvSample(env_from_map(env_dir(uv)), env_radiance(uv) * frame.settings.env_radiance, pdf);
 }

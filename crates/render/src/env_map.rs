@@ -1,9 +1,12 @@
 //! The environment map on the GPU: texels with each pixel's sampling probability, and the
 //! alias table that draws pixels by it (`shaders/pathtrace/env.wgsl`).
 //!
-//! A pixel's probability is proportional to its luminance times `sin θ` at its center (the
-//! solid angle an equirectangular row covers), so bright, large regions are sampled
-//! often; the shader turns it into a solid-angle pdf with the same `sin θ`.
+//! A pixel's probability is proportional to the mean luminance of its 3×3 neighbourhood
+//! (wrapping around in x) times `sin θ` at its center (the solid angle an equirectangular row
+//! covers), so bright, large regions are sampled often; the shader turns it into a
+//! solid-angle pdf with the same `sin θ`. The neighbourhood covers the texels the shader's
+//! bilinear lookup (Mitsuba's) blends into the pixel, so every direction with radiance can
+//! be sampled: light sampling alone converges to the same image.
 
 use std::path::Path;
 
@@ -34,23 +37,32 @@ pub fn tables(
     uniform: bool,
 ) -> (Vec<[f32; 4]>, Vec<lumagraph_scene::GpuAliasEntry>) {
     let (w, h) = (image.width as usize, image.height as usize);
+    let lum: Vec<f32> = image
+        .pixels
+        .iter()
+        .map(|p| {
+            let l = luminance(glam::Vec3::new(p[0], p[1], p[2]));
+            if l.is_finite() { l.max(0.0) } else { 0.0 }
+        })
+        .collect();
     let mut weights = Vec::with_capacity(w * h);
     for y in 0..h {
         #[expect(clippy::cast_precision_loss, reason = "image rows")]
         let sin_theta = ((y as f64 + 0.5) / h as f64 * std::f64::consts::PI).sin();
         for x in 0..w {
-            let p = image.pixels[y * w + x];
             let l = if uniform {
                 1.0
             } else {
-                luminance(glam::Vec3::new(p[0], p[1], p[2])).max(0.0)
+                let mut sum = 0.0;
+                for yy in y.saturating_sub(1)..=(y + 1).min(h - 1) {
+                    for dx in [w - 1, 0, 1] {
+                        sum += f64::from(lum[yy * w + (x + dx) % w]);
+                    }
+                }
+                sum / 9.0
             };
             #[expect(clippy::cast_possible_truncation, reason = "weights in f32")]
-            weights.push(if l.is_finite() {
-                l * sin_theta as f32
-            } else {
-                0.0
-            });
+            weights.push((l * sin_theta) as f32);
         }
     }
     let total: f64 = weights.iter().map(|&v| f64::from(v)).sum();

@@ -9,6 +9,7 @@
 //! - [`Executor`]: runs a [`lumagraph_graph::Plan`] frame by frame.
 //! - [`image_io`] and [`cpu`]: image files, and plain-Rust references of every post node.
 
+pub mod bsdf_check;
 pub mod bsdf_tables;
 mod context;
 pub mod cpu;

@@ -71,41 +71,45 @@ fn tex16(t: u32) -> u32 {
     }
 }
 
-fn gpu_material(m: &Material) -> GpuMaterial {
-    let mut flags = if m.two_sided { MATERIAL_TWO_SIDED } else { 0 };
-    if m.conductor.is_some() {
-        flags |= MATERIAL_CONDUCTOR;
-    }
-    if !m.multiscatter {
-        flags |= MATERIAL_SINGLE_SCATTER;
-    }
-    let (eta, k, f_avg) = m.conductor.map_or(([0.0; 3], [0.0; 3], [0.0; 3]), |c| {
-        (
-            c.eta.to_array(),
-            c.k.to_array(),
-            c.average_reflectance().to_array(),
-        )
-    });
-    GpuMaterial {
-        base_color: m.base_color.to_array(),
-        roughness: m.roughness,
-        emission: m.emission.to_array(),
-        metallic: m.metallic,
-        specular: m.specular,
-        specular_tint: m.specular_tint,
-        transmission: m.transmission,
-        ior: m.ior,
-        tex_base_mr: tex16(m.textures.base_color) | (tex16(m.textures.metallic_roughness) << 16),
-        tex_emissive_normal: tex16(m.textures.emissive) | (tex16(m.textures.normal) << 16),
-        flags,
-        normal_scale: m.normal_scale,
-        tex_transmission_specular: tex16(m.textures.transmission)
-            | (tex16(m.textures.specular) << 16),
-        tex_specular_color: tex16(m.textures.specular_color) | (0xFFFF << 16),
-        eta,
-        k,
-        f_avg,
-        ..GpuMaterial::default()
+impl From<&Material> for GpuMaterial {
+    /// The material as the path tracer reads it.
+    fn from(m: &Material) -> Self {
+        let mut flags = if m.two_sided { MATERIAL_TWO_SIDED } else { 0 };
+        if m.conductor.is_some() {
+            flags |= MATERIAL_CONDUCTOR;
+        }
+        if !m.multiscatter {
+            flags |= MATERIAL_SINGLE_SCATTER;
+        }
+        let (eta, k, f_avg) = m.conductor.map_or(([0.0; 3], [0.0; 3], [0.0; 3]), |c| {
+            (
+                c.eta.to_array(),
+                c.k.to_array(),
+                c.average_reflectance().to_array(),
+            )
+        });
+        GpuMaterial {
+            base_color: m.base_color.to_array(),
+            roughness: m.roughness,
+            emission: m.emission.to_array(),
+            metallic: m.metallic,
+            specular: m.specular,
+            specular_tint: m.specular_tint,
+            transmission: m.transmission,
+            ior: m.ior,
+            tex_base_mr: tex16(m.textures.base_color)
+                | (tex16(m.textures.metallic_roughness) << 16),
+            tex_emissive_normal: tex16(m.textures.emissive) | (tex16(m.textures.normal) << 16),
+            flags,
+            normal_scale: m.normal_scale,
+            tex_transmission_specular: tex16(m.textures.transmission)
+                | (tex16(m.textures.specular) << 16),
+            tex_specular_color: tex16(m.textures.specular_color) | (0xFFFF << 16),
+            eta,
+            k,
+            f_avg,
+            ..GpuMaterial::default()
+        }
     }
 }
 
@@ -267,7 +271,7 @@ impl GpuScene {
         let flat = bvh::build(&tri_boxes, &sphere_boxes, options)?;
 
         let mut out = Self {
-            materials: scene.materials.iter().map(gpu_material).collect(),
+            materials: scene.materials.iter().map(GpuMaterial::from).collect(),
             bvh_nodes: flat.nodes,
             tri_source: flat.tri_order,
             sphere_source: flat.sphere_order,

@@ -1,0 +1,181 @@
+//! The path tracer's BSDF (`shaders/pathtrace/bsdf.wgsl`) on its own, sampled and evaluated
+//! on the GPU for one material and outgoing direction, so tests can check each lobe's
+//! sampling against its pdf (chi-square), its weights against `f · cos / pdf` and its
+//! reciprocity. The kernel is `shaders/pathtrace/bsdf_check.wgsl`.
+
+use glam::Vec3;
+use lumagraph_scene::GpuMaterial;
+use wgpu::util::DeviceExt as _;
+
+use crate::context::GpuContext;
+use crate::error::Result;
+use crate::kernel::{Binding, Kernel, uniform_buffer};
+use crate::readback::{compute_and_read, groups_1d};
+
+/// One sample of the BSDF, in the shading frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// Sampled incident direction (unit).
+    pub wi: Vec3,
+    /// Solid-angle pdf the path tracer uses for MIS (0 for delta and glass samples).
+    pub pdf: f32,
+    /// `f · cos / pdf` of the sampling done.
+    pub weight: Vec3,
+    /// Whether the sample is valid (else the path ends).
+    pub valid: bool,
+}
+
+/// `eval_bsdf` at one incident direction, and with the directions swapped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfValue {
+    /// `f(wo, wi) · cos θi`.
+    pub f_cos: Vec3,
+    /// Solid-angle pdf of sampling `wi` from `wo`.
+    pub pdf: f32,
+    /// `f(wi, wo) · cos θo`.
+    pub f_cos_swapped: Vec3,
+    /// Solid-angle pdf of sampling `wo` from `wi`.
+    pub pdf_swapped: f32,
+}
+
+/// What one dispatch of the kernel does.
+enum Job<'a> {
+    /// `count` samples with random numbers from `seed`.
+    Sample { count: u32, seed: u32 },
+    /// Evaluation at these directions.
+    Eval(&'a [[f32; 4]]),
+}
+
+/// The BSDF kernel with the GGX albedo tables.
+#[derive(Debug)]
+pub struct BsdfCheck {
+    kernel: Kernel,
+    ggx_table: wgpu::Buffer,
+}
+
+impl BsdfCheck {
+    /// Compiles the kernel (every lobe compiled in).
+    ///
+    /// # Errors
+    /// When the shader does not compile.
+    pub fn new(ctx: &GpuContext) -> Result<Self> {
+        let storage = Binding::Storage { read_only: true };
+        let kernel = Kernel::new(
+            ctx,
+            "pathtrace/bsdf_check.wgsl",
+            &[
+                Binding::Uniform,
+                storage,
+                storage,
+                storage,
+                Binding::Storage { read_only: false },
+            ],
+        )?;
+        let ggx_table = ctx
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("ggx albedo table"),
+                contents: bytemuck::cast_slice(crate::bsdf_tables::ggx_table()),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+        Ok(Self { kernel, ggx_table })
+    }
+
+    fn run(
+        &self,
+        ctx: &GpuContext,
+        material: &GpuMaterial,
+        wo: Vec3,
+        job: &Job<'_>,
+    ) -> Result<Vec<[f32; 4]>> {
+        let (mode, seed, dirs, count) = match *job {
+            Job::Sample { count, seed } => (0, seed, &[][..], count),
+            Job::Eval(dirs) => (1, 0, dirs, u32::try_from(dirs.len()).unwrap_or(u32::MAX)),
+        };
+        let mut params = [0u32; 8];
+        params[..3].copy_from_slice(&wo.to_array().map(f32::to_bits));
+        params[3] = count;
+        params[4] = mode;
+        params[5] = seed;
+        let params = uniform_buffer(ctx, "bsdf check params", bytemuck::cast_slice(&params));
+        let buffer = |label, contents: &[u8]| {
+            ctx.device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage: wgpu::BufferUsages::STORAGE,
+                })
+        };
+        let material = buffer("bsdf check material", bytemuck::bytes_of(material));
+        let dirs = if dirs.is_empty() {
+            buffer("bsdf check directions", &[0; 16])
+        } else {
+            buffer("bsdf check directions", bytemuck::cast_slice(dirs))
+        };
+        compute_and_read::<[f32; 4]>(ctx, "bsdf check", 2 * count as usize, |encoder, out| {
+            self.kernel
+                .pass("bsdf check")
+                .uniform(&params)
+                .buffer(&material)
+                .buffer(&self.ggx_table)
+                .buffer(&dirs)
+                .buffer(out)
+                .dispatch(ctx, encoder, groups_1d(count, 64), None)
+        })
+    }
+
+    /// `count` samples of `material` seen from `wo` (unit, shading frame), with random
+    /// numbers from `seed`.
+    ///
+    /// # Errors
+    /// When the GPU work fails.
+    pub fn sample(
+        &self,
+        ctx: &GpuContext,
+        material: &GpuMaterial,
+        wo: Vec3,
+        count: u32,
+        seed: u32,
+    ) -> Result<Vec<BsdfSample>> {
+        if count == 0 {
+            return Ok(Vec::new());
+        }
+        let raw = self.run(ctx, material, wo, &Job::Sample { count, seed })?;
+        Ok(raw
+            .chunks_exact(2)
+            .map(|p| BsdfSample {
+                wi: Vec3::new(p[0][0], p[0][1], p[0][2]),
+                pdf: p[0][3],
+                weight: Vec3::new(p[1][0], p[1][1], p[1][2]),
+                valid: p[1][3] != 0.0,
+            })
+            .collect())
+    }
+
+    /// `eval_bsdf` of `material` from `wo` at every direction of `wis` (and swapped).
+    ///
+    /// # Errors
+    /// When the GPU work fails.
+    pub fn eval(
+        &self,
+        ctx: &GpuContext,
+        material: &GpuMaterial,
+        wo: Vec3,
+        wis: &[Vec3],
+    ) -> Result<Vec<BsdfValue>> {
+        if wis.is_empty() {
+            return Ok(Vec::new());
+        }
+        let dirs: Vec<[f32; 4]> = wis.iter().map(|d| d.extend(0.0).to_array()).collect();
+        let raw = self.run(ctx, material, wo, &Job::Eval(&dirs))?;
+        Ok(raw
+            .chunks_exact(2)
+            .map(|p| BsdfValue {
+                f_cos: Vec3::new(p[0][0], p[0][1], p[0][2]),
+                pdf: p[0][3],
+                f_cos_swapped: Vec3::new(p[1][0], p[1][1], p[1][2]),
+                pdf_swapped: p[1][3],
+            })
+            .collect())
+    }
+}

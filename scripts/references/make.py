@@ -1,0 +1,263 @@
+#!/usr/bin/env python3
+"""Mitsuba 3 references for the path tracer's test suite (tests/scenes/*.ron).
+
+For each scene: `lumagraph export` writes the resolved scene (what the path tracer renders:
+materials, spheres, triangles as OBJ, lights, environment, camera) as JSON; this script maps
+it onto Mitsuba 3 plugins, renders a reference at `--spp` samples per pixel and Mitsuba's own
+256-spp images with `--seeds` seeds, and writes into tests/reference/suite/:
+
+  NAME.exr   the reference, linear RGB, half float
+  NAME.json  how it was made: spp, Mitsuba version and variant, the plugin each material
+             became, and Mitsuba's relMSE at 256 spp against the reference (per seed and
+             mean): the figure the tests hold lumagraph to (1.25x).
+
+Usage (from the repository root):
+  python3 -m venv .venv-mitsuba && .venv-mitsuba/bin/pip install -r scripts/references/requirements.txt
+  cargo build --release
+  .venv-mitsuba/bin/python scripts/references/make.py                 # every scene
+  .venv-mitsuba/bin/python scripts/references/make.py conductors      # some scenes
+
+Materials map one to one or the scene is refused (never an approximation in silence):
+  specular 0, metallic 0, transmission 0          -> diffuse
+  metallic 1 with eta/k (conductor presets)       -> conductor / roughconductor (GGX)
+  transmission 1, metallic 0                       -> dielectric / roughdielectric (GGX)
+  metallic 0, transmission 0, specular > 0         -> plastic / roughplastic (GGX, int_ior
+                                                      from F0 = 0.08 specular): NOT the same
+                                                      model as lumagraph's layer (see
+                                                      docs/pathtracer.md), flagged in the JSON
+Rough lobes need `multiscatter: false` to be the same model as Mitsuba's (which has no
+multiple-scattering compensation); a rough lobe with it on is flagged too.
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+SCENES = os.path.join(ROOT, "tests", "scenes")
+OUT = os.path.join(ROOT, "tests", "reference", "suite")
+ALPHA_MIN = 1e-3  # below this alpha lumagraph's lobes are perfect mirrors / interfaces
+
+
+class Refused(Exception):
+    pass
+
+
+def rgb(v):
+    return {"type": "rgb", "value": [float(x) for x in v]}
+
+
+def bsdf(m):
+    """Mitsuba BSDF dict for a lumagraph material, and notes on the mapping."""
+    notes = []
+    if m["textured"]:
+        raise Refused(f"material {m['name']}: textured materials have no mapping here")
+    alpha = m["roughness"] ** 2
+    smooth = alpha < ALPHA_MIN
+    metallic, transmission, specular = m["metallic"], m["transmission"], m["specular"]
+    rough_lobe = False
+    if metallic == 1.0:
+        if m["eta"] is None:
+            raise Refused(f"material {m['name']}: a Schlick metal (base_color) has no Mitsuba "
+                          "equivalent; give `conductor` or `eta`/`k`")
+        d = {"type": "conductor" if smooth else "roughconductor",
+             "eta": rgb(m["eta"]), "k": rgb(m["k"])}
+        rough_lobe = not smooth
+    elif metallic == 0.0 and transmission == 1.0:
+        d = {"type": "dielectric" if smooth else "roughdielectric",
+             "int_ior": float(m["ior"]), "ext_ior": 1.0,
+             "specular_transmittance": rgb(m["base_color"])}
+        rough_lobe = not smooth
+    elif metallic == 0.0 and transmission == 0.0 and specular == 0.0:
+        d = {"type": "diffuse", "reflectance": rgb(m["base_color"])}
+    elif metallic == 0.0 and transmission == 0.0 and m["specular_tint"] == 0.0:
+        f0 = min(0.08 * specular, 0.999)
+        ior = (1 + math.sqrt(f0)) / (1 - math.sqrt(f0))
+        d = {"type": "plastic" if smooth else "roughplastic", "int_ior": ior, "ext_ior": 1.0,
+             "diffuse_reflectance": rgb(m["base_color"]), "nonlinear": False}
+        notes.append("model differs: lumagraph's dielectric layer (Schlick F0 = 0.08 specular, "
+                     "energy-coupled Lambertian base) against Mitsuba's plastic (exact Fresnel "
+                     f"of ior {ior:.4f}, internal reflection, 1/eta^2)")
+    else:
+        raise Refused(f"material {m['name']}: mixture metallic {metallic}, transmission "
+                      f"{transmission} has no single Mitsuba plugin")
+    if not smooth and d["type"] != "diffuse":
+        d["alpha"] = alpha
+        d["distribution"] = "ggx"
+    if rough_lobe and m["multiscatter"]:
+        notes.append("model differs: multiple-scattering compensation on (Mitsuba has none)")
+    return d, notes
+
+
+def rotation(axis, degrees):
+    import mitsuba as mi
+    return mi.ScalarTransform4f().rotate(axis, degrees)
+
+
+def mitsuba_scene(export_dir, spp, seed):
+    import mitsuba as mi
+    T = mi.ScalarTransform4f
+    with open(os.path.join(export_dir, "scene.json")) as f:
+        s = json.load(f)
+    c, r = s["camera"], s["render"]
+    sensor = {
+        "type": "thinlens" if c["aperture_radius"] > 0 else "perspective",
+        "fov": c["fov_y"], "fov_axis": "y",
+        "to_world": T().look_at(origin=c["position"], target=c["target"], up=c["up"]),
+        "film": {"type": "hdrfilm", "width": r["width"], "height": r["height"],
+                 "rfilter": {"type": "box"}, "pixel_format": "rgb"},
+        "sampler": {"type": "independent", "sample_count": spp, "seed": seed},
+    }
+    if c["aperture_radius"] > 0:
+        sensor["aperture_radius"] = c["aperture_radius"]
+        sensor["focus_distance"] = c["focus_distance"]
+    d = {"type": "scene",
+         "integrator": {"type": "path", "max_depth": r["max_bounces"] + 1, "rr_depth": 5},
+         "sensor": sensor}
+    plugins, notes = {}, []
+    mats = s["materials"]
+
+    def material(i):
+        b, n = bsdf(mats[i])
+        plugins[mats[i]["name"]] = b["type"]
+        notes.extend(f"{mats[i]['name']}: {x}" for x in n if x not in notes)
+        return b
+
+    def emitter(i):
+        m = mats[i]
+        if max(m["emission"]) <= 0:
+            return None
+        if m["two_sided"]:
+            raise Refused(f"material {m['name']}: two-sided emitters are one-sided in Mitsuba")
+        return {"type": "area", "radiance": rgb(m["emission"])}
+
+    for k, mesh in enumerate(s["meshes"]):
+        shape = {"type": "obj", "filename": os.path.join(export_dir, mesh["file"]),
+                 "face_normals": not mesh["smooth"], "bsdf": material(mesh["material"])}
+        e = emitter(mesh["material"])
+        if e:
+            shape["emitter"] = e
+        d[f"mesh_{k}"] = shape
+    for k, sph in enumerate(s["spheres"]):
+        shape = {"type": "sphere", "center": sph["center"], "radius": sph["radius"],
+                 "bsdf": material(sph["material"])}
+        e = emitter(sph["material"])
+        if e:
+            shape["emitter"] = e
+        d[f"sphere_{k}"] = shape
+    for k, l in enumerate(s["lights"]):
+        if l["type"] == "point":
+            d[f"light_{k}"] = {"type": "point", "position": l["position"],
+                               "intensity": rgb(l["intensity"])}
+        elif l["type"] == "spot":
+            up = [0, 1, 0] if abs(l["target"][1] - l["position"][1]) < 0.99 * math.dist(
+                l["target"], l["position"]) else [1, 0, 0]
+            d[f"light_{k}"] = {"type": "spot", "intensity": rgb(l["intensity"]),
+                               "cutoff_angle": l["cutoff_angle"], "beam_width": l["beam_width"],
+                               "to_world": T().look_at(origin=l["position"], target=l["target"],
+                                                       up=up)}
+        elif l["type"] == "directional":
+            d[f"light_{k}"] = {"type": "directional", "direction": l["direction"],
+                               "irradiance": rgb(l["irradiance"])}
+    env = s["environment"]
+    if env["type"] == "constant":
+        d["environment"] = {"type": "constant", "radiance": rgb(env["radiance"])}
+    elif env["type"] == "map":
+        if not env["show_background"]:
+            raise Refused("show_background: false has no Mitsuba equivalent here")
+        d["environment"] = {"type": "envmap", "filename": env["path"], "scale": env["intensity"],
+                            "to_world": T().rotate([0, 1, 0], env["azimuth"])
+                            @ T().rotate([1, 0, 0], env["elevation"])}
+    return d, plugins, notes
+
+
+def relmse(x, ref):
+    return float(np.mean((x - ref) ** 2 / (ref ** 2 + 1e-2)))
+
+
+def render(d, spp, seed):
+    import mitsuba as mi
+    d = dict(d)
+    d["sensor"] = dict(d["sensor"])
+    d["sensor"]["sampler"] = {"type": "independent", "sample_count": spp, "seed": seed}
+    scene = mi.load_dict(d)
+    return np.array(mi.render(scene, spp=spp, seed=seed), dtype=np.float64)[..., :3]
+
+
+def make(name, lumagraph, spp, chunk, seeds):
+    import mitsuba as mi
+    src = os.path.join(SCENES, name + ".ron")
+    with tempfile.TemporaryDirectory() as tmp:
+        subprocess.run([lumagraph, "export", src, "--out", tmp], check=True,
+                       stdout=subprocess.DEVNULL)
+        d, plugins, notes = mitsuba_scene(tmp, chunk, 0)
+        render(d, 1, 999)  # compile the kernels before timing
+        start = time.time()
+        acc, done, k = None, 0, 0
+        while done < spp:
+            n = min(chunk, spp - done)
+            img = render(d, n, 1000 + k) * n
+            acc = img if acc is None else acc + img
+            done += n
+            k += 1
+            print(f"  {name}: {done}/{spp} spp, {time.time() - start:.0f} s", flush=True)
+        ref = acc / spp
+        seconds = time.time() - start
+        per_seed = []
+        for s in range(seeds):
+            t = time.time()
+            img = render(d, 256, s)
+            per_seed.append({"seed": s, "relmse": relmse(img, ref), "seconds": time.time() - t})
+    os.makedirs(OUT, exist_ok=True)
+    bmp = mi.Bitmap(ref.astype(np.float32), pixel_format=mi.Bitmap.PixelFormat.RGB)
+    bmp = bmp.convert(component_format=mi.Struct.Type.Float16)
+    bmp.write(os.path.join(OUT, name + ".exr"))
+    meta = {
+        "scene": f"tests/scenes/{name}.ron",
+        "renderer": f"Mitsuba {mi.__version__} ({mi.variant()}), integrator path, "
+                    "independent sampler, box filter",
+        "spp": spp,
+        "seconds": round(seconds, 1),
+        "plugins": plugins,
+        "model_differences": notes,
+        "mitsuba_relmse_256": {"mean": float(np.mean([p["relmse"] for p in per_seed])),
+                               "per_seed": per_seed},
+    }
+    with open(os.path.join(OUT, name + ".json"), "w") as f:
+        json.dump(meta, f, indent=1)
+        f.write("\n")
+    print(f"{name}: {spp} spp in {seconds:.0f} s, Mitsuba relMSE at 256 spp "
+          f"{meta['mitsuba_relmse_256']['mean']:.3e}; plugins {sorted(set(plugins.values()))}"
+          + ("".join(f"\n  note: {n}" for n in notes)))
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("scenes", nargs="*", help="scene names in tests/scenes (default: all)")
+    p.add_argument("--lumagraph", default=os.path.join(ROOT, "target", "release", "lumagraph"))
+    p.add_argument("--spp", type=int, default=16384, help="reference samples per pixel")
+    p.add_argument("--chunk", type=int, default=1024, help="samples per Mitsuba render call")
+    p.add_argument("--seeds", type=int, default=4, help="seeds of Mitsuba's 256-spp images")
+    a = p.parse_args()
+    import mitsuba as mi
+    mi.set_variant("llvm_ad_rgb")
+    names = a.scenes or sorted(f[:-4] for f in os.listdir(SCENES) if f.endswith(".ron"))
+    failed = []
+    for name in names:
+        try:
+            make(name, a.lumagraph, a.spp, a.chunk, a.seeds)
+        except Refused as e:
+            print(f"{name}: refused: {e}", file=sys.stderr)
+            failed.append(name)
+    if failed:
+        sys.exit(f"no reference for: {', '.join(failed)}")
+
+
+if __name__ == "__main__":
+    main()
