@@ -1145,9 +1145,10 @@ fn half_transmitting_texture_transmits_where_its_texel_says() {
 /// selection and with the emissive factors' powers put back (the former behaviour), 16 spp
 /// each, and compared with a 1 024-spp render of another seed. Both are unbiased: each mean
 /// lies within 4 standard errors of the reference's over the pixels that see only the floor
-/// (standard error: the RMSE over √pixels; measured within 0.8). The texture-weighted one is
-/// less noisy: RMSE ratio below 0.8 (measured 0.646 at this seed, 0.618–0.642 at two
-/// others; the limit leaves room for the noise of the measurement).
+/// (standard error: the RMSE over √pixels; measured within 1.6). The texture-weighted one is
+/// less noisy: RMSE ratio below 0.95 (measured 0.910 at this seed, 0.899 at another; half of
+/// the light samples are spread uniformly over the lights, `light_selection`, so the
+/// weighting acts on the other half: with selection by power alone the ratio was 0.62–0.65).
 #[test]
 fn textured_emitter_selection_follows_the_texture() {
     let dir = temp();
@@ -1206,7 +1207,8 @@ fn textured_emitter_selection_follows_the_texture() {
         l.power = factor_power(l);
     }
     let powers: Vec<f32> = by_factor.lights.iter().map(|l| l.power).collect();
-    by_factor.light_alias = lumagraph::scene::alias_table(&powers);
+    by_factor.light_alias =
+        lumagraph::scene::alias_table(&lumagraph::scene::light_selection(&powers));
     by_factor.header.total_light_power = powers.iter().sum();
     // Pixels that see only the floor (their four corners hit it): the emitters' own faces
     // are the same in both and only add antialiasing noise.
@@ -1265,5 +1267,5 @@ fn textured_emitter_selection_follows_the_texture() {
         (mf - mr).abs() < 4.0 * ef / n.sqrt(),
         "factor-weighted mean {mf} vs {mr}"
     );
-    assert!(ew / ef < 0.8, "RMSE ratio {}", ew / ef);
+    assert!(ew / ef < 0.95, "RMSE ratio {}", ew / ef);
 }

@@ -21,10 +21,12 @@ Materials map one to one or the scene is refused (never an approximation in sile
   specular 0, metallic 0, transmission 0          -> diffuse
   metallic 1 with eta/k (conductor presets)       -> conductor / roughconductor (GGX)
   transmission 1, metallic 0                       -> dielectric / roughdielectric (GGX)
-  metallic 0, transmission 0, specular > 0         -> plastic / roughplastic (GGX, int_ior
-                                                      from F0 = 0.08 specular): NOT the same
-                                                      model as lumagraph's layer (see
-                                                      docs/pathtracer.md), flagged in the JSON
+  metallic 0, transmission 0, specular > 0         -> principled (base_color, roughness,
+                                                      specular: F0 = 0.08 specular in both):
+                                                      NOT the same model as lumagraph's layer
+                                                      (see docs/pathtracer.md), flagged in the
+                                                      JSON; --layer roughplastic maps it to
+                                                      plastic / roughplastic instead
 Rough lobes need `multiscatter: false` to be the same model as Mitsuba's (which has no
 multiple-scattering compensation); a rough lobe with it on is flagged too.
 """
@@ -43,6 +45,7 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 SCENES = os.path.join(ROOT, "tests", "scenes")
 OUT = os.path.join(ROOT, "tests", "reference", "suite")
 ALPHA_MIN = 1e-3  # below this alpha lumagraph's lobes are perfect mirrors / interfaces
+LAYER = "principled"  # what the dielectric layer maps to (--layer)
 
 
 class Refused(Exception):
@@ -76,6 +79,14 @@ def bsdf(m):
         rough_lobe = not smooth
     elif metallic == 0.0 and transmission == 0.0 and specular == 0.0:
         d = {"type": "diffuse", "reflectance": rgb(m["base_color"])}
+    elif metallic == 0.0 and transmission == 0.0 and m["specular_tint"] == 0.0 and LAYER == "principled":
+        d = {"type": "principled", "base_color": rgb(m["base_color"]),
+             "roughness": float(m["roughness"]), "specular": float(specular), "metallic": 0.0}
+        notes.append("model differs: lumagraph's dielectric layer (GGX with Schlick F0 = 0.08 "
+                     "specular over a Lambertian base that gets exactly the energy the specular "
+                     "leaves) against Mitsuba's principled (Disney: retro-reflective diffuse, "
+                     "uncoupled specular; reflects more than it receives)")
+        return d, notes
     elif metallic == 0.0 and transmission == 0.0 and m["specular_tint"] == 0.0:
         f0 = min(0.08 * specular, 0.999)
         ior = (1 + math.sqrt(f0)) / (1 - math.sqrt(f0))
@@ -83,7 +94,8 @@ def bsdf(m):
              "diffuse_reflectance": rgb(m["base_color"]), "nonlinear": False}
         notes.append("model differs: lumagraph's dielectric layer (Schlick F0 = 0.08 specular, "
                      "energy-coupled Lambertian base) against Mitsuba's plastic (exact Fresnel "
-                     f"of ior {ior:.4f}, internal reflection, 1/eta^2)")
+                     f"of ior {ior:.4f}, internal reflection, 1/eta^2; single-scattering rough "
+                     "interface)")
     else:
         raise Refused(f"material {m['name']}: mixture metallic {metallic}, transmission "
                       f"{transmission} has no single Mitsuba plugin")
@@ -244,7 +256,11 @@ def main():
     p.add_argument("--spp", type=int, default=16384, help="reference samples per pixel")
     p.add_argument("--chunk", type=int, default=1024, help="samples per Mitsuba render call")
     p.add_argument("--seeds", type=int, default=4, help="seeds of Mitsuba's 256-spp images")
+    p.add_argument("--layer", choices=["principled", "roughplastic"], default="principled",
+                   help="Mitsuba plugin for lumagraph's dielectric layer")
     a = p.parse_args()
+    global LAYER
+    LAYER = a.layer
     import mitsuba as mi
     mi.set_variant("llvm_ad_rgb")
     names = a.scenes or sorted(f[:-4] for f in os.listdir(SCENES) if f.endswith(".ron"))

@@ -295,9 +295,14 @@ fn sample_glass(m: Material, lp: LobeParams, wo: vec3f, u: vec3f) -> BsdfSample 
     }
     if single {
         // f cos / pdf of a visible-normal sample of a single-scattering microfacet
-        // interface: the shadowing of wi, G2(wo, wi) / G1(wo).
+        // interface: the shadowing of wi, G2(wo, wi) / G1(wo). Exactly tangent directions
+        // (0 / 0) carry nothing.
         let zi = abs(wi.z);
-        weight *= smith_g2(wo_l.z, zi, lp.a2) / smith_g1(wo_l.z, lp.a2);
+        let g1 = smith_g1(wo_l.z, lp.a2);
+        if !(g1 > 0.0 && zi > 0.0) {
+            return BsdfSample(vec3f(0.0, 0.0, 1.0), vec3f(0.0), 0.0, false);
+        }
+        weight *= smith_g2(wo_l.z, zi, lp.a2) / g1;
     }
     return BsdfSample(normalize(vec3f(wi.xy, wi.z * s)), weight, 0.0, true);
 }

@@ -1,10 +1,12 @@
-// Environment lighting from an equirectangular map, importance sampled by pixel: each
-// pixel's probability is proportional to its luminance times sin(theta) (its solid angle),
-// drawn with an alias table, and the pdf is constant over a pixel. The radiance is Mitsuba's
-// `envmap` lookup: bilinear between texel values placed at u = (x + 1/2) / W (wrapping
-// around) and v = y / (H - 1), so renders compare with Mitsuba's pixel for pixel. The includer declares `env_texels: array<vec4f>` (rgb radiance,
-// a = pixel probability), `env_alias: array<AliasEntry>` and `frame` (map size, rotation,
-// scale in `frame.settings`).
+// Environment lighting from an equirectangular map. Radiance is Mitsuba's `envmap` lookup:
+// bilinear between texel values placed at u = (x + 1/2) / W (wrapping around) and
+// v = y / (H - 1), so renders compare with Mitsuba's pixel for pixel. Sampling follows the
+// same interpolant (crates/render/src/env_map.rs): a cell between four texel points is drawn
+// with an alias table by its weights (luminance x sin theta), then a point in it from their
+// bilinear interpolant; `a` of each texel is that interpolant's value over its integral, the
+// pdf in (u, v). The includer declares `env_texels: array<vec4f>`, `env_alias:
+// array<AliasEntry>` (one entry per cell) and `frame` (map size, rotation, scale in
+// `frame.settings`).
 #import "pathtrace/scene_types.wgsl"
 #import "common/sampling.wgsl"
 
@@ -41,45 +43,55 @@ fn env_dir(uv: vec2f) -> vec3f {
     return vec3f(s * sin(phi), cos(theta), -s * cos(phi));
 }
 
-// Radiance of the map (unscaled) at `uv`: Mitsuba's bilinear lookup (see above).
-fn env_radiance(uv: vec2f) -> vec3f {
+// Where `uv` falls between texel points: the cell's corners (x0, x1 wrapping; y0, y1) and
+// the position inside it.
+struct EnvCell {
+    x0: u32,
+    x1: u32,
+    y0: u32,
+    y1: u32,
+    f: vec2f,
+}
+
+fn env_cell(uv: vec2f) -> EnvCell {
     let w = frame.env_width;
     let h = frame.env_height;
     let x = uv.x * f32(w) - 0.5;
-    let y = uv.y * f32(max(h, 2u) - 1u);
+    let y = uv.y * f32(h - 1u);
     let xf = floor(x);
-    let fx = x - xf;
     let x0 = u32(i32(xf) + i32(w)) % w;
-    let x1 = (x0 + 1u) % w;
-    let y0 = min(u32(max(floor(y), 0.0)), h - 1u);
-    let fy = clamp(y - f32(y0), 0.0, 1.0);
-    let y1 = min(y0 + 1u, h - 1u);
-    let top = mix(env_texels[y0 * w + x0].rgb, env_texels[y0 * w + x1].rgb, fx);
-    let bottom = mix(env_texels[y1 * w + x0].rgb, env_texels[y1 * w + x1].rgb, fx);
-    return mix(top, bottom, fy);
+    let y0 = min(u32(max(floor(y), 0.0)), h - 2u);
+    return EnvCell(x0, (x0 + 1u) % w, y0, y0 + 1u, vec2f(x - xf, clamp(y - f32(y0), 0.0, 1.0)));
 }
 
-fn env_texel(uv: vec2f) -> u32 {
+// Bilinear interpolation of the texels at the corners of `c`.
+fn env_lerp(c: EnvCell) -> vec4f {
     let w = frame.env_width;
-    let h = frame.env_height;
-    let x = min(u32(uv.x * f32(w)), w - 1u);
-    let y = min(u32(uv.y * f32(h)), h - 1u);
-    return y * w + x;
+    let top = mix(env_texels[c.y0 * w + c.x0], env_texels[c.y0 * w + c.x1], c.f.x);
+    let bottom = mix(env_texels[c.y1 * w + c.x0], env_texels[c.y1 * w + c.x1], c.f.x);
+    return mix(top, bottom, c.f.y);
 }
 
-// Solid-angle pdf of a direction whose pixel has probability `p`.
-fn env_pixel_pdf(p: f32, sin_theta: f32) -> f32 {
-    let n = f32(frame.env_width * frame.env_height);
-    return select(0.0, p * n / (2.0 * PI * PI * sin_theta), sin_theta > 0.0);
+// Solid-angle pdf of a direction whose (u, v) pdf is `p`.
+fn env_solid_angle_pdf(p: f32, sin_theta: f32) -> f32 {
+    return select(0.0, p / (2.0 * PI * PI * sin_theta), sin_theta > 0.0);
 }
 
 // Radiance (rgb) and solid-angle pdf (a) of the map in world direction d.
 fn env_eval(d: vec3f) -> vec4f {
     let m = env_to_map(d);
-    let uv = env_uv(m);
-    let p = env_texels[env_texel(uv)].a;
+    let t = env_lerp(env_cell(env_uv(m)));
     let sin_theta = sqrt(max(0.0, 1.0 - m.y * m.y));
-    return vec4f(env_radiance(uv) * frame.settings.env_radiance, env_pixel_pdf(p, sin_theta));
+    return vec4f(t.rgb * frame.settings.env_radiance, env_solid_angle_pdf(t.a, sin_theta));
+}
+
+// A sample of [0, 1) with density proportional to (1 - x) a + x b (pbrt-v4's SampleLinear).
+fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
+    if a == b {
+        return u;
+    }
+    let x = u * (a + b) / (a + sqrt(mix(a * a, b * b, u)));
+    return min(x, 0.99999994);
 }
 
 struct EnvSample {
@@ -89,14 +101,30 @@ struct EnvSample {
 }
 
 fn sample_env(u_pick: f32, u: vec2f) -> EnvSample {
-    let n = frame.env_width * frame.env_height;
-    let scaled = u_pick * f32(n);
-    let i = min(u32(scaled), n - 1u);
+    let w = frame.env_width;
+    let cells = w * (frame.env_height - 1u);
+    let scaled = u_pick * f32(cells);
+    let i = min(u32(scaled), cells - 1u);
     let e = env_alias[i];
     let idx = select(e.other, i, scaled - f32(i) < e.prob);
-    let x = idx % frame.env_width;
-    let y = idx / frame.env_width;
-    let uv = vec2f((f32(x) + u.x) / f32(frame.env_width), (f32(y) + u.y) / f32(frame.env_height));
-    let pdf = env_pixel_pdf(env_texels[idx].a, sin(uv.y * PI));
-    return EnvSample(env_from_map(env_dir(uv)), env_radiance(uv) * frame.settings.env_radiance, pdf);
+    var c: EnvCell;
+    c.x0 = idx % w;
+    c.x1 = (c.x0 + 1u) % w;
+    c.y0 = idx / w;
+    c.y1 = c.y0 + 1u;
+    // A point of the cell from the bilinear interpolant of its corners' pdfs: v from the
+    // marginal, then u given v.
+    let p00 = env_texels[c.y0 * w + c.x0].a;
+    let p10 = env_texels[c.y0 * w + c.x1].a;
+    let p01 = env_texels[c.y1 * w + c.x0].a;
+    let p11 = env_texels[c.y1 * w + c.x1].a;
+    c.f.y = sample_linear(u.y, p00 + p10, p01 + p11);
+    c.f.x = sample_linear(u.x, mix(p00, p01, c.f.y), mix(p10, p11, c.f.y));
+    let uv = vec2f(
+        fract((f32(c.x0) + 0.5 + c.f.x) / f32(w)),
+        (f32(c.y0) + c.f.y) / f32(frame.env_height - 1u),
+    );
+    let t = env_lerp(c);
+    let pdf = env_solid_angle_pdf(t.a, sin(uv.y * PI));
+    return EnvSample(env_from_map(env_dir(uv)), t.rgb * frame.settings.env_radiance, pdf);
 }

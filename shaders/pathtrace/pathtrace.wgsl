@@ -170,8 +170,15 @@ fn env_select_prob() -> f32 {
     return select(1.0, 0.5, HAS_LIGHTS && frame.header.num_lights > 0u);
 }
 
+// Probability that light sampling picks `l`: half by power, half uniformly (see
+// `light_selection` in crates/scene/src/flatten.rs, which builds the alias table).
+const LIGHT_UNIFORM_SHARE: f32 = 0.5;
+
 fn light_select_pdf(l: Light) -> f32 {
-    return (1.0 - env_select_prob()) * l.power / frame.header.total_light_power;
+    let total = frame.header.total_light_power;
+    let uniform = 1.0 / f32(frame.header.num_lights);
+    let by_power = select(uniform, l.power / total, total > 0.0);
+    return (1.0 - env_select_prob()) * mix(by_power, uniform, LIGHT_UNIFORM_SHARE);
 }
 
 // Solid-angle pdf of sampling the point `y` (normal `ny`) on light `l` from `x`.

@@ -121,7 +121,7 @@ struct TriTexcoords {
 // without area: point (position p0, intensity in `emission`), spot (also unit axis e1,
 // e2 = (cutoff, beam width) half-angles in radians), directional (unit travel direction e1,
 // irradiance in `emission`).
-// Selection probability = power / SceneHeader.total_light_power.
+// Selection probability: half power / SceneHeader.total_light_power, half 1 / num_lights.
 struct Light {
     p0: vec3<f32>,
     flags: u32,

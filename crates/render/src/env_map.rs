@@ -1,12 +1,14 @@
-//! The environment map on the GPU: texels with each pixel's sampling probability, and the
-//! alias table that draws pixels by it (`shaders/pathtrace/env.wgsl`).
+//! The environment map on the GPU: texels with their sampling weights, and the alias table
+//! that draws cells by them (`shaders/pathtrace/env.wgsl`).
 //!
-//! A pixel's probability is proportional to the mean luminance of its 3×3 neighbourhood
-//! (wrapping around in x) times `sin θ` at its center (the solid angle an equirectangular row
-//! covers), so bright, large regions are sampled often; the shader turns it into a
-//! solid-angle pdf with the same `sin θ`. The neighbourhood covers the texels the shader's
-//! bilinear lookup (Mitsuba's) blends into the pixel, so every direction with radiance can
-//! be sampled: light sampling alone converges to the same image.
+//! Radiance is Mitsuba's `envmap` lookup: bilinear between texel values placed at
+//! u = (x + ½) / W (wrapping around) and v = y / (H − 1). Sampling follows the same
+//! interpolant: each texel point carries the weight luminance × sin θ (θ = π v, the solid
+//! angle a row of the equirectangular map covers); a cell between four texel points is drawn
+//! in proportion to its weights' mean, then a point in it from their bilinear interpolant.
+//! The pdf in (u, v) is that interpolant over its integral, so it is proportional to the
+//! interpolated luminance × sin θ up to sin θ's variation inside a cell, and positive
+//! wherever the radiance is: light sampling alone converges to the same image.
 
 use std::path::Path;
 
@@ -14,73 +16,82 @@ use lumagraph_scene::{alias_table, luminance};
 use wgpu::util::DeviceExt as _;
 
 use crate::context::GpuContext;
-use crate::error::Result;
+use crate::error::{RenderError, Result};
 
 /// The map's buffers and size.
 #[derive(Debug)]
 pub struct EnvMap {
-    /// `width × height` texels: rgb radiance, a = pixel probability.
+    /// `width × height` texels: rgb radiance, a = sampling weight over the interpolant's
+    /// integral in (u, v) (the pdf in (u, v) at the texel point).
     pub texels: wgpu::Buffer,
-    /// Alias table over the pixels.
+    /// Alias table over the `width × (height − 1)` cells between texel points.
     pub alias: wgpu::Buffer,
     /// Width in pixels.
     pub width: u32,
-    /// Height in pixels.
+    /// Height in pixels (at least 2).
     pub height: u32,
 }
 
-/// Texels with probabilities, and the alias table, of an equirectangular image. With
-/// `uniform`, pixels are drawn by solid angle alone (uniform directions), the baseline
-/// importance sampling is measured against.
+/// Texels with their (u, v) pdf, and the alias table over cells, of an equirectangular
+/// image at least 2 pixels tall. With `uniform`, every texel has luminance 1 (uniform
+/// directions up to the interpolation of sin θ), the baseline importance sampling is
+/// measured against.
 pub fn tables(
     image: &crate::cpu::Image,
     uniform: bool,
 ) -> (Vec<[f32; 4]>, Vec<lumagraph_scene::GpuAliasEntry>) {
     let (w, h) = (image.width as usize, image.height as usize);
-    let lum: Vec<f32> = image
+    let weights: Vec<f64> = image
         .pixels
         .iter()
-        .map(|p| {
-            let l = luminance(glam::Vec3::new(p[0], p[1], p[2]));
-            if l.is_finite() { l.max(0.0) } else { 0.0 }
-        })
-        .collect();
-    let mut weights = Vec::with_capacity(w * h);
-    for y in 0..h {
-        #[expect(clippy::cast_precision_loss, reason = "image rows")]
-        let sin_theta = ((y as f64 + 0.5) / h as f64 * std::f64::consts::PI).sin();
-        for x in 0..w {
+        .enumerate()
+        .map(|(i, p)| {
+            #[expect(clippy::cast_precision_loss, reason = "image rows")]
+            let sin_theta = ((i / w) as f64 / (h - 1) as f64 * std::f64::consts::PI).sin();
             let l = if uniform {
                 1.0
             } else {
-                let mut sum = 0.0;
-                for yy in y.saturating_sub(1)..=(y + 1).min(h - 1) {
-                    for dx in [w - 1, 0, 1] {
-                        sum += f64::from(lum[yy * w + (x + dx) % w]);
-                    }
-                }
-                sum / 9.0
+                f64::from(luminance(glam::Vec3::new(p[0], p[1], p[2])))
             };
-            #[expect(clippy::cast_possible_truncation, reason = "weights in f32")]
-            weights.push((l * sin_theta) as f32);
+            if l.is_finite() {
+                l.max(0.0) * sin_theta
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    // Cell (x, y) between texel points (x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1),
+    // wrapping in x; its integral is the corners' mean times its area 1 / (W (H − 1)).
+    let mut cells = Vec::with_capacity(w * (h - 1));
+    for y in 0..h - 1 {
+        for x in 0..w {
+            let x1 = (x + 1) % w;
+            let c = weights[y * w + x]
+                + weights[y * w + x1]
+                + weights[(y + 1) * w + x]
+                + weights[(y + 1) * w + x1];
+            cells.push(0.25 * c);
         }
     }
-    let total: f64 = weights.iter().map(|&v| f64::from(v)).sum();
+    #[expect(clippy::cast_precision_loss, reason = "image sizes")]
+    let total = cells.iter().sum::<f64>() / (w * (h - 1)) as f64;
     let texels = image
         .pixels
         .iter()
         .zip(&weights)
         .map(|(p, &wgt)| {
-            #[expect(clippy::cast_possible_truncation, reason = "probabilities in f32")]
-            let prob = if total > 0.0 {
-                (f64::from(wgt) / total) as f32
+            #[expect(clippy::cast_possible_truncation, reason = "pdfs in f32")]
+            let pdf = if total > 0.0 {
+                (wgt / total) as f32
             } else {
                 0.0
             };
-            [p[0], p[1], p[2], prob]
+            [p[0], p[1], p[2], pdf]
         })
         .collect();
-    (texels, alias_table(&weights))
+    #[expect(clippy::cast_possible_truncation, reason = "weights in f32")]
+    let cells: Vec<f32> = cells.iter().map(|&c| c as f32).collect();
+    (texels, alias_table(&cells))
 }
 
 impl EnvMap {
@@ -91,6 +102,15 @@ impl EnvMap {
     /// When the image cannot be read.
     pub fn load(ctx: &GpuContext, path: &Path, uniform: bool) -> Result<Self> {
         let image = crate::image_io::load(path)?;
+        if image.height < 2 {
+            return Err(RenderError::Image {
+                path: path.to_owned(),
+                message: format!(
+                    "environment map of {}x{} pixels: it must be at least 2 pixels tall",
+                    image.width, image.height
+                ),
+            });
+        }
         let (texels, alias) = tables(&image, uniform);
         Ok(Self::upload(
             ctx,
@@ -101,13 +121,13 @@ impl EnvMap {
         ))
     }
 
-    /// A 1×1 black stand-in for scenes without a map (the bindings must exist).
+    /// A 1×2 black stand-in for scenes without a map (the bindings must exist).
     pub fn empty(ctx: &GpuContext) -> Self {
         let alias = [lumagraph_scene::GpuAliasEntry {
             prob: 1.0,
             other: 0,
-        }; 2];
-        Self::upload(ctx, &[[0.0; 4]; 1], &alias, 1, 1)
+        }; 1];
+        Self::upload(ctx, &[[0.0; 4]; 2], &alias, 1, 2)
     }
 
     fn upload(

@@ -237,9 +237,10 @@ pub struct GpuLight {
     pub area: f32,
     /// Emitted radiance, linear RGB (offset 48).
     pub emission: [f32; 3],
-    /// Power used for selection: luminance(emission) × area × π (× 2 if two-sided), × the
+    /// Emitted power for selection: luminance(emission) × area × π (× 2 if two-sided), × the
     /// emissive texture's mean over the triangle when it has one (offset 60). Selection
-    /// probability = power / `GpuHeader::total_light_power`.
+    /// probability: [`crate::light_selection`], half power / `GpuHeader::total_light_power`,
+    /// half 1 / `num_lights`.
     pub power: f32,
 }
 

@@ -9,7 +9,7 @@
 //! - [`export`]: the resolved scene as JSON + OBJ for other renderers (Mitsuba references).
 //! - [`GpuScene`]: the scene flattened into `#[repr(C)]` arrays laid out as WGSL lays out
 //!   storage buffers ([`gpu`]), with a BVH built by obvhs ([`bvh`]), lights and an alias
-//!   table for picking them by power.
+//!   table for picking them (half by power, half uniformly).
 //! - [`texture`]: decoded glTF textures, their packing for the GPU and a CPU sampler
 //!   that mirrors the shader's.
 //! - [`traverse`]: CPU ray queries over exactly that layout, mirrored by
@@ -34,7 +34,7 @@ pub mod traverse;
 pub use bvh::{BVH_STACK_SIZE, BvhOptions};
 pub use error::{ErrorKind, Pos, SceneError};
 pub use file::{Environment, LightDesc, RenderSettings, VERSION};
-pub use flatten::{GpuScene, alias_table, luminance};
+pub use flatten::{GpuScene, LIGHT_UNIFORM_SHARE, alias_table, light_selection, luminance};
 pub use gpu::*;
 pub use load::transform_matrix;
 pub use scene::{
