@@ -227,9 +227,9 @@ fn cell_masses(pdf: &dyn Fn(&[Vec3]) -> Vec<f64>) -> Vec<f64> {
     masses
 }
 
-/// Pearson's χ² of the sampled directions against the cell masses (plus the invalid cell),
-/// pooling cells expecting fewer than 5; the p-value, or why the test fails outright.
-fn chi_square(samples: &[BsdfSample], masses: &[f64]) -> Result<(f64, f64, usize), String> {
+/// Observed and expected counts per cell, the last cell holding the invalid samples (its
+/// expected count: the mass the pdf leaves outside the sphere's cells).
+fn counts(samples: &[BsdfSample], masses: &[f64]) -> (Vec<f64>, Vec<f64>) {
     let n = samples.len() as f64;
     let mut observed = vec![0.0_f64; masses.len() + 1];
     for s in samples {
@@ -243,6 +243,13 @@ fn chi_square(samples: &[BsdfSample], masses: &[f64]) -> Result<(f64, f64, usize
     let valid_mass: f64 = masses.iter().sum();
     let mut expected: Vec<f64> = masses.iter().map(|m| m * n).collect();
     expected.push((1.0 - valid_mass).max(0.0) * n);
+    (observed, expected)
+}
+
+/// Pearson's χ² of the sampled directions against the cell masses (plus the invalid cell),
+/// pooling cells expecting fewer than 5; the p-value, or why the test fails outright.
+fn chi_square(samples: &[BsdfSample], masses: &[f64]) -> Result<(f64, f64, usize), String> {
+    let (observed, expected) = counts(samples, masses);
     let (mut chi2, mut cells) = (0.0, 0);
     let (mut pool_o, mut pool_e) = (0.0, 0.0);
     for (i, (&o, &e)) in observed.iter().zip(&expected).enumerate() {
@@ -270,24 +277,12 @@ fn chi_square(samples: &[BsdfSample], masses: &[f64]) -> Result<(f64, f64, usize
 /// The cells that add most to χ², for failure messages: θ and φ ranges in degrees,
 /// observed and expected counts.
 fn worst_cells(samples: &[BsdfSample], masses: &[f64]) -> String {
-    let n = samples.len() as f64;
-    let mut observed = vec![0.0_f64; masses.len() + 1];
-    for s in samples {
-        let cell = if s.valid && s.wi.is_finite() {
-            cell_of(s.wi)
-        } else {
-            masses.len()
-        };
-        observed[cell] += 1.0;
-    }
-    let valid: f64 = masses.iter().sum();
+    let (observed, expected) = counts(samples, masses);
     let mut rows: Vec<(f64, usize, f64, f64)> = observed
         .iter()
+        .zip(&expected)
         .enumerate()
-        .map(|(i, &o)| {
-            let e = masses.get(i).map_or((1.0 - valid).max(0.0), |m| *m) * n;
-            ((o - e).powi(2) / e.max(1.0), i, o, e)
-        })
+        .map(|(i, (&o, &e))| ((o - e).powi(2) / e.max(1.0), i, o, e))
         .collect();
     rows.sort_by(|a, b| b.0.total_cmp(&a.0));
     let (dt, dp) = (180.0 / THETA_BINS as f64, 360.0 / PHI_BINS as f64);

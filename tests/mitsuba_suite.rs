@@ -17,12 +17,9 @@
 
 mod common;
 
-use std::sync::Arc;
-
-use lumagraph::graph::{Edge, Graph, Node, ParamValue};
+use lumagraph::graph::ParamValue;
 use lumagraph::render::cpu::Image;
-use lumagraph::render::{Executor, Resources, compile, image_io, metrics};
-use lumagraph::scene::GpuScene;
+use lumagraph::render::{image_io, metrics};
 
 const BLOCK: u32 = 32;
 const BLOCK_TOLERANCE: f64 = 0.02;
@@ -44,32 +41,6 @@ fn entry(name: &str) -> (String, Option<serde_json::Value>) {
         .unwrap_or(name)
         .to_owned();
     (reference, e)
-}
-
-fn executor(scene: &Arc<GpuScene>) -> Option<Executor> {
-    let ctx = common::gpu()?;
-    let graph = Graph {
-        nodes: vec![
-            Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(16)),
-            Node::new("acc", "Accumulate"),
-        ],
-        edges: vec![Edge::new("pt.color", "acc.color")],
-        origin: None,
-    };
-    let plan = compile(&graph, &["acc.color".into()], Some(scene)).unwrap();
-    let resources = Resources {
-        scene: Some(Arc::clone(scene)),
-        ..Resources::default()
-    };
-    Some(Executor::new(ctx, plan, &resources).unwrap())
-}
-
-fn dropped(exec: &mut Executor) -> u64 {
-    exec.counters()
-        .unwrap()
-        .iter()
-        .find(|(_, c)| c.name == "dropped_samples")
-        .map_or(0, |(_, c)| c.value)
 }
 
 /// Block-mean deviations of `ours` from `reference` above the floor: (block, channel,
@@ -96,7 +67,8 @@ fn block_deviations(ours: &Image, reference: &Image) -> Vec<(usize, usize, f64, 
 fn check(name: &str) {
     let (reference_name, entry) = entry(name);
     let scene = common::gpu_scene(&format!("tests/scenes/{name}.ron"), None);
-    let Some(mut exec) = executor(&scene) else {
+    let Some(mut exec) = common::progressive(&scene, &[("samples_per_frame", ParamValue::Int(16))])
+    else {
         return;
     };
     let reference = image_io::load(&common::repo(&format!(
@@ -126,7 +98,11 @@ fn check(name: &str) {
         deviations.len(),
         start.elapsed().as_secs_f64()
     );
-    assert_eq!(dropped(&mut exec), 0, "{name}: NaN/Inf samples");
+    assert_eq!(
+        common::counter(&mut exec, "dropped_samples"),
+        0,
+        "{name}: NaN/Inf samples"
+    );
     if let Some(limit) = entry
         .as_ref()
         .and_then(|e| e.get("model_difference"))

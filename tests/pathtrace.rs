@@ -14,7 +14,7 @@ mod common;
 
 use std::sync::Arc;
 
-use lumagraph::graph::{Edge, Graph, Node, ParamValue};
+use lumagraph::graph::{Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
 use lumagraph::render::{Executor, Resources, compile, image_io, metrics};
 use lumagraph::scene::{GpuScene, Scene};
@@ -25,41 +25,15 @@ fn scene(name: &str) -> Arc<GpuScene> {
 }
 
 fn progressive_graph(samples_per_frame: i64) -> Graph {
-    Graph {
-        nodes: vec![
-            Node::new("pt", "PathTrace")
-                .with("samples_per_frame", ParamValue::Int(samples_per_frame)),
-            Node::new("acc", "Accumulate"),
-        ],
-        edges: vec![Edge::new("pt.color", "acc.color")],
-        origin: None,
-    }
+    common::progressive_graph(&[("samples_per_frame", ParamValue::Int(samples_per_frame))])
 }
 
 /// An executor over `scene` accumulating `samples_per_frame` samples a frame.
 fn executor(scene: &Arc<GpuScene>, samples_per_frame: i64) -> Option<Executor> {
-    let ctx = common::gpu()?;
-    let plan = compile(
-        &progressive_graph(samples_per_frame),
-        &["acc.color".into()],
-        Some(scene),
+    common::progressive(
+        scene,
+        &[("samples_per_frame", ParamValue::Int(samples_per_frame))],
     )
-    .unwrap();
-    let resources = Resources {
-        scene: Some(Arc::clone(scene)),
-        ..Resources::default()
-    };
-    Some(Executor::new(ctx, plan, &resources).unwrap())
-}
-
-fn counter(exec: &mut Executor, name: &str) -> u64 {
-    exec.counters()
-        .unwrap()
-        .iter()
-        .find(|(_, c)| c.name == name)
-        .unwrap()
-        .1
-        .value
 }
 
 fn reference(name: &str) -> Image {
@@ -90,7 +64,7 @@ fn cornell_matches_mitsuba() {
     let start = std::time::Instant::now();
     exec.run_frames(16, true).unwrap();
     let at_256 = exec.read_port("acc.color").unwrap();
-    assert_eq!(counter(&mut exec, "samples_per_pixel"), 256);
+    assert_eq!(common::counter(&mut exec, "samples_per_pixel"), 256);
     let relmse = metrics::relmse(&at_256, &reference);
     let limit = 1.25 * mitsuba_relmse_at(256);
     eprintln!(
@@ -103,8 +77,8 @@ fn cornell_matches_mitsuba() {
     );
 
     exec.run_frames(48, true).unwrap();
-    assert_eq!(counter(&mut exec, "samples_per_pixel"), 1024);
-    assert_eq!(counter(&mut exec, "dropped_samples"), 0);
+    assert_eq!(common::counter(&mut exec, "samples_per_pixel"), 1024);
+    assert_eq!(common::counter(&mut exec, "dropped_samples"), 0);
     let at_1024 = exec.read_port("acc.color").unwrap();
     let ours = metrics::block_means(&at_1024, 32);
     let theirs = metrics::block_means(&reference, 32);
@@ -145,7 +119,7 @@ fn white_furnace_is_white() {
     let reference = reference("furnace_ref.exr");
     let rel = metrics::relmse(&image, &reference);
     eprintln!("furnace 64 spp: means {m:?}, relMSE vs reference {rel:.3e}");
-    assert_eq!(counter(&mut exec, "dropped_samples"), 0);
+    assert_eq!(common::counter(&mut exec, "dropped_samples"), 0);
 }
 
 #[test]

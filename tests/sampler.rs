@@ -15,10 +15,10 @@ mod common;
 
 use std::sync::Arc;
 
-use lumagraph::graph::{Edge, Graph, Node, ParamValue};
+use lumagraph::graph::ParamValue;
 use lumagraph::render::cpu::Image;
 use lumagraph::render::sampler::{SamplerCheck, SamplerQuery};
-use lumagraph::render::{Executor, Resources, compile, metrics};
+use lumagraph::render::{Executor, metrics};
 use lumagraph::scene::{GpuScene, Scene};
 
 #[test]
@@ -169,33 +169,13 @@ fn edges_scene(seed: u32) -> Arc<GpuScene> {
 }
 
 fn executor(scene: &Arc<GpuScene>, sampler: &str, samples_per_frame: i64) -> Option<Executor> {
-    let ctx = common::gpu()?;
-    let graph = Graph {
-        nodes: vec![
-            Node::new("pt", "PathTrace")
-                .with("samples_per_frame", ParamValue::Int(samples_per_frame))
-                .with("sampler", ParamValue::Str(sampler.into())),
-            Node::new("acc", "Accumulate"),
+    common::progressive(
+        scene,
+        &[
+            ("samples_per_frame", ParamValue::Int(samples_per_frame)),
+            ("sampler", ParamValue::Str(sampler.into())),
         ],
-        edges: vec![Edge::new("pt.color", "acc.color")],
-        origin: None,
-    };
-    let plan = compile(&graph, &["acc.color".into()], Some(scene)).unwrap();
-    let resources = Resources {
-        scene: Some(Arc::clone(scene)),
-        ..Resources::default()
-    };
-    Some(Executor::new(ctx, plan, &resources).unwrap())
-}
-
-fn dropped(exec: &mut Executor) -> u64 {
-    exec.counters()
-        .unwrap()
-        .iter()
-        .find(|(_, c)| c.name == "dropped_samples")
-        .unwrap()
-        .1
-        .value
+    )
 }
 
 /// `frames` frames of `samples_per_frame` samples.
@@ -207,7 +187,11 @@ fn render(
 ) -> Option<Image> {
     let mut exec = executor(scene, sampler, samples_per_frame)?;
     exec.run_frames(frames, true).unwrap();
-    assert_eq!(dropped(&mut exec), 0, "NaN/Inf samples dropped");
+    assert_eq!(
+        common::counter(&mut exec, "dropped_samples"),
+        0,
+        "NaN/Inf samples dropped"
+    );
     Some(exec.read_port("acc.color").unwrap())
 }
 

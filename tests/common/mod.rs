@@ -94,6 +94,58 @@ pub fn gpu_scene(rel: &str, size: Option<u32>) -> std::sync::Arc<lumagraph::scen
     std::sync::Arc::new(lumagraph::scene::GpuScene::build(&scene).unwrap())
 }
 
+/// `PathTrace` (`pt`, with `params`) feeding `Accumulate` (`acc`): a progressive render.
+pub fn progressive_graph(
+    params: &[(&str, lumagraph::graph::ParamValue)],
+) -> lumagraph::graph::Graph {
+    use lumagraph::graph::{Edge, Graph, Node};
+    let mut pt = Node::new("pt", "PathTrace");
+    for (k, v) in params {
+        pt = pt.with(k, v.clone());
+    }
+    Graph {
+        nodes: vec![pt, Node::new("acc", "Accumulate")],
+        edges: vec![Edge::new("pt.color", "acc.color")],
+        origin: None,
+    }
+}
+
+/// An executor of `graph` over `scene` keeping the ports `keep`, or `None` when there is no
+/// GPU and that is allowed.
+pub fn executor(
+    graph: &lumagraph::graph::Graph,
+    keep: &[&str],
+    scene: &std::sync::Arc<lumagraph::scene::GpuScene>,
+) -> Option<lumagraph::render::Executor> {
+    use lumagraph::render::{Executor, Resources, compile};
+    let ctx = gpu()?;
+    let keep: Vec<String> = keep.iter().map(|&k| k.to_owned()).collect();
+    let plan = compile(graph, &keep, Some(scene)).unwrap();
+    let resources = Resources {
+        scene: Some(std::sync::Arc::clone(scene)),
+        ..Resources::default()
+    };
+    Some(Executor::new(ctx, plan, &resources).unwrap())
+}
+
+/// A progressive render of `scene` ([`progressive_graph`]) keeping `acc.color`.
+pub fn progressive(
+    scene: &std::sync::Arc<lumagraph::scene::GpuScene>,
+    params: &[(&str, lumagraph::graph::ParamValue)],
+) -> Option<lumagraph::render::Executor> {
+    executor(&progressive_graph(params), &["acc.color"], scene)
+}
+
+/// The value of the counter called `name` (`samples_per_pixel`, `dropped_samples`, `rays`).
+pub fn counter(exec: &mut lumagraph::render::Executor, name: &str) -> u64 {
+    exec.counters()
+        .unwrap()
+        .iter()
+        .find(|(_, c)| c.name == name)
+        .map(|(_, c)| c.value)
+        .unwrap_or_else(|| panic!("no counter {name}"))
+}
+
 /// `frames` independent estimates of `scene`'s image with random seed `seed`, each the
 /// mean of `spp` samples per pixel from `PathTrace` with the independent sampler (so frames
 /// are independent, and so are runs with different seeds) and `params`.
@@ -105,11 +157,8 @@ pub fn independent_frames(
     spp: i64,
 ) -> Option<Vec<lumagraph::render::cpu::Image>> {
     use lumagraph::graph::{Graph, Node, ParamValue};
-    use lumagraph::render::{Executor, Resources, compile};
-    let ctx = gpu()?;
     let mut scene = scene.clone();
     scene.settings.seed = seed;
-    let scene = std::sync::Arc::new(scene);
     let mut pt = Node::new("pt", "PathTrace")
         .with("samples_per_frame", ParamValue::Int(spp))
         .with("sampler", ParamValue::Str("independent".into()));
@@ -121,12 +170,7 @@ pub fn independent_frames(
         edges: Vec::new(),
         origin: None,
     };
-    let plan = compile(&graph, &["pt.color".into()], Some(&scene)).unwrap();
-    let resources = Resources {
-        scene: Some(scene),
-        ..Resources::default()
-    };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = executor(&graph, &["pt.color"], &std::sync::Arc::new(scene))?;
     Some(
         (0..frames)
             .map(|_| {

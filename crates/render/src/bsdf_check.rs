@@ -5,11 +5,10 @@
 
 use glam::Vec3;
 use lumagraph_scene::GpuMaterial;
-use wgpu::util::DeviceExt as _;
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::kernel::{Binding, Kernel, uniform_buffer};
+use crate::kernel::{Binding, Kernel, storage_buffer, uniform_buffer};
 use crate::readback::{compute_and_read, groups_1d};
 
 /// One sample of the BSDF, in the shading frame.
@@ -71,13 +70,7 @@ impl BsdfCheck {
                 Binding::Storage { read_only: false },
             ],
         )?;
-        let ggx_table = ctx
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("ggx albedo table"),
-                contents: bytemuck::cast_slice(crate::bsdf_tables::ggx_table()),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
+        let ggx_table = crate::bsdf_tables::upload(ctx);
         Ok(Self { kernel, ggx_table })
     }
 
@@ -98,20 +91,13 @@ impl BsdfCheck {
         params[4] = mode;
         params[5] = seed;
         let params = uniform_buffer(ctx, "bsdf check params", bytemuck::cast_slice(&params));
-        let buffer = |label, contents: &[u8]| {
-            ctx.device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage: wgpu::BufferUsages::STORAGE,
-                })
-        };
-        let material = buffer("bsdf check material", bytemuck::bytes_of(material));
+        let material = storage_buffer(ctx, "bsdf check material", bytemuck::bytes_of(material));
         let dirs = if dirs.is_empty() {
-            buffer("bsdf check directions", &[0; 16])
+            &[[0.0; 4]][..]
         } else {
-            buffer("bsdf check directions", bytemuck::cast_slice(dirs))
+            dirs
         };
+        let dirs = storage_buffer(ctx, "bsdf check directions", bytemuck::cast_slice(dirs));
         compute_and_read::<[f32; 4]>(ctx, "bsdf check", 2 * count as usize, |encoder, out| {
             self.kernel
                 .pass("bsdf check")

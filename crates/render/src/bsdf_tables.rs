@@ -115,6 +115,11 @@ fn build() -> Vec<[f32; 2]> {
     out
 }
 
+/// The table in a storage buffer, as `shaders/pathtrace/bsdf.wgsl` reads it (`ggx_table`).
+pub fn upload(ctx: &crate::GpuContext) -> wgpu::Buffer {
+    crate::kernel::storage_buffer(ctx, "ggx albedo table", bytemuck::cast_slice(ggx_table()))
+}
+
 /// The table as uploaded: `N × N` entries `(A, B)` (roughness-major), then `N` averages.
 pub fn ggx_table() -> &'static [[f32; 2]] {
     static TABLE: LazyLock<Vec<[f32; 2]>> = LazyLock::new(build);

@@ -13,10 +13,10 @@
 use std::path::Path;
 
 use lumagraph_scene::{alias_table, luminance};
-use wgpu::util::DeviceExt as _;
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
+use crate::kernel::storage_buffer;
 
 /// The map's buffers and size.
 #[derive(Debug)]
@@ -137,17 +137,9 @@ impl EnvMap {
         width: u32,
         height: u32,
     ) -> Self {
-        let buffer = |label, contents: &[u8]| {
-            ctx.device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage: wgpu::BufferUsages::STORAGE,
-                })
-        };
         Self {
-            texels: buffer("environment texels", bytemuck::cast_slice(texels)),
-            alias: buffer("environment alias table", bytemuck::cast_slice(alias)),
+            texels: storage_buffer(ctx, "environment texels", bytemuck::cast_slice(texels)),
+            alias: storage_buffer(ctx, "environment alias table", bytemuck::cast_slice(alias)),
             width,
             height,
         }

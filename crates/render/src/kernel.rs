@@ -13,6 +13,8 @@
 
 use lumagraph_graph::Extent;
 
+use wgpu::util::DeviceExt as _;
+
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::timing::GpuTimer;
@@ -261,6 +263,16 @@ impl<'a> PassBuilder<'a> {
         pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
         Ok(())
     }
+}
+
+/// Creates a read-only storage buffer holding `contents`.
+pub fn storage_buffer(ctx: &GpuContext, label: &str, contents: &[u8]) -> wgpu::Buffer {
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents,
+            usage: wgpu::BufferUsages::STORAGE,
+        })
 }
 
 /// Creates a uniform buffer holding `data`.

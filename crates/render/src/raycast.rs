@@ -4,11 +4,10 @@
 
 use bytemuck::{Pod, Zeroable};
 use lumagraph_scene::Hit;
-use wgpu::util::DeviceExt as _;
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::kernel::{Binding, Kernel, uniform_buffer};
+use crate::kernel::{Binding, Kernel, storage_buffer, uniform_buffer};
 use crate::readback::{compute_and_read, groups_1d};
 use crate::scene_gpu::SceneBuffers;
 
@@ -78,13 +77,7 @@ impl Raycaster {
         }
         let count = u32::try_from(rays.len()).unwrap_or(u32::MAX);
         let params = uniform_buffer(ctx, "raycast params", bytemuck::bytes_of(&[count, 0, 0, 0]));
-        let queries = ctx
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("raycast queries"),
-                contents: bytemuck::cast_slice(rays),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
+        let queries = storage_buffer(ctx, "raycast queries", bytemuck::cast_slice(rays));
         let hits =
             compute_and_read::<GpuHit>(ctx, "raycast hits", rays.len(), |encoder, output| {
                 self.kernel

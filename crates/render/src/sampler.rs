@@ -2,11 +2,9 @@
 //! list of queries so tests can hold it against the `sobol_burley` crate and check the
 //! stratification of the points a pixel gets.
 
-use wgpu::util::DeviceExt as _;
-
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::kernel::{Binding, Kernel, uniform_buffer};
+use crate::kernel::{Binding, Kernel, storage_buffer, uniform_buffer};
 use crate::readback::{compute_and_read, groups_1d};
 
 /// What a query asks for.
@@ -100,13 +98,7 @@ impl SamplerCheck {
             "sampler params",
             bytemuck::bytes_of(&[count, mode, 0, 0]),
         );
-        let input = ctx
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("sampler queries"),
-                contents: bytemuck::cast_slice(&words),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
+        let input = storage_buffer(ctx, "sampler queries", bytemuck::cast_slice(&words));
         compute_and_read::<[f32; 2]>(ctx, "sampler points", queries.len(), |encoder, output| {
             self.kernel
                 .pass("sampler")

@@ -97,13 +97,7 @@ impl PathTrace {
             )?,
             None => crate::env_map::EnvMap::empty(ctx),
         };
-        let ggx_table = ctx
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("ggx albedo table"),
-                contents: bytemuck::cast_slice(crate::bsdf_tables::ggx_table()),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
+        let ggx_table = crate::bsdf_tables::upload(ctx);
         // Outputs nothing reads are bound to 1x1 stand-ins (stores outside them are dropped).
         let one = lumagraph_graph::Extent::new(1, 1);
         let unused = [
