@@ -25,7 +25,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context as _, Result, bail};
-use lumagraph::graph::{Graph, ParamValue};
+use lumagraph::graph::registry::SAMPLES_PER_FRAME;
+use lumagraph::graph::{Category, Graph, ParamValue, Registry};
 use lumagraph::render::cpu::Image;
 use lumagraph::render::{Executor, GpuContext, Resources, compile, image_io, metrics};
 use lumagraph::scene::GpuScene;
@@ -57,27 +58,29 @@ struct Row {
 /// The graph without sinks, 1 spp per frame; returns it with the ports scored, as
 /// `(port, is_denoised)`.
 fn prepare(graph: &mut Graph) -> Result<Vec<(String, bool)>> {
+    let registry = Registry::builtin();
+    let kind = |n: &lumagraph::graph::Node| registry.get(&n.kind);
     let sinks: Vec<String> = graph
         .nodes
         .iter()
-        .filter(|n| n.kind == "Output")
+        .filter(|n| kind(n).is_some_and(|k| k.sink))
         .map(|n| n.id.clone())
         .collect();
-    graph.nodes.retain(|n| n.kind != "Output");
+    graph.nodes.retain(|n| !sinks.contains(&n.id));
     graph.edges.retain(|e| {
         let to = e.to.rsplit_once('.').map_or(e.to.as_str(), |(n, _)| n);
         !sinks.iter().any(|s| s == to)
     });
     let mut ports = Vec::new();
     for n in &mut graph.nodes {
-        match n.kind.as_str() {
-            "PathTrace" => {
-                n.params
-                    .insert("samples_per_frame".into(), ParamValue::Int(1));
-            }
-            "Accumulate" => ports.push((format!("{}.color", n.id), false)),
-            "Denoise" => ports.push((format!("{}.color", n.id), true)),
-            _ => {}
+        let Some(k) = kind(n) else { continue };
+        if k.param(SAMPLES_PER_FRAME).is_some() {
+            n.params
+                .insert(SAMPLES_PER_FRAME.into(), ParamValue::Int(1));
+        } else if k.history {
+            ports.push((format!("{}.color", n.id), false));
+        } else if k.category == Category::Denoise {
+            ports.push((format!("{}.color", n.id), true));
         }
     }
     if !ports.iter().any(|(_, d)| !d) {

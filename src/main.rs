@@ -208,22 +208,22 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
 }
 
 fn uses_scene(plan: &lumagraph::graph::Plan) -> bool {
+    plan.passes.iter().any(|p| p.renders_scene)
+}
+
+/// The pass the render's samples come from (it has `samples_per_frame`), if any.
+fn progressive_source(plan: &lumagraph::graph::Plan) -> Option<&lumagraph::graph::Pass> {
     plan.passes
         .iter()
-        .any(|p| p.kind == "PathTrace" || p.kind == "GBuffer")
+        .find(|p| p.params.has(lumagraph::graph::registry::SAMPLES_PER_FRAME))
 }
 
 /// Runs the progressive part of the graph for `spp` samples per pixel, then the rest once,
 /// with a progress bar once the render has taken more than a second.
 fn render_progressive(exec: &mut Executor, spp: u32) -> Result<lumagraph::render::FrameReport> {
-    let spf = exec
-        .plan()
-        .passes
-        .iter()
-        .find(|p| p.kind == "PathTrace")
-        .map_or(1, |p| {
-            u32::try_from(p.params.int("samples_per_frame")).unwrap_or(1)
-        });
+    let spf = progressive_source(exec.plan()).map_or(1, |p| {
+        u32::try_from(p.params.int(lumagraph::graph::registry::SAMPLES_PER_FRAME)).unwrap_or(1)
+    });
     let frames = spp.div_ceil(spf).max(1);
     // Warm-up: drivers compile pipelines at their first dispatch; keep that out of the timing.
     let warm = Instant::now();
@@ -270,12 +270,7 @@ fn render_progressive(exec: &mut Executor, spp: u32) -> Result<lumagraph::render
             .map_or(0, |(_, c)| c.value)
     };
     let samples = get("samples_per_pixel");
-    let extent = exec
-        .plan()
-        .passes
-        .iter()
-        .find(|p| p.kind == "PathTrace")
-        .map(|p| p.extent);
+    let extent = progressive_source(exec.plan()).map(|p| p.extent);
     let pixels = extent.map_or(0, lumagraph::graph::Extent::pixels);
     let secs = wall.as_secs_f64();
     #[expect(clippy::cast_precision_loss, reason = "report figures")]
@@ -350,17 +345,16 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
     Ok(())
 }
 
-/// The path tracer's shader features for the scene: compiled in, and left out with why.
+/// The shader features of every pass specialized to the scene: compiled in, and left out
+/// with why.
 fn print_features(plan: &lumagraph::graph::Plan, scene: &GpuScene) {
-    for pass in plan.passes.iter().filter(|p| p.kind == "PathTrace") {
-        let options = lumagraph::render::specialize::PathTraceOptions {
-            specialize: true,
-            aovs: ["albedo", "normal", "depth"]
-                .iter()
-                .any(|port| pass.output(port).is_some()),
-            data_in_buffers: false,
+    for pass in &plan.passes {
+        let Some(features) =
+            lumagraph::render::nodes::implementation(pass.kind).and_then(|i| i.features)
+        else {
+            continue;
         };
-        let features = lumagraph::render::specialize::features(scene, options);
+        let features = features(pass, scene);
         println!("shader features of {} for this scene:", pass.node);
         for included in [true, false] {
             println!("  {}:", if included { "compiled in" } else { "left out" });

@@ -323,11 +323,7 @@ impl Preview {
                 ..Resources::default()
             };
             let exec = Executor::new(&self.gpu, plan, &paths).map_err(|e| e.to_string())?;
-            self.progressive = exec
-                .plan()
-                .passes
-                .iter()
-                .any(|p| Registry::builtin().get(p.kind).is_some_and(|k| k.history));
+            self.progressive = exec.plan().passes.iter().any(|p| p.history);
             self.target_spp = self
                 .scene
                 .as_ref()
@@ -394,7 +390,12 @@ impl Preview {
         let Some(exec) = &mut self.exec else {
             return Ok(());
         };
-        if !exec.plan().passes.iter().any(|p| p.kind == "PathTrace") {
+        if !exec
+            .plan()
+            .passes
+            .iter()
+            .any(|p| p.params.has(lumagraph_graph::registry::SAMPLES_PER_FRAME))
+        {
             self.samples = None;
             return Ok(());
         }

@@ -25,6 +25,11 @@ use crate::types::{Extent, ParamValue};
 pub struct Params(pub BTreeMap<String, ParamValue>);
 
 impl Params {
+    /// Whether the kind declares a param called `name`.
+    pub fn has(&self, name: &str) -> bool {
+        self.0.contains_key(name)
+    }
+
     fn get(&self, name: &str) -> &ParamValue {
         self.0
             .get(name)
@@ -480,6 +485,10 @@ fn build_plan(
         passes.push(Pass {
             node: node.id.clone(),
             kind: kind.name,
+            category: kind.category,
+            sink: kind.sink,
+            history: kind.history,
+            renders_scene: kind.renders_scene,
             params,
             inputs,
             outputs,

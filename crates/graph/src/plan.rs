@@ -4,6 +4,7 @@
 use std::fmt;
 
 use crate::compile::Params;
+use crate::registry::Category;
 use crate::types::{Extent, PortType, TexFormat};
 
 /// Index of a logical texture in [`Plan::textures`].
@@ -17,6 +18,14 @@ pub struct Pass {
     pub node: String,
     /// Node kind name.
     pub kind: &'static str,
+    /// The kind's category.
+    pub category: Category,
+    /// The kind writes results out of the graph (`NodeKind::sink`).
+    pub sink: bool,
+    /// The kind keeps history across frames (`NodeKind::history`).
+    pub history: bool,
+    /// The kind renders the scene (`NodeKind::renders_scene`).
+    pub renders_scene: bool,
     /// Checked params with defaults filled in.
     pub params: Params,
     /// Input port → texture read.

@@ -27,15 +27,19 @@ pub fn source_extent(
     node: &Node,
     params: &Params,
 ) -> std::result::Result<Extent, String> {
-    match node.kind.as_str() {
-        "ImageInput" => crate::image_io::dimensions(&base_dir.join(params.str("path")))
-            .map_err(|e| e.to_string()),
-        "PathTrace" | "GBuffer" => scene
+    if Registry::builtin()
+        .get(&node.kind)
+        .is_some_and(|k| k.renders_scene)
+    {
+        return scene
             .map(|s| Extent::new(s.settings.width, s.settings.height))
             .ok_or_else(|| {
                 "renders a scene, but none was given (lumagraph render --scene FILE)".to_owned()
-            }),
-        other => Err(format!("{other} is not a source")),
+            });
+    }
+    match nodes::implementation(&node.kind).and_then(|i| i.source_extent) {
+        Some(extent) => extent(base_dir, params),
+        None => Err(format!("{} is not a source", node.kind)),
     }
 }
 
@@ -484,11 +488,7 @@ impl Executor {
 
 /// For each pass, whether it is a node with history or feeds one.
 fn every_frame(plan: &Plan) -> Vec<bool> {
-    let mut flags: Vec<bool> = plan
-        .passes
-        .iter()
-        .map(|p| Registry::builtin().get(p.kind).is_some_and(|k| k.history))
-        .collect();
+    let mut flags: Vec<bool> = plan.passes.iter().map(|p| p.history).collect();
     // Walk backwards: a pass runs every frame if a later pass that does reads its output.
     for i in (0..plan.passes.len()).rev() {
         if !flags[i] {

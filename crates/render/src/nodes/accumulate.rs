@@ -13,9 +13,31 @@ use lumagraph_graph::{Extent, Pass, TexFormat};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::kernel::{Binding, Kernel, uniform_buffer};
-use crate::nodes::{FrameIo, NodeExec};
+use crate::nodes::{FrameIo, NodeExec, NodeImpl, boxed};
 use crate::pool::{PooledTexture, create};
 use crate::timing::GpuTimer;
+
+/// The `Accumulate` kind: it owns its history buffers.
+pub(crate) const IMPL: NodeImpl = NodeImpl {
+    kind: "Accumulate",
+    create: |ctx, pass, _| boxed(Accumulate::new(ctx, pass)),
+    owned_memory: |pass| {
+        let buffers = if pass.output("variance").is_some() {
+            3
+        } else {
+            2
+        };
+        Some((
+            buffers * 16 * pass.extent.pixels(),
+            format!(
+                "{buffers} history buffers of 16 B per pixel (sum, compensation{})",
+                if buffers == 3 { ", second moment" } else { "" }
+            ),
+        ))
+    },
+    source_extent: None,
+    features: None,
+};
 
 pub(crate) struct Accumulate {
     kernel: Kernel,

@@ -17,12 +17,29 @@ use lumagraph_graph::{Extent, Pass, TexFormat};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::kernel::{Binding, Kernel, uniform_buffer};
-use crate::nodes::{FrameIo, NodeExec};
+use crate::nodes::{FrameIo, NodeExec, NodeImpl, boxed};
 use crate::pool::{PooledTexture, create};
 use crate::timing::GpuTimer;
 
 /// Most passes the registry allows.
 const MAX_ITERATIONS: u32 = 8;
+
+/// The `Denoise` kind: it owns its scratch images.
+pub(crate) const IMPL: NodeImpl = NodeImpl {
+    kind: "Denoise",
+    create: |ctx, pass, _| boxed(Denoise::new(ctx, pass)),
+    owned_memory: |pass| {
+        let n = u32::try_from(pass.params.int("iterations")).unwrap_or(1);
+        let what = if n > 1 {
+            "2 rgba32f ping-pong images"
+        } else {
+            "1 rgba32f image (demodulated input)"
+        };
+        Some((scratch_bytes(pass.extent, n), what.to_owned()))
+    },
+    source_extent: None,
+    features: None,
+};
 
 pub(crate) struct Denoise {
     kernel: Kernel,

@@ -5,8 +5,17 @@ use lumagraph_graph::Pass;
 use crate::context::GpuContext;
 use crate::cpu::exposure_scale;
 use crate::error::Result;
-use crate::nodes::{ColorFilter, FrameIo, NodeExec};
+use crate::nodes::{ColorFilter, FrameIo, NodeExec, NodeImpl, boxed, owns_nothing};
 use crate::timing::GpuTimer;
+
+/// The `Exposure` kind.
+pub(crate) const IMPL: NodeImpl = NodeImpl {
+    kind: "Exposure",
+    create: |ctx, pass, _| boxed(Exposure::new(ctx, pass)),
+    owned_memory: owns_nothing,
+    source_extent: None,
+    features: None,
+};
 
 pub(crate) struct Exposure {
     filter: ColorFilter,

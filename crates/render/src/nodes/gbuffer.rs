@@ -18,7 +18,7 @@ use wgpu::util::DeviceExt as _;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::kernel::uniform_buffer;
-use crate::nodes::{FrameIo, NodeExec, Resources};
+use crate::nodes::{FrameIo, NodeExec, NodeImpl, Resources, boxed};
 use crate::pool::{PooledTexture, create, wgpu_format};
 use crate::timing::GpuTimer;
 
@@ -31,6 +31,20 @@ const PORTS: [(&str, TexFormat); 3] = [
     ("normal", TexFormat::Rgba32Float),
     ("depth", TexFormat::R32Float),
 ];
+
+/// The `GBuffer` kind: it owns its depth attachment.
+pub(crate) const IMPL: NodeImpl = NodeImpl {
+    kind: "GBuffer",
+    create: |ctx, pass, resources| boxed(GBuffer::new(ctx, pass, resources)),
+    owned_memory: |pass| {
+        Some((
+            4 * pass.extent.pixels(),
+            "depth attachment (depth32float)".to_owned(),
+        ))
+    },
+    source_extent: None,
+    features: None,
+};
 
 pub(crate) struct GBuffer {
     scene: std::sync::Arc<GpuScene>,

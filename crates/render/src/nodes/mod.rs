@@ -12,7 +12,7 @@ mod tonemap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use lumagraph_graph::{Pass, Plan, TextureId};
+use lumagraph_graph::{Extent, Pass, Plan, TextureId};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
@@ -135,39 +135,69 @@ pub trait NodeExec {
     }
 }
 
-/// Memory a node allocates for itself, outside the plan's textures (history, scratch
-/// images, depth attachments), in bytes with what it is; `None` for nodes that own none.
-/// The CLI's `plan` prints it beside the plan's textures.
-pub fn owned_memory(pass: &Pass) -> Option<(u64, String)> {
-    let px = pass.extent.pixels();
-    match pass.kind {
-        "Accumulate" => {
-            let buffers = if pass.output("variance").is_some() {
-                3
-            } else {
-                2
-            };
-            Some((
-                buffers * 16 * px,
-                format!(
-                    "{buffers} history buffers of 16 B per pixel (sum, compensation{})",
-                    if buffers == 3 { ", second moment" } else { "" }
-                ),
-            ))
-        }
-        "Denoise" => {
-            let n = u32::try_from(pass.params.int("iterations")).unwrap_or(1);
-            let bytes = denoise::scratch_bytes(pass.extent, n);
-            let what = if n > 1 {
-                "2 rgba32f ping-pong images"
-            } else {
-                "1 rgba32f image (demodulated input)"
-            };
-            Some((bytes, what.to_owned()))
-        }
-        "GBuffer" => Some((4 * px, "depth attachment (depth32float)".to_owned())),
-        _ => None,
+/// The size of the image a source produces from its params (paths relative to the folder
+/// given), or why it cannot tell.
+pub type SourceExtent = fn(&Path, &lumagraph_graph::Params) -> std::result::Result<Extent, String>;
+
+/// How a node kind of the registry runs: one entry per kind, declared in the kind's own
+/// file (`IMPL`) and listed in [`IMPLEMENTATIONS`]. Nothing else in the program matches kind
+/// names: what the rest needs to know of a kind is on its registry entry (and copied onto
+/// its [`Pass`]) or here.
+#[derive(Clone, Copy)]
+pub struct NodeImpl {
+    /// The registry kind it implements.
+    pub kind: &'static str,
+    /// Creates the GPU side of a pass of this kind.
+    pub create: fn(&GpuContext, &Pass, &Resources) -> Result<Box<dyn NodeExec>>,
+    /// Memory it allocates for itself, outside the plan's textures (history, scratch
+    /// images, depth attachments), in bytes with what it is; the CLI's `plan` prints it.
+    pub owned_memory: fn(&Pass) -> Option<(u64, String)>,
+    /// For a source that does not render the scene: the size of the image it produces from
+    /// its params (paths relative to the folder given), or why it cannot tell.
+    pub source_extent: Option<SourceExtent>,
+    /// For a kind whose shader is specialized to the scene: what a pass of it compiles in
+    /// and leaves out for `scene` (with the default resources), for `lumagraph plan`.
+    pub features: Option<fn(&Pass, &lumagraph_scene::GpuScene) -> Vec<crate::specialize::Feature>>,
+}
+
+impl std::fmt::Debug for NodeImpl {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NodeImpl")
+            .field("kind", &self.kind)
+            .finish_non_exhaustive()
     }
+}
+
+/// [`NodeImpl::owned_memory`] of a kind that owns no memory.
+pub(crate) fn owns_nothing(_: &Pass) -> Option<(u64, String)> {
+    None
+}
+
+/// Boxes a node's GPU side for [`NodeImpl::create`].
+pub(crate) fn boxed<N: NodeExec + 'static>(node: Result<N>) -> Result<Box<dyn NodeExec>> {
+    node.map(|n| Box::new(n) as Box<dyn NodeExec>)
+}
+
+/// Every implemented kind; a test checks that they are exactly the registry's kinds.
+pub static IMPLEMENTATIONS: &[NodeImpl] = &[
+    image_input::IMPL,
+    pathtrace::IMPL,
+    accumulate::IMPL,
+    gbuffer::IMPL,
+    denoise::IMPL,
+    exposure::IMPL,
+    tonemap::IMPL,
+    output::IMPL,
+];
+
+/// The implementation of the kind called `kind`.
+pub fn implementation(kind: &str) -> Option<&'static NodeImpl> {
+    IMPLEMENTATIONS.iter().find(|i| i.kind == kind)
+}
+
+/// Memory a pass's node allocates for itself (see [`NodeImpl::owned_memory`]).
+pub fn owned_memory(pass: &Pass) -> Option<(u64, String)> {
+    implementation(pass.kind).and_then(|i| (i.owned_memory)(pass))
 }
 
 /// The common shape of a post-processing node: `color` in, `color` out (in `out_format`),
@@ -236,16 +266,9 @@ impl ColorFilter {
 /// # Errors
 /// When the kind has no implementation or its setup fails; the error names the node.
 pub fn create(ctx: &GpuContext, pass: &Pass, paths: &Resources) -> Result<Box<dyn NodeExec>> {
-    let node: Result<Box<dyn NodeExec>> = match pass.kind {
-        "ImageInput" => image_input::ImageInput::new(ctx, pass, paths).map(|n| Box::new(n) as _),
-        "Accumulate" => accumulate::Accumulate::new(ctx, pass).map(|n| Box::new(n) as _),
-        "Exposure" => exposure::Exposure::new(ctx, pass).map(|n| Box::new(n) as _),
-        "Tonemap" => tonemap::Tonemap::new(ctx, pass).map(|n| Box::new(n) as _),
-        "PathTrace" => pathtrace::PathTrace::new(ctx, pass, paths).map(|n| Box::new(n) as _),
-        "GBuffer" => gbuffer::GBuffer::new(ctx, pass, paths).map(|n| Box::new(n) as _),
-        "Denoise" => denoise::Denoise::new(ctx, pass).map(|n| Box::new(n) as _),
-        "Output" => output::Output::new(ctx, pass, paths).map(|n| Box::new(n) as _),
-        other => Err(RenderError::Unimplemented(other.to_owned())),
+    let node = match implementation(pass.kind) {
+        Some(i) => (i.create)(ctx, pass, paths),
+        None => Err(RenderError::Unimplemented(pass.kind.to_owned())),
     };
     node.map_err(|e| e.in_node(&pass.node))
 }
@@ -268,4 +291,33 @@ pub fn check_writable(path: &Path) -> Result<()> {
                 .map(|_| ())
         })
         .map_err(|e| RenderError::image(path, format!("cannot write output: {e}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The registry and the implementation table list the same kinds, once each.
+    #[test]
+    fn every_registry_kind_has_one_implementation() {
+        let kinds: Vec<&str> = lumagraph_graph::Registry::builtin()
+            .kinds()
+            .iter()
+            .map(|k| k.name)
+            .collect();
+        let mut implemented: Vec<&str> = IMPLEMENTATIONS.iter().map(|i| i.kind).collect();
+        let mut sorted = kinds.clone();
+        sorted.sort_unstable();
+        implemented.sort_unstable();
+        assert_eq!(sorted, implemented);
+        for k in lumagraph_graph::Registry::builtin().kinds() {
+            let i = implementation(k.name).unwrap();
+            assert_eq!(
+                i.source_extent.is_some(),
+                k.is_source() && !k.renders_scene,
+                "{}: a source that does not render the scene tells its size, no other kind does",
+                k.name
+            );
+        }
+    }
 }

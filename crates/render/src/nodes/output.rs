@@ -6,8 +6,17 @@ use lumagraph_graph::{Extent, Pass, PortType, TexFormat};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::nodes::{FrameIo, NodeExec, Resources, check_writable};
+use crate::nodes::{FrameIo, NodeExec, NodeImpl, Resources, boxed, check_writable, owns_nothing};
 use crate::timing::GpuTimer;
+
+/// The `Output` kind.
+pub(crate) const IMPL: NodeImpl = NodeImpl {
+    kind: "Output",
+    create: |ctx, pass, resources| boxed(Output::new(ctx, pass, resources)),
+    owned_memory: owns_nothing,
+    source_extent: None,
+    features: None,
+};
 
 pub(crate) struct Output {
     paths: Resources,

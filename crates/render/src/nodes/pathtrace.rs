@@ -10,7 +10,7 @@ use crate::error::{RenderError, Result};
 use crate::kernel::{Binding, Kernel, uniform_buffer};
 use lumagraph_graph::TexFormat;
 
-use crate::nodes::{Counter, FrameIo, NodeExec, Resources};
+use crate::nodes::{Counter, FrameIo, NodeExec, NodeImpl, Resources, boxed, owns_nothing};
 use crate::pool::{PooledTexture, create};
 use crate::readback::map_read;
 use crate::scene_gpu::SceneBuffers;
@@ -18,6 +18,29 @@ use crate::timing::GpuTimer;
 
 /// `stats` slots: dropped (non-finite) samples, rays traced (low, high 32 bits).
 const STATS: u64 = 4;
+
+/// The `PathTrace` kind.
+pub(crate) const IMPL: NodeImpl = NodeImpl {
+    kind: "PathTrace",
+    create: |ctx, pass, resources| boxed(PathTrace::new(ctx, pass, resources)),
+    owned_memory: owns_nothing,
+    source_extent: None,
+    features: Some(|pass, scene| {
+        crate::specialize::features(scene, options(pass, &Resources::default()))
+    }),
+};
+
+/// How a pass's shader is specialized: to the scene unless the resources ask for the
+/// general shader, with first-hit AOVs when something reads them.
+fn options(pass: &Pass, resources: &Resources) -> crate::specialize::PathTraceOptions {
+    crate::specialize::PathTraceOptions {
+        specialize: !resources.general_shaders,
+        data_in_buffers: resources.scene_data_in_buffers,
+        aovs: ["albedo", "normal", "depth"]
+            .iter()
+            .any(|p| pass.output(p).is_some()),
+    }
+}
 
 pub(crate) struct PathTrace {
     kernel: Kernel,
@@ -55,15 +78,7 @@ impl PathTrace {
             RenderError::Gpu("PathTrace needs a scene (lumagraph render --scene FILE)".into())
         })?;
         let storage = Binding::Storage { read_only: true };
-        let aovs = ["albedo", "normal", "depth"]
-            .iter()
-            .any(|p| pass.output(p).is_some());
-        let options = crate::specialize::PathTraceOptions {
-            specialize: !resources.general_shaders,
-            data_in_buffers: resources.scene_data_in_buffers,
-            aovs,
-        };
-        let (source, how) = crate::specialize::pathtrace_source(&scene, options)?;
+        let (source, how) = crate::specialize::pathtrace_source(&scene, options(pass, resources))?;
         let kernel = Kernel::from_source(
             ctx,
             "pathtrace/pathtrace.wgsl",

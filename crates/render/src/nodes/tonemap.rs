@@ -5,7 +5,7 @@ use lumagraph_graph::registry::TONEMAP_OPERATORS;
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::nodes::{ColorFilter, FrameIo, NodeExec};
+use crate::nodes::{ColorFilter, FrameIo, NodeExec, NodeImpl, boxed, owns_nothing};
 use crate::timing::GpuTimer;
 
 /// The shader's number for an operator name (its index in the registry).
@@ -16,6 +16,15 @@ pub(crate) fn operator_index(name: &str) -> u32 {
         .and_then(|i| u32::try_from(i).ok())
         .unwrap_or(0)
 }
+
+/// The `Tonemap` kind.
+pub(crate) const IMPL: NodeImpl = NodeImpl {
+    kind: "Tonemap",
+    create: |ctx, pass, _| boxed(Tonemap::new(ctx, pass)),
+    owned_memory: owns_nothing,
+    source_extent: None,
+    features: None,
+};
 
 pub(crate) struct Tonemap {
     filter: ColorFilter,

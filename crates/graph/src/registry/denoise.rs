@@ -1,0 +1,100 @@
+//! Denoising nodes.
+
+use super::{COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef};
+use crate::types::{ParamType, PortType};
+
+pub(super) fn kinds() -> Vec<NodeKind> {
+    vec![NodeKind {
+        name: "Denoise",
+        category: Category::Denoise,
+        doc: "Edge-avoiding à-trous wavelet filter (Dammertz et al. 2010, with SVGF's \
+              weights): `iterations` passes of the 5×5 B3-spline kernel with holes of \
+              1, 2, 4, 8, 16… pixels. Color is divided by the albedo before filtering and \
+              multiplied back after; each tap is weighted by luminance (scaled by the \
+              pixel's standard deviation when `variance_guided`), normal and depth \
+              differences. Two ping-pong images are the only memory it adds.",
+        inputs: &[
+            InputDef {
+                name: "color",
+                accepts: COLOR_TYPES,
+                doc: "noisy linear color (e.g. Accumulate.color)",
+            },
+            InputDef {
+                name: "albedo",
+                accepts: &[PortType::Albedo],
+                doc: "first-hit albedo (GBuffer or PathTrace)",
+            },
+            InputDef {
+                name: "normal",
+                accepts: &[PortType::Normal],
+                doc: "first-hit world-space normal",
+            },
+            InputDef {
+                name: "depth",
+                accepts: &[PortType::Depth],
+                doc: "first-hit distance along the camera ray",
+            },
+            InputDef {
+                name: "variance",
+                accepts: &[PortType::Variance],
+                doc: "variance of the color's mean (Accumulate.variance); read only when \
+                      `variance_guided` is on, but always connected",
+            },
+        ],
+        outputs: &[OutputDef {
+            name: "color",
+            ty: PortType::HdrColor,
+            doc: "filtered linear color",
+        }],
+        params: vec![
+            ParamDef {
+                name: "iterations",
+                ty: ParamType::Int {
+                    default: 5,
+                    min: 1,
+                    max: 8,
+                },
+                doc: "à-trous passes; pass i spaces the kernel's taps 2^i pixels apart",
+            },
+            ParamDef {
+                name: "sigma_color",
+                ty: ParamType::Float {
+                    default: 4.0,
+                    min: 0.0,
+                    max: 1000.0,
+                },
+                doc: "luminance tolerance: in standard deviations when variance-guided, \
+                      else in units of luminance, halved every pass (0 = stop at any \
+                      difference)",
+            },
+            ParamDef {
+                name: "sigma_normal",
+                ty: ParamType::Float {
+                    default: 0.02,
+                    min: 0.0,
+                    max: 10.0,
+                },
+                doc: "normal tolerance: weight exp(-(1 - n_p·n_q) / sigma_normal)",
+            },
+            ParamDef {
+                name: "sigma_depth",
+                ty: ParamType::Float {
+                    default: 0.5,
+                    min: 0.0,
+                    max: 1000.0,
+                },
+                doc: "depth tolerance, in multiples of the depth change the local gradient \
+                      predicts over the tap's offset",
+            },
+            ParamDef {
+                name: "variance_guided",
+                ty: ParamType::Bool { default: true },
+                doc: "scale the luminance tolerance by the per-pixel standard deviation \
+                      (SVGF); off: a fixed tolerance halved every pass (Dammertz)",
+            },
+        ],
+        sink: false,
+        history: false,
+        renders_scene: false,
+    }]
+}

@@ -1,0 +1,30 @@
+//! Input nodes: images from files.
+
+use super::{Category, NodeKind, OutputDef, ParamDef};
+use crate::types::{ParamType, PortType};
+
+pub(super) fn kinds() -> Vec<NodeKind> {
+    vec![NodeKind {
+        name: "ImageInput",
+        category: Category::Input,
+        doc: "Reads an image file. EXR and Radiance .hdr are taken as linear; PNG and JPEG are \
+              decoded from sRGB to linear. The image sets the size of everything downstream.",
+        inputs: &[],
+        outputs: &[OutputDef {
+            name: "color",
+            ty: PortType::HdrColor,
+            doc: "the image, linear RGB",
+        }],
+        params: vec![ParamDef {
+            name: "path",
+            ty: ParamType::Path {
+                default: "image.exr",
+                extensions: &["exr", "hdr", "png", "jpg", "jpeg"],
+            },
+            doc: "image file, relative to the graph file's folder",
+        }],
+        sink: false,
+        history: false,
+        renders_scene: false,
+    }]
+}
