@@ -1,7 +1,8 @@
 //! WGSL sources and the `#import` resolver.
 //!
 //! Shaders live in `shaders/` by topic; a line `#import "common/color.wgsl"` is replaced by
-//! that file's text (each file at most once, recursively), so shared code is written once.
+//! that file's text (each file at most once, recursively; `lumagraph-wgsl`), so shared code
+//! is written once.
 //! Release builds use copies embedded at build time; debug builds read the folder on disk
 //! when it is there, so an edited shader is picked up by the next pipeline created. The
 //! same resolver is used by the naga validation test, so every shader the program can
@@ -63,10 +64,7 @@ pub fn resolve(name: &str) -> Result<String> {
 /// # Errors
 /// When a file or one it imports is missing, or an import line is malformed.
 pub fn resolve_with(name: &str, overrides: &[(&str, String)]) -> Result<String> {
-    let mut seen = Vec::new();
-    let mut out = String::new();
-    resolve_into(name, overrides, &mut seen, &mut out)?;
-    Ok(out)
+    lumagraph_wgsl::resolve(name, overrides, &|n: &str| raw(n).ok()).map_err(shader_error)
 }
 
 /// Every file `name` imports, directly or not, in inclusion order (itself included).
@@ -74,45 +72,12 @@ pub fn resolve_with(name: &str, overrides: &[(&str, String)]) -> Result<String> 
 /// # Errors
 /// As [`resolve`].
 pub fn imports(name: &str) -> Result<Vec<String>> {
-    let mut seen = Vec::new();
-    resolve_into(name, &[], &mut seen, &mut String::new())?;
-    Ok(seen)
+    lumagraph_wgsl::imports(name, &|n: &str| raw(n).ok()).map_err(shader_error)
 }
 
-fn resolve_into(
-    name: &str,
-    overrides: &[(&str, String)],
-    seen: &mut Vec<String>,
-    out: &mut String,
-) -> Result<()> {
-    if seen.iter().any(|s| s == name) {
-        return Ok(());
+fn shader_error(e: lumagraph_wgsl::ImportError) -> RenderError {
+    RenderError::Shader {
+        name: e.file,
+        message: e.message,
     }
-    seen.push(name.to_owned());
-    let text = match overrides.iter().find(|(n, _)| *n == name) {
-        Some((_, text)) => text.clone(),
-        None => raw(name)?,
-    };
-    for (i, line) in text.lines().enumerate() {
-        if let Some(rest) = line.trim_start().strip_prefix("#import") {
-            let target = rest.trim().trim_matches('"');
-            if target.is_empty() || !rest.trim().starts_with('"') {
-                return Err(RenderError::Shader {
-                    name: name.to_owned(),
-                    message: format!("line {}: expected #import \"path.wgsl\"", i + 1),
-                });
-            }
-            resolve_into(target, overrides, seen, out).map_err(|e| match e {
-                RenderError::Shader { name: n, message } if n == target => RenderError::Shader {
-                    name: name.to_owned(),
-                    message: format!("line {}: cannot import {target}: {message}", i + 1),
-                },
-                e => e,
-            })?;
-        } else {
-            out.push_str(line);
-            out.push('\n');
-        }
-    }
-    Ok(())
 }

@@ -3,31 +3,18 @@
 
 mod common;
 
-use std::collections::HashSet;
 use std::mem::{offset_of, size_of};
-use std::path::Path;
 
 use lumagraph_scene::{
     GpuAliasEntry, GpuBvhNode, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere,
     GpuTriShading, GpuTriTexcoords, GpuTriangle,
 };
 
-/// Resolves `#import "<path relative to shaders/>"` lines by textual inclusion, each file
-/// once (the project's rule).
-fn resolve(root: &Path, rel: &str, seen: &mut HashSet<String>, out: &mut String) {
-    if !seen.insert(rel.to_owned()) {
-        return;
-    }
-    let text = std::fs::read_to_string(root.join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
-    for line in text.lines() {
-        if let Some(rest) = line.trim().strip_prefix("#import") {
-            let path = rest.trim().trim_matches('"');
-            resolve(root, path, seen, out);
-        } else {
-            out.push_str(line);
-            out.push('\n');
-        }
-    }
+/// `name` with its imports resolved as the renderer resolves them (`lumagraph-wgsl`), read
+/// from the repository's `shaders/` folder.
+fn resolve(name: &str) -> String {
+    lumagraph_wgsl::resolve(name, &[], &lumagraph_wgsl::from_dir(common::shaders()))
+        .unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn validate(source: &str, what: &str) -> naga::Module {
@@ -63,29 +50,20 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 
 #[test]
 fn bvh_wgsl_validates_with_a_stub() {
-    let mut src = String::new();
-    let mut seen = HashSet::new();
-    resolve(
-        &common::shaders(),
+    let imported = lumagraph_wgsl::imports(
         "pathtrace/bvh.wgsl",
-        &mut seen,
-        &mut src,
-    );
-    assert!(seen.contains("pathtrace/scene_types.wgsl"));
+        &lumagraph_wgsl::from_dir(common::shaders()),
+    )
+    .unwrap();
+    assert!(imported.iter().any(|f| f == "pathtrace/scene_types.wgsl"));
+    let mut src = resolve("pathtrace/bvh.wgsl");
     src.push_str(STUB);
     validate(&src, "bvh.wgsl + stub");
 }
 
 #[test]
 fn scene_types_validate_alone() {
-    let mut src = String::new();
-    resolve(
-        &common::shaders(),
-        "pathtrace/scene_types.wgsl",
-        &mut HashSet::new(),
-        &mut src,
-    );
-    validate(&src, "scene_types.wgsl");
+    validate(&resolve("pathtrace/scene_types.wgsl"), "scene_types.wgsl");
 }
 
 macro_rules! layout {
@@ -197,13 +175,7 @@ fn wgsl_layouts_match_rust() {
             ]
         ),
     ];
-    let mut src = String::new();
-    resolve(
-        &common::shaders(),
-        "pathtrace/scene_types.wgsl",
-        &mut HashSet::new(),
-        &mut src,
-    );
+    let src = resolve("pathtrace/scene_types.wgsl");
     let module = validate(&src, "scene_types.wgsl");
     let mut layouter = naga::proc::Layouter::default();
     layouter.update(module.to_ctx()).unwrap();
