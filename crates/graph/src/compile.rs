@@ -245,6 +245,22 @@ fn check<'g>(
     registry: &'g Registry,
     errors: &mut Vec<GraphError>,
 ) -> Checked<'g> {
+    let (kinds, params) = check_nodes(graph, registry, errors);
+    let inputs = check_edges(graph, &kinds, errors);
+    Checked {
+        kinds,
+        params,
+        inputs,
+    }
+}
+
+/// Each node's kind (`None` when unknown) and checked params, reporting bad ids, unknown
+/// kinds and bad params.
+fn check_nodes<'g>(
+    graph: &'g Graph,
+    registry: &'g Registry,
+    errors: &mut Vec<GraphError>,
+) -> (Vec<Option<&'g NodeKind>>, Vec<Params>) {
     let mut seen = HashSet::new();
     let mut kinds = Vec::with_capacity(graph.nodes.len());
     let mut params = Vec::with_capacity(graph.nodes.len());
@@ -286,7 +302,17 @@ fn check<'g>(
         }
         kinds.push(kind);
     }
+    (kinds, params)
+}
 
+/// The input each edge connects, as (node, input port) → (node, output port), reporting
+/// bad port references, missing nodes and ports, incompatible types and two edges into one
+/// input.
+fn check_edges<'g>(
+    graph: &'g Graph,
+    kinds: &[Option<&'g NodeKind>],
+    errors: &mut Vec<GraphError>,
+) -> HashMap<(usize, &'g str), (usize, &'g str)> {
     let index: HashMap<&str, usize> = graph
         .nodes
         .iter()
@@ -389,11 +415,7 @@ fn check<'g>(
         }
         inputs.insert((ti, inp.name), (fi, out.name));
     }
-    Checked {
-        kinds,
-        params,
-        inputs,
-    }
+    inputs
 }
 
 fn build_plan(

@@ -236,6 +236,49 @@ fn finite4(p: [f32; 4]) -> [f32; 4] {
     p.map(|v| if v.is_finite() { v } else { 0.0 })
 }
 
+/// The depth gradient at (x, y): per axis the one-sided difference of smaller magnitude
+/// (0 at the image's edge on both sides), as the GPU filter computes it.
+fn depth_gradient(depth: &Image, x: i32, y: i32) -> [f32; 2] {
+    let (w, h) = (depth.width as i32, depth.height as i32);
+    let z = |x: i32, y: i32| {
+        (x >= 0 && y >= 0 && x < w && y < h).then(|| finite4(depth.pixels[(y * w + x) as usize])[0])
+    };
+    let z_p = z(x, y).unwrap_or(0.0);
+    [(1, 0), (0, 1)].map(|(ex, ey)| {
+        let forward = z(x + ex, y + ey).map(|q| q - z_p);
+        let backward = z(x - ex, y - ey).map(|q| z_p - q);
+        match (forward, backward) {
+            (Some(f), Some(b)) => {
+                if b.abs() < f.abs() {
+                    b
+                } else {
+                    f
+                }
+            }
+            (Some(d), None) | (None, Some(d)) => d,
+            (None, None) => 0.0,
+        }
+    })
+}
+
+/// The variance (alpha of `cur`) at (x, y) blurred by the 3×3 binomial kernel over the
+/// pixels inside the image, clamped at 0.
+fn blurred_variance(cur: &[[f32; 4]], width: u32, height: u32, x: i32, y: i32) -> f32 {
+    let (w, h) = (width as i32, height as i32);
+    let (mut sum, mut wsum) = (0.0, 0.0);
+    for dy in -1..=1 {
+        for dx in -1..=1 {
+            let (qx, qy) = (x + dx, y + dy);
+            if qx >= 0 && qy >= 0 && qx < w && qy < h {
+                let wt = if dx == 0 { 0.5 } else { 0.25 } * if dy == 0 { 0.5 } else { 0.25 };
+                sum += wt * finite4(cur[(qy * w + qx) as usize])[3];
+                wsum += wt;
+            }
+        }
+    }
+    (sum / wsum).max(0.0)
+}
+
 /// The à-trous filter of `shaders/post/denoise.wgsl`, mirrored: demodulation, then
 /// `iterations` passes, then remodulation. Depth is read from channel 0 of `depth`; an albedo
 /// alpha above 1.5 marks an emitter, which shares no taps with other pixels.
@@ -290,34 +333,9 @@ pub fn denoise(
                 let l_p = luminance(rgb(center));
                 let n_p = nrm(i);
                 let z_p = z(i);
-                let mut grad = [0.0_f32; 2];
-                for (axis, g) in grad.iter_mut().enumerate() {
-                    let (ex, ey) = if axis == 0 { (1, 0) } else { (0, 1) };
-                    let mut best = 1e30_f32;
-                    if inside(x + ex, y + ey) {
-                        best = z(idx(x + ex, y + ey)) - z_p;
-                    }
-                    if inside(x - ex, y - ey) {
-                        let b = z_p - z(idx(x - ex, y - ey));
-                        if b.abs() < best.abs() {
-                            best = b;
-                        }
-                    }
-                    *g = if best.abs() < 1e29 { best } else { 0.0 };
-                }
+                let grad = depth_gradient(depth, x, y);
                 let s = if params.variance_guided {
-                    let (mut sum, mut wsum) = (0.0, 0.0);
-                    for dy in -1..=1 {
-                        for dx in -1..=1 {
-                            if inside(x + dx, y + dy) {
-                                let wt = if dx == 0 { 0.5 } else { 0.25 }
-                                    * if dy == 0 { 0.5 } else { 0.25 };
-                                sum += wt * finite4(cur[idx(x + dx, y + dy)])[3];
-                                wsum += wt;
-                            }
-                        }
-                    }
-                    (sum / wsum).max(0.0).sqrt()
+                    blurred_variance(&cur, color.width, color.height, x, y).sqrt()
                 } else {
                     scale
                 };

@@ -146,21 +146,9 @@ fn table_fns(name: &str, ty: &str, types: &[&str], rows: &[Vec<String>]) -> Stri
     out
 }
 
-/// Generated replacement for `pathtrace/scene_data.wgsl`: materials, lights, the light
-/// alias table and every primitive's position and shading data written into the code and
-/// returned by id, or `None` when the scene is too large ([`INLINE_MAX_PRIMITIVES`],
-/// [`INLINE_MAX_MATERIALS`]), textured (texture lookups read their buffers anyway), or holds
-/// a value that is not finite.
-pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
-    if scene.tri_positions.len() + scene.spheres.len() > INLINE_MAX_PRIMITIVES
-        || scene.materials.len() > INLINE_MAX_MATERIALS
-        || scene.header.features & lumagraph_scene::FEATURE_TEXTURES != 0
-    {
-        return None;
-    }
-    let l = Literals::default();
-    let (f3, f1, u1) = ("vec3f", "f32", "u32");
-    let materials: Vec<Vec<String>> = scene
+/// Every material as WGSL literals, field by field.
+fn materials_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
+    scene
         .materials
         .iter()
         .map(|m| {
@@ -189,8 +177,12 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
                 u(0),
             ]
         })
-        .collect();
-    let lights: Vec<Vec<String>> = scene
+        .collect()
+}
+
+/// Every light as WGSL literals.
+fn lights_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
+    scene
         .lights
         .iter()
         .map(|x| {
@@ -205,19 +197,31 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
                 l.f(x.power),
             ]
         })
-        .collect();
-    let alias: Vec<Vec<String>> = scene
+        .collect()
+}
+
+/// The light alias table as WGSL literals.
+fn alias_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
+    scene
         .light_alias
         .iter()
         .map(|a| vec![l.f(a.prob), u(a.other)])
-        .collect();
-    let positions: Vec<Vec<String>> = scene
+        .collect()
+}
+
+/// Every triangle's intersection data as WGSL literals.
+fn positions_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
+    scene
         .tri_positions
         .iter()
         .map(|t| vec![l.v3(t.v0), u(0), l.v3(t.e1), u(0), l.v3(t.e2), u(0)])
-        .collect();
-    // Normals are read only with TRI_VERTEX_NORMALS: without, zeros (longer runs).
-    let shading: Vec<Vec<String>> = scene
+        .collect()
+}
+
+/// Every triangle's shading data as WGSL literals; normals only with `TRI_VERTEX_NORMALS`
+/// (else zeros, which make longer runs).
+fn shading_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
+    scene
         .tri_shading
         .iter()
         .map(|t| {
@@ -238,8 +242,12 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
                 u(t.flags),
             ]
         })
-        .collect();
-    let spheres: Vec<Vec<String>> = scene
+        .collect()
+}
+
+/// Every sphere as WGSL literals.
+fn spheres_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
+    scene
         .spheres
         .iter()
         .map(|s| {
@@ -252,7 +260,29 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
                 u(0),
             ]
         })
-        .collect();
+        .collect()
+}
+
+/// Generated replacement for `pathtrace/scene_data.wgsl`: materials, lights, the light
+/// alias table and every primitive's position and shading data written into the code and
+/// returned by id, or `None` when the scene is too large ([`INLINE_MAX_PRIMITIVES`],
+/// [`INLINE_MAX_MATERIALS`]), textured (texture lookups read their buffers anyway), or holds
+/// a value that is not finite.
+pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
+    if scene.tri_positions.len() + scene.spheres.len() > INLINE_MAX_PRIMITIVES
+        || scene.materials.len() > INLINE_MAX_MATERIALS
+        || scene.header.features & lumagraph_scene::FEATURE_TEXTURES != 0
+    {
+        return None;
+    }
+    let l = Literals::default();
+    let (f3, f1, u1) = ("vec3f", "f32", "u32");
+    let materials = materials_rows(scene, &l);
+    let lights = lights_rows(scene, &l);
+    let alias = alias_rows(scene, &l);
+    let positions = positions_rows(scene, &l);
+    let shading = shading_rows(scene, &l);
+    let spheres = spheres_rows(scene, &l);
     if l.not_finite.get() {
         return None;
     }
@@ -330,6 +360,59 @@ fn feature(name: &'static str, included: bool, reason: impl Into<String>) -> Fea
     }
 }
 
+/// Why materials, lights and shading data are (or are not) written into the shader.
+fn inline_data_reason(scene: &GpuScene, options: PathTraceOptions, included: bool) -> String {
+    let m = scene.materials.len();
+    let prims = scene.tri_positions.len() + scene.spheres.len();
+    let textured = scene.header.features & lumagraph_scene::FEATURE_TEXTURES != 0;
+    if included {
+        format!(
+            "{m} materials, {} lights, {prims} primitives' shading data",
+            scene.lights.len()
+        )
+    } else if !options.specialize {
+        "general shader (specialization off)".to_owned()
+    } else if prims > INLINE_MAX_PRIMITIVES {
+        format!("{prims} primitives > {INLINE_MAX_PRIMITIVES}: read from buffers")
+    } else if options.data_in_buffers {
+        "forced off: read from buffers".to_owned()
+    } else if textured {
+        "textured materials: read from buffers".to_owned()
+    } else if m > INLINE_MAX_MATERIALS {
+        format!("{m} materials > {INLINE_MAX_MATERIALS}: read from buffers")
+    } else {
+        "a value is not finite: read from buffers".to_owned()
+    }
+}
+
+/// Why texture sampling is (or is not) compiled in.
+fn textures_reason(scene: &GpuScene, all: bool) -> String {
+    let textured_materials = scene
+        .materials
+        .iter()
+        .filter(|x| {
+            [
+                x.tex_base_mr,
+                x.tex_emissive_normal,
+                x.tex_transmission_specular,
+                x.tex_specular_color,
+            ]
+            .iter()
+            .any(|&t| t & 0xFFFF != 0xFFFF || t >> 16 != 0xFFFF)
+        })
+        .count();
+    if all {
+        "general shader (specialization off)".to_owned()
+    } else if textured_materials > 0 {
+        format!(
+            "{textured_materials} textured materials, {} KiB of texels",
+            scene.textures.len() * 4 / 1024
+        )
+    } else {
+        "no material has a texture".to_owned()
+    }
+}
+
 /// The features of the path tracer for `scene`: what is compiled in, what is left out.
 pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
     let all = !options.specialize;
@@ -350,16 +433,6 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
         && !textured
         && m.len() <= INLINE_MAX_MATERIALS
         && inline_scene_data(scene).is_some();
-    let textured_materials = count(&|x| {
-        [
-            x.tex_base_mr,
-            x.tex_emissive_normal,
-            x.tex_transmission_specular,
-            x.tex_specular_color,
-        ]
-        .iter()
-        .any(|&t| t & 0xFFFF != 0xFFFF || t >> 16 != 0xFFFF)
-    });
     let why = |n: usize, what: &str| {
         if all {
             "general shader (specialization off)".to_owned()
@@ -383,27 +456,7 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
         feature(
             "inline materials and lights",
             inline_data,
-            if inline_data {
-                format!(
-                    "{} materials, {lights} lights, {prims} primitives' shading data",
-                    m.len()
-                )
-            } else if all {
-                "general shader (specialization off)".to_owned()
-            } else if !inline {
-                format!("{prims} primitives > {INLINE_MAX_PRIMITIVES}: read from buffers")
-            } else if options.data_in_buffers {
-                "forced off: read from buffers".to_owned()
-            } else if textured {
-                "textured materials: read from buffers".to_owned()
-            } else if m.len() > INLINE_MAX_MATERIALS {
-                format!(
-                    "{} materials > {INLINE_MAX_MATERIALS}: read from buffers",
-                    m.len()
-                )
-            } else {
-                "a value is not finite: read from buffers".to_owned()
-            },
+            inline_data_reason(scene, options, inline_data),
         ),
         feature(
             "light sampling (NEE + MIS)",
@@ -455,16 +508,7 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
         feature(
             "material textures",
             all || textured,
-            if all {
-                "general shader (specialization off)".to_owned()
-            } else if textured {
-                format!(
-                    "{textured_materials} textured materials, {} KiB of texels",
-                    scene.textures.len() * 4 / 1024
-                )
-            } else {
-                "no material has a texture".to_owned()
-            },
+            textures_reason(scene, all),
         ),
     ]
 }

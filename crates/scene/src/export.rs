@@ -143,30 +143,17 @@ fn write_atomic(path: &Path, text: &str) -> Result<(), SceneError> {
     std::fs::rename(&tmp, path).map_err(io)
 }
 
-/// Writes `scene` (flattened as `gpu`, for the resolved camera) into `dir`: `scene.json` and
-/// `mesh_<material>[_smooth].obj` files. Returns the files written.
-///
-/// # Errors
-/// When `dir` cannot be created or a file cannot be written.
-pub fn export(scene: &Scene, gpu: &GpuScene, dir: &Path) -> Result<Vec<PathBuf>, SceneError> {
-    std::fs::create_dir_all(dir).map_err(|source| {
-        SceneError::new(ErrorKind::Io {
-            what: "export folder",
-            source,
-        })
-        .in_file(dir)
-    })?;
-    let mut written = Vec::new();
-    // Triangles grouped by (material, smooth), in file order.
+/// Writes the triangles of `scene` into `dir` as OBJ files, one per material and shading,
+/// in file order; returns their descriptions and paths.
+fn write_meshes(scene: &Scene, dir: &Path) -> Result<(Vec<MeshOut>, Vec<PathBuf>), SceneError> {
     let mut groups: Vec<((u32, bool), String, usize)> = Vec::new();
     for t in &scene.triangles {
         let key = (t.material, t.normals.is_some());
-        let i = match groups.iter().position(|g| g.0 == key) {
-            Some(i) => i,
-            None => {
-                groups.push((key, String::new(), 0));
-                groups.len() - 1
-            }
+        let i = if let Some(i) = groups.iter().position(|g| g.0 == key) {
+            i
+        } else {
+            groups.push((key, String::new(), 0));
+            groups.len() - 1
         };
         let (_, obj, count) = &mut groups[i];
         let base = *count * 3 + 1;
@@ -190,6 +177,7 @@ pub fn export(scene: &Scene, gpu: &GpuScene, dir: &Path) -> Result<Vec<PathBuf>,
         *count += 1;
     }
     let mut meshes = Vec::new();
+    let mut written = Vec::new();
     for ((material, smooth), obj, triangles) in groups {
         let file = format!("mesh_{material}{}.obj", if smooth { "_smooth" } else { "" });
         let path = dir.join(&file);
@@ -202,6 +190,94 @@ pub fn export(scene: &Scene, gpu: &GpuScene, dir: &Path) -> Result<Vec<PathBuf>,
             smooth,
         });
     }
+    Ok((meshes, written))
+}
+
+fn material_out(m: &crate::scene::Material) -> MaterialOut {
+    MaterialOut {
+        name: m.name.clone(),
+        base_color: m.base_color.to_array(),
+        emission: m.emission.to_array(),
+        roughness: m.roughness,
+        metallic: m.metallic,
+        specular: m.specular,
+        specular_tint: m.specular_tint,
+        transmission: m.transmission,
+        ior: m.ior,
+        two_sided: m.two_sided,
+        eta: m.conductor.map(|c| c.eta.to_array()),
+        k: m.conductor.map(|c| c.k.to_array()),
+        multiscatter: m.multiscatter,
+        textured: m.textures.any(),
+    }
+}
+
+fn light_out(l: &PunctualLight) -> LightOut {
+    match *l {
+        PunctualLight::Point {
+            position,
+            intensity,
+        } => LightOut::Point {
+            position: position.to_array(),
+            intensity: intensity.to_array(),
+        },
+        PunctualLight::Spot {
+            position,
+            axis,
+            intensity,
+            cutoff,
+            beam,
+        } => LightOut::Spot {
+            position: position.to_array(),
+            target: (position + axis).to_array(),
+            intensity: intensity.to_array(),
+            cutoff_angle: cutoff.to_degrees(),
+            beam_width: beam.to_degrees(),
+        },
+        PunctualLight::Directional {
+            direction,
+            irradiance,
+        } => LightOut::Directional {
+            direction: direction.to_array(),
+            irradiance: irradiance.to_array(),
+        },
+    }
+}
+
+fn environment_out(env: &Environment) -> EnvironmentOut {
+    match env {
+        Environment::Constant(c) => EnvironmentOut::Constant { radiance: *c },
+        Environment::Map {
+            path,
+            intensity,
+            azimuth,
+            elevation,
+            show_background,
+        } => EnvironmentOut::Map {
+            path: path.clone(),
+            intensity: *intensity,
+            azimuth: *azimuth,
+            elevation: *elevation,
+            show_background: *show_background,
+        },
+        _ => EnvironmentOut::None,
+    }
+}
+
+/// Writes `scene` (flattened as `gpu`, for the resolved camera) into `dir`: `scene.json` and
+/// `mesh_<material>[_smooth].obj` files. Returns the files written.
+///
+/// # Errors
+/// When `dir` cannot be created or a file cannot be written.
+pub fn export(scene: &Scene, gpu: &GpuScene, dir: &Path) -> Result<Vec<PathBuf>, SceneError> {
+    std::fs::create_dir_all(dir).map_err(|source| {
+        SceneError::new(ErrorKind::Io {
+            what: "export folder",
+            source,
+        })
+        .in_file(dir)
+    })?;
+    let (meshes, mut written) = write_meshes(scene, dir)?;
     let c = &scene.camera;
     let (_, up, forward) = c.basis();
     let out = Export {
@@ -222,26 +298,7 @@ pub fn export(scene: &Scene, gpu: &GpuScene, dir: &Path) -> Result<Vec<PathBuf>,
             spp: scene.settings.spp,
             seed: scene.settings.seed,
         },
-        materials: scene
-            .materials
-            .iter()
-            .map(|m| MaterialOut {
-                name: m.name.clone(),
-                base_color: m.base_color.to_array(),
-                emission: m.emission.to_array(),
-                roughness: m.roughness,
-                metallic: m.metallic,
-                specular: m.specular,
-                specular_tint: m.specular_tint,
-                transmission: m.transmission,
-                ior: m.ior,
-                two_sided: m.two_sided,
-                eta: m.conductor.map(|c| c.eta.to_array()),
-                k: m.conductor.map(|c| c.k.to_array()),
-                multiscatter: m.multiscatter,
-                textured: m.textures.any(),
-            })
-            .collect(),
+        materials: scene.materials.iter().map(material_out).collect(),
         meshes,
         spheres: scene
             .spheres
@@ -252,56 +309,8 @@ pub fn export(scene: &Scene, gpu: &GpuScene, dir: &Path) -> Result<Vec<PathBuf>,
                 material: s.material,
             })
             .collect(),
-        lights: scene
-            .lights
-            .iter()
-            .map(|l| match *l {
-                PunctualLight::Point {
-                    position,
-                    intensity,
-                } => LightOut::Point {
-                    position: position.to_array(),
-                    intensity: intensity.to_array(),
-                },
-                PunctualLight::Spot {
-                    position,
-                    axis,
-                    intensity,
-                    cutoff,
-                    beam,
-                } => LightOut::Spot {
-                    position: position.to_array(),
-                    target: (position + axis).to_array(),
-                    intensity: intensity.to_array(),
-                    cutoff_angle: cutoff.to_degrees(),
-                    beam_width: beam.to_degrees(),
-                },
-                PunctualLight::Directional {
-                    direction,
-                    irradiance,
-                } => LightOut::Directional {
-                    direction: direction.to_array(),
-                    irradiance: irradiance.to_array(),
-                },
-            })
-            .collect(),
-        environment: match &scene.environment {
-            Environment::Constant(c) => EnvironmentOut::Constant { radiance: *c },
-            Environment::Map {
-                path,
-                intensity,
-                azimuth,
-                elevation,
-                show_background,
-            } => EnvironmentOut::Map {
-                path: path.clone(),
-                intensity: *intensity,
-                azimuth: *azimuth,
-                elevation: *elevation,
-                show_background: *show_background,
-            },
-            _ => EnvironmentOut::None,
-        },
+        lights: scene.lights.iter().map(light_out).collect(),
+        environment: environment_out(&scene.environment),
     };
     let json = serde_json::to_string_pretty(&out).map_err(|e| {
         SceneError::new(ErrorKind::BadValue {

@@ -303,123 +303,13 @@ impl GpuScene {
             ..Self::default()
         };
         let textured = scene.materials.iter().any(|m| m.textures.any());
-        if scene.textures.len() >= 0xFFFF {
-            return Err(SceneError::new(ErrorKind::BadValue {
-                field: "textures",
-                message: format!("{} textures; at most 65534", scene.textures.len()),
-            }));
-        }
-        for m in &scene.materials {
-            if let Some(&t) = m
-                .textures
-                .all()
-                .iter()
-                .find(|&&t| t != NO_TEXTURE && t as usize >= scene.textures.len())
-            {
-                return Err(SceneError::new(ErrorKind::BadValue {
-                    field: "textures",
-                    message: format!(
-                        "material \"{}\" uses texture {t} of {}",
-                        m.name,
-                        scene.textures.len()
-                    ),
-                }));
-            }
-        }
+        check_textures(scene)?;
         if textured {
             out.textures = crate::texture::pack_textures(&scene.textures);
         }
         let mut weights = Vec::new();
-        for (i, &src) in out.tri_source.iter().enumerate() {
-            let t = &scene.triangles[src as usize];
-            let [p0, p1, p2] = t.positions;
-            let (e1, e2) = (p1 - p0, p2 - p0);
-            out.tri_positions.push(GpuTriangle {
-                v0: p0.to_array(),
-                e1: e1.to_array(),
-                e2: e2.to_array(),
-                ..GpuTriangle::default()
-            });
-            let flat_n = e1.cross(e2).normalize();
-            let ns = t.normals.unwrap_or([flat_n; 3]);
-            if textured {
-                let uv = t.uvs.unwrap_or([glam::Vec2::ZERO; 3]);
-                let tan = t
-                    .tangents
-                    .unwrap_or_else(|| crate::texture::triangle_tangents(t.positions, ns, uv));
-                out.tri_texcoords.push(GpuTriTexcoords {
-                    t0: tan[0].to_array(),
-                    t1: tan[1].to_array(),
-                    t2: tan[2].to_array(),
-                    uv01: [uv[0].x, uv[0].y, uv[1].x, uv[1].y],
-                    uv2: uv[2].to_array(),
-                    ..GpuTriTexcoords::default()
-                });
-            }
-            let m = &scene.materials[t.material as usize];
-            let mut light = NO_LIGHT;
-            if m.is_emissive() {
-                light = out.lights.len() as u32;
-                let area = t.area();
-                let sides = if m.two_sided { 2.0 } else { 1.0 };
-                let mut power = luminance(m.emission) * area * std::f32::consts::PI * sides;
-                if textured && m.textures.emissive != NO_TEXTURE {
-                    let uv = t.uvs.unwrap_or([glam::Vec2::ZERO; 3]);
-                    power *= textured_emission_scale(scene, m, uv);
-                }
-                weights.push(power);
-                out.lights.push(GpuLight {
-                    p0: p0.to_array(),
-                    flags: if m.two_sided { LIGHT_TWO_SIDED } else { 0 },
-                    e1: e1.to_array(),
-                    prim: i as u32,
-                    e2: e2.to_array(),
-                    area,
-                    emission: m.emission.to_array(),
-                    power,
-                });
-            }
-            out.tri_shading.push(GpuTriShading {
-                n0: ns[0].to_array(),
-                material: t.material,
-                n1: ns[1].to_array(),
-                light,
-                n2: ns[2].to_array(),
-                flags: if t.normals.is_some() {
-                    TRI_VERTEX_NORMALS
-                } else {
-                    0
-                },
-            });
-        }
-        for (i, &src) in out.sphere_source.iter().enumerate() {
-            let s = &scene.spheres[src as usize];
-            let m = &scene.materials[s.material as usize];
-            let mut light = NO_LIGHT;
-            if m.is_emissive() {
-                light = out.lights.len() as u32;
-                let area = 4.0 * std::f32::consts::PI * s.radius * s.radius;
-                let power = luminance(m.emission) * area * std::f32::consts::PI;
-                weights.push(power);
-                out.lights.push(GpuLight {
-                    p0: s.center.to_array(),
-                    flags: LIGHT_SPHERE,
-                    e1: [s.radius, 0.0, 0.0],
-                    prim: i as u32,
-                    e2: [0.0; 3],
-                    area,
-                    emission: m.emission.to_array(),
-                    power,
-                });
-            }
-            out.spheres.push(GpuSphere {
-                center: s.center.to_array(),
-                radius: s.radius,
-                material: s.material,
-                light,
-                ..GpuSphere::default()
-            });
-        }
+        out.push_triangles(scene, textured, &mut weights);
+        out.push_spheres(scene, &mut weights);
         let radius = out.bvh_nodes.first().map_or(1.0, |root| {
             0.5 * (Vec3::from(root.aabb_max) - Vec3::from(root.aabb_min)).length()
         });
@@ -444,6 +334,136 @@ impl GpuScene {
         out.settings = settings(scene);
         Ok(out)
     }
+
+    /// Appends the triangles in BVH order: intersection data, shading data, texture
+    /// coordinates (when `textured`), and a light for each emissive one (its power pushed
+    /// to `weights`).
+    fn push_triangles(&mut self, scene: &Scene, textured: bool, weights: &mut Vec<f32>) {
+        for (i, &src) in self.tri_source.iter().enumerate() {
+            let t = &scene.triangles[src as usize];
+            let [p0, p1, p2] = t.positions;
+            let (e1, e2) = (p1 - p0, p2 - p0);
+            self.tri_positions.push(GpuTriangle {
+                v0: p0.to_array(),
+                e1: e1.to_array(),
+                e2: e2.to_array(),
+                ..GpuTriangle::default()
+            });
+            let flat_n = e1.cross(e2).normalize();
+            let ns = t.normals.unwrap_or([flat_n; 3]);
+            if textured {
+                let uv = t.uvs.unwrap_or([glam::Vec2::ZERO; 3]);
+                let tan = t
+                    .tangents
+                    .unwrap_or_else(|| crate::texture::triangle_tangents(t.positions, ns, uv));
+                self.tri_texcoords.push(GpuTriTexcoords {
+                    t0: tan[0].to_array(),
+                    t1: tan[1].to_array(),
+                    t2: tan[2].to_array(),
+                    uv01: [uv[0].x, uv[0].y, uv[1].x, uv[1].y],
+                    uv2: uv[2].to_array(),
+                    ..GpuTriTexcoords::default()
+                });
+            }
+            let m = &scene.materials[t.material as usize];
+            let mut light = NO_LIGHT;
+            if m.is_emissive() {
+                light = self.lights.len() as u32;
+                let area = t.area();
+                let sides = if m.two_sided { 2.0 } else { 1.0 };
+                let mut power = luminance(m.emission) * area * std::f32::consts::PI * sides;
+                if textured && m.textures.emissive != NO_TEXTURE {
+                    let uv = t.uvs.unwrap_or([glam::Vec2::ZERO; 3]);
+                    power *= textured_emission_scale(scene, m, uv);
+                }
+                weights.push(power);
+                self.lights.push(GpuLight {
+                    p0: p0.to_array(),
+                    flags: if m.two_sided { LIGHT_TWO_SIDED } else { 0 },
+                    e1: e1.to_array(),
+                    prim: i as u32,
+                    e2: e2.to_array(),
+                    area,
+                    emission: m.emission.to_array(),
+                    power,
+                });
+            }
+            self.tri_shading.push(GpuTriShading {
+                n0: ns[0].to_array(),
+                material: t.material,
+                n1: ns[1].to_array(),
+                light,
+                n2: ns[2].to_array(),
+                flags: if t.normals.is_some() {
+                    TRI_VERTEX_NORMALS
+                } else {
+                    0
+                },
+            });
+        }
+    }
+
+    /// Appends the spheres in BVH order, and a light for each emissive one (its power
+    /// pushed to `weights`).
+    fn push_spheres(&mut self, scene: &Scene, weights: &mut Vec<f32>) {
+        for (i, &src) in self.sphere_source.iter().enumerate() {
+            let s = &scene.spheres[src as usize];
+            let m = &scene.materials[s.material as usize];
+            let mut light = NO_LIGHT;
+            if m.is_emissive() {
+                light = self.lights.len() as u32;
+                let area = 4.0 * std::f32::consts::PI * s.radius * s.radius;
+                let power = luminance(m.emission) * area * std::f32::consts::PI;
+                weights.push(power);
+                self.lights.push(GpuLight {
+                    p0: s.center.to_array(),
+                    flags: LIGHT_SPHERE,
+                    e1: [s.radius, 0.0, 0.0],
+                    prim: i as u32,
+                    e2: [0.0; 3],
+                    area,
+                    emission: m.emission.to_array(),
+                    power,
+                });
+            }
+            self.spheres.push(GpuSphere {
+                center: s.center.to_array(),
+                radius: s.radius,
+                material: s.material,
+                light,
+                ..GpuSphere::default()
+            });
+        }
+    }
+}
+
+/// Refuses more textures than the GPU layout can index and materials that use a texture
+/// the scene does not have.
+fn check_textures(scene: &Scene) -> Result<(), SceneError> {
+    if scene.textures.len() >= 0xFFFF {
+        return Err(SceneError::new(ErrorKind::BadValue {
+            field: "textures",
+            message: format!("{} textures; at most 65534", scene.textures.len()),
+        }));
+    }
+    for m in &scene.materials {
+        if let Some(&t) = m
+            .textures
+            .all()
+            .iter()
+            .find(|&&t| t != NO_TEXTURE && t as usize >= scene.textures.len())
+        {
+            return Err(SceneError::new(ErrorKind::BadValue {
+                field: "textures",
+                message: format!(
+                    "material \"{}\" uses texture {t} of {}",
+                    m.name,
+                    scene.textures.len()
+                ),
+            }));
+        }
+    }
+    Ok(())
 }
 
 fn header(scene: &Scene, g: &GpuScene, depth: usize, total_power: f32) -> GpuHeader {

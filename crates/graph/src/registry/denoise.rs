@@ -4,7 +4,11 @@ use super::{COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef};
 use crate::types::{ParamType, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
-    vec![NodeKind {
+    vec![denoise()]
+}
+
+fn denoise() -> NodeKind {
+    NodeKind {
         name: "Denoise",
         category: Category::Denoise,
         doc: "Edge-avoiding à-trous wavelet filter (Dammertz et al. 2010, with SVGF's \
@@ -96,5 +100,5 @@ pub(super) fn kinds() -> Vec<NodeKind> {
         sink: false,
         history: false,
         renders_scene: false,
-    }]
+    }
 }

@@ -4,7 +4,11 @@ use super::{Category, NodeKind, OutputDef, ParamDef};
 use crate::types::{ParamType, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
-    vec![NodeKind {
+    vec![image_input()]
+}
+
+fn image_input() -> NodeKind {
+    NodeKind {
         name: "ImageInput",
         category: Category::Input,
         doc: "Reads an image file. EXR and Radiance .hdr are taken as linear; PNG and JPEG are \
@@ -26,5 +30,5 @@ pub(super) fn kinds() -> Vec<NodeKind> {
         sink: false,
         history: false,
         renders_scene: false,
-    }]
+    }
 }

@@ -4,7 +4,11 @@ use super::{ANY_IMAGE, Category, InputDef, NodeKind, ParamDef};
 use crate::types::ParamType;
 
 pub(super) fn kinds() -> Vec<NodeKind> {
-    vec![NodeKind {
+    vec![output()]
+}
+
+fn output() -> NodeKind {
+    NodeKind {
         name: "Output",
         category: Category::Output,
         doc: "Writes its input to a file: PNG (8-bit sRGB) or EXR (32-bit float RGBA), chosen \
@@ -27,5 +31,5 @@ pub(super) fn kinds() -> Vec<NodeKind> {
         sink: true,
         history: false,
         renders_scene: false,
-    }]
+    }
 }

@@ -4,196 +4,204 @@ use super::{COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef};
 use crate::types::{ParamType, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
-    vec![
-        NodeKind {
-            name: "PathTrace",
-            category: Category::Render,
-            doc: "Path traces the scene (`--scene`) on the GPU: BVH traversal in WGSL, next-event \
-              estimation with multiple importance sampling, Russian roulette. Each frame adds \
-              `samples_per_frame` samples per pixel and outputs their mean; feed it to \
-              Accumulate for a progressive render. Image size, bounces and seed come from \
-              the scene.",
-            inputs: &[],
-            outputs: &[
-                OutputDef {
-                    name: "color",
-                    ty: PortType::HdrColor,
-                    doc: "this frame's radiance estimate",
-                },
-                OutputDef {
-                    name: "albedo",
-                    ty: PortType::Albedo,
-                    doc: "base color at the first hit through the pixel center; alpha 2 on emitters, 1 \
-                      elsewhere (0 on a miss)",
-                },
-                OutputDef {
-                    name: "normal",
-                    ty: PortType::Normal,
-                    doc: "world-space shading normal at that hit (0 on a miss)",
-                },
-                OutputDef {
-                    name: "depth",
-                    ty: PortType::Depth,
-                    doc: "distance from the camera to that hit (0 on a miss)",
-                },
-            ],
-            params: vec![
-                ParamDef {
-                    name: "samples_per_frame",
-                    ty: ParamType::Int {
-                        default: 4,
-                        min: 1,
-                        max: 4096,
-                    },
-                    doc: "samples per pixel in one frame (one dispatch)",
-                },
-                ParamDef {
-                    name: "firefly_clamp",
-                    ty: ParamType::Float {
-                        default: 0.0,
-                        min: 0.0,
-                        max: 1e9,
-                    },
-                    doc: "largest channel value one sample may contribute; 0 is off (on is biased, and the render report says so)",
-                },
-                ParamDef {
-                    name: "env_sampling",
-                    ty: ParamType::Enum {
-                        default: "importance",
-                        options: &[
-                            (
-                                "importance",
-                                "environment map pixels drawn by luminance x solid angle",
-                            ),
-                            ("uniform", "uniform directions (a baseline for comparisons)"),
-                        ],
-                    },
-                    doc: "how light sampling draws directions from an environment map",
-                },
-                ParamDef {
-                    name: "sampler",
-                    ty: ParamType::Enum {
-                        default: "sobol",
-                        options: &[
-                            (
-                                "sobol",
-                                "Owen-scrambled Sobol points for the pixel, lens, and first-hit \
-                             light and BSDF samples; the other dimensions independent",
-                            ),
-                            (
-                                "independent",
-                                "every dimension from a PCG hash stream (a baseline for \
-                             comparisons)",
-                            ),
-                        ],
-                    },
-                    doc: "how the random numbers of a path are drawn (docs/pathtracer.md)",
-                },
-                ParamDef {
-                    name: "strategy",
-                    ty: ParamType::Enum {
-                        default: "mis",
-                        options: &[
-                            (
-                                "mis",
-                                "light sampling and BSDF sampling, weighted by the power \
-                             heuristic",
-                            ),
-                            (
-                                "light",
-                                "light sampling only: emitters a BSDF-sampled ray hits count \
-                             only after mirrors and interfaces (a check, noisy on glossy \
-                             surfaces)",
-                            ),
-                            (
-                                "bsdf",
-                                "BSDF sampling only: emitters count when hit; shadow rays only \
-                             to point, spot and directional lights, which no ray can hit \
-                             (a check, noisy for small lights)",
-                            ),
-                        ],
-                    },
-                    doc: "how direct light is estimated; every strategy converges to the same \
-                      image (docs/pathtracer.md)",
-                },
-            ],
-            sink: false,
-            history: false,
-            renders_scene: true,
-        },
-        NodeKind {
-            name: "Accumulate",
-            category: Category::Render,
-            doc: "Running mean of its input over frames (progressive rendering). Sums are kept in \
-              f32 with Kahan compensation, so millions of frames do not drift. Restarts when \
-              the scene, the camera or anything upstream changes. Also estimates the \
-              variance of the mean (for Denoise) when its `variance` output is read.",
-            inputs: &[InputDef {
+    vec![path_trace(), accumulate(), gbuffer()]
+}
+
+fn path_trace() -> NodeKind {
+    NodeKind {
+        name: "PathTrace",
+        category: Category::Render,
+        doc: "Path traces the scene (`--scene`) on the GPU: BVH traversal in WGSL, next-event \
+          estimation with multiple importance sampling, Russian roulette. Each frame adds \
+          `samples_per_frame` samples per pixel and outputs their mean; feed it to \
+          Accumulate for a progressive render. Image size, bounces and seed come from \
+          the scene.",
+        inputs: &[],
+        outputs: &[
+            OutputDef {
                 name: "color",
-                accepts: COLOR_TYPES,
-                doc: "this frame's estimate",
-            }],
-            outputs: &[
-                OutputDef {
-                    name: "color",
-                    ty: PortType::HdrColor,
-                    doc: "mean of all frames so far",
-                },
-                OutputDef {
-                    name: "variance",
-                    ty: PortType::Variance,
-                    doc: "variance of that mean per pixel (rgb per channel, alpha of the \
-                      luminance), from a Welford second moment over frames; after a single \
-                      frame, estimated over the pixel's 3×3 neighborhood (luminance: from the median \
-                      absolute deviation)",
-                },
-            ],
-            params: vec![],
-            sink: false,
-            history: true,
-            renders_scene: false,
-        },
-        NodeKind {
-            name: "GBuffer",
-            category: Category::Render,
-            doc: "Rasterizes the scene (`--scene`) from the path tracer's camera: triangles with \
-              their shading normals, spheres tessellated and then intersected exactly per \
-              pixel. Writes what the path tracer's first hit through the pixel center sees, \
-              without tracing a ray; the guides of Denoise. Image size from the scene.",
-            inputs: &[],
-            outputs: &[
-                OutputDef {
-                    name: "albedo",
-                    ty: PortType::Albedo,
-                    doc: "material base color; alpha 2 on emitters, 1 elsewhere (0 where nothing is \
-                      hit)",
-                },
-                OutputDef {
-                    name: "normal",
-                    ty: PortType::Normal,
-                    doc: "world-space shading normal, interpolated vertex normals where the \
-                      triangle has them (0 where nothing is hit)",
-                },
-                OutputDef {
-                    name: "depth",
-                    ty: PortType::Depth,
-                    doc: "distance from the camera along the ray through the pixel center \
-                      (0 where nothing is hit)",
-                },
-            ],
-            params: vec![ParamDef {
-                name: "sphere_segments",
+                ty: PortType::HdrColor,
+                doc: "this frame's radiance estimate",
+            },
+            OutputDef {
+                name: "albedo",
+                ty: PortType::Albedo,
+                doc: "base color at the first hit through the pixel center; alpha 2 on emitters, 1 \
+                  elsewhere (0 on a miss)",
+            },
+            OutputDef {
+                name: "normal",
+                ty: PortType::Normal,
+                doc: "world-space shading normal at that hit (0 on a miss)",
+            },
+            OutputDef {
+                name: "depth",
+                ty: PortType::Depth,
+                doc: "distance from the camera to that hit (0 on a miss)",
+            },
+        ],
+        params: vec![
+            ParamDef {
+                name: "samples_per_frame",
                 ty: ParamType::Int {
-                    default: 48,
-                    min: 8,
-                    max: 512,
+                    default: 4,
+                    min: 1,
+                    max: 4096,
                 },
-                doc: "segments around a sphere's tessellation (the silhouette is exact anyway: \
-                  each fragment intersects the true sphere)",
-            }],
-            sink: false,
-            history: false,
-            renders_scene: true,
-        },
-    ]
+                doc: "samples per pixel in one frame (one dispatch)",
+            },
+            ParamDef {
+                name: "firefly_clamp",
+                ty: ParamType::Float {
+                    default: 0.0,
+                    min: 0.0,
+                    max: 1e9,
+                },
+                doc: "largest channel value one sample may contribute; 0 is off (on is biased, and the render report says so)",
+            },
+            ParamDef {
+                name: "env_sampling",
+                ty: ParamType::Enum {
+                    default: "importance",
+                    options: &[
+                        (
+                            "importance",
+                            "environment map pixels drawn by luminance x solid angle",
+                        ),
+                        ("uniform", "uniform directions (a baseline for comparisons)"),
+                    ],
+                },
+                doc: "how light sampling draws directions from an environment map",
+            },
+            ParamDef {
+                name: "sampler",
+                ty: ParamType::Enum {
+                    default: "sobol",
+                    options: &[
+                        (
+                            "sobol",
+                            "Owen-scrambled Sobol points for the pixel, lens, and first-hit \
+                         light and BSDF samples; the other dimensions independent",
+                        ),
+                        (
+                            "independent",
+                            "every dimension from a PCG hash stream (a baseline for \
+                         comparisons)",
+                        ),
+                    ],
+                },
+                doc: "how the random numbers of a path are drawn (docs/pathtracer.md)",
+            },
+            ParamDef {
+                name: "strategy",
+                ty: ParamType::Enum {
+                    default: "mis",
+                    options: &[
+                        (
+                            "mis",
+                            "light sampling and BSDF sampling, weighted by the power \
+                         heuristic",
+                        ),
+                        (
+                            "light",
+                            "light sampling only: emitters a BSDF-sampled ray hits count \
+                         only after mirrors and interfaces (a check, noisy on glossy \
+                         surfaces)",
+                        ),
+                        (
+                            "bsdf",
+                            "BSDF sampling only: emitters count when hit; shadow rays only \
+                         to point, spot and directional lights, which no ray can hit \
+                         (a check, noisy for small lights)",
+                        ),
+                    ],
+                },
+                doc: "how direct light is estimated; every strategy converges to the same \
+                  image (docs/pathtracer.md)",
+            },
+        ],
+        sink: false,
+        history: false,
+        renders_scene: true,
+    }
+}
+
+fn accumulate() -> NodeKind {
+    NodeKind {
+        name: "Accumulate",
+        category: Category::Render,
+        doc: "Running mean of its input over frames (progressive rendering). Sums are kept in \
+          f32 with Kahan compensation, so millions of frames do not drift. Restarts when \
+          the scene, the camera or anything upstream changes. Also estimates the \
+          variance of the mean (for Denoise) when its `variance` output is read.",
+        inputs: &[InputDef {
+            name: "color",
+            accepts: COLOR_TYPES,
+            doc: "this frame's estimate",
+        }],
+        outputs: &[
+            OutputDef {
+                name: "color",
+                ty: PortType::HdrColor,
+                doc: "mean of all frames so far",
+            },
+            OutputDef {
+                name: "variance",
+                ty: PortType::Variance,
+                doc: "variance of that mean per pixel (rgb per channel, alpha of the \
+                  luminance), from a Welford second moment over frames; after a single \
+                  frame, estimated over the pixel's 3×3 neighborhood (luminance: from the median \
+                  absolute deviation)",
+            },
+        ],
+        params: vec![],
+        sink: false,
+        history: true,
+        renders_scene: false,
+    }
+}
+
+fn gbuffer() -> NodeKind {
+    NodeKind {
+        name: "GBuffer",
+        category: Category::Render,
+        doc: "Rasterizes the scene (`--scene`) from the path tracer's camera: triangles with \
+          their shading normals, spheres tessellated and then intersected exactly per \
+          pixel. Writes what the path tracer's first hit through the pixel center sees, \
+          without tracing a ray; the guides of Denoise. Image size from the scene.",
+        inputs: &[],
+        outputs: &[
+            OutputDef {
+                name: "albedo",
+                ty: PortType::Albedo,
+                doc: "material base color; alpha 2 on emitters, 1 elsewhere (0 where nothing is \
+                  hit)",
+            },
+            OutputDef {
+                name: "normal",
+                ty: PortType::Normal,
+                doc: "world-space shading normal, interpolated vertex normals where the \
+                  triangle has them (0 where nothing is hit)",
+            },
+            OutputDef {
+                name: "depth",
+                ty: PortType::Depth,
+                doc: "distance from the camera along the ray through the pixel center \
+                  (0 where nothing is hit)",
+            },
+        ],
+        params: vec![ParamDef {
+            name: "sphere_segments",
+            ty: ParamType::Int {
+                default: 48,
+                min: 8,
+                max: 512,
+            },
+            doc: "segments around a sphere's tessellation (the silhouette is exact anyway: \
+              each fragment intersects the true sphere)",
+        }],
+        sink: false,
+        history: false,
+        renders_scene: true,
+    }
 }

@@ -1,0 +1,294 @@
+//! Files: opening and saving graphs (atomically), the file dialog, scenes, and the
+//! unsaved-changes prompt before a graph is replaced or the window closed.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use lumagraph_graph::{Graph, Registry};
+
+use super::{Dialog, Editor, EditorScene, Pick, Then};
+use crate::EditorError;
+use crate::files;
+use crate::preview::PreviewScene;
+
+impl Editor {
+    /// Opens the file dialog for `pick`, starting in the folder that fits it.
+    pub fn open_file_dialog(&mut self, pick: Pick) {
+        use egui_file_dialog::FileDialog;
+        let base = self.doc.base_dir();
+        let start = |p: Option<&Path>| {
+            p.and_then(Path::parent)
+                .filter(|d| !d.as_os_str().is_empty())
+                .map_or_else(|| base.clone(), Path::to_path_buf)
+        };
+        let (title, dir, extensions): (&str, PathBuf, Vec<&'static str>) = match &pick {
+            Pick::OpenGraph => ("Open graph", start(self.doc.path.as_deref()), vec!["ron"]),
+            Pick::SaveGraph => (
+                "Save graph as",
+                start(self.doc.path.as_deref()),
+                vec!["ron"],
+            ),
+            Pick::Scene => (
+                "Open scene",
+                start(self.scene.as_ref().map(|s| s.path.as_path())),
+                vec!["ron"],
+            ),
+            Pick::Param(node, param) => {
+                let extensions = self
+                    .doc
+                    .graph
+                    .node(node)
+                    .and_then(|n| Registry::builtin().get(&n.kind))
+                    .and_then(|k| k.params.iter().find(|d| d.name == param))
+                    .and_then(|d| match &d.ty {
+                        lumagraph_graph::ParamType::Path { extensions, .. } => {
+                            Some(extensions.to_vec())
+                        }
+                        _ => None,
+                    })
+                    .unwrap_or_default();
+                let current = self
+                    .doc
+                    .graph
+                    .node(node)
+                    .and_then(|n| n.params.get(param.as_str()))
+                    .and_then(|v| match v {
+                        lumagraph_graph::ParamValue::Str(s) => Some(base.join(s)),
+                        _ => None,
+                    });
+                ("Pick a file", start(current.as_deref()), extensions)
+            }
+        };
+        let dir = std::path::absolute(&dir).unwrap_or(dir);
+        let name = extensions
+            .iter()
+            .map(|e| format!(".{e}"))
+            .collect::<Vec<_>>()
+            .join(" ");
+        let mut dialog = FileDialog::new()
+            .title(title)
+            .id(egui::Id::new("file_dialog"))
+            .initial_directory(dir);
+        if !extensions.is_empty() {
+            dialog = dialog
+                .add_file_filter_extensions(&name, extensions.clone())
+                .default_file_filter(&name);
+        }
+        if pick == Pick::SaveGraph {
+            dialog = dialog
+                .add_save_extension("graph", "ron")
+                .default_save_extension("graph")
+                .default_file_name(
+                    &self
+                        .doc
+                        .path
+                        .as_deref()
+                        .and_then(Path::file_name)
+                        .map_or_else(
+                            || "untitled.ron".to_owned(),
+                            |n| n.to_string_lossy().into_owned(),
+                        ),
+                );
+            dialog.save_file();
+        } else {
+            dialog.pick_file();
+        }
+        self.file_dialog = Some((pick, dialog));
+    }
+
+    /// Applies a path picked in the file dialog for `pick`: opens, saves, loads the scene,
+    /// or sets the param (an undoable edit, relative to the graph's folder when inside it).
+    pub fn apply_pick(&mut self, pick: &Pick, path: &Path) {
+        match pick {
+            Pick::OpenGraph => self.ask(Then::Open(path.to_owned())),
+            Pick::SaveGraph => match self.save_as(path) {
+                Ok(()) => {
+                    if let Some(then) = self.after_save.take() {
+                        self.proceed(then);
+                    }
+                }
+                Err(e) => {
+                    self.after_save = None;
+                    self.say(e.to_string(), true);
+                }
+            },
+            Pick::Scene => {
+                self.load_scene(path);
+            }
+            Pick::Param(node, param) => {
+                let base = std::path::absolute(self.doc.base_dir()).unwrap_or_default();
+                let value = path
+                    .strip_prefix(&base)
+                    .map_or_else(|_| path.display().to_string(), |p| p.display().to_string());
+                self.doc
+                    .set_param(node, param, lumagraph_graph::ParamValue::Str(value));
+                self.doc.end_gesture();
+            }
+        }
+    }
+
+    pub(super) fn file_dialog_ui(&mut self, ctx: &egui::Context) {
+        let Some((pick, dialog)) = &mut self.file_dialog else {
+            return;
+        };
+        dialog.update(ctx);
+        match dialog.state() {
+            egui_file_dialog::DialogState::Picked(path) => {
+                let (pick, path) = (pick.clone(), path.clone());
+                self.file_dialog = None;
+                self.apply_pick(&pick, &path);
+            }
+            egui_file_dialog::DialogState::Open => {}
+            _ => {
+                // Cancelled: whatever waited for a save does not happen.
+                self.file_dialog = None;
+                self.after_save = None;
+            }
+        }
+    }
+
+    /// Opens a graph file in place of the current one (no unsaved-changes check).
+    pub fn open(&mut self, path: &Path) {
+        match files::open(path) {
+            Ok(graph) => {
+                self.doc.replace(graph, Some(path.to_owned()));
+                self.selected.clear();
+                self.preview_port = None;
+                if let Err(e) = self.recent.add(path) {
+                    self.say(e.to_string(), true);
+                } else {
+                    self.say(format!("opened {}", path.display()), false);
+                }
+            }
+            Err(e) => {
+                self.doc.replace(Graph::new(), None);
+                self.say(format!("cannot open: {e}"), true);
+            }
+        }
+    }
+
+    /// Saves to the current file.
+    ///
+    /// # Errors
+    /// When there is no file yet or it cannot be written.
+    pub fn save(&mut self) -> Result<(), EditorError> {
+        let path = self.doc.path.clone().ok_or(EditorError::NoPath)?;
+        self.save_as(&path)
+    }
+
+    /// Saves to `path` (atomically), which becomes the document's file.
+    ///
+    /// # Errors
+    /// When the file cannot be written.
+    pub fn save_as(&mut self, path: &Path) -> Result<(), EditorError> {
+        let saved = files::save(&self.doc.graph, &self.doc.base_dir(), path)?;
+        let origin = self.doc.graph.origin.take();
+        self.doc.graph = saved;
+        self.doc.graph.origin = origin;
+        self.doc.mark_saved(path.to_owned());
+        let _ = self.recent.add(path);
+        self.say(format!("saved {}", path.display()), false);
+        Ok(())
+    }
+
+    /// The window title: file name, a `●` when there are unsaved changes.
+    pub fn title(&self) -> String {
+        let name = self.doc.path.as_deref().map_or_else(
+            || "untitled".to_owned(),
+            |p| {
+                p.file_name().map_or_else(
+                    || p.display().to_string(),
+                    |n| n.to_string_lossy().into_owned(),
+                )
+            },
+        );
+        let dirty = if self.doc.is_dirty() { "● " } else { "" };
+        format!("{dirty}{name} — lumagraph editor")
+    }
+
+    pub(super) fn save_or_ask(&mut self) {
+        if self.doc.path.is_some() {
+            if let Err(e) = self.save() {
+                self.say(e.to_string(), true);
+            }
+        } else {
+            self.open_file_dialog(Pick::SaveGraph);
+        }
+    }
+
+    /// Runs `then`, first asking about unsaved changes when there are some.
+    pub(super) fn ask(&mut self, then: Then) {
+        if self.doc.is_dirty() && then != Then::Open(PathBuf::new()) {
+            self.dialog = Some(Dialog::Unsaved(then));
+        } else {
+            self.proceed(then);
+        }
+    }
+
+    pub(super) fn proceed(&mut self, then: Then) {
+        match then {
+            Then::Quit => {
+                self.quit_confirmed = true;
+                self.wants_close = true;
+            }
+            Then::New => {
+                self.doc.replace(Graph::new(), None);
+                self.selected.clear();
+            }
+            Then::Open(p) if p.as_os_str().is_empty() => self.open_file_dialog(Pick::OpenGraph),
+            Then::Open(p) => self.open(&p),
+        }
+    }
+
+    /// Loads the scene that `PathTrace` and `GBuffer` nodes render, restarting the
+    /// preview. A scene that cannot be loaded leaves the current one (if any) and the
+    /// error in the status line and the side panel. Returns whether it loaded.
+    pub fn load_scene(&mut self, path: &Path) -> bool {
+        let loaded = lumagraph_scene::Scene::load(path)
+            .and_then(|scene| lumagraph_scene::GpuScene::build(&scene));
+        match loaded {
+            Ok(mut gpu) => {
+                let full = (gpu.settings.width, gpu.settings.height);
+                let longest = full.0.max(full.1).max(1);
+                if longest > self.preview_max {
+                    let scale = |x: u32| {
+                        u32::try_from(
+                            u64::from(x) * u64::from(self.preview_max) / u64::from(longest),
+                        )
+                        .unwrap_or(1)
+                        .max(1)
+                    };
+                    gpu.settings.width = scale(full.0);
+                    gpu.settings.height = scale(full.1);
+                }
+                self.scene_generation += 1;
+                self.scene = Some(EditorScene {
+                    path: path.to_owned(),
+                    full,
+                    preview: PreviewScene {
+                        gpu: Arc::new(gpu),
+                        generation: self.scene_generation,
+                    },
+                });
+                self.scene_error = None;
+                self.errors_for = None;
+                self.say(format!("scene {}", path.display()), false);
+                true
+            }
+            Err(e) => {
+                let text = format!("cannot load the scene: {e}");
+                self.scene_error = Some(text.clone());
+                self.say(text, true);
+                false
+            }
+        }
+    }
+
+    /// Removes the scene; nodes that render one then show an error.
+    pub fn close_scene(&mut self) {
+        self.scene = None;
+        self.scene_error = None;
+        self.errors_for = None;
+        self.scene_generation += 1;
+    }
+}
