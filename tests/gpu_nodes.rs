@@ -219,3 +219,70 @@ fn dead_branch_never_executes() {
         assert!(times.iter().all(|(name, _)| name != "dead"));
     }
 }
+
+/// A kernel's bindings are its shader's: a pass that binds its output texture with `read`
+/// and its input with `write` (swapped), or a storage buffer where the shader has a uniform,
+/// is refused before anything is recorded, with the binding and the method it wants.
+#[test]
+fn swapped_or_mistyped_bindings_are_refused() {
+    use lumagraph::render::kernel::Kernel;
+    use lumagraph::render::{PooledTexture, uniform_buffer};
+    let Some(ctx) = common::gpu() else { return };
+    let kernel = Kernel::new(ctx, "post/exposure.wgsl").unwrap();
+    let extent = lumagraph::graph::Extent::new(4, 4);
+    let tex = |label| -> PooledTexture {
+        lumagraph::render::create_texture(
+            ctx,
+            label,
+            lumagraph::graph::TexFormat::Rgba32Float,
+            extent,
+        )
+    };
+    let (input, output) = (tex("input"), tex("output"));
+    let params = uniform_buffer(ctx, "params", &[0; 16]);
+    let storage = lumagraph::render::kernel::storage_buffer(ctx, "storage", &[0; 16]);
+    kernel
+        .pass("exposure")
+        .read(&input.view)
+        .write(&output.view)
+        .uniform(&params)
+        .check()
+        .unwrap();
+    let swapped = kernel
+        .pass("exposure")
+        .write(&input.view)
+        .read(&output.view)
+        .uniform(&params)
+        .check()
+        .unwrap_err()
+        .to_string();
+    assert!(
+        swapped.contains("binding 0")
+            && swapped.contains("bound with `write`")
+            && swapped.contains("wants `read`"),
+        "{swapped}"
+    );
+    let mixed = kernel
+        .pass("exposure")
+        .read(&input.view)
+        .write(&output.view)
+        .buffer(&storage)
+        .check()
+        .unwrap_err()
+        .to_string();
+    assert!(
+        mixed.contains("binding 2") && mixed.contains("wants `uniform`"),
+        "{mixed}"
+    );
+    let short = kernel
+        .pass("exposure")
+        .read(&input.view)
+        .write(&output.view)
+        .check()
+        .unwrap_err()
+        .to_string();
+    assert!(
+        short.contains("2 resources given for 3 bindings"),
+        "{short}"
+    );
+}

@@ -63,3 +63,22 @@ fn missing_shader_is_an_error_not_a_panic() {
     let e = shader::resolve("post/nope.wgsl").unwrap_err();
     assert!(e.to_string().contains("no such shader file"), "{e}");
 }
+
+/// Every compute shader declares only bindings kernels support, numbered from 0 in group 0,
+/// and an entry point `main`: what `Kernel` reads instead of a list in Rust.
+#[test]
+fn every_compute_shader_reflects_its_bindings() {
+    let mut checked = 0;
+    for name in shader::all_names() {
+        let raw = shader::raw(name).unwrap();
+        if !raw.contains("@compute") {
+            continue;
+        }
+        let source = shader::resolve(name).unwrap();
+        let (bindings, workgroup) =
+            lumagraph::render::kernel::reflect(name, &source).unwrap_or_else(|e| panic!("{e}"));
+        assert!(!bindings.is_empty() && workgroup[0] > 0, "{name}");
+        checked += 1;
+    }
+    assert!(checked >= 8, "{checked} compute shaders");
+}

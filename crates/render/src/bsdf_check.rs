@@ -8,7 +8,7 @@ use lumagraph_scene::GpuMaterial;
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::kernel::{Binding, Kernel, storage_buffer, uniform_buffer};
+use crate::kernel::{Kernel, storage_buffer, uniform_buffer};
 use crate::readback::{compute_and_read, groups_1d};
 
 /// One sample of the BSDF, in the shading frame.
@@ -58,18 +58,7 @@ impl BsdfCheck {
     /// # Errors
     /// When the shader does not compile.
     pub fn new(ctx: &GpuContext) -> Result<Self> {
-        let storage = Binding::Storage { read_only: true };
-        let kernel = Kernel::new(
-            ctx,
-            "pathtrace/bsdf_check.wgsl",
-            &[
-                Binding::Uniform,
-                storage,
-                storage,
-                storage,
-                Binding::Storage { read_only: false },
-            ],
-        )?;
+        let kernel = Kernel::new(ctx, "pathtrace/bsdf_check.wgsl")?;
         let ggx_table = crate::bsdf_tables::upload(ctx);
         Ok(Self { kernel, ggx_table })
     }

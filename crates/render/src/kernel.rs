@@ -19,14 +19,20 @@ use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::timing::GpuTimer;
 
-/// One binding of a kernel, at `@group(0) @binding(i)` for the i-th entry.
+/// One binding of a kernel, at `@group(0) @binding(i)` for the i-th entry, as the shader
+/// declares it ([`reflect`] reads them from the WGSL).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum Binding {
     /// `texture_2d<f32>`, read with `textureLoad`.
     Texture,
-    /// `texture_storage_2d<format, write>`.
-    StorageTexture(wgpu::TextureFormat),
+    /// `texture_storage_2d<format, access>`.
+    StorageTexture {
+        /// Texel format.
+        format: wgpu::TextureFormat,
+        /// `read`, `write` or `read_write`.
+        access: wgpu::StorageTextureAccess,
+    },
     /// `var<uniform>`.
     Uniform,
     /// `var<storage, read>` (or `read_write` when `read_only` is false).
@@ -44,8 +50,8 @@ impl Binding {
                 view_dimension: wgpu::TextureViewDimension::D2,
                 multisampled: false,
             },
-            Self::StorageTexture(format) => wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
+            Self::StorageTexture { format, access } => wgpu::BindingType::StorageTexture {
+                access,
                 format,
                 view_dimension: wgpu::TextureViewDimension::D2,
             },
@@ -62,42 +68,151 @@ impl Binding {
         }
     }
 
-    fn is_texture(self) -> bool {
-        matches!(self, Self::Texture | Self::StorageTexture(_))
+    /// What the pass builder calls this binding: the method that binds it.
+    fn builder_method(self) -> &'static str {
+        match self {
+            Self::Texture
+            | Self::StorageTexture {
+                access: wgpu::StorageTextureAccess::ReadOnly,
+                ..
+            } => "read",
+            Self::StorageTexture { .. } => "write",
+            Self::Uniform => "uniform",
+            Self::Storage { .. } => "buffer",
+        }
     }
 }
 
-/// A compute pipeline with its declared bindings.
+fn storage_format(format: naga::StorageFormat) -> Option<wgpu::TextureFormat> {
+    use naga::StorageFormat as S;
+    use wgpu::TextureFormat as T;
+    Some(match format {
+        S::Rgba32Float => T::Rgba32Float,
+        S::Rgba16Float => T::Rgba16Float,
+        S::R32Float => T::R32Float,
+        S::Rg32Float => T::Rg32Float,
+        S::Rgba8Unorm => T::Rgba8Unorm,
+        S::R32Uint => T::R32Uint,
+        _ => return None,
+    })
+}
+
+/// The bindings of group 0 of a compute shader, in binding order, and the workgroup size
+/// of its entry point `main`, read from the WGSL with naga: a node states its bindings once,
+/// in its shader.
+///
+/// # Errors
+/// When the shader does not parse, has no entry point `main`, uses another bind group, leaves
+/// a binding index out, or declares a binding kind kernels do not support.
+pub fn reflect(label: &str, source: &str) -> Result<(Vec<Binding>, [u32; 3])> {
+    let err = |message: String| RenderError::Shader {
+        name: label.to_owned(),
+        message,
+    };
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| err(e.emit_to_string(source)))?;
+    let entry = module
+        .entry_points
+        .iter()
+        .find(|e| e.name == "main")
+        .ok_or_else(|| err("no entry point `main`".to_owned()))?;
+    let mut bindings: Vec<(u32, Binding)> = Vec::new();
+    for (_, var) in module.global_variables.iter() {
+        let Some(rb) = var.binding else { continue };
+        let name = var.name.as_deref().unwrap_or("?");
+        if rb.group != 0 {
+            return Err(err(format!(
+                "`{name}` is in group {}; kernels use group 0",
+                rb.group
+            )));
+        }
+        let binding = match (var.space, &module.types[var.ty].inner) {
+            (naga::AddressSpace::Uniform, _) => Binding::Uniform,
+            (naga::AddressSpace::Storage { access }, _) => Binding::Storage {
+                read_only: !access.contains(naga::StorageAccess::STORE),
+            },
+            (
+                naga::AddressSpace::Handle,
+                naga::TypeInner::Image {
+                    dim: naga::ImageDimension::D2,
+                    arrayed: false,
+                    class,
+                },
+            ) => match *class {
+                naga::ImageClass::Sampled {
+                    kind: naga::ScalarKind::Float,
+                    multi: false,
+                } => Binding::Texture,
+                naga::ImageClass::Storage { format, access } => Binding::StorageTexture {
+                    format: storage_format(format).ok_or_else(|| {
+                        err(format!(
+                            "`{name}`: storage format {format:?} is not supported"
+                        ))
+                    })?,
+                    access: match (
+                        access.contains(naga::StorageAccess::LOAD),
+                        access.contains(naga::StorageAccess::STORE),
+                    ) {
+                        (true, true) => wgpu::StorageTextureAccess::ReadWrite,
+                        (true, false) => wgpu::StorageTextureAccess::ReadOnly,
+                        _ => wgpu::StorageTextureAccess::WriteOnly,
+                    },
+                },
+                _ => {
+                    return Err(err(format!(
+                        "`{name}`: this kind of texture is not supported"
+                    )));
+                }
+            },
+            (_, inner) => {
+                return Err(err(format!(
+                    "`{name}` (binding {}): {inner:?} is not a supported binding",
+                    rb.binding
+                )));
+            }
+        };
+        bindings.push((rb.binding, binding));
+    }
+    bindings.sort_by_key(|b| b.0);
+    for (i, (b, _)) in bindings.iter().enumerate() {
+        if *b as usize != i {
+            return Err(err(format!(
+                "binding {i} is missing (bindings must be 0, 1, 2, …)"
+            )));
+        }
+    }
+    Ok((
+        bindings.into_iter().map(|b| b.1).collect(),
+        entry.workgroup_size,
+    ))
+}
+
+/// A compute pipeline with the bindings its shader declares.
 #[derive(Debug)]
 pub struct Kernel {
     label: String,
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     bindings: Vec<Binding>,
-    workgroup: [u32; 2],
+    workgroup: [u32; 3],
 }
 
 impl Kernel {
-    /// Builds a kernel from a shader file under `shaders/` (imports resolved), entry point `main`,
-    /// workgroup size 8×8.
+    /// Builds a kernel from a shader file under `shaders/` (imports resolved), entry point
+    /// `main`; its bindings and workgroup size are the shader's ([`reflect`]).
     ///
     /// # Errors
     /// When the shader is missing or does not compile.
-    pub fn new(ctx: &GpuContext, shader: &str, bindings: &[Binding]) -> Result<Self> {
+    pub fn new(ctx: &GpuContext, shader: &str) -> Result<Self> {
         let source = crate::shader::resolve(shader)?;
-        Self::from_source(ctx, shader, &source, bindings)
+        Self::from_source(ctx, shader, &source)
     }
 
-    /// Builds a kernel from WGSL text (entry point `main`, workgroup size 8×8).
+    /// Builds a kernel from WGSL text (entry point `main`).
     ///
     /// # Errors
-    /// When the shader does not compile or does not match `bindings`.
-    pub fn from_source(
-        ctx: &GpuContext,
-        label: &str,
-        source: &str,
-        bindings: &[Binding],
-    ) -> Result<Self> {
+    /// When the shader does not compile or declares bindings kernels do not support.
+    pub fn from_source(ctx: &GpuContext, label: &str, source: &str) -> Result<Self> {
+        let (bindings, workgroup) = reflect(label, source)?;
         let device = &ctx.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -141,8 +256,8 @@ impl Kernel {
             label: label.to_owned(),
             pipeline,
             layout,
-            bindings: bindings.to_vec(),
-            workgroup: [8, 8],
+            bindings,
+            workgroup,
         })
     }
 
@@ -152,48 +267,87 @@ impl Kernel {
             kernel: self,
             name,
             resources: Vec::with_capacity(self.bindings.len()),
-            kinds: Vec::with_capacity(self.bindings.len()),
+            methods: Vec::with_capacity(self.bindings.len()),
         }
+    }
+
+    /// The bindings its shader declares, in binding order.
+    pub fn bindings(&self) -> &[Binding] {
+        &self.bindings
     }
 }
 
-/// A pass being declared: its resources in binding order, then the dispatch.
+/// A pass being declared: its resources in binding order, then the dispatch. Each resource
+/// is given by the method of its binding's kind — `read` (a sampled or read-only storage
+/// texture), `write` (a writable storage texture), `uniform`, `buffer` (storage) — and the
+/// dispatch refuses any other order or kind, naming the pass and the binding.
 #[derive(Debug)]
 pub struct PassBuilder<'a> {
     kernel: &'a Kernel,
     name: &'a str,
     resources: Vec<wgpu::BindingResource<'a>>,
-    kinds: Vec<bool>,
+    methods: Vec<&'static str>,
 }
 
 impl<'a> PassBuilder<'a> {
+    fn push(mut self, method: &'static str, resource: wgpu::BindingResource<'a>) -> Self {
+        self.resources.push(resource);
+        self.methods.push(method);
+        self
+    }
+
     /// A texture the pass reads.
     #[must_use]
-    pub fn read(mut self, view: &'a wgpu::TextureView) -> Self {
-        self.resources
-            .push(wgpu::BindingResource::TextureView(view));
-        self.kinds.push(true);
-        self
+    pub fn read(self, view: &'a wgpu::TextureView) -> Self {
+        self.push("read", wgpu::BindingResource::TextureView(view))
     }
 
     /// A texture the pass writes.
     #[must_use]
     pub fn write(self, view: &'a wgpu::TextureView) -> Self {
-        self.read(view)
+        self.push("write", wgpu::BindingResource::TextureView(view))
     }
 
-    /// A uniform or storage buffer.
+    /// A storage buffer.
     #[must_use]
-    pub fn buffer(mut self, buffer: &'a wgpu::Buffer) -> Self {
-        self.resources.push(buffer.as_entire_binding());
-        self.kinds.push(false);
-        self
+    pub fn buffer(self, buffer: &'a wgpu::Buffer) -> Self {
+        self.push("buffer", buffer.as_entire_binding())
     }
 
     /// A uniform buffer.
     #[must_use]
     pub fn uniform(self, buffer: &'a wgpu::Buffer) -> Self {
-        self.buffer(buffer)
+        self.push("uniform", buffer.as_entire_binding())
+    }
+
+    /// Whether the resources given match the shader's bindings, one by one.
+    ///
+    /// # Errors
+    /// At the first binding given by the wrong method (a written texture bound with `read`,
+    /// a storage buffer with `uniform`…) or when there are too many or too few.
+    pub fn check(&self) -> Result<()> {
+        let declared = &self.kernel.bindings;
+        let err = |message: String| RenderError::Shader {
+            name: self.kernel.label.clone(),
+            message: format!("pass \"{}\": {message}", self.name),
+        };
+        for (i, (b, given)) in declared.iter().zip(&self.methods).enumerate() {
+            if b.builder_method() != *given {
+                return Err(err(format!(
+                    "binding {i} is {b:?}, bound with `{}`; the shader wants `{}`",
+                    given,
+                    b.builder_method()
+                )));
+            }
+        }
+        if declared.len() != self.methods.len() {
+            return Err(err(format!(
+                "{} resources given for {} bindings",
+                self.methods.len(),
+                declared.len()
+            )));
+        }
+        Ok(())
     }
 
     /// Records the pass over an image of `extent`, one invocation per pixel.
@@ -207,7 +361,7 @@ impl<'a> PassBuilder<'a> {
         extent: Extent,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let [wx, wy] = self.kernel.workgroup;
+        let [wx, wy, _] = self.kernel.workgroup;
         let groups = [extent.width.div_ceil(wx), extent.height.div_ceil(wy), 1];
         self.dispatch(ctx, encoder, groups, timer)
     }
@@ -223,22 +377,7 @@ impl<'a> PassBuilder<'a> {
         workgroups: [u32; 3],
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let declared = &self.kernel.bindings;
-        let matches = declared.len() == self.kinds.len()
-            && declared
-                .iter()
-                .zip(&self.kinds)
-                .all(|(b, &is_tex)| b.is_texture() == is_tex);
-        if !matches {
-            return Err(RenderError::Shader {
-                name: self.kernel.label.clone(),
-                message: format!(
-                    "pass \"{}\" binds {} resources that do not match the declared {declared:?}",
-                    self.name,
-                    self.kinds.len()
-                ),
-            });
-        }
+        self.check()?;
         let entries: Vec<_> = self
             .resources
             .into_iter()

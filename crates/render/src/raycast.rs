@@ -7,7 +7,7 @@ use lumagraph_scene::Hit;
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::kernel::{Binding, Kernel, storage_buffer, uniform_buffer};
+use crate::kernel::{Kernel, storage_buffer, uniform_buffer};
 use crate::readback::{compute_and_read, groups_1d};
 use crate::scene_gpu::SceneBuffers;
 
@@ -46,19 +46,7 @@ impl Raycaster {
     /// # Errors
     /// When the shader does not compile.
     pub fn new(ctx: &GpuContext) -> Result<Self> {
-        let read = Binding::Storage { read_only: true };
-        let kernel = Kernel::new(
-            ctx,
-            "pathtrace/raycast.wgsl",
-            &[
-                Binding::Uniform,
-                read,
-                Binding::Storage { read_only: false },
-                read,
-                read,
-                read,
-            ],
-        )?;
+        let kernel = Kernel::new(ctx, "pathtrace/raycast.wgsl")?;
         Ok(Self { kernel })
     }
 

@@ -4,7 +4,7 @@
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::kernel::{Binding, Kernel, storage_buffer, uniform_buffer};
+use crate::kernel::{Kernel, storage_buffer, uniform_buffer};
 use crate::readback::{compute_and_read, groups_1d};
 
 /// What a query asks for.
@@ -46,15 +46,7 @@ impl SamplerCheck {
     /// # Errors
     /// When the shader does not compile.
     pub fn new(ctx: &GpuContext) -> Result<Self> {
-        let kernel = Kernel::new(
-            ctx,
-            "pathtrace/sampler_points.wgsl",
-            &[
-                Binding::Uniform,
-                Binding::Storage { read_only: true },
-                Binding::Storage { read_only: false },
-            ],
-        )?;
+        let kernel = Kernel::new(ctx, "pathtrace/sampler_points.wgsl")?;
         Ok(Self { kernel })
     }
 

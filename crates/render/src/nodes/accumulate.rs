@@ -12,7 +12,7 @@ use lumagraph_graph::{Extent, Pass, TexFormat};
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::kernel::{Binding, Kernel, uniform_buffer};
+use crate::kernel::{Kernel, uniform_buffer};
 use crate::nodes::{FrameIo, NodeExec, NodeImpl, boxed};
 use crate::pool::{PooledTexture, create};
 use crate::timing::GpuTimer;
@@ -52,19 +52,7 @@ pub(crate) struct Accumulate {
 
 impl Accumulate {
     pub(crate) fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
-        let kernel = Kernel::new(
-            ctx,
-            "post/accumulate.wgsl",
-            &[
-                Binding::Texture,
-                Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
-                Binding::Storage { read_only: false },
-                Binding::Storage { read_only: false },
-                Binding::Uniform,
-                Binding::Storage { read_only: false },
-                Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
-            ],
-        )?;
+        let kernel = Kernel::new(ctx, "post/accumulate.wgsl")?;
         let variance = pass.output("variance").is_some();
         let mut words = [0_u32; 4];
         words[0] = 1.0_f32.to_bits();

@@ -16,7 +16,7 @@ use lumagraph_graph::{Extent, Pass, TexFormat};
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::kernel::{Binding, Kernel, uniform_buffer};
+use crate::kernel::{Kernel, uniform_buffer};
 use crate::nodes::{FrameIo, NodeExec, NodeImpl, boxed};
 use crate::pool::{PooledTexture, create};
 use crate::timing::GpuTimer;
@@ -70,19 +70,7 @@ fn iterations(pass: &Pass) -> u32 {
 
 impl Denoise {
     pub(crate) fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
-        let kernel = Kernel::new(
-            ctx,
-            "post/denoise.wgsl",
-            &[
-                Binding::Texture,
-                Binding::Texture,
-                Binding::Texture,
-                Binding::Texture,
-                Binding::Texture,
-                Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
-                Binding::Uniform,
-            ],
-        )?;
+        let kernel = Kernel::new(ctx, "post/denoise.wgsl")?;
         let params = (0..=MAX_ITERATIONS)
             .map(|i| uniform_buffer(ctx, &format!("denoise params {i}"), &[0; 32]))
             .collect();

@@ -23,7 +23,7 @@ pub(crate) struct Exposure {
 
 impl Exposure {
     pub(crate) fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
-        let filter = ColorFilter::new(ctx, "post/exposure.wgsl", wgpu::TextureFormat::Rgba32Float)?;
+        let filter = ColorFilter::new(ctx, "post/exposure.wgsl")?;
         let mut node = Self { filter };
         node.update(ctx, pass)?;
         Ok(node)

@@ -208,25 +208,14 @@ pub(crate) struct ColorFilter {
 }
 
 impl ColorFilter {
-    /// Compiles `shader` (bindings: input texture, output storage texture, uniform).
+    /// Compiles `shader` (bindings: input texture, output storage texture in the format it
+    /// declares, uniform).
     ///
     /// # Errors
     /// When the shader does not compile.
-    pub(crate) fn new(
-        ctx: &GpuContext,
-        shader: &str,
-        out_format: wgpu::TextureFormat,
-    ) -> Result<Self> {
-        use crate::kernel::{Binding, Kernel, uniform_buffer};
-        let kernel = Kernel::new(
-            ctx,
-            shader,
-            &[
-                Binding::Texture,
-                Binding::StorageTexture(out_format),
-                Binding::Uniform,
-            ],
-        )?;
+    pub(crate) fn new(ctx: &GpuContext, shader: &str) -> Result<Self> {
+        use crate::kernel::{Kernel, uniform_buffer};
+        let kernel = Kernel::new(ctx, shader)?;
         let params = uniform_buffer(ctx, shader, &[0; 16]);
         Ok(Self { kernel, params })
     }

@@ -7,7 +7,7 @@ use wgpu::util::DeviceExt as _;
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::kernel::{Binding, Kernel, uniform_buffer};
+use crate::kernel::{Kernel, uniform_buffer};
 use lumagraph_graph::TexFormat;
 
 use crate::nodes::{Counter, FrameIo, NodeExec, NodeImpl, Resources, boxed, owns_nothing};
@@ -77,33 +77,8 @@ impl PathTrace {
         let scene = resources.scene.clone().ok_or_else(|| {
             RenderError::Gpu("PathTrace needs a scene (lumagraph render --scene FILE)".into())
         })?;
-        let storage = Binding::Storage { read_only: true };
         let (source, how) = crate::specialize::pathtrace_source(&scene, options(pass, resources))?;
-        let kernel = Kernel::from_source(
-            ctx,
-            "pathtrace/pathtrace.wgsl",
-            &source,
-            &[
-                Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
-                Binding::Uniform,
-                storage,
-                storage,
-                storage,
-                storage,
-                storage,
-                storage,
-                storage,
-                Binding::Storage { read_only: false },
-                Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
-                Binding::StorageTexture(wgpu::TextureFormat::Rgba32Float),
-                Binding::StorageTexture(wgpu::TextureFormat::R32Float),
-                storage,
-                storage,
-                storage,
-                storage,
-                storage,
-            ],
-        )?;
+        let kernel = Kernel::from_source(ctx, "pathtrace/pathtrace.wgsl", &source)?;
         let env = match &scene.environment_map {
             Some(path) => crate::env_map::EnvMap::load(
                 ctx,

@@ -32,7 +32,7 @@ pub(crate) struct Tonemap {
 
 impl Tonemap {
     pub(crate) fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
-        let filter = ColorFilter::new(ctx, "post/tonemap.wgsl", wgpu::TextureFormat::Rgba8Unorm)?;
+        let filter = ColorFilter::new(ctx, "post/tonemap.wgsl")?;
         let mut node = Self { filter };
         node.update(ctx, pass)?;
         Ok(node)
