@@ -20,6 +20,7 @@ pub mod image_io;
 pub mod kernel;
 pub mod metrics;
 pub mod nodes;
+pub mod params;
 mod pool;
 pub mod raycast;
 pub mod readback;

@@ -39,6 +39,16 @@ pub(crate) const IMPL: NodeImpl = NodeImpl {
     features: None,
 };
 
+crate::param_block! {
+    /// Accumulate's params: a 1.0 the compiler cannot fold away (it keeps the Kahan
+    /// compensation), whether to estimate the variance, and the image size.
+    pub(crate) struct AccumulateParams in "post/accumulate.wgsl" as "Params" {
+        one: f32,
+        variance: u32,
+        size: [u32; 2],
+    }
+}
+
 pub(crate) struct Accumulate {
     kernel: Kernel,
     params: wgpu::Buffer,
@@ -54,10 +64,12 @@ impl Accumulate {
     pub(crate) fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
         let kernel = Kernel::new(ctx, "post/accumulate.wgsl")?;
         let variance = pass.output("variance").is_some();
-        let mut words = [0_u32; 4];
-        words[0] = 1.0_f32.to_bits();
-        words[1] = u32::from(variance);
-        let params = uniform_buffer(ctx, "accumulate params", bytemuck::bytes_of(&words));
+        let block = AccumulateParams {
+            one: 1.0,
+            variance: u32::from(variance),
+            size: [0; 2],
+        };
+        let params = uniform_buffer(ctx, "accumulate params", bytemuck::bytes_of(&block));
         let one = Extent::new(1, 1);
         Ok(Self {
             kernel,
@@ -133,13 +145,13 @@ impl NodeExec for Accumulate {
         }
         if clear {
             // The image size rides with the params (outputs may be 1×1 stand-ins).
-            let mut words = [0_u32; 4];
-            words[0] = 1.0_f32.to_bits();
-            words[1] = u32::from(self.variance);
-            words[2] = extent.width;
-            words[3] = extent.height;
+            let block = AccumulateParams {
+                one: 1.0,
+                variance: u32::from(self.variance),
+                size: [extent.width, extent.height],
+            };
             ctx.queue
-                .write_buffer(&self.params, 0, bytemuck::bytes_of(&words));
+                .write_buffer(&self.params, 0, bytemuck::bytes_of(&block));
         }
         let view = |t: Option<lumagraph_graph::TextureId>, i: usize| {
             t.map_or(&self.unused[i].view, |t| &io.texture(t).view)

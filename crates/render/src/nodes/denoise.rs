@@ -41,6 +41,20 @@ pub(crate) const IMPL: NodeImpl = NodeImpl {
     features: None,
 };
 
+crate::param_block! {
+    /// One à-trous pass's params (and the demodulation pass's, `first`).
+    pub(crate) struct DenoiseParams in "post/denoise.wgsl" as "Params" {
+        step: i32,
+        first: u32,
+        last: u32,
+        guided: u32,
+        sigma_color: f32,
+        sigma_normal: f32,
+        sigma_depth: f32,
+        scale: f32,
+    }
+}
+
 pub(crate) struct Denoise {
     kernel: Kernel,
     /// One uniform buffer per pass (step, first/last flags, sigmas); the demodulation
@@ -72,7 +86,13 @@ impl Denoise {
     pub(crate) fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
         let kernel = Kernel::new(ctx, "post/denoise.wgsl")?;
         let params = (0..=MAX_ITERATIONS)
-            .map(|i| uniform_buffer(ctx, &format!("denoise params {i}"), &[0; 32]))
+            .map(|i| {
+                uniform_buffer(
+                    ctx,
+                    &format!("denoise params {i}"),
+                    bytemuck::bytes_of(&DenoiseParams::default()),
+                )
+            })
             .collect();
         let mut node = Self {
             kernel,
@@ -97,25 +117,29 @@ impl NodeExec for Denoise {
             p.float("sigma_depth") as f32,
         );
         let guided = u32::from(p.bool("variance_guided"));
-        let demodulate: [u32; 8] = [0, 1, 0, 0, 0, 0, 0, 0];
+        let demodulate = DenoiseParams {
+            first: 1,
+            ..DenoiseParams::default()
+        };
         ctx.queue.write_buffer(
             &self.params[MAX_ITERATIONS as usize],
             0,
             bytemuck::bytes_of(&demodulate),
         );
         for i in 0..self.iterations {
-            let words: [u32; 8] = [
-                1_u32 << i,
-                0,
-                u32::from(i + 1 == self.iterations),
+            let pass_i = i32::try_from(i).unwrap_or(0);
+            let block = DenoiseParams {
+                step: 1 << pass_i,
+                first: 0,
+                last: u32::from(i + 1 == self.iterations),
                 guided,
-                sigma_color.to_bits(),
-                sigma_normal.to_bits(),
-                sigma_depth.to_bits(),
-                0.5_f32.powi(i32::try_from(i).unwrap_or(0)).to_bits(),
-            ];
+                sigma_color,
+                sigma_normal,
+                sigma_depth,
+                scale: 0.5_f32.powi(pass_i),
+            };
             ctx.queue
-                .write_buffer(&self.params[i as usize], 0, bytemuck::bytes_of(&words));
+                .write_buffer(&self.params[i as usize], 0, bytemuck::bytes_of(&block));
         }
         Ok(())
     }

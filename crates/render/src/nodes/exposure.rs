@@ -17,13 +17,20 @@ pub(crate) const IMPL: NodeImpl = NodeImpl {
     features: None,
 };
 
+crate::param_block! {
+    /// Exposure's params: the colour scale 2^ev.
+    pub(crate) struct ExposureParams in "post/exposure.wgsl" as "Params" {
+        scale: f32,
+    }
+}
+
 pub(crate) struct Exposure {
-    filter: ColorFilter,
+    filter: ColorFilter<ExposureParams>,
 }
 
 impl Exposure {
     pub(crate) fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
-        let filter = ColorFilter::new(ctx, "post/exposure.wgsl")?;
+        let filter = ColorFilter::new(ctx)?;
         let mut node = Self { filter };
         node.update(ctx, pass)?;
         Ok(node)
@@ -33,9 +40,7 @@ impl Exposure {
 impl NodeExec for Exposure {
     fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
         let scale = exposure_scale(pass.params.float("ev"));
-        let mut bytes = [0_u8; 16];
-        bytes[..4].copy_from_slice(&scale.to_le_bytes());
-        self.filter.set_params(ctx, &bytes);
+        self.filter.set_params(ctx, &ExposureParams { scale });
         Ok(())
     }
 

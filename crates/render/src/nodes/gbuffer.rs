@@ -71,7 +71,11 @@ impl GBuffer {
             )],
         )?;
         let (pipeline, layout) = pipeline(ctx, source)?;
-        let camera = uniform_buffer(ctx, "gbuffer camera", &camera_bytes(&scene));
+        let camera = uniform_buffer(
+            ctx,
+            "gbuffer camera",
+            bytemuck::bytes_of(&raster_camera(&scene)),
+        );
         // The materials are always read (their emission marks emitters); the textures only
         // with textures: without, a zeroed stand-in.
         let storage = |label: &str, bytes: &[u8], textured: bool| {
@@ -226,21 +230,34 @@ fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
-/// The camera uniform: `GpuCamera` with the image size in its two spare floats.
-fn camera_bytes(scene: &GpuScene) -> Vec<u8> {
+crate::param_block! {
+    /// The raster camera: the path tracer's pinhole camera, the image size in its spare floats.
+    pub(crate) struct RasterCamera in "gbuffer/gbuffer.wgsl" as "RasterCamera" {
+        position: [f32; 3],
+        tan_half_fov: f32,
+        right: [f32; 3],
+        aspect: f32,
+        up: [f32; 3],
+        width: f32,
+        forward: [f32; 3],
+        height: f32,
+    }
+}
+
+fn raster_camera(scene: &GpuScene) -> RasterCamera {
     let c = &scene.camera;
     #[expect(clippy::cast_precision_loss, reason = "image sizes are small")]
-    let (w, h) = (scene.settings.width as f32, scene.settings.height as f32);
-    let mut v = Vec::with_capacity(16);
-    v.extend_from_slice(&c.position);
-    v.push(c.tan_half_fov);
-    v.extend_from_slice(&c.right);
-    v.push(c.aspect);
-    v.extend_from_slice(&c.up);
-    v.push(w);
-    v.extend_from_slice(&c.forward);
-    v.push(h);
-    bytemuck::cast_slice(&v).to_vec()
+    let (width, height) = (scene.settings.width as f32, scene.settings.height as f32);
+    RasterCamera {
+        position: c.position,
+        tan_half_fov: c.tan_half_fov,
+        right: c.right,
+        aspect: c.aspect,
+        up: c.up,
+        width,
+        forward: c.forward,
+        height,
+    }
 }
 
 fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {

@@ -1,13 +1,13 @@
 //! GPU implementations of the node kinds, one file per kind, each named as in the registry.
 
-mod accumulate;
-mod denoise;
-mod exposure;
-mod gbuffer;
+pub(crate) mod accumulate;
+pub(crate) mod denoise;
+pub(crate) mod exposure;
+pub(crate) mod gbuffer;
 mod image_input;
 mod output;
-mod pathtrace;
-mod tonemap;
+pub(crate) mod pathtrace;
+pub(crate) mod tonemap;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -16,6 +16,7 @@ use lumagraph_graph::{Extent, Pass, Plan, TextureId};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
+use crate::params::ParamBlock;
 use crate::pool::PooledTexture;
 use crate::timing::GpuTimer;
 
@@ -200,29 +201,36 @@ pub fn owned_memory(pass: &Pass) -> Option<(u64, String)> {
     implementation(pass.kind).and_then(|i| (i.owned_memory)(pass))
 }
 
-/// The common shape of a post-processing node: `color` in, `color` out (in `out_format`),
-/// one 16-byte uniform block of params; the nodes differ only in their shader and params.
-pub(crate) struct ColorFilter {
+/// The common shape of a post-processing node: `color` in, `color` out (in the format its
+/// shader declares), one uniform param block `P` (which names the shader); the nodes differ
+/// only in their shader and params.
+pub(crate) struct ColorFilter<P: ParamBlock> {
     kernel: crate::kernel::Kernel,
     params: wgpu::Buffer,
+    block: std::marker::PhantomData<P>,
 }
 
-impl ColorFilter {
-    /// Compiles `shader` (bindings: input texture, output storage texture in the format it
-    /// declares, uniform).
+impl<P: ParamBlock> ColorFilter<P> {
+    /// Compiles the shader of `P` (bindings: input texture, output storage texture, `P`).
     ///
     /// # Errors
     /// When the shader does not compile.
-    pub(crate) fn new(ctx: &GpuContext, shader: &str) -> Result<Self> {
+    pub(crate) fn new(ctx: &GpuContext) -> Result<Self> {
         use crate::kernel::{Kernel, uniform_buffer};
+        let shader = P::LAYOUT.shader;
         let kernel = Kernel::new(ctx, shader)?;
-        let params = uniform_buffer(ctx, shader, &[0; 16]);
-        Ok(Self { kernel, params })
+        let params = uniform_buffer(ctx, shader, bytemuck::bytes_of(&P::zeroed()));
+        Ok(Self {
+            kernel,
+            params,
+            block: std::marker::PhantomData,
+        })
     }
 
-    /// Writes the params block.
-    pub(crate) fn set_params(&self, ctx: &GpuContext, bytes: &[u8; 16]) {
-        ctx.queue.write_buffer(&self.params, 0, bytes);
+    /// Writes the param block.
+    pub(crate) fn set_params(&self, ctx: &GpuContext, params: &P) {
+        ctx.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(params));
     }
 
     /// Records the pass over `pass`'s `color` ports.

@@ -42,6 +42,27 @@ fn options(pass: &Pass, resources: &Resources) -> crate::specialize::PathTraceOp
     }
 }
 
+crate::param_block! {
+    /// The path tracer's per-frame uniform block.
+    pub(crate) struct Frame in "pathtrace/pathtrace.wgsl" as "Frame" {
+        settings: lumagraph_scene::GpuSettings,
+        camera: lumagraph_scene::GpuCamera,
+        header: lumagraph_scene::GpuHeader,
+        /// Index of this frame's first sample in each pixel's sequence.
+        sample_offset: u32,
+        samples_per_frame: u32,
+        env_width: u32,
+        env_height: u32,
+        /// Largest channel value one sample may contribute (0: off).
+        firefly_clamp: f32,
+        /// The `sampler` param's option index.
+        sampler: u32,
+        /// The `strategy` param's option index.
+        strategy: u32,
+        pad2: u32,
+    }
+}
+
 pub(crate) struct PathTrace {
     kernel: Kernel,
     scene: std::sync::Arc<lumagraph_scene::GpuScene>,
@@ -65,7 +86,7 @@ pub(crate) struct PathTrace {
     env: crate::env_map::EnvMap,
     /// Largest channel value a sample may contribute; 0 is off.
     firefly_clamp: f32,
-    /// `SAMPLER_SOBOL` (0) or `SAMPLER_INDEPENDENT` (1) in `pathtrace/sampler.wgsl`.
+    /// The `sampler` param's option index (`SAMPLER_*` in `pathtrace/sampler.wgsl`).
     sampler: u32,
     /// `STRATEGY_MIS` (0), `STRATEGY_LIGHT` (1) or `STRATEGY_BSDF` (2) in
     /// `pathtrace/pathtrace.wgsl`.
@@ -97,7 +118,11 @@ impl PathTrace {
             create(ctx, "unused depth", TexFormat::R32Float, one),
         ];
         let buffers = SceneBuffers::upload(ctx, &scene);
-        let frame = uniform_buffer(ctx, "pathtrace frame", &[0; 176]);
+        let frame = uniform_buffer(
+            ctx,
+            "pathtrace frame",
+            bytemuck::bytes_of(&Frame::default()),
+        );
         let stats = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pathtrace stats"),
             size: STATS * 4,
@@ -135,25 +160,21 @@ impl PathTrace {
         Ok(node)
     }
 
-    fn frame_bytes(&self) -> Vec<u8> {
+    fn frame(&self) -> Frame {
         let s = &self.scene;
-        let mut bytes = Vec::with_capacity(160);
-        bytes.extend_from_slice(bytemuck::bytes_of(&s.settings));
-        bytes.extend_from_slice(bytemuck::bytes_of(&s.camera));
-        bytes.extend_from_slice(bytemuck::bytes_of(&s.header));
-        for v in [
-            self.samples,
-            self.samples_per_frame,
-            self.env.width,
-            self.env.height,
-        ] {
-            bytes.extend_from_slice(&v.to_le_bytes());
+        Frame {
+            settings: s.settings,
+            camera: s.camera,
+            header: s.header,
+            sample_offset: self.samples,
+            samples_per_frame: self.samples_per_frame,
+            env_width: self.env.width,
+            env_height: self.env.height,
+            firefly_clamp: self.firefly_clamp,
+            sampler: self.sampler,
+            strategy: self.strategy,
+            pad2: 0,
         }
-        bytes.extend_from_slice(&self.firefly_clamp.to_le_bytes());
-        bytes.extend_from_slice(&self.sampler.to_le_bytes());
-        bytes.extend_from_slice(&self.strategy.to_le_bytes());
-        bytes.extend_from_slice(&[0; 4]);
-        bytes
     }
 }
 
@@ -163,12 +184,8 @@ impl NodeExec for PathTrace {
         #[expect(clippy::cast_possible_truncation, reason = "GPU math is f32")]
         let clamp = pass.params.float("firefly_clamp") as f32;
         self.firefly_clamp = clamp;
-        self.sampler = u32::from(pass.params.str("sampler") == "independent");
-        self.strategy = match pass.params.str("strategy") {
-            "light" => 1,
-            "bsdf" => 2,
-            _ => 0,
-        };
+        self.sampler = crate::params::enum_index(pass, "sampler")?;
+        self.strategy = crate::params::enum_index(pass, "strategy")?;
         Ok(())
     }
 
@@ -192,7 +209,7 @@ impl NodeExec for PathTrace {
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("pathtrace frame staging"),
-                contents: &self.frame_bytes(),
+                contents: bytemuck::bytes_of(&self.frame()),
                 usage: wgpu::BufferUsages::COPY_SRC,
             });
         encoder.copy_buffer_to_buffer(&staging, 0, &self.frame, 0, self.frame.size());
