@@ -13,17 +13,7 @@ use lumagraph::render::{Executor, Resources, compile, image_io};
 
 /// Runs `graph` once with `keep` ports kept alive and returns them.
 fn run(graph: &Graph, keep: &[&str], out_dir: &std::path::Path) -> Option<Vec<Image>> {
-    let ctx = common::gpu()?;
-    let keep: Vec<String> = keep.iter().map(|s| (*s).to_owned()).collect();
-    let plan = compile(graph, &keep, None).unwrap_or_else(|e| panic!("{e}"));
-    let paths = Resources {
-        base_dir: common::root(),
-        out_dir: out_dir.to_owned(),
-        ..Resources::default()
-    };
-    let mut exec = Executor::new(ctx, plan, &paths).unwrap();
-    exec.run_frame().unwrap();
-    Some(keep.iter().map(|k| exec.read_port(k).unwrap()).collect())
+    common::run_graph(graph, keep, out_dir)
 }
 
 fn chart() -> Image {

@@ -1,19 +1,10 @@
-// Exposure: color × 2^ev (the scale is computed on the CPU).
+// Exposure: color × 2^ev.
+#import "post/filter.wgsl"
 
 struct Params {
-    scale: f32,
+    ev: f32,
 }
 
-@group(0) @binding(0) var input: texture_2d<f32>;
-@group(0) @binding(1) var output: texture_storage_2d<rgba32float, write>;
-@group(0) @binding(2) var<uniform> params: Params;
-
-@compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) id: vec3u) {
-    let size = textureDimensions(output);
-    if id.x >= size.x || id.y >= size.y {
-        return;
-    }
-    let c = textureLoad(input, id.xy, 0);
-    textureStore(output, id.xy, vec4f(c.rgb * params.scale, c.a));
+fn filter_pixel(c: vec4f, pixel: vec2u, size: vec2u) -> vec4f {
+    return vec4f(c.rgb * exp2(params.ev), c.a);
 }

@@ -257,3 +257,24 @@ pub fn same_means(
     }
     Ok((tests.len(), worst.4.abs() / crit))
 }
+
+/// Runs `graph` for one frame (paths relative to the repository root, outputs into
+/// `out_dir`) and returns the ports `keep`, or `None` without a GPU (when allowed).
+pub fn run_graph(
+    graph: &lumagraph::graph::Graph,
+    keep: &[&str],
+    out_dir: &Path,
+) -> Option<Vec<lumagraph::render::cpu::Image>> {
+    use lumagraph::render::{Executor, Resources, compile};
+    let ctx = gpu()?;
+    let keep: Vec<String> = keep.iter().map(|s| (*s).to_owned()).collect();
+    let plan = compile(graph, &keep, None).unwrap_or_else(|e| panic!("{e}"));
+    let paths = Resources {
+        base_dir: root(),
+        out_dir: out_dir.to_owned(),
+        ..Resources::default()
+    };
+    let mut exec = Executor::new(ctx, plan, &paths).unwrap();
+    exec.run_frame().unwrap();
+    Some(keep.iter().map(|k| exec.read_port(k).unwrap()).collect())
+}

@@ -13,7 +13,7 @@ use lumagraph_scene::GpuScene;
 use crate::context::GpuContext;
 use crate::cpu::Image;
 use crate::error::{RenderError, Result};
-use crate::nodes::{self, Counter, FrameIo, NodeExec, Resources};
+use crate::nodes::{self, Counter, FrameIo, NodeExec, Recording, Resources};
 use crate::pool::{PooledTexture, TexturePool};
 use crate::timing::GpuTimer;
 
@@ -376,8 +376,13 @@ impl Executor {
                     let before = std::mem::replace(&mut encoder, new_encoder(&self.ctx));
                     submit_and_wait(&self.ctx, before)?;
                     let t = Instant::now();
-                    node.record(&self.ctx, &mut encoder, pass, &io, None)
-                        .map_err(|e| e.in_node(&pass.node))?;
+                    let rec = Recording {
+                        ctx: &self.ctx,
+                        encoder: &mut encoder,
+                        io: &io,
+                        timer: None,
+                    };
+                    node.record(pass, rec).map_err(|e| e.in_node(&pass.node))?;
                     let this = std::mem::replace(&mut encoder, new_encoder(&self.ctx));
                     submit_and_wait(&self.ctx, this).map_err(|e| e.in_node(&pass.node))?;
                     let ms = t.elapsed().as_secs_f64() * 1e3;
@@ -386,8 +391,13 @@ impl Executor {
                         None => wall_ms.push((pass.node.clone(), ms)),
                     }
                 } else {
-                    node.record(&self.ctx, &mut encoder, pass, &io, timer)
-                        .map_err(|e| e.in_node(&pass.node))?;
+                    let rec = Recording {
+                        ctx: &self.ctx,
+                        encoder: &mut encoder,
+                        io: &io,
+                        timer,
+                    };
+                    node.record(pass, rec).map_err(|e| e.in_node(&pass.node))?;
                 }
                 if last {
                     executed.push(pass.node.clone());

@@ -69,7 +69,6 @@ macro_rules! param_block {
 
 /// Every param block of the nodes, for the layout test.
 pub const BLOCKS: &[BlockLayout] = &[
-    <crate::nodes::exposure::ExposureParams as ParamBlock>::LAYOUT,
     <crate::nodes::tonemap::TonemapParams as ParamBlock>::LAYOUT,
     <crate::nodes::accumulate::AccumulateParams as ParamBlock>::LAYOUT,
     <crate::nodes::denoise::DenoiseParams as ParamBlock>::LAYOUT,

@@ -1,28 +1,20 @@
-//! Colour nodes: exposure and tone mapping.
+//! Colour nodes: exposure, vignette and tone mapping.
 
-use super::{COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, TONEMAP_OPERATORS};
+use super::{
+    COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, TONEMAP_OPERATORS, post_filter,
+};
 use crate::types::{ParamType, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
-    vec![exposure(), tonemap()]
+    vec![exposure(), vignette(), tonemap()]
 }
 
 fn exposure() -> NodeKind {
-    NodeKind {
-        name: "Exposure",
-        category: Category::Color,
-        doc: "Scales linear color by 2^ev.",
-        inputs: &[InputDef {
-            name: "color",
-            accepts: COLOR_TYPES,
-            doc: "linear color",
-        }],
-        outputs: &[OutputDef {
-            name: "color",
-            ty: PortType::HdrColor,
-            doc: "color × 2^ev",
-        }],
-        params: vec![ParamDef {
+    post_filter(
+        "Exposure",
+        Category::Color,
+        "Scales linear color by 2^ev.",
+        vec![ParamDef {
             name: "ev",
             ty: ParamType::Float {
                 default: 0.0,
@@ -31,10 +23,48 @@ fn exposure() -> NodeKind {
             },
             doc: "exposure in stops; +1 doubles the brightness",
         }],
-        sink: false,
-        history: false,
-        renders_scene: false,
-    }
+        "post/exposure.wgsl",
+    )
+}
+
+fn vignette() -> NodeKind {
+    post_filter(
+        "Vignette",
+        Category::Color,
+        "Darkens the image towards its corners, as a lens does: color × (1 − strength · s), \
+         s rising smoothly from 0 at `radius` to 1 at `radius + softness`, distances in units \
+         of half the image diagonal from its center.",
+        vec![
+            ParamDef {
+                name: "strength",
+                ty: ParamType::Float {
+                    default: 0.5,
+                    min: 0.0,
+                    max: 1.0,
+                },
+                doc: "fraction of the light removed where the vignette is full",
+            },
+            ParamDef {
+                name: "radius",
+                ty: ParamType::Float {
+                    default: 0.6,
+                    min: 0.0,
+                    max: 2.0,
+                },
+                doc: "where darkening starts, in half-diagonals from the center",
+            },
+            ParamDef {
+                name: "softness",
+                ty: ParamType::Float {
+                    default: 0.6,
+                    min: 0.001,
+                    max: 2.0,
+                },
+                doc: "how far beyond `radius` it reaches full strength",
+            },
+        ],
+        "post/vignette.wgsl",
+    )
 }
 
 fn tonemap() -> NodeKind {
@@ -75,5 +105,6 @@ fn tonemap() -> NodeKind {
         sink: false,
         history: false,
         renders_scene: false,
+        shader: None,
     }
 }

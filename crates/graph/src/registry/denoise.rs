@@ -100,5 +100,6 @@ fn denoise() -> NodeKind {
         sink: false,
         history: false,
         renders_scene: false,
+        shader: None,
     }
 }

@@ -30,5 +30,6 @@ fn image_input() -> NodeKind {
         sink: false,
         history: false,
         renders_scene: false,
+        shader: None,
     }
 }

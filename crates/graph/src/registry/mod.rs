@@ -101,6 +101,12 @@ pub struct NodeKind {
     /// Whether the node renders the scene given with `--scene`: it needs one, and its
     /// images are the scene's size.
     pub renders_scene: bool,
+    /// A post filter run by the generic implementation: this WGSL file (under `shaders/`)
+    /// reads input `color`, writes output `color`, and gets the params in declaration order
+    /// in its `Params` struct, member names as the params' (float → `f32`, int → `i32`,
+    /// bool and enum option index → `u32`). `None`: the kind has an implementation of its
+    /// own in the render crate.
+    pub shader: Option<&'static str>,
 }
 
 impl NodeKind {
@@ -179,6 +185,37 @@ pub const TONEMAP_OPERATORS: &[(&str, &str)] = &[
         "Khronos PBR Neutral: keeps base colors, compresses highlights",
     ),
 ];
+
+/// A post filter on the generic implementation ([`NodeKind::shader`]): linear colour in on
+/// `color`, HDR colour out on `color`, with `params` packed for `shader`.
+pub(crate) fn post_filter(
+    name: &'static str,
+    category: Category,
+    doc: &'static str,
+    params: Vec<ParamDef>,
+    shader: &'static str,
+) -> NodeKind {
+    NodeKind {
+        name,
+        category,
+        doc,
+        inputs: &[InputDef {
+            name: "color",
+            accepts: COLOR_TYPES,
+            doc: "linear color",
+        }],
+        outputs: &[OutputDef {
+            name: "color",
+            ty: PortType::HdrColor,
+            doc: "the filtered linear color",
+        }],
+        params,
+        sink: false,
+        history: false,
+        renders_scene: false,
+        shader: Some(shader),
+    }
+}
 
 fn builtin_kinds() -> Vec<NodeKind> {
     [

@@ -31,5 +31,6 @@ fn output() -> NodeKind {
         sink: true,
         history: false,
         renders_scene: false,
+        shader: None,
     }
 }

@@ -123,6 +123,7 @@ fn path_trace() -> NodeKind {
         sink: false,
         history: false,
         renders_scene: true,
+        shader: None,
     }
 }
 
@@ -158,6 +159,7 @@ fn accumulate() -> NodeKind {
         sink: false,
         history: true,
         renders_scene: false,
+        shader: None,
     }
 }
 
@@ -203,5 +205,6 @@ fn gbuffer() -> NodeKind {
         sink: false,
         history: false,
         renders_scene: true,
+        shader: None,
     }
 }

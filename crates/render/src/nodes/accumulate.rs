@@ -13,9 +13,8 @@ use lumagraph_graph::{Extent, Pass, TexFormat};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::kernel::{Kernel, uniform_buffer};
-use crate::nodes::{FrameIo, NodeExec, NodeImpl, boxed};
+use crate::nodes::{NodeExec, NodeImpl, Recording, boxed};
 use crate::pool::{PooledTexture, create};
-use crate::timing::GpuTimer;
 
 /// The `Accumulate` kind: it owns its history buffers.
 pub(crate) const IMPL: NodeImpl = NodeImpl {
@@ -99,14 +98,8 @@ impl NodeExec for Accumulate {
         self.clear = true;
     }
 
-    fn record(
-        &mut self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        pass: &Pass,
-        io: &FrameIo<'_>,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
+    fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
+        let (ctx, encoder, io, timer) = rec.parts();
         let input = io.input(pass, "color")?;
         let (out, var) = (pass.output("color"), pass.output("variance"));
         if out.is_none() && var.is_none() {

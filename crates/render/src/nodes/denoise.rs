@@ -17,9 +17,8 @@ use lumagraph_graph::{Extent, Pass, TexFormat};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::kernel::{Kernel, uniform_buffer};
-use crate::nodes::{FrameIo, NodeExec, NodeImpl, boxed};
+use crate::nodes::{NodeExec, NodeImpl, Recording, boxed};
 use crate::pool::{PooledTexture, create};
-use crate::timing::GpuTimer;
 
 /// Most passes the registry allows.
 const MAX_ITERATIONS: u32 = 8;
@@ -144,14 +143,8 @@ impl NodeExec for Denoise {
         Ok(())
     }
 
-    fn record(
-        &mut self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        pass: &Pass,
-        io: &FrameIo<'_>,
-        mut timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
+    fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
+        let (ctx, encoder, io, mut timer) = rec.parts();
         let Some(out) = pass.output("color") else {
             return Ok(());
         };

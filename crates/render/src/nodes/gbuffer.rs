@@ -18,9 +18,8 @@ use wgpu::util::DeviceExt as _;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::kernel::uniform_buffer;
-use crate::nodes::{FrameIo, NodeExec, NodeImpl, Resources, boxed};
+use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed};
 use crate::pool::{PooledTexture, create, wgpu_format};
-use crate::timing::GpuTimer;
 
 /// Floats per vertex: position, normal, albedo (3 each), sphere (4), uv (2), tangent (4),
 /// material id (the bits of a `u32`).
@@ -402,14 +401,8 @@ impl NodeExec for GBuffer {
         Ok(())
     }
 
-    fn record(
-        &mut self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        pass: &Pass,
-        io: &FrameIo<'_>,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
+    fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
+        let (ctx, encoder, io, timer) = rec.parts();
         let extent = pass.extent;
         if self.targets.as_ref().is_none_or(|(e, _, _)| *e != extent) {
             let depth = ctx.device.create_texture(&wgpu::TextureDescriptor {

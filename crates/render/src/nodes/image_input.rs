@@ -6,9 +6,8 @@ use lumagraph_graph::{Pass, TexFormat};
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::nodes::{FrameIo, NodeExec, NodeImpl, Resources, boxed, owns_nothing};
+use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed, owns_nothing};
 use crate::pool::{PooledTexture, create};
-use crate::timing::GpuTimer;
 
 /// The `ImageInput` kind: its size is the image file's.
 pub(crate) const IMPL: NodeImpl = NodeImpl {
@@ -66,14 +65,8 @@ impl NodeExec for ImageInput {
         Ok(())
     }
 
-    fn record(
-        &mut self,
-        _ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        pass: &Pass,
-        io: &FrameIo<'_>,
-        _timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
+    fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
+        let (_, encoder, io, _) = rec.parts();
         let (Some(out), Some((_, src))) = (pass.output("color"), &self.loaded) else {
             return Ok(());
         };

@@ -2,11 +2,11 @@
 
 pub(crate) mod accumulate;
 pub(crate) mod denoise;
-pub(crate) mod exposure;
 pub(crate) mod gbuffer;
 mod image_input;
 mod output;
 pub(crate) mod pathtrace;
+pub mod post_filter;
 pub(crate) mod tonemap;
 
 use std::path::{Path, PathBuf};
@@ -90,6 +90,35 @@ impl FrameIo<'_> {
     }
 }
 
+/// What recording a pass works with: the device, the frame's command encoder, the frame's
+/// textures, and the GPU timer when this frame is timed.
+#[derive(Debug)]
+pub struct Recording<'r> {
+    /// The device and queue.
+    pub ctx: &'r GpuContext,
+    /// The frame's command encoder.
+    pub encoder: &'r mut wgpu::CommandEncoder,
+    /// The plan and the textures its ports are bound to.
+    pub io: &'r FrameIo<'r>,
+    /// Timestamp queries for this pass, when the frame is timed on them.
+    pub timer: Option<&'r mut GpuTimer>,
+}
+
+/// A [`Recording`] taken apart: device, encoder, textures, timer.
+pub type RecordingParts<'r> = (
+    &'r GpuContext,
+    &'r mut wgpu::CommandEncoder,
+    &'r FrameIo<'r>,
+    Option<&'r mut GpuTimer>,
+);
+
+impl<'r> Recording<'r> {
+    /// Its parts, for a `let (ctx, encoder, io, timer) = rec.parts();` line.
+    pub fn parts(self) -> RecordingParts<'r> {
+        (self.ctx, self.encoder, self.io, self.timer)
+    }
+}
+
 /// A node's GPU side.
 pub trait NodeExec {
     /// Takes new param values (the kind and ports are unchanged).
@@ -105,14 +134,7 @@ pub trait NodeExec {
     ///
     /// # Errors
     /// When recording fails.
-    fn record(
-        &mut self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        pass: &Pass,
-        io: &FrameIo<'_>,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()>;
+    fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()>;
 
     /// Lines describing how the node was set up (shader specialization and such).
     fn notes(&self) -> Vec<String> {
@@ -179,21 +201,25 @@ pub(crate) fn boxed<N: NodeExec + 'static>(node: Result<N>) -> Result<Box<dyn No
     node.map(|n| Box::new(n) as Box<dyn NodeExec>)
 }
 
-/// Every implemented kind; a test checks that they are exactly the registry's kinds.
+/// Every kind with an implementation of its own; a test checks that with the generic post
+/// filters ([`post_filter`]) they are exactly the registry's kinds.
 pub static IMPLEMENTATIONS: &[NodeImpl] = &[
     image_input::IMPL,
     pathtrace::IMPL,
     accumulate::IMPL,
     gbuffer::IMPL,
     denoise::IMPL,
-    exposure::IMPL,
     tonemap::IMPL,
     output::IMPL,
 ];
 
-/// The implementation of the kind called `kind`.
+/// The implementation of the kind called `kind`: its own, or the generic post filter for
+/// a kind that names a shader.
 pub fn implementation(kind: &str) -> Option<&'static NodeImpl> {
-    IMPLEMENTATIONS.iter().find(|i| i.kind == kind)
+    IMPLEMENTATIONS
+        .iter()
+        .find(|i| i.kind == kind)
+        .or_else(|| post_filter::is_post_filter(kind).then_some(&post_filter::IMPL))
 }
 
 /// Memory a pass's node allocates for itself (see [`NodeImpl::owned_memory`]).
@@ -201,50 +227,38 @@ pub fn owned_memory(pass: &Pass) -> Option<(u64, String)> {
     implementation(pass.kind).and_then(|i| (i.owned_memory)(pass))
 }
 
-/// The common shape of a post-processing node: `color` in, `color` out (in the format its
-/// shader declares), one uniform param block `P` (which names the shader); the nodes differ
-/// only in their shader and params.
-pub(crate) struct ColorFilter<P: ParamBlock> {
+/// The pass of a post-processing node: `color` in, `color` out (in the format its shader
+/// declares), one uniform param block.
+pub(crate) struct FilterPass {
     kernel: crate::kernel::Kernel,
     params: wgpu::Buffer,
-    block: std::marker::PhantomData<P>,
 }
 
-impl<P: ParamBlock> ColorFilter<P> {
-    /// Compiles the shader of `P` (bindings: input texture, output storage texture, `P`).
+impl FilterPass {
+    /// Compiles `shader` (bindings: input texture, output storage texture, uniform) with its
+    /// param block holding `params`.
     ///
     /// # Errors
     /// When the shader does not compile.
-    pub(crate) fn new(ctx: &GpuContext) -> Result<Self> {
+    pub(crate) fn new(ctx: &GpuContext, shader: &str, params: &[u8]) -> Result<Self> {
         use crate::kernel::{Kernel, uniform_buffer};
-        let shader = P::LAYOUT.shader;
-        let kernel = Kernel::new(ctx, shader)?;
-        let params = uniform_buffer(ctx, shader, bytemuck::bytes_of(&P::zeroed()));
         Ok(Self {
-            kernel,
-            params,
-            block: std::marker::PhantomData,
+            kernel: Kernel::new(ctx, shader)?,
+            params: uniform_buffer(ctx, shader, params),
         })
     }
 
     /// Writes the param block.
-    pub(crate) fn set_params(&self, ctx: &GpuContext, params: &P) {
-        ctx.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(params));
+    pub(crate) fn set_params(&self, ctx: &GpuContext, params: &[u8]) {
+        ctx.queue.write_buffer(&self.params, 0, params);
     }
 
     /// Records the pass over `pass`'s `color` ports.
     ///
     /// # Errors
     /// When the input is not bound or the bindings do not match the kernel.
-    pub(crate) fn record(
-        &self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        pass: &Pass,
-        io: &FrameIo<'_>,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
+    pub(crate) fn record(&self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
+        let (ctx, encoder, io, timer) = rec.parts();
         let input = io.input(pass, "color")?;
         let Some(out) = pass.output("color") else {
             return Ok(());
@@ -255,6 +269,38 @@ impl<P: ParamBlock> ColorFilter<P> {
             .write(&io.texture(out).view)
             .uniform(&self.params)
             .dispatch_2d(ctx, encoder, pass.extent, timer)
+    }
+}
+
+/// A [`FilterPass`] whose params are the block `P` (which names the shader).
+pub(crate) struct ColorFilter<P: ParamBlock> {
+    pass: FilterPass,
+    block: std::marker::PhantomData<P>,
+}
+
+impl<P: ParamBlock> ColorFilter<P> {
+    /// Compiles the shader of `P`.
+    ///
+    /// # Errors
+    /// When the shader does not compile.
+    pub(crate) fn new(ctx: &GpuContext) -> Result<Self> {
+        Ok(Self {
+            pass: FilterPass::new(ctx, P::LAYOUT.shader, bytemuck::bytes_of(&P::zeroed()))?,
+            block: std::marker::PhantomData,
+        })
+    }
+
+    /// Writes the param block.
+    pub(crate) fn set_params(&self, ctx: &GpuContext, params: &P) {
+        self.pass.set_params(ctx, bytemuck::bytes_of(params));
+    }
+
+    /// Records the pass (see [`FilterPass::record`]).
+    ///
+    /// # Errors
+    /// As [`FilterPass::record`].
+    pub(crate) fn record(&self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
+        self.pass.record(pass, rec)
     }
 }
 
@@ -294,12 +340,14 @@ pub fn check_writable(path: &Path) -> Result<()> {
 mod tests {
     use super::*;
 
-    /// The registry and the implementation table list the same kinds, once each.
+    /// The registry's kinds are the implementation table's and the generic post filters,
+    /// each once.
     #[test]
     fn every_registry_kind_has_one_implementation() {
         let kinds: Vec<&str> = lumagraph_graph::Registry::builtin()
             .kinds()
             .iter()
+            .filter(|k| k.shader.is_none())
             .map(|k| k.name)
             .collect();
         let mut implemented: Vec<&str> = IMPLEMENTATIONS.iter().map(|i| i.kind).collect();
@@ -308,6 +356,11 @@ mod tests {
         implemented.sort_unstable();
         assert_eq!(sorted, implemented);
         for k in lumagraph_graph::Registry::builtin().kinds() {
+            assert!(
+                !(k.shader.is_some() && IMPLEMENTATIONS.iter().any(|i| i.kind == k.name)),
+                "{}: a post filter with an implementation of its own",
+                k.name
+            );
             let i = implementation(k.name).unwrap();
             assert_eq!(
                 i.source_extent.is_some(),
@@ -316,5 +369,40 @@ mod tests {
                 k.name
             );
         }
+    }
+}
+
+#[cfg(test)]
+mod post_filter_tests {
+    /// Every generic post filter's shader keeps the contract (bindings, output format,
+    /// `Params` = the node's params by name, in order, as packed).
+    #[test]
+    fn every_post_filter_shader_matches_its_registry_entry() {
+        let registry = lumagraph_graph::Registry::builtin();
+        let filters: Vec<_> = registry
+            .kinds()
+            .iter()
+            .filter(|k| k.shader.is_some())
+            .collect();
+        assert!(filters.len() >= 2);
+        let failures: Vec<String> = filters
+            .iter()
+            .filter_map(|k| super::post_filter::check(k).err())
+            .collect();
+        assert!(failures.is_empty(), "{}", failures.join("\n"));
+    }
+
+    /// A shader whose `Params` differs from the node's params is caught: the contract test
+    /// fails on a kind pointed at another filter's shader.
+    #[test]
+    fn a_shader_that_does_not_match_its_params_is_caught() {
+        let registry = lumagraph_graph::Registry::builtin();
+        let mut vignette = registry.get("Vignette").unwrap().clone();
+        vignette.shader = Some("post/exposure.wgsl");
+        let e = super::post_filter::check(&vignette).unwrap_err();
+        assert!(
+            e.contains("struct Params has") && e.contains("strength"),
+            "{e}"
+        );
     }
 }

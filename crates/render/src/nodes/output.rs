@@ -6,8 +6,7 @@ use lumagraph_graph::{Extent, Pass, PortType, TexFormat};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::nodes::{FrameIo, NodeExec, NodeImpl, Resources, boxed, check_writable, owns_nothing};
-use crate::timing::GpuTimer;
+use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed, check_writable, owns_nothing};
 
 /// The `Output` kind.
 pub(crate) const IMPL: NodeImpl = NodeImpl {
@@ -51,14 +50,8 @@ impl NodeExec for Output {
         check_writable(&self.path(pass))
     }
 
-    fn record(
-        &mut self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        pass: &Pass,
-        io: &FrameIo<'_>,
-        _timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
+    fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
+        let (ctx, encoder, io, _) = rec.parts();
         let id = pass
             .input("color")
             .ok_or_else(|| RenderError::Gpu("input \"color\" is not bound".into()))?;

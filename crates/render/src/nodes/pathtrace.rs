@@ -10,11 +10,10 @@ use crate::error::{RenderError, Result};
 use crate::kernel::{Kernel, uniform_buffer};
 use lumagraph_graph::TexFormat;
 
-use crate::nodes::{Counter, FrameIo, NodeExec, NodeImpl, Resources, boxed, owns_nothing};
+use crate::nodes::{Counter, NodeExec, NodeImpl, Recording, Resources, boxed, owns_nothing};
 use crate::pool::{PooledTexture, create};
 use crate::readback::map_read;
 use crate::scene_gpu::SceneBuffers;
-use crate::timing::GpuTimer;
 
 /// `stats` slots: dropped (non-finite) samples, rays traced (low, high 32 bits).
 const STATS: u64 = 4;
@@ -195,14 +194,8 @@ impl NodeExec for PathTrace {
         self.rays = 0;
     }
 
-    fn record(
-        &mut self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        pass: &Pass,
-        io: &FrameIo<'_>,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
+    fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
+        let (ctx, encoder, io, timer) = rec.parts();
         // Each frame has its own uniform contents: stage them through a copy recorded in
         // order, so many frames can share one submission.
         let staging = ctx

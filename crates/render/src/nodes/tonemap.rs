@@ -4,8 +4,7 @@ use lumagraph_graph::Pass;
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::nodes::{ColorFilter, FrameIo, NodeExec, NodeImpl, boxed, owns_nothing};
-use crate::timing::GpuTimer;
+use crate::nodes::{ColorFilter, NodeExec, NodeImpl, Recording, boxed, owns_nothing};
 
 /// The `Tonemap` kind.
 pub(crate) const IMPL: NodeImpl = NodeImpl {
@@ -47,14 +46,7 @@ impl NodeExec for Tonemap {
         Ok(())
     }
 
-    fn record(
-        &mut self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        pass: &Pass,
-        io: &FrameIo<'_>,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
-        self.filter.record(ctx, encoder, pass, io, timer)
+    fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
+        self.filter.record(pass, rec)
     }
 }

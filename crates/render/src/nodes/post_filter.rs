@@ -1,0 +1,162 @@
+//! The generic single-input post filter: every registry kind that names a `shader` runs
+//! here. The pass reads input `color`, writes output `color` and gets the node's params in
+//! declaration order in the shader's `Params` struct (float → `f32`, int → `i32`, bool and
+//! enum option index → `u32`), so a new filter of this shape is its registry entry, its
+//! WGSL and its CPU reference test, with no Rust of its own. [`check`] holds every such
+//! kind's shader to that contract without a GPU.
+
+use lumagraph_graph::{NodeKind, ParamType, Pass, Registry};
+
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+use crate::kernel::Binding;
+use crate::nodes::{FilterPass, NodeExec, NodeImpl, Recording, boxed, owns_nothing};
+
+/// The implementation of every kind with a `shader` (its `kind` is a placeholder:
+/// [`crate::nodes::implementation`] hands it out for those kinds).
+pub(crate) const IMPL: NodeImpl = NodeImpl {
+    kind: "(post filter)",
+    create: |ctx, pass, _| boxed(PostFilter::new(ctx, pass)),
+    owned_memory: owns_nothing,
+    source_extent: None,
+    features: None,
+};
+
+/// The registry kind of `pass` and its shader, when it is a generic post filter.
+fn kind_and_shader(kind: &str) -> Option<(&'static NodeKind, &'static str)> {
+    let k = Registry::builtin().get(kind)?;
+    Some((k, k.shader?))
+}
+
+/// Whether `kind` runs on the generic post filter.
+pub(crate) fn is_post_filter(kind: &str) -> bool {
+    kind_and_shader(kind).is_some()
+}
+
+/// The WGSL type each kind of param is given as.
+fn wgsl_scalar(ty: &ParamType) -> Option<&'static str> {
+    match ty {
+        ParamType::Float { .. } => Some("f32"),
+        ParamType::Int { .. } => Some("i32"),
+        ParamType::Bool { .. } | ParamType::Enum { .. } => Some("u32"),
+        _ => None,
+    }
+}
+
+/// The node's params packed for its `Params` struct, 4 bytes each in declaration order.
+fn pack(kind: &NodeKind, pass: &Pass) -> Result<Vec<u8>> {
+    let mut words: Vec<u32> = Vec::with_capacity(kind.params.len());
+    for p in &kind.params {
+        #[expect(clippy::cast_possible_truncation, reason = "GPU math is f32 and i32")]
+        let word = match p.ty {
+            ParamType::Float { .. } => (pass.params.float(p.name) as f32).to_bits(),
+            ParamType::Int { .. } => (pass.params.int(p.name) as i32).cast_unsigned(),
+            ParamType::Bool { .. } => u32::from(pass.params.bool(p.name)),
+            ParamType::Enum { .. } => crate::params::enum_index(pass, p.name)?,
+            _ => {
+                return Err(RenderError::Gpu(format!(
+                    "{}: param \"{}\" cannot be given to a shader",
+                    kind.name, p.name
+                )));
+            }
+        };
+        words.push(word);
+    }
+    words.resize(words.len().next_multiple_of(4).max(4), 0);
+    Ok(bytemuck::cast_slice(&words).to_vec())
+}
+
+struct PostFilter {
+    filter: FilterPass,
+    kind: &'static NodeKind,
+}
+
+impl PostFilter {
+    fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
+        let (kind, shader) = kind_and_shader(pass.kind)
+            .ok_or_else(|| RenderError::Unimplemented(pass.kind.to_owned()))?;
+        Ok(Self {
+            filter: FilterPass::new(ctx, shader, &pack(kind, pass)?)?,
+            kind,
+        })
+    }
+}
+
+impl NodeExec for PostFilter {
+    fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
+        self.filter.set_params(ctx, &pack(self.kind, pass)?);
+        Ok(())
+    }
+
+    fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
+        self.filter.record(pass, rec)
+    }
+}
+
+/// Whether `kind`'s shader keeps the generic filter's contract: bindings input texture,
+/// output storage texture in the format of the output port's type, uniform `Params`; and
+/// `Params` declares the kind's params, by name, in order, as the scalars they are packed
+/// as.
+///
+/// # Errors
+/// What differs.
+pub fn check(kind: &NodeKind) -> std::result::Result<(), String> {
+    let shader = kind.shader.ok_or("no shader")?;
+    let source = crate::shader::resolve(shader).map_err(|e| e.to_string())?;
+    let (bindings, _) = crate::kernel::reflect(shader, &source).map_err(|e| e.to_string())?;
+    let format = crate::pool::wgpu_format(kind.outputs[0].ty.format());
+    let want = [
+        Binding::Texture,
+        Binding::StorageTexture {
+            format,
+            access: wgpu::StorageTextureAccess::WriteOnly,
+        },
+        Binding::Uniform,
+    ];
+    if bindings != want {
+        return Err(format!("{shader}: bindings {bindings:?}, want {want:?}"));
+    }
+    let module = naga::front::wgsl::parse_str(&source).map_err(|e| e.emit_to_string(&source))?;
+    let (_, params) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some("Params"))
+        .ok_or_else(|| format!("{shader}: no struct Params"))?;
+    let naga::TypeInner::Struct { members, .. } = &params.inner else {
+        return Err(format!("{shader}: Params is not a struct"));
+    };
+    let got: Vec<(String, String)> = members
+        .iter()
+        .map(|m| {
+            let ty = match module.types[m.ty].inner {
+                naga::TypeInner::Scalar(s) => match (s.kind, s.width) {
+                    (naga::ScalarKind::Float, 4) => "f32",
+                    (naga::ScalarKind::Sint, 4) => "i32",
+                    (naga::ScalarKind::Uint, 4) => "u32",
+                    _ => "?",
+                },
+                _ => "?",
+            };
+            (m.name.clone().unwrap_or_default(), ty.to_owned())
+        })
+        .collect();
+    let want: Vec<(String, String)> = kind
+        .params
+        .iter()
+        .map(|p| {
+            (
+                p.name.to_owned(),
+                wgsl_scalar(&p.ty)
+                    .unwrap_or("(not a shader param)")
+                    .to_owned(),
+            )
+        })
+        .collect();
+    if got != want {
+        return Err(format!(
+            "{shader}: struct Params has {got:?}; the {} node's params are {want:?}",
+            kind.name
+        ));
+    }
+    Ok(())
+}
