@@ -17,26 +17,23 @@ use crate::nodes::{NodeExec, NodeImpl, Recording, boxed};
 use crate::pool::{PooledTexture, create};
 
 /// The `Accumulate` kind: it owns its history buffers.
-pub(crate) const IMPL: NodeImpl = NodeImpl {
-    kind: "Accumulate",
-    create: |ctx, pass, _| boxed(Accumulate::new(ctx, pass)),
-    owned_memory: |pass| {
-        let buffers = if pass.output("variance").is_some() {
-            3
-        } else {
-            2
-        };
-        Some((
-            buffers * 16 * pass.extent.pixels(),
-            format!(
-                "{buffers} history buffers of 16 B per pixel (sum, compensation{})",
-                if buffers == 3 { ", second moment" } else { "" }
-            ),
-        ))
-    },
-    source_extent: None,
-    features: None,
-};
+pub(crate) const IMPL: NodeImpl = NodeImpl::new("Accumulate", |ctx, pass, _| {
+    boxed(Accumulate::new(ctx, pass))
+})
+.owning(|pass| {
+    let buffers = if pass.output("variance").is_some() {
+        3
+    } else {
+        2
+    };
+    Some((
+        buffers * 16 * pass.extent.pixels(),
+        format!(
+            "{buffers} history buffers of 16 B per pixel (sum, compensation{})",
+            if buffers == 3 { ", second moment" } else { "" }
+        ),
+    ))
+});
 
 crate::param_block! {
     /// Accumulate's params: a 1.0 the compiler cannot fold away (it keeps the Kahan

@@ -24,10 +24,8 @@ use crate::pool::{PooledTexture, create};
 const MAX_ITERATIONS: u32 = 8;
 
 /// The `Denoise` kind: it owns its scratch images.
-pub(crate) const IMPL: NodeImpl = NodeImpl {
-    kind: "Denoise",
-    create: |ctx, pass, _| boxed(Denoise::new(ctx, pass)),
-    owned_memory: |pass| {
+pub(crate) const IMPL: NodeImpl =
+    NodeImpl::new("Denoise", |ctx, pass, _| boxed(Denoise::new(ctx, pass))).owning(|pass| {
         let n = u32::try_from(pass.params.int("iterations")).unwrap_or(1);
         let what = if n > 1 {
             "2 rgba32f ping-pong images"
@@ -35,10 +33,7 @@ pub(crate) const IMPL: NodeImpl = NodeImpl {
             "1 rgba32f image (demodulated input)"
         };
         Some((scratch_bytes(pass.extent, n), what.to_owned()))
-    },
-    source_extent: None,
-    features: None,
-};
+    });
 
 crate::param_block! {
     /// One à-trous pass's params (and the demodulation pass's, `first`).

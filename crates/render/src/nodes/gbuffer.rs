@@ -32,18 +32,15 @@ const PORTS: [(&str, TexFormat); 3] = [
 ];
 
 /// The `GBuffer` kind: it owns its depth attachment.
-pub(crate) const IMPL: NodeImpl = NodeImpl {
-    kind: "GBuffer",
-    create: |ctx, pass, resources| boxed(GBuffer::new(ctx, pass, resources)),
-    owned_memory: |pass| {
-        Some((
-            4 * pass.extent.pixels(),
-            "depth attachment (depth32float)".to_owned(),
-        ))
-    },
-    source_extent: None,
-    features: None,
-};
+pub(crate) const IMPL: NodeImpl = NodeImpl::new("GBuffer", |ctx, pass, resources| {
+    boxed(GBuffer::new(ctx, pass, resources))
+})
+.owning(|pass| {
+    Some((
+        4 * pass.extent.pixels(),
+        "depth attachment (depth32float)".to_owned(),
+    ))
+});
 
 pub(crate) struct GBuffer {
     scene: std::sync::Arc<GpuScene>,

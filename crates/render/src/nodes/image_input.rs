@@ -6,19 +6,16 @@ use lumagraph_graph::{Pass, TexFormat};
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed, owns_nothing};
+use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed};
 use crate::pool::{PooledTexture, create};
 
 /// The `ImageInput` kind: its size is the image file's.
-pub(crate) const IMPL: NodeImpl = NodeImpl {
-    kind: "ImageInput",
-    create: |ctx, pass, resources| boxed(ImageInput::new(ctx, pass, resources)),
-    owned_memory: owns_nothing,
-    source_extent: Some(|base_dir, params| {
-        crate::image_io::dimensions(&base_dir.join(params.str("path"))).map_err(|e| e.to_string())
-    }),
-    features: None,
-};
+pub(crate) const IMPL: NodeImpl = NodeImpl::new("ImageInput", |ctx, pass, resources| {
+    boxed(ImageInput::new(ctx, pass, resources))
+})
+.sized_by(|base_dir, params| {
+    crate::image_io::dimensions(&base_dir.join(params.str("path"))).map_err(|e| e.to_string())
+});
 
 pub(crate) struct ImageInput {
     paths: Resources,

@@ -191,8 +191,49 @@ impl std::fmt::Debug for NodeImpl {
     }
 }
 
+impl NodeImpl {
+    /// The implementation of `kind` made by `create`: no memory of its own, no source size,
+    /// no shader features (the builder methods add them).
+    pub const fn new(
+        kind: &'static str,
+        create: fn(&GpuContext, &Pass, &Resources) -> Result<Box<dyn NodeExec>>,
+    ) -> Self {
+        Self {
+            kind,
+            create,
+            owned_memory: owns_nothing,
+            source_extent: None,
+            features: None,
+        }
+    }
+
+    /// With memory of its own (see [`NodeImpl::owned_memory`]).
+    #[must_use]
+    pub const fn owning(mut self, owned_memory: fn(&Pass) -> Option<(u64, String)>) -> Self {
+        self.owned_memory = owned_memory;
+        self
+    }
+
+    /// A source telling its image size from its params.
+    #[must_use]
+    pub const fn sized_by(mut self, source_extent: SourceExtent) -> Self {
+        self.source_extent = Some(source_extent);
+        self
+    }
+
+    /// With shader features to list for a scene.
+    #[must_use]
+    pub const fn with_features(
+        mut self,
+        features: fn(&Pass, &lumagraph_scene::GpuScene) -> Vec<crate::specialize::Feature>,
+    ) -> Self {
+        self.features = Some(features);
+        self
+    }
+}
+
 /// [`NodeImpl::owned_memory`] of a kind that owns no memory.
-pub(crate) fn owns_nothing(_: &Pass) -> Option<(u64, String)> {
+fn owns_nothing(_: &Pass) -> Option<(u64, String)> {
     None
 }
 

@@ -6,16 +6,12 @@ use lumagraph_graph::{Extent, Pass, PortType, TexFormat};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed, check_writable, owns_nothing};
+use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed, check_writable};
 
 /// The `Output` kind.
-pub(crate) const IMPL: NodeImpl = NodeImpl {
-    kind: "Output",
-    create: |ctx, pass, resources| boxed(Output::new(ctx, pass, resources)),
-    owned_memory: owns_nothing,
-    source_extent: None,
-    features: None,
-};
+pub(crate) const IMPL: NodeImpl = NodeImpl::new("Output", |ctx, pass, resources| {
+    boxed(Output::new(ctx, pass, resources))
+});
 
 pub(crate) struct Output {
     paths: Resources,

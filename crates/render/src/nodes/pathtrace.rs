@@ -10,7 +10,7 @@ use crate::error::{RenderError, Result};
 use crate::kernel::{Kernel, uniform_buffer};
 use lumagraph_graph::TexFormat;
 
-use crate::nodes::{Counter, NodeExec, NodeImpl, Recording, Resources, boxed, owns_nothing};
+use crate::nodes::{Counter, NodeExec, NodeImpl, Recording, Resources, boxed};
 use crate::pool::{PooledTexture, create};
 use crate::readback::map_read;
 use crate::scene_gpu::SceneBuffers;
@@ -19,15 +19,12 @@ use crate::scene_gpu::SceneBuffers;
 const STATS: u64 = 4;
 
 /// The `PathTrace` kind.
-pub(crate) const IMPL: NodeImpl = NodeImpl {
-    kind: "PathTrace",
-    create: |ctx, pass, resources| boxed(PathTrace::new(ctx, pass, resources)),
-    owned_memory: owns_nothing,
-    source_extent: None,
-    features: Some(|pass, scene| {
-        crate::specialize::features(scene, options(pass, &Resources::default()))
-    }),
-};
+pub(crate) const IMPL: NodeImpl = NodeImpl::new("PathTrace", |ctx, pass, resources| {
+    boxed(PathTrace::new(ctx, pass, resources))
+})
+.with_features(|pass, scene| {
+    crate::specialize::features(scene, options(pass, &Resources::default()))
+});
 
 /// How a pass's shader is specialized: to the scene unless the resources ask for the
 /// general shader, with first-hit AOVs when something reads them.

@@ -10,17 +10,13 @@ use lumagraph_graph::{NodeKind, ParamType, Pass, Registry};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::kernel::Binding;
-use crate::nodes::{FilterPass, NodeExec, NodeImpl, Recording, boxed, owns_nothing};
+use crate::nodes::{FilterPass, NodeExec, NodeImpl, Recording, boxed};
 
 /// The implementation of every kind with a `shader` (its `kind` is a placeholder:
 /// [`crate::nodes::implementation`] hands it out for those kinds).
-pub(crate) const IMPL: NodeImpl = NodeImpl {
-    kind: "(post filter)",
-    create: |ctx, pass, _| boxed(PostFilter::new(ctx, pass)),
-    owned_memory: owns_nothing,
-    source_extent: None,
-    features: None,
-};
+pub(crate) const IMPL: NodeImpl = NodeImpl::new("(post filter)", |ctx, pass, _| {
+    boxed(PostFilter::new(ctx, pass))
+});
 
 /// The registry kind of `pass` and its shader, when it is a generic post filter.
 fn kind_and_shader(kind: &str) -> Option<(&'static NodeKind, &'static str)> {

@@ -4,16 +4,11 @@ use lumagraph_graph::Pass;
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::nodes::{ColorFilter, NodeExec, NodeImpl, Recording, boxed, owns_nothing};
+use crate::nodes::{ColorFilter, NodeExec, NodeImpl, Recording, boxed};
 
 /// The `Tonemap` kind.
-pub(crate) const IMPL: NodeImpl = NodeImpl {
-    kind: "Tonemap",
-    create: |ctx, pass, _| boxed(Tonemap::new(ctx, pass)),
-    owned_memory: owns_nothing,
-    source_extent: None,
-    features: None,
-};
+pub(crate) const IMPL: NodeImpl =
+    NodeImpl::new("Tonemap", |ctx, pass, _| boxed(Tonemap::new(ctx, pass)));
 
 crate::param_block! {
     /// Tonemap's params: the operator (its index in the registry's options) and the white
