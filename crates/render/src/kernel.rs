@@ -270,11 +270,6 @@ impl Kernel {
             methods: Vec::with_capacity(self.bindings.len()),
         }
     }
-
-    /// The bindings its shader declares, in binding order.
-    pub fn bindings(&self) -> &[Binding] {
-        &self.bindings
-    }
 }
 
 /// A pass being declared: its resources in binding order, then the dispatch. Each resource

@@ -89,7 +89,7 @@ pub fn check_layout(layout: &BlockLayout) -> std::result::Result<(), String> {
     layouter
         .update(module.to_ctx())
         .map_err(|e| format!("{}: {e}", layout.shader))?;
-    let (handle, ty) = module
+    let (_, ty) = module
         .types
         .iter()
         .find(|(_, t)| t.name.as_deref() == Some(layout.wgsl))
@@ -107,7 +107,6 @@ pub fn check_layout(layout: &BlockLayout) -> std::result::Result<(), String> {
             layout.size
         ));
     }
-    let _ = handle;
     let wgsl: Vec<(&str, usize)> = members
         .iter()
         .map(|m| (m.name.as_deref().unwrap_or("?"), m.offset as usize))

@@ -18,7 +18,7 @@ pub(crate) const IMPL: NodeImpl = NodeImpl::new("(post filter)", |ctx, pass, _| 
     boxed(PostFilter::new(ctx, pass))
 });
 
-/// The registry kind of `pass` and its shader, when it is a generic post filter.
+/// The registry entry of `kind` and its shader, when it is a generic post filter.
 fn kind_and_shader(kind: &str) -> Option<(&'static NodeKind, &'static str)> {
     let k = Registry::builtin().get(kind)?;
     Some((k, k.shader?))
