@@ -58,7 +58,7 @@ struct Row {
 /// The graph without sinks, 1 spp per frame; returns it with the ports scored, as
 /// `(port, is_denoised)`.
 fn prepare(graph: &mut Graph) -> Result<Vec<(String, bool)>> {
-    let registry = Registry::builtin();
+    let registry = Registry::with_builtins();
     let kind = |n: &lumagraph::graph::Node| registry.get(&n.kind);
     let sinks: Vec<String> = graph
         .nodes

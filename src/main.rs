@@ -208,7 +208,7 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
 }
 
 fn uses_scene(plan: &lumagraph::graph::Plan) -> bool {
-    plan.passes.iter().any(|p| p.renders_scene)
+    plan.passes.iter().any(|p| p.kind.renders_scene)
 }
 
 /// The pass the render's samples come from (it has `samples_per_frame`), if any.
@@ -350,7 +350,7 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
 fn print_features(plan: &lumagraph::graph::Plan, scene: &GpuScene) {
     for pass in &plan.passes {
         let Some(features) =
-            lumagraph::render::nodes::implementation(pass.kind).and_then(|i| i.features)
+            lumagraph::render::nodes::implementation(&pass.kind).and_then(|i| i.features)
         else {
             continue;
         };
@@ -428,13 +428,13 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Nodes { markdown } => {
-            let r = Registry::builtin();
+            let r = Registry::with_builtins();
             print!(
                 "{}",
                 if markdown {
-                    docs::markdown(r)
+                    docs::markdown(&r)
                 } else {
-                    docs::text(r)
+                    docs::text(&r)
                 }
             );
             Ok(())

@@ -102,3 +102,45 @@ fn every_compute_shader_reflects_its_bindings() {
     }
     assert!(checked >= 8, "{checked} compute shaders");
 }
+
+/// Textures in a shader with a filtering sampler are reflected as filterable (2D and 3D),
+/// the sampler as a sampler; without a sampler a texture stays a plain `textureLoad` one.
+#[test]
+fn samplers_make_textures_filterable() {
+    use lumagraph::render::Binding;
+    use lumagraph::render::kernel::reflect;
+    let source = "
+        @group(0) @binding(0) var image: texture_2d<f32>;
+        @group(0) @binding(1) var lut: texture_3d<f32>;
+        @group(0) @binding(2) var smp: sampler;
+        @group(0) @binding(3) var out: texture_storage_2d<rgba32float, write>;
+        @compute @workgroup_size(8, 8)
+        fn main(@builtin(global_invocation_id) id: vec3u) {
+            let c = textureSampleLevel(image, smp, vec2f(0.5), 0.0);
+            let g = textureSampleLevel(lut, smp, c.rgb, 0.0);
+            textureStore(out, id.xy, g);
+        }";
+    let (bindings, _) = reflect("lut", source).unwrap();
+    assert_eq!(
+        bindings,
+        [
+            Binding::FilteredTexture {
+                dim: wgpu::TextureViewDimension::D2
+            },
+            Binding::FilteredTexture {
+                dim: wgpu::TextureViewDimension::D3
+            },
+            Binding::Sampler,
+            Binding::StorageTexture {
+                format: wgpu::TextureFormat::Rgba32Float,
+                access: wgpu::StorageTextureAccess::WriteOnly
+            },
+        ]
+    );
+    let resize = shader::resolve("post/resize.wgsl").unwrap();
+    let (bindings, _) = reflect("post/resize.wgsl", &resize).unwrap();
+    assert_eq!(bindings[1], Binding::Sampler);
+    let exposure = shader::resolve("post/exposure.wgsl").unwrap();
+    let (bindings, _) = reflect("post/exposure.wgsl", &exposure).unwrap();
+    assert_eq!(bindings[0], Binding::Texture);
+}

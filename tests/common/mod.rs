@@ -278,3 +278,81 @@ pub fn run_graph(
     exec.run_frame().unwrap();
     Some(keep.iter().map(|k| exec.read_port(k).unwrap()).collect())
 }
+
+/// Runs one node of `kind` with `params` on image files (`(input port, path)`, paths
+/// relative to the repository root or absolute) and returns its `color` output, or `None`
+/// without a GPU (when allowed).
+pub fn run_node(
+    kind: &str,
+    params: &[(&str, lumagraph::graph::ParamValue)],
+    inputs: &[(&str, &str)],
+) -> Option<lumagraph::render::cpu::Image> {
+    use lumagraph::graph::{Edge, Graph, Node, ParamValue};
+    let mut node = Node::new("n", kind);
+    for (k, v) in params {
+        node = node.with(k, v.clone());
+    }
+    let mut graph = Graph {
+        nodes: vec![node],
+        edges: Vec::new(),
+        origin: None,
+    };
+    for (i, (port, path)) in inputs.iter().enumerate() {
+        let id = format!("in{i}");
+        graph
+            .nodes
+            .push(Node::new(&id, "ImageInput").with("path", ParamValue::Str((*path).into())));
+        graph
+            .edges
+            .push(Edge::new(format!("{id}.color"), format!("n.{port}")));
+    }
+    let dir = tempfile::tempdir().unwrap();
+    run_graph(&graph, &["n.color"], dir.path()).map(|mut v| v.remove(0))
+}
+
+/// Asserts `got` is `want`'s size and each channel within `bound(pixel index, channel)` of
+/// it; prints the worst error as a fraction of its bound under `label`.
+pub fn assert_within(
+    label: &str,
+    got: &lumagraph::render::cpu::Image,
+    want: &lumagraph::render::cpu::Image,
+    bound: impl Fn(usize, usize) -> f64,
+) {
+    assert_eq!(
+        (got.width, got.height),
+        (want.width, want.height),
+        "{label}: size"
+    );
+    let mut worst = 0.0_f64;
+    for (i, (g, w)) in got.pixels.iter().zip(&want.pixels).enumerate() {
+        for c in 0..4 {
+            let err = f64::from((g[c] - w[c]).abs());
+            let b = bound(i, c);
+            worst = worst.max(err / b);
+            assert!(
+                err <= b,
+                "{label}: pixel {} ({}, {}) channel {c}: {} vs {} (bound {b:.2e})",
+                i,
+                i % want.width as usize,
+                i / want.width as usize,
+                g[c],
+                w[c]
+            );
+        }
+    }
+    eprintln!("{label}: worst error {worst:.3} of the bound");
+}
+
+/// `image` with each pixel mapped by `f`.
+pub fn map_pixels(
+    image: &lumagraph::render::cpu::Image,
+    mut f: impl FnMut(usize, [f64; 4]) -> [f64; 4],
+) -> lumagraph::render::cpu::Image {
+    let mut out = image.clone();
+    for (i, p) in out.pixels.iter_mut().enumerate() {
+        #[expect(clippy::cast_possible_truncation, reason = "f32 images")]
+        let q = f(i, p.map(f64::from)).map(|v| v as f32);
+        *p = q;
+    }
+    out
+}

@@ -13,8 +13,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use egui::{Key, Modifiers, Ui, ViewportCommand};
-use lumagraph_graph::{CompileOptions, Graph, Node, Params, Registry};
-use lumagraph_render::{GpuContext, source_extent};
+use lumagraph_graph::Graph;
+use lumagraph_render::{GpuContext, compile_with};
 
 use crate::canvas::{Canvas, CanvasEvent, NodeInfo};
 use crate::document::Document;
@@ -197,15 +197,7 @@ impl Editor {
         self.graph_errors.clear();
         let base = self.doc.base_dir();
         let scene = self.scene.as_ref().map(|s| &*s.preview.gpu);
-        let extent = |node: &Node, params: &Params| source_extent(&base, scene, node, params);
-        let result = lumagraph_graph::compile(
-            &key.0,
-            Registry::builtin(),
-            &CompileOptions {
-                source_extent: &extent,
-                keep: &[],
-            },
-        );
+        let result = compile_with(&key.0, self.doc.registry(), &base, &[], scene);
         if let Err(errs) = result {
             for e in errs.0 {
                 match e.node {
@@ -276,9 +268,13 @@ impl Editor {
         let port = self.effective_port();
         let base = self.doc.base_dir();
         let scene = self.scene.as_ref().map(|s| &s.preview);
-        let ran = self
-            .preview
-            .update(&self.doc.graph, &base, port.as_deref(), scene);
+        let ran = self.preview.update(
+            self.doc.registry(),
+            &self.doc.graph,
+            &base,
+            port.as_deref(),
+            scene,
+        );
         if let Some(p) = port.as_deref()
             && !ran
             && self.preview.wants_frames()

@@ -7,6 +7,7 @@
 //! all come from the registry, so new node kinds appear without editor changes.
 
 use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
 
 use egui::{Color32, Pos2, RichText, Ui, pos2};
 use egui_snarl::ui::{PinInfo, SnarlPin, SnarlStyle, SnarlViewer, SnarlWidget};
@@ -71,10 +72,11 @@ pub fn port_color(ty: PortType) -> Color32 {
     }
 }
 
-fn kind_of(graph: &Graph, id: &str) -> Option<&'static NodeKind> {
+fn kind_of<'r>(registry: &'r Registry, graph: &Graph, id: &str) -> Option<&'r NodeKind> {
     graph
         .node(id)
-        .and_then(|n| Registry::builtin().get(&n.kind))
+        .and_then(|n| registry.get(&n.kind))
+        .map(|k| &**k)
 }
 
 fn structure(graph: &Graph) -> Layout {
@@ -95,7 +97,7 @@ fn edges(graph: &Graph) -> Vec<(String, String)> {
 
 impl Canvas {
     /// Rebuilds the snarl when the graph's nodes, positions or edges changed.
-    fn sync(&mut self, graph: &Graph) {
+    fn sync(&mut self, registry: &Registry, graph: &Graph) {
         let s = structure(graph);
         let e = edges(graph);
         if self.built_from.as_ref() == Some(&s) && self.built_edges == e {
@@ -120,7 +122,10 @@ impl Canvas {
             else {
                 continue;
             };
-            let (Some(fk), Some(tk)) = (kind_of(graph, fnode), kind_of(graph, tnode)) else {
+            let (Some(fk), Some(tk)) = (
+                kind_of(registry, graph, fnode),
+                kind_of(registry, graph, tnode),
+            ) else {
                 continue;
             };
             let (Some(o), Some(i)) = (
@@ -152,7 +157,7 @@ impl Canvas {
         doc: &mut Document,
         info: &NodeInfo<'_>,
     ) -> Vec<CanvasEvent> {
-        self.sync(&doc.graph);
+        self.sync(doc.registry(), &doc.graph);
         let mut events = Vec::new();
         let mut viewer = Viewer {
             doc,
@@ -271,8 +276,9 @@ struct Viewer<'a, 'i> {
 }
 
 impl Viewer<'_, '_> {
-    fn kind(&self, id: &str) -> Option<&'static NodeKind> {
-        kind_of(&self.doc.graph, id)
+    fn kind(&self, id: &str) -> Option<Arc<NodeKind>> {
+        let kind = self.doc.graph.node(id)?.kind.as_str();
+        self.doc.registry().get(kind).cloned()
     }
 
     fn out_ref(&self, snarl: &Snarl<String>, pin: OutPinId) -> Option<String> {
@@ -290,11 +296,10 @@ impl Viewer<'_, '_> {
 
 /// The add-node menu: a search field and the registry's kinds grouped by category.
 /// Returns the kind picked.
-pub fn add_node_menu(ui: &mut Ui, search: &mut String) -> Option<&'static str> {
+pub fn add_node_menu(ui: &mut Ui, reg: &Registry, search: &mut String) -> Option<&'static str> {
     ui.add(egui::TextEdit::singleline(search).hint_text("search nodes"))
         .request_focus();
     let needle = search.to_lowercase();
-    let reg = Registry::builtin();
     let mut by_cat: BTreeMap<Category, Vec<&NodeKind>> = BTreeMap::new();
     for k in reg.kinds() {
         if needle.is_empty()
@@ -390,7 +395,7 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
     ) -> impl SnarlPin + 'static {
         let Some(def) = self
             .kind(&snarl[pin.id.node])
-            .and_then(|k| k.inputs.get(pin.id.input))
+            .and_then(|k| k.inputs.get(pin.id.input).cloned())
         else {
             return PinInfo::circle();
         };
@@ -412,7 +417,10 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
         snarl: &mut Snarl<String>,
     ) -> impl SnarlPin + 'static {
         let id = snarl[pin.id.node].clone();
-        let Some(def) = self.kind(&id).and_then(|k| k.outputs.get(pin.id.output)) else {
+        let Some(def) = self
+            .kind(&id)
+            .and_then(|k| k.outputs.get(pin.id.output).cloned())
+        else {
             return PinInfo::circle();
         };
         let port = format!("{id}.{}", def.name);
@@ -497,7 +505,7 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
 
     fn show_graph_menu(&mut self, pos: Pos2, ui: &mut Ui, _snarl: &mut Snarl<String>) {
         ui.label("Add node");
-        if let Some(kind) = add_node_menu(ui, self.search) {
+        if let Some(kind) = add_node_menu(ui, self.doc.registry(), self.search) {
             match self.doc.add_node(kind, Some((pos.x, pos.y))) {
                 Ok(id) => self.events.push(CanvasEvent::Added(id)),
                 Err(e) => self.events.push(CanvasEvent::Refused(e)),
@@ -519,7 +527,7 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
     ) {
         let id = snarl[node].clone();
         if let Some(k) = self.kind(&id) {
-            for o in k.outputs {
+            for o in &k.outputs {
                 if ui.button(format!("Preview {}", o.name)).clicked() {
                     self.events
                         .push(CanvasEvent::Preview(format!("{id}.{}", o.name)));

@@ -7,32 +7,47 @@
 
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use lumagraph_graph::{Edge, ErrorKind, Graph, Node, ParamValue, Registry, split_port_ref};
 
 use crate::undo::History;
 
 /// A graph being edited.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct Document {
     /// The graph: what is saved, compiled and previewed.
     pub graph: Graph,
     /// The file it was opened from or last saved to.
     pub path: Option<PathBuf>,
+    /// The node kinds the graph is checked against.
+    registry: Arc<Registry>,
     saved: Graph,
     history: History,
+}
+
+impl Default for Document {
+    fn default() -> Self {
+        Self::new(Graph::default(), None)
+    }
 }
 
 /// Where a new node goes when none is given: right of the rightmost node.
 const NODE_SPACING: f32 = 220.0;
 
 impl Document {
-    /// A document for `graph`, as if just opened from `path`.
+    /// A document for `graph`, as if just opened from `path`, with the built-in kinds.
     pub fn new(graph: Graph, path: Option<PathBuf>) -> Self {
+        Self::with_registry(graph, path, Arc::new(Registry::with_builtins()))
+    }
+
+    /// A document for `graph` checked against `registry`.
+    pub fn with_registry(graph: Graph, path: Option<PathBuf>, registry: Arc<Registry>) -> Self {
         Self {
             saved: graph.clone(),
             graph,
             path,
+            registry,
             history: History::default(),
         }
     }
@@ -57,9 +72,9 @@ impl Document {
             .unwrap_or_default()
     }
 
-    /// The registry the document is checked against.
-    pub fn registry() -> &'static Registry {
-        Registry::builtin()
+    /// The node kinds the document is checked against.
+    pub fn registry(&self) -> &Registry {
+        &self.registry
     }
 
     fn record(&mut self, key: Option<&str>) {
@@ -128,7 +143,7 @@ impl Document {
     /// # Errors
     /// When the registry has no such kind.
     pub fn add_node(&mut self, kind: &str, pos: Option<(f32, f32)>) -> Result<String, String> {
-        if Self::registry().get(kind).is_none() {
+        if self.registry().get(kind).is_none() {
             return Err(format!("unknown node kind \"{kind}\""));
         }
         let pos = pos.unwrap_or_else(|| {
@@ -152,7 +167,7 @@ impl Document {
     /// Why an edge `from` → `to` (each `"node.port"`) cannot be made, in the compiler's
     /// words; `None` when it can.
     pub fn check_edge(&self, from: &str, to: &str) -> Option<String> {
-        let reg = Self::registry();
+        let reg = self.registry();
         let (Some((fnode, fport)), Some((tnode, tport))) =
             (split_port_ref(from), split_port_ref(to))
         else {

@@ -87,11 +87,16 @@ pub fn open(path: &Path) -> Result<Graph, EditorError> {
 ///
 /// # Errors
 /// When the file cannot be written.
-pub fn save(graph: &Graph, old_base: &Path, path: &Path) -> Result<Graph, EditorError> {
+pub fn save(
+    registry: &Registry,
+    graph: &Graph,
+    old_base: &Path,
+    path: &Path,
+) -> Result<Graph, EditorError> {
     let new_base = path.parent().unwrap_or(Path::new(""));
     let mut out = graph.clone();
     if absolute(old_base) != absolute(new_base) {
-        rebase_inputs(&mut out, old_base, new_base);
+        rebase_inputs(registry, &mut out, old_base, new_base);
     }
     out.save(path)
         .map_err(|e| EditorError::Graph(e.to_string()))?;
@@ -139,11 +144,10 @@ fn relative_to(target: &Path, base: &Path) -> PathBuf {
 
 /// Rewrites the relative path params of input nodes (non-sinks; sink paths are relative
 /// to the output folder) from `old_base` to `new_base`.
-pub fn rebase_inputs(graph: &mut Graph, old_base: &Path, new_base: &Path) {
+pub fn rebase_inputs(registry: &Registry, graph: &mut Graph, old_base: &Path, new_base: &Path) {
     let (old_base, new_base) = (absolute(old_base), absolute(new_base));
-    let reg = Registry::builtin();
     for node in &mut graph.nodes {
-        let Some(kind) = reg.get(&node.kind) else {
+        let Some(kind) = registry.get(&node.kind) else {
             continue;
         };
         if kind.sink {

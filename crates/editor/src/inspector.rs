@@ -9,7 +9,7 @@ use std::path::Path;
 
 use egui::{Color32, RichText, Ui};
 use lumagraph_graph::registry::ParamDef;
-use lumagraph_graph::{ParamType, ParamValue, Registry};
+use lumagraph_graph::{ParamType, ParamValue};
 
 use crate::document::Document;
 
@@ -32,7 +32,7 @@ pub fn show(
         return None;
     };
     ui.heading(&node.id);
-    let Some(kind) = Registry::builtin().get(&node.kind) else {
+    let Some(kind) = doc.registry().get(&node.kind).cloned() else {
         ui.colored_label(
             Color32::from_rgb(230, 60, 60),
             format!("unknown node kind \"{}\"", node.kind),

@@ -27,8 +27,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-use lumagraph_graph::{CompileOptions, Graph, Node, Params, Plan, PortType, Registry};
-use lumagraph_render::{Executor, FrameReport, GpuContext, Resources, source_extent};
+use lumagraph_graph::{Graph, Plan, PortType, Registry};
+use lumagraph_render::{Executor, FrameReport, GpuContext, Resources, compile_with};
 use lumagraph_scene::GpuScene;
 
 /// The scene the preview renders, already at the preview's resolution.
@@ -111,8 +111,7 @@ impl std::fmt::Debug for Preview {
 }
 
 /// The graph the preview runs: `graph` without its sinks (nothing is written to disk).
-pub fn preview_graph(graph: &Graph) -> Graph {
-    let reg = Registry::builtin();
+pub fn preview_graph(reg: &Registry, graph: &Graph) -> Graph {
     let is_sink = |id: &str| {
         graph
             .node(id)
@@ -134,8 +133,7 @@ pub fn preview_graph(graph: &Graph) -> Graph {
 /// So the preview runs what `lumagraph render` runs, no two of those outputs share
 /// texture memory (a param edit can re-run only what is downstream of it), and previewing
 /// another of them is not a structural change (accumulation goes on).
-pub fn preview_keep(graph: &Graph, port: &str) -> Vec<String> {
-    let reg = Registry::builtin();
+pub fn preview_keep(reg: &Registry, graph: &Graph, port: &str) -> Vec<String> {
     let node_of = |p: &str| lumagraph_graph::split_port_ref(p).map(|(n, _)| n.to_owned());
     let mut upstream = BTreeSet::new();
     let mut stack: Vec<String> = graph
@@ -172,23 +170,15 @@ pub fn preview_keep(graph: &Graph, port: &str) -> Vec<String> {
 /// # Errors
 /// The compiler's messages, one a line.
 pub fn compile_preview(
+    registry: &Registry,
     graph: &Graph,
     base: &Path,
     port: &str,
     scene: Option<&GpuScene>,
 ) -> Result<Plan, String> {
-    let g = preview_graph(graph);
-    let extent = |node: &Node, params: &Params| source_extent(base, scene, node, params);
-    let keep = preview_keep(graph, port);
-    lumagraph_graph::compile(
-        &g,
-        Registry::builtin(),
-        &CompileOptions {
-            source_extent: &extent,
-            keep: &keep,
-        },
-    )
-    .map_err(|e| {
+    let g = preview_graph(registry, graph);
+    let keep = preview_keep(registry, graph, port);
+    compile_with(&g, registry, base, &keep, scene).map_err(|e| {
         e.0.iter()
             .map(|e| match &e.node {
                 Some(n) => format!("{n}: {}", e.kind),
@@ -235,6 +225,7 @@ impl Preview {
     /// Returns whether a frame ran.
     pub fn update(
         &mut self,
+        registry: &Registry,
         graph: &Graph,
         base: &Path,
         port: Option<&str>,
@@ -244,7 +235,7 @@ impl Preview {
             self.clear(Some("select a node with an output to preview it".into()));
             return false;
         };
-        let mut g = preview_graph(graph);
+        let mut g = preview_graph(registry, graph);
         g.origin = None;
         let generation = scene.map_or(0, |s| s.generation);
         let key = (g, port.to_owned(), base.to_owned(), generation);
@@ -258,7 +249,7 @@ impl Preview {
             self.exec = None;
             self.scene = scene.map(|s| Arc::clone(&s.gpu));
         }
-        match self.render(graph, base, port) {
+        match self.render(registry, graph, base, port) {
             Ok(()) => {
                 self.error = None;
                 true
@@ -280,8 +271,14 @@ impl Preview {
         self.error = error;
     }
 
-    fn render(&mut self, graph: &Graph, base: &Path, port: &str) -> Result<(), String> {
-        let plan = compile_preview(graph, base, port, self.scene.as_deref())?;
+    fn render(
+        &mut self,
+        registry: &Registry,
+        graph: &Graph,
+        base: &Path,
+        port: &str,
+    ) -> Result<(), String> {
+        let plan = compile_preview(registry, graph, base, port, self.scene.as_deref())?;
         let changed: Vec<String> = match &self.exec {
             Some(exec) => exec
                 .plan()
@@ -323,7 +320,7 @@ impl Preview {
                 ..Resources::default()
             };
             let exec = Executor::new(&self.gpu, plan, &paths).map_err(|e| e.to_string())?;
-            self.progressive = exec.plan().passes.iter().any(|p| p.history);
+            self.progressive = exec.plan().passes.iter().any(|p| p.kind.history);
             self.target_spp = self
                 .scene
                 .as_ref()

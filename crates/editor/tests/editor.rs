@@ -427,14 +427,18 @@ fn param_edits_are_cheaper_than_rebuilds() {
     let base = ed.doc.base_dir();
     let port = Some("tonemap.color");
     let t = std::time::Instant::now();
-    ed.preview.update(&ed.doc.graph, &base, port, None);
+    ed.preview
+        .update(ed.doc.registry(), &ed.doc.graph, &base, port, None);
     let first = t.elapsed();
     let n: u32 = 10;
     let t = std::time::Instant::now();
     for i in 0..n {
         ed.doc
             .set_param("exposure", "ev", ParamValue::Float(f64::from(i + 1) * 0.1));
-        assert!(ed.preview.update(&ed.doc.graph, &base, port, None));
+        assert!(
+            ed.preview
+                .update(ed.doc.registry(), &ed.doc.graph, &base, port, None)
+        );
     }
     let per_edit = t.elapsed() / n;
     let s = &ed.preview.stats;

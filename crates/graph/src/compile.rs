@@ -10,6 +10,7 @@
 //!    and size agree share one allocation (greedy interval assignment).
 
 use std::collections::{BTreeMap, HashMap, HashSet};
+use std::sync::Arc;
 
 use petgraph::algo::{tarjan_scc, toposort};
 use petgraph::graph::{DiGraph, NodeIndex};
@@ -115,8 +116,9 @@ pub fn resolve_params(node: &Node, kind: &NodeKind) -> Result<Params, Vec<(Strin
 
 /// What the compiler needs from outside the graph.
 pub struct CompileOptions<'a> {
-    /// The image size a source node (one with no inputs) produces, or why it cannot tell.
-    pub source_extent: &'a dyn Fn(&Node, &Params) -> Result<Extent, String>,
+    /// The image size a source node (one with no inputs) of a kind produces with the
+    /// params given, or why it cannot tell.
+    pub source_extent: &'a dyn Fn(&NodeKind, &Params) -> Result<Extent, String>,
     /// Extra `"node.port"` outputs to keep alive to the end of the frame (live previews).
     pub keep: &'a [String],
 }
@@ -130,7 +132,7 @@ impl std::fmt::Debug for CompileOptions<'_> {
 }
 
 struct Checked<'g> {
-    kinds: Vec<Option<&'g NodeKind>>,
+    kinds: Vec<Option<&'g Arc<NodeKind>>>,
     params: Vec<Params>,
     /// (consumer node, input port) → (producer node, output port).
     inputs: HashMap<(usize, &'g str), (usize, &'g str)>,
@@ -217,8 +219,8 @@ pub fn compile(
         if !live[i] || !edges_ok {
             continue;
         }
-        for input in kind.inputs {
-            if !checked.inputs.contains_key(&(i, input.name)) {
+        for input in &kind.inputs {
+            if !input.optional && !checked.inputs.contains_key(&(i, input.name)) {
                 let e = GraphError::new(ErrorKind::UnconnectedInput {
                     port: input.name.to_owned(),
                 })
@@ -260,7 +262,7 @@ fn check_nodes<'g>(
     graph: &'g Graph,
     registry: &'g Registry,
     errors: &mut Vec<GraphError>,
-) -> (Vec<Option<&'g NodeKind>>, Vec<Params>) {
+) -> (Vec<Option<&'g Arc<NodeKind>>>, Vec<Params>) {
     let mut seen = HashSet::new();
     let mut kinds = Vec::with_capacity(graph.nodes.len());
     let mut params = Vec::with_capacity(graph.nodes.len());
@@ -310,7 +312,7 @@ fn check_nodes<'g>(
 /// input.
 fn check_edges<'g>(
     graph: &'g Graph,
-    kinds: &[Option<&'g NodeKind>],
+    kinds: &[Option<&'g Arc<NodeKind>>],
     errors: &mut Vec<GraphError>,
 ) -> HashMap<(usize, &'g str), (usize, &'g str)> {
     let index: HashMap<&str, usize> = graph
@@ -426,7 +428,6 @@ fn build_plan(
     errors: &mut Vec<GraphError>,
 ) -> Plan {
     let position: HashMap<usize, usize> = order.iter().enumerate().map(|(p, &i)| (i, p)).collect();
-    let mut extents: HashMap<usize, Extent> = HashMap::new();
     let mut textures: Vec<TextureDesc> = Vec::new();
     let mut texture_of: HashMap<(usize, &str), TextureId> = HashMap::new();
     let mut passes = Vec::with_capacity(order.len());
@@ -436,25 +437,34 @@ fn build_plan(
         let node = &graph.nodes[i];
         let kind = checked.kinds[i].expect("live nodes have known kinds");
         let params = checked.params[i].clone();
+        let located = |m: String, param: Option<&str>| {
+            graph.locate(
+                GraphError::new(ErrorKind::Source(m)).at_node(&node.id),
+                None,
+                param,
+            )
+        };
         let mut inputs = Vec::new();
         let mut extent = None;
-        for input in kind.inputs {
-            let (from, port) = checked.inputs[&(i, input.name)];
+        for input in &kind.inputs {
+            let Some(&(from, port)) = checked.inputs.get(&(i, input.name)) else {
+                left_out.push(LeftOut {
+                    what: format!("input {}.{}", node.id, input.name),
+                    reason: "optional, not connected".into(),
+                });
+                continue;
+            };
             let t = texture_of[&(from, port)];
             let e = textures[t.0].extent;
             match extent {
                 None => extent = Some(e),
-                Some(prev) if prev != e => errors.push(
-                    graph.locate(
-                        GraphError::new(ErrorKind::Source(format!(
-                            "inputs differ in size: {prev} and {e} (input \"{}\")",
-                            input.name
-                        )))
-                        .at_node(&node.id),
-                        None,
-                        None,
+                Some(prev) if prev != e => errors.push(located(
+                    format!(
+                        "inputs differ in size: {prev} and {e} (input \"{}\")",
+                        input.name
                     ),
-                ),
+                    None,
+                )),
                 Some(_) => {}
             }
             textures[t.0].last = textures[t.0].last.max(p);
@@ -462,22 +472,17 @@ fn build_plan(
         }
         let extent = match extent {
             Some(e) => e,
-            None => match (options.source_extent)(node, &params) {
+            None => match (options.source_extent)(kind, &params) {
                 Ok(e) => e,
                 Err(m) => {
-                    errors.push(graph.locate(
-                        GraphError::new(ErrorKind::Source(m)).at_node(&node.id),
-                        None,
-                        Some("path"),
-                    ));
+                    errors.push(located(m, Some("path")));
                     Extent::new(1, 1)
                 }
             },
         };
-        extents.insert(i, extent);
 
         let mut outputs = Vec::new();
-        for output in kind.outputs {
+        for output in &kind.outputs {
             let name = format!("{}.{}", node.id, output.name);
             let consumed = checked.inputs.iter().any(|((to, _), (from, port))| {
                 *from == i && *port == output.name && position.contains_key(to)
@@ -490,13 +495,20 @@ fn build_plan(
                 });
                 continue;
             }
+            let size = match output.size.extent(extent, &params) {
+                Ok(e) => e,
+                Err(m) => {
+                    errors.push(located(format!("output \"{}\": {m}", output.name), None));
+                    extent
+                }
+            };
             let id = TextureId(textures.len());
             textures.push(TextureDesc {
                 id,
                 name,
                 ty: output.ty,
                 format: output.ty.format(),
-                extent,
+                extent: size,
                 first: p,
                 last: if kept { order.len() } else { p },
                 slot: 0,
@@ -506,11 +518,7 @@ fn build_plan(
         }
         passes.push(Pass {
             node: node.id.clone(),
-            kind: kind.name,
-            category: kind.category,
-            sink: kind.sink,
-            history: kind.history,
-            renders_scene: kind.renders_scene,
+            kind: Arc::clone(kind),
             params,
             inputs,
             outputs,

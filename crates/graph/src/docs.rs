@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use crate::registry::{NodeKind, Registry};
+use crate::registry::{InputDef, NodeKind, OutputDef, Registry};
 use crate::types::{ParamType, PortType};
 
 fn param_range(ty: &ParamType) -> String {
@@ -32,23 +32,46 @@ fn accepts(types: &[PortType]) -> String {
         .join(" | ")
 }
 
+/// An input's description, marked when it is optional.
+fn input_doc(p: &InputDef) -> String {
+    if p.optional {
+        format!("(optional) {}", p.doc)
+    } else {
+        p.doc.to_owned()
+    }
+}
+
+/// An output's description, with its size rule when it is not the pass's size.
+fn output_doc(p: &OutputDef) -> String {
+    match p.size.describe() {
+        Some(size) => format!("{}; size: {size}", p.doc),
+        None => p.doc.to_owned(),
+    }
+}
+
 /// A plain-text listing of every kind, for the terminal.
 pub fn text(registry: &Registry) -> String {
     let mut s = String::new();
     for kind in registry.kinds() {
         let _ = writeln!(s, "{} [{}]", kind.name, kind.category.name());
         let _ = writeln!(s, "    {}", kind.doc);
-        for p in kind.inputs {
+        for p in &kind.inputs {
             let _ = writeln!(
                 s,
                 "    in   {:<10} {:<24} {}",
                 p.name,
                 accepts(p.accepts),
-                p.doc
+                input_doc(p)
             );
         }
-        for p in kind.outputs {
-            let _ = writeln!(s, "    out  {:<10} {:<24} {}", p.name, p.ty.name(), p.doc);
+        for p in &kind.outputs {
+            let _ = writeln!(
+                s,
+                "    out  {:<10} {:<24} {}",
+                p.name,
+                p.ty.name(),
+                output_doc(p)
+            );
         }
         for p in &kind.params {
             let _ = writeln!(
@@ -73,17 +96,23 @@ fn kind_markdown(s: &mut String, kind: &NodeKind) {
             s,
             "| port | direction | type | description |\n|---|---|---|---|"
         );
-        for p in kind.inputs {
+        for p in &kind.inputs {
             let _ = writeln!(
                 s,
                 "| `{}` | in | {} | {} |",
                 p.name,
                 accepts(p.accepts),
-                p.doc
+                input_doc(p)
             );
         }
-        for p in kind.outputs {
-            let _ = writeln!(s, "| `{}` | out | {} | {} |", p.name, p.ty.name(), p.doc);
+        for p in &kind.outputs {
+            let _ = writeln!(
+                s,
+                "| `{}` | out | {} | {} |",
+                p.name,
+                p.ty.name(),
+                output_doc(p)
+            );
         }
         s.push('\n');
     }

@@ -2,9 +2,10 @@
 //! allocations, and everything left out.
 
 use std::fmt;
+use std::sync::Arc;
 
 use crate::compile::Params;
-use crate::registry::Category;
+use crate::registry::NodeKind;
 use crate::types::{Extent, PortType, TexFormat};
 
 /// Index of a logical texture in [`Plan::textures`].
@@ -12,28 +13,36 @@ use crate::types::{Extent, PortType, TexFormat};
 pub struct TextureId(pub usize);
 
 /// One node's work in a frame.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct Pass {
     /// Node id.
     pub node: String,
-    /// Node kind name.
-    pub kind: &'static str,
-    /// The kind's category.
-    pub category: Category,
-    /// The kind writes results out of the graph (`NodeKind::sink`).
-    pub sink: bool,
-    /// The kind keeps history across frames (`NodeKind::history`).
-    pub history: bool,
-    /// The kind renders the scene (`NodeKind::renders_scene`).
-    pub renders_scene: bool,
+    /// The node's kind: its ports, params, flags (`sink`, `history`, `renders_scene`) and
+    /// shader, so that running the pass needs no registry.
+    pub kind: Arc<NodeKind>,
     /// Checked params with defaults filled in.
     pub params: Params,
-    /// Input port → texture read.
+    /// Input port → texture read (optional inputs left unconnected are absent).
     pub inputs: Vec<(&'static str, TextureId)>,
     /// Output port → texture written (only outputs something reads).
     pub outputs: Vec<(&'static str, TextureId)>,
-    /// Size of the images the pass works on.
+    /// Size of the images the pass works on: its inputs' size, or the size a source
+    /// produces. An output port may have another size ([`OutputSize`](crate::registry::OutputSize));
+    /// [`Plan::texture`]'s extent is the one a texture really has.
     pub extent: Extent,
+}
+
+impl fmt::Debug for Pass {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Pass")
+            .field("node", &self.node)
+            .field("kind", &self.kind.name)
+            .field("params", &self.params)
+            .field("inputs", &self.inputs)
+            .field("outputs", &self.outputs)
+            .field("extent", &self.extent)
+            .finish()
+    }
 }
 
 impl Pass {
@@ -43,6 +52,11 @@ impl Pass {
             .iter()
             .find(|(p, _)| *p == port)
             .map(|(_, t)| *t)
+    }
+
+    /// The kind's name.
+    pub fn kind_name(&self) -> &'static str {
+        self.kind.name
     }
 
     /// The texture bound to output `port`, if anything reads it.
@@ -121,6 +135,11 @@ impl Plan {
         self.passes.iter().find(|p| p.node == id)
     }
 
+    /// The logical texture `id`.
+    pub fn texture(&self, id: TextureId) -> &TextureDesc {
+        &self.textures[id.0]
+    }
+
     /// Bytes allocated for transient textures.
     pub fn texture_bytes(&self) -> u64 {
         self.slots.iter().map(Slot::bytes).sum()
@@ -160,7 +179,7 @@ impl fmt::Display for Plan {
                 "  {:>2}. {:<w$}  {:<12} {:>9}",
                 i + 1,
                 p.node,
-                p.kind,
+                p.kind.name,
                 p.extent.to_string()
             )?;
             if !reads.is_empty() {

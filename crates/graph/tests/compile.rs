@@ -1,18 +1,18 @@
 //! Validation, pruning and texture assignment, and the RON round trip.
 
 use lumagraph_graph::{
-    CompileOptions, Edge, ErrorKind, Extent, Graph, GraphErrors, Node, ParamValue, Plan, Registry,
-    compile,
+    CompileOptions, Edge, ErrorKind, Extent, Graph, GraphErrors, Node, NodeKind, ParamValue, Plan,
+    Registry, compile,
 };
 
-fn extent(_: &Node, _: &lumagraph_graph::Params) -> Result<Extent, String> {
+fn extent(_: &NodeKind, _: &lumagraph_graph::Params) -> Result<Extent, String> {
     Ok(Extent::new(64, 32))
 }
 
 fn compile_graph(g: &Graph) -> Result<Plan, GraphErrors> {
     compile(
         g,
-        Registry::builtin(),
+        &Registry::with_builtins(),
         &CompileOptions {
             source_extent: &extent,
             keep: &[],
@@ -121,7 +121,7 @@ fn kept_port_stays_alive_to_the_end() {
     let keep = ["exposure.color".to_owned()];
     let plan = compile(
         &chain(),
-        Registry::builtin(),
+        &Registry::with_builtins(),
         &CompileOptions {
             source_extent: &extent,
             keep: &keep,
@@ -389,10 +389,10 @@ fn unconnected_input_of_needed_node() {
 #[test]
 fn source_that_cannot_tell_its_size() {
     let g = load_str(&graph_text(GOOD_NODES, GOOD_EDGES)).unwrap();
-    let fail = |_: &Node, _: &lumagraph_graph::Params| Err("cannot open in.exr".to_owned());
+    let fail = |_: &NodeKind, _: &lumagraph_graph::Params| Err("cannot open in.exr".to_owned());
     let e = compile(
         &g,
-        Registry::builtin(),
+        &Registry::with_builtins(),
         &CompileOptions {
             source_extent: &fail,
             keep: &[],
@@ -438,4 +438,225 @@ fn saved_files_are_readable_by_others_and_keep_permissions() {
         std::fs::metadata(&path).unwrap().permissions().mode() & 0o777,
         0o600
     );
+}
+
+fn compile_with(g: &Graph, registry: &Registry) -> Result<Plan, GraphErrors> {
+    compile(
+        g,
+        registry,
+        &CompileOptions {
+            source_extent: &extent,
+            keep: &[],
+        },
+    )
+}
+
+/// A Denoise without its optional `variance` compiles; the plan says it was left out.
+/// Its required inputs still are required.
+#[test]
+fn optional_input_may_stay_unconnected() {
+    let mut g = Graph::new();
+    g.nodes = vec![
+        Node::new("img", "ImageInput"),
+        Node::new("dn", "Denoise"),
+        Node::new("out", "Output"),
+    ];
+    g.edges = vec![
+        Edge::new("img.color", "dn.color"),
+        Edge::new("dn.color", "out.color"),
+    ];
+    // albedo, normal, depth are required: three errors, none for variance.
+    let e = compile_graph(&g).unwrap_err();
+    let m = e.to_string();
+    assert_eq!(e.0.len(), 3, "{m}");
+    assert!(!m.contains("variance"), "{m}");
+
+    g.nodes.insert(0, Node::new("gb", "GBuffer"));
+    g.edges = vec![
+        Edge::new("img.color", "dn.color"),
+        Edge::new("gb.albedo", "dn.albedo"),
+        Edge::new("gb.normal", "dn.normal"),
+        Edge::new("gb.depth", "dn.depth"),
+        Edge::new("dn.color", "out.color"),
+    ];
+    let plan = compile_graph(&g).unwrap();
+    let dn = plan.pass("dn").unwrap();
+    assert_eq!(dn.inputs.len(), 4);
+    assert!(dn.input("variance").is_none());
+    assert!(
+        plan.left_out
+            .iter()
+            .any(|l| l.what == "input dn.variance" && l.reason.contains("optional")),
+        "{plan}"
+    );
+}
+
+/// A test kind with a half-size output and one sized from a param, on an owned registry
+/// that also holds the built-ins.
+fn sized_registry() -> Registry {
+    use lumagraph_graph::registry::{InputDef, OutputDef, OutputSize, ParamDef};
+    use lumagraph_graph::{Category, ParamType, PortType};
+    fn from_width(input: Extent, params: &lumagraph_graph::Params) -> Result<Extent, String> {
+        let w = params.int("width");
+        if w > 4096 {
+            return Err(format!("width {w} is more than 4096"));
+        }
+        let w = u32::try_from(w).map_err(|e| e.to_string())?;
+        // keep the aspect ratio
+        let h = (u64::from(input.height) * u64::from(w)).div_ceil(u64::from(input.width));
+        Ok(Extent::new(w, u32::try_from(h).map_err(|e| e.to_string())?))
+    }
+    let mut r = Registry::with_builtins();
+    r.add(NodeKind {
+        name: "Pyramid",
+        category: Category::Color,
+        doc: "test kind",
+        inputs: vec![InputDef::new("color", &[PortType::HdrColor], "in")],
+        outputs: vec![
+            OutputDef::new("half", PortType::HdrColor, "half size")
+                .sized(OutputSize::Scaled { num: 1, den: 2 }),
+            OutputDef::new("wide", PortType::HdrColor, "sized by a param").sized(OutputSize::Rule(
+                from_width,
+                "`width` wide, the input's aspect ratio",
+            )),
+            OutputDef::new("same", PortType::HdrColor, "same size"),
+        ],
+        params: vec![ParamDef {
+            name: "width",
+            ty: ParamType::Int {
+                default: 100,
+                min: 1,
+                max: 100_000,
+            },
+            doc: "width of `wide`",
+        }],
+        sink: false,
+        history: false,
+        renders_scene: false,
+        shader: None,
+    })
+    .unwrap();
+    r
+}
+
+/// Each output has the size its rule gives; passes downstream run at their input's size;
+/// textures of different sizes never share an allocation.
+#[test]
+fn outputs_have_their_own_sizes() {
+    let registry = sized_registry();
+    let mut g = Graph::new();
+    g.nodes = vec![
+        Node::new("img", "ImageInput"), // 64x32
+        Node::new("p", "Pyramid").with("width", ParamValue::Int(16)),
+        Node::new("e_half", "Exposure"),
+        Node::new("e_wide", "Exposure"),
+        Node::new("e_same", "Exposure"),
+        Node::new("o1", "Output"),
+        Node::new("o2", "Output"),
+        Node::new("o3", "Output"),
+    ];
+    g.edges = vec![
+        Edge::new("img.color", "p.color"),
+        Edge::new("p.half", "e_half.color"),
+        Edge::new("p.wide", "e_wide.color"),
+        Edge::new("p.same", "e_same.color"),
+        Edge::new("e_half.color", "o1.color"),
+        Edge::new("e_wide.color", "o2.color"),
+        Edge::new("e_same.color", "o3.color"),
+    ];
+    let plan = compile_with(&g, &registry).unwrap();
+    let size = |port: &str| {
+        plan.textures
+            .iter()
+            .find(|t| t.name == port)
+            .unwrap()
+            .extent
+    };
+    assert_eq!(size("p.half"), Extent::new(32, 16));
+    assert_eq!(size("p.wide"), Extent::new(16, 8));
+    assert_eq!(size("p.same"), Extent::new(64, 32));
+    assert_eq!(plan.pass("p").unwrap().extent, Extent::new(64, 32));
+    assert_eq!(plan.pass("e_half").unwrap().extent, Extent::new(32, 16));
+    assert_eq!(plan.pass("e_wide").unwrap().extent, Extent::new(16, 8));
+    assert_eq!(size("e_half.color"), Extent::new(32, 16));
+    for slot in &plan.slots {
+        for t in &slot.textures {
+            assert_eq!(plan.texture(*t).extent, slot.extent, "{plan}");
+        }
+    }
+    // The docs state the rules.
+    let md = lumagraph_graph::docs::markdown(&registry);
+    assert!(md.contains("size: 1/2 of the input size"), "{md}");
+    assert!(md.contains("size: `width` wide"), "{md}");
+    assert!(
+        md.contains("(optional) variance of the color's mean"),
+        "{md}"
+    );
+
+    // A rule that refuses its params is an error located at the node.
+    g.nodes[1] = Node::new("p", "Pyramid").with("width", ParamValue::Int(5000));
+    let m = compile_with(&g, &registry).unwrap_err().to_string();
+    assert!(
+        m.contains("node \"p\"") && m.contains("output \"wide\": width 5000 is more than 4096"),
+        "{m}"
+    );
+}
+
+/// A node whose inputs arrive at different sizes is refused, naming both sizes.
+#[test]
+fn inputs_of_different_sizes_are_refused() {
+    let registry = sized_registry();
+    let mut g = Graph::new();
+    g.nodes = vec![
+        Node::new("img", "ImageInput"),
+        Node::new("p", "Pyramid"),
+        Node::new("gb", "GBuffer"),
+        Node::new("dn", "Denoise"),
+        Node::new("out", "Output"),
+    ];
+    g.edges = vec![
+        Edge::new("img.color", "p.color"),
+        Edge::new("p.half", "dn.color"),
+        Edge::new("img.color", "dn.albedo"),
+        Edge::new("gb.normal", "dn.normal"),
+        Edge::new("gb.depth", "dn.depth"),
+        Edge::new("dn.color", "out.color"),
+    ];
+    // albedo is an Albedo port; feed it from the GBuffer instead of the image
+    g.edges[2] = Edge::new("gb.albedo", "dn.albedo");
+    let m = compile_with(&g, &registry).unwrap_err().to_string();
+    assert!(
+        m.contains("node \"dn\"") && m.contains("inputs differ in size: 32x16 and 64x32"),
+        "{m}"
+    );
+}
+
+/// The registry is a value: kinds are added at run time, a second kind of the same name
+/// or a kind repeating a port name is refused, and a graph using an added kind compiles
+/// only against the registry that has it.
+#[test]
+fn registry_is_an_owned_value() {
+    let mut registry = sized_registry();
+    let exposure = NodeKind::clone(registry.get("Exposure").unwrap());
+    let e = registry.add(exposure.clone()).unwrap_err();
+    assert!(e.contains("\"Exposure\" is already registered"), "{e}");
+    let mut twice = exposure;
+    twice.name = "Twice";
+    twice.params.push(twice.params[0].clone());
+    let e = registry.add(twice).unwrap_err();
+    assert!(e.contains("declares param \"ev\" twice"), "{e}");
+
+    let mut g = Graph::new();
+    g.nodes = vec![
+        Node::new("img", "ImageInput"),
+        Node::new("p", "Pyramid"),
+        Node::new("out", "Output"),
+    ];
+    g.edges = vec![
+        Edge::new("img.color", "p.color"),
+        Edge::new("p.same", "out.color"),
+    ];
+    assert!(compile_with(&g, &registry).is_ok());
+    let m = compile_graph(&g).unwrap_err().to_string();
+    assert!(m.contains("unknown node kind \"Pyramid\""), "{m}");
 }

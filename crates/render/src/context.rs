@@ -119,7 +119,9 @@ impl GpuContext {
 
     /// Features lumagraph enables when the adapter has them.
     pub fn optional_features() -> wgpu::Features {
-        wgpu::Features::TIMESTAMP_QUERY
+        // Filtering rgba32float images (bilinear taps in blur, bloom, resize and LUT
+        // nodes): every desktop GPU and lavapipe have it; a shader that samples needs it.
+        wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::FLOAT32_FILTERABLE
     }
 
     /// Limits lumagraph asks for: the adapter's own (large images, big scene buffers).

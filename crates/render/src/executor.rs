@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use lumagraph_graph::{
-    CompileOptions, Extent, Graph, GraphErrors, Node, Params, Plan, Registry, TextureId,
+    CompileOptions, Extent, Graph, GraphErrors, NodeKind, Params, Plan, Registry, TextureId,
 };
 
 use lumagraph_scene::GpuScene;
@@ -24,27 +24,24 @@ use crate::timing::GpuTimer;
 pub fn source_extent(
     base_dir: &Path,
     scene: Option<&GpuScene>,
-    node: &Node,
+    kind: &NodeKind,
     params: &Params,
 ) -> std::result::Result<Extent, String> {
-    if Registry::builtin()
-        .get(&node.kind)
-        .is_some_and(|k| k.renders_scene)
-    {
+    if kind.renders_scene {
         return scene
             .map(|s| Extent::new(s.settings.width, s.settings.height))
             .ok_or_else(|| {
                 "renders a scene, but none was given (lumagraph render --scene FILE)".to_owned()
             });
     }
-    match nodes::implementation(&node.kind).and_then(|i| i.source_extent) {
+    match nodes::implementation(kind).and_then(|i| i.source_extent) {
         Some(extent) => extent(base_dir, params),
-        None => Err(format!("{} is not a source", node.kind)),
+        None => Err(format!("{} is not a source", kind.name)),
     }
 }
 
-/// Compiles `graph` with the built-in registry, sizing sources from their files and from
-/// the scene.
+/// Compiles `graph` with the built-in node kinds ([`compile_with`] takes a registry),
+/// sizing sources from their files and from the scene.
 ///
 /// # Errors
 /// Every problem found in the graph.
@@ -53,11 +50,31 @@ pub fn compile(
     keep: &[String],
     scene: Option<&GpuScene>,
 ) -> std::result::Result<Plan, GraphErrors> {
-    let base = graph.base_dir();
-    let extent = |node: &Node, params: &Params| source_extent(&base, scene, node, params);
+    compile_with(
+        graph,
+        &Registry::with_builtins(),
+        &graph.base_dir(),
+        keep,
+        scene,
+    )
+}
+
+/// Compiles `graph` against `registry`, sizing sources from their files (relative to
+/// `base_dir`) and from the scene.
+///
+/// # Errors
+/// Every problem found in the graph.
+pub fn compile_with(
+    graph: &Graph,
+    registry: &Registry,
+    base_dir: &Path,
+    keep: &[String],
+    scene: Option<&GpuScene>,
+) -> std::result::Result<Plan, GraphErrors> {
+    let extent = |kind: &NodeKind, params: &Params| source_extent(base_dir, scene, kind, params);
     lumagraph_graph::compile(
         graph,
-        Registry::builtin(),
+        registry,
         &CompileOptions {
             source_extent: &extent,
             keep,
@@ -498,7 +515,7 @@ impl Executor {
 
 /// For each pass, whether it is a node with history or feeds one.
 fn every_frame(plan: &Plan) -> Vec<bool> {
-    let mut flags: Vec<bool> = plan.passes.iter().map(|p| p.history).collect();
+    let mut flags: Vec<bool> = plan.passes.iter().map(|p| p.kind.history).collect();
     // Walk backwards: a pass runs every frame if a later pass that does reads its output.
     for i in (0..plan.passes.len()).rev() {
         if !flags[i] {
@@ -516,7 +533,7 @@ fn same_structure(a: &Plan, b: &Plan) -> bool {
     let passes = a.passes.len() == b.passes.len()
         && a.passes.iter().zip(&b.passes).all(|(p, q)| {
             p.node == q.node
-                && p.kind == q.kind
+                && p.kind.name == q.kind.name
                 && p.inputs == q.inputs
                 && p.outputs == q.outputs
                 && p.extent == q.extent

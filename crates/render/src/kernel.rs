@@ -26,6 +26,15 @@ use crate::timing::GpuTimer;
 pub enum Binding {
     /// `texture_2d<f32>`, read with `textureLoad`.
     Texture,
+    /// `texture_2d<f32>` or `texture_3d<f32>` in a shader that declares a filtering
+    /// `sampler`: bound as filterable float (`rgba32float` needs the adapter's
+    /// `FLOAT32_FILTERABLE`, which [`GpuContext`] asks for).
+    FilteredTexture {
+        /// 2D or 3D.
+        dim: wgpu::TextureViewDimension,
+    },
+    /// `sampler` (filtering; comparison samplers are not supported).
+    Sampler,
     /// `texture_storage_2d<format, access>`.
     StorageTexture {
         /// Texel format.
@@ -50,6 +59,12 @@ impl Binding {
                 view_dimension: wgpu::TextureViewDimension::D2,
                 multisampled: false,
             },
+            Self::FilteredTexture { dim } => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: dim,
+                multisampled: false,
+            },
+            Self::Sampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
             Self::StorageTexture { format, access } => wgpu::BindingType::StorageTexture {
                 access,
                 format,
@@ -72,6 +87,7 @@ impl Binding {
     fn builder_method(self) -> &'static str {
         match self {
             Self::Texture
+            | Self::FilteredTexture { .. }
             | Self::StorageTexture {
                 access: wgpu::StorageTextureAccess::ReadOnly,
                 ..
@@ -79,6 +95,7 @@ impl Binding {
             Self::StorageTexture { .. } => "write",
             Self::Uniform => "uniform",
             Self::Storage { .. } => "buffer",
+            Self::Sampler => "sampler",
         }
     }
 }
@@ -115,6 +132,13 @@ pub fn reflect(label: &str, source: &str) -> Result<(Vec<Binding>, [u32; 3])> {
         .iter()
         .find(|e| e.name == "main")
         .ok_or_else(|| err("no entry point `main`".to_owned()))?;
+    // Textures are bound filterable exactly when the shader has a sampler to filter them.
+    let filtering = module.global_variables.iter().any(|(_, var)| {
+        matches!(
+            module.types[var.ty].inner,
+            naga::TypeInner::Sampler { comparison: false }
+        )
+    });
     let mut bindings: Vec<(u32, Binding)> = Vec::new();
     for (_, var) in module.global_variables.iter() {
         let Some(rb) = var.binding else { continue };
@@ -130,6 +154,23 @@ pub fn reflect(label: &str, source: &str) -> Result<(Vec<Binding>, [u32; 3])> {
             (naga::AddressSpace::Storage { access }, _) => Binding::Storage {
                 read_only: !access.contains(naga::StorageAccess::STORE),
             },
+            (naga::AddressSpace::Handle, naga::TypeInner::Sampler { comparison: false }) => {
+                Binding::Sampler
+            }
+            (
+                naga::AddressSpace::Handle,
+                naga::TypeInner::Image {
+                    dim: naga::ImageDimension::D3,
+                    arrayed: false,
+                    class:
+                        naga::ImageClass::Sampled {
+                            kind: naga::ScalarKind::Float,
+                            multi: false,
+                        },
+                },
+            ) if filtering => Binding::FilteredTexture {
+                dim: wgpu::TextureViewDimension::D3,
+            },
             (
                 naga::AddressSpace::Handle,
                 naga::TypeInner::Image {
@@ -138,6 +179,12 @@ pub fn reflect(label: &str, source: &str) -> Result<(Vec<Binding>, [u32; 3])> {
                     class,
                 },
             ) => match *class {
+                naga::ImageClass::Sampled {
+                    kind: naga::ScalarKind::Float,
+                    multi: false,
+                } if filtering => Binding::FilteredTexture {
+                    dim: wgpu::TextureViewDimension::D2,
+                },
                 naga::ImageClass::Sampled {
                     kind: naga::ScalarKind::Float,
                     multi: false,
@@ -186,6 +233,20 @@ pub fn reflect(label: &str, source: &str) -> Result<(Vec<Binding>, [u32; 3])> {
     ))
 }
 
+/// The sampler of filtering kernels: bilinear, clamped to the edge (no mipmaps).
+pub fn linear_sampler(ctx: &GpuContext) -> wgpu::Sampler {
+    ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("linear clamp"),
+        address_mode_u: wgpu::AddressMode::ClampToEdge,
+        address_mode_v: wgpu::AddressMode::ClampToEdge,
+        address_mode_w: wgpu::AddressMode::ClampToEdge,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Nearest,
+        ..Default::default()
+    })
+}
+
 /// A compute pipeline with the bindings its shader declares.
 #[derive(Debug)]
 pub struct Kernel {
@@ -214,6 +275,20 @@ impl Kernel {
     pub fn from_source(ctx: &GpuContext, label: &str, source: &str) -> Result<Self> {
         let (bindings, workgroup) = reflect(label, source)?;
         let device = &ctx.device;
+        if bindings
+            .iter()
+            .any(|b| matches!(b, Binding::FilteredTexture { .. }))
+            && !device
+                .features()
+                .contains(wgpu::Features::FLOAT32_FILTERABLE)
+        {
+            return Err(RenderError::Shader {
+                name: label.to_owned(),
+                message: "filters float textures with a sampler, and this adapter cannot \
+                          (no FLOAT32_FILTERABLE feature)"
+                    .to_owned(),
+            });
+        }
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(label),
@@ -261,6 +336,11 @@ impl Kernel {
         })
     }
 
+    /// The bindings its shader declares, in binding order.
+    pub fn bindings(&self) -> &[Binding] {
+        &self.bindings
+    }
+
     /// Starts recording a pass named `name` (the name its GPU time is reported under).
     pub fn pass<'a>(&'a self, name: &'a str) -> PassBuilder<'a> {
         PassBuilder {
@@ -274,7 +354,8 @@ impl Kernel {
 
 /// A pass being declared: its resources in binding order, then the dispatch. Each resource
 /// is given by the method of its binding's kind — `read` (a sampled or read-only storage
-/// texture), `write` (a writable storage texture), `uniform`, `buffer` (storage) — and the
+/// texture), `write` (a writable storage texture), `sampler`, `uniform`, `buffer`
+/// (storage) — and the
 /// dispatch refuses any other order or kind, naming the pass and the binding.
 #[derive(Debug)]
 pub struct PassBuilder<'a> {
@@ -301,6 +382,12 @@ impl<'a> PassBuilder<'a> {
     #[must_use]
     pub fn write(self, view: &'a wgpu::TextureView) -> Self {
         self.push("write", wgpu::BindingResource::TextureView(view))
+    }
+
+    /// A sampler.
+    #[must_use]
+    pub fn sampler(self, sampler: &'a wgpu::Sampler) -> Self {
+        self.push("sampler", wgpu::BindingResource::Sampler(sampler))
     }
 
     /// A storage buffer.

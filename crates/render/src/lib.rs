@@ -32,7 +32,7 @@ mod timing;
 
 pub use context::{GPU_TIMEOUT, GpuContext};
 pub use error::{RenderError, Result};
-pub use executor::{Executor, FrameReport, PassClock, compile, source_extent};
+pub use executor::{Executor, FrameReport, PassClock, compile, compile_with, source_extent};
 pub use kernel::{Binding, Kernel, PassBuilder, uniform_buffer};
 pub use nodes::{Counter, Resources};
 pub use pool::{PooledTexture, TexturePool, create as create_texture, wgpu_format};

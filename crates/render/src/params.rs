@@ -5,7 +5,7 @@
 //! GPU runs. Enum params reach shaders as the index of their option in the registry
 //! ([`enum_index`]), and a test holds the shaders' constants to that order.
 
-use lumagraph_graph::{ParamType, Pass, Registry};
+use lumagraph_graph::{ParamType, Pass};
 
 use crate::error::{RenderError, Result};
 
@@ -127,14 +127,16 @@ pub fn check_layout(layout: &BlockLayout) -> std::result::Result<(), String> {
 /// When the param is not an enum of the pass's kind or its value is not one of its options
 /// (the compiler refuses such graphs; this refuses them again rather than guess).
 pub fn enum_index(pass: &Pass, param: &str) -> Result<u32> {
-    let options = Registry::builtin()
-        .get(pass.kind)
-        .and_then(|k| k.param(param))
+    let options = pass
+        .kind
+        .param(param)
         .and_then(|p| match &p.ty {
             ParamType::Enum { options, .. } => Some(*options),
             _ => None,
         })
-        .ok_or_else(|| RenderError::Gpu(format!("{} has no enum param \"{param}\"", pass.kind)))?;
+        .ok_or_else(|| {
+            RenderError::Gpu(format!("{} has no enum param \"{param}\"", pass.kind.name))
+        })?;
     let value = pass.params.str(param);
     options
         .iter()
@@ -224,13 +226,10 @@ mod tests {
     /// Each enum option's shader constant is its index in the registry's options.
     #[test]
     fn shader_enum_constants_follow_the_registry() {
+        let registry = lumagraph_graph::Registry::with_builtins();
         for &(kind, param, shader, prefix) in ENUM_CONSTANTS {
-            let ParamType::Enum { options, .. } = &Registry::builtin()
-                .get(kind)
-                .unwrap()
-                .param(param)
-                .unwrap()
-                .ty
+            let ParamType::Enum { options, .. } =
+                &registry.get(kind).unwrap().param(param).unwrap().ty
             else {
                 panic!("{kind}.{param} is not an enum");
             };

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use lumagraph_graph::{Graph, Registry};
+use lumagraph_graph::Graph;
 
 use super::{Dialog, Editor, EditorScene, Pick, Then};
 use crate::EditorError;
@@ -38,7 +38,7 @@ impl Editor {
                     .doc
                     .graph
                     .node(node)
-                    .and_then(|n| Registry::builtin().get(&n.kind))
+                    .and_then(|n| self.doc.registry().get(&n.kind))
                     .and_then(|k| k.params.iter().find(|d| d.name == param))
                     .and_then(|d| match &d.ty {
                         lumagraph_graph::ParamType::Path { extensions, .. } => {
@@ -181,7 +181,12 @@ impl Editor {
     /// # Errors
     /// When the file cannot be written.
     pub fn save_as(&mut self, path: &Path) -> Result<(), EditorError> {
-        let saved = files::save(&self.doc.graph, &self.doc.base_dir(), path)?;
+        let saved = files::save(
+            self.doc.registry(),
+            &self.doc.graph,
+            &self.doc.base_dir(),
+            path,
+        )?;
         let origin = self.doc.graph.origin.take();
         self.doc.graph = saved;
         self.doc.graph.origin = origin;

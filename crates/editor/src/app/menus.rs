@@ -88,7 +88,8 @@ impl Editor {
                 }
             });
             ui.menu_button("Add node", |ui| {
-                if let Some(kind) = add_node_menu(ui, &mut self.canvas.search) {
+                if let Some(kind) = add_node_menu(ui, self.doc.registry(), &mut self.canvas.search)
+                {
                     match self.doc.add_node(kind, None) {
                         Ok(id) => self.select(vec![id]),
                         Err(e) => self.say(e, true),

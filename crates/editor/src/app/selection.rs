@@ -1,7 +1,7 @@
 //! The selection: which nodes are selected, which port the preview shows, copy, paste
 //! and delete.
 
-use lumagraph_graph::{Graph, Registry, split_port_ref};
+use lumagraph_graph::{Graph, split_port_ref};
 
 use super::Editor;
 
@@ -25,7 +25,7 @@ impl Editor {
     /// The port previewed for node `id`: its first output, or what feeds a sink.
     pub(super) fn port_for_node(&self, id: &str) -> Option<String> {
         let node = self.doc.graph.node(id)?;
-        let kind = Registry::builtin().get(&node.kind)?;
+        let kind = self.doc.registry().get(&node.kind)?;
         if let Some(o) = kind.outputs.first() {
             return Some(format!("{id}.{}", o.name));
         }
@@ -47,14 +47,14 @@ impl Editor {
                 self.doc
                     .graph
                     .node(n)
-                    .and_then(|n| Registry::builtin().get(&n.kind))
+                    .and_then(|n| self.doc.registry().get(&n.kind))
                     .is_some_and(|k| k.output(port).is_some())
             })
         };
         if let Some(p) = self.preview_port.as_deref().filter(|p| exists(p)) {
             return Some(p.to_owned());
         }
-        let reg = Registry::builtin();
+        let reg = self.doc.registry();
         self.doc
             .graph
             .nodes

@@ -6,7 +6,113 @@ use super::{
 use crate::types::{ParamType, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
-    vec![exposure(), vignette(), tonemap()]
+    vec![
+        exposure(),
+        white_balance(),
+        cdl(),
+        contrast(),
+        hue_saturation(),
+        vignette(),
+        tonemap(),
+    ]
+}
+
+fn white_balance() -> NodeKind {
+    post_filter(
+        "WhiteBalance",
+        Category::Color,
+        "Adapts the image from the white of a light source to neutral: the white at \
+         `temperature` on the Planckian locus, moved by `tint` along its isotherm, is \
+         mapped to the locus's white at 6504 K with the Bradford chromatic adaptation (linear \
+         Rec.709 primaries). The defaults change nothing; a lower temperature cools a warm \
+         (tungsten-lit) image.",
+        vec![
+            ParamDef::float(
+                "temperature",
+                6504.0,
+                [1000.0, 15000.0],
+                "color temperature of the light the image is corrected for, in kelvin",
+            ),
+            ParamDef::float(
+                "tint",
+                0.0,
+                [-1.0, 1.0],
+                "shift of that white off the locus: + magenta, − green (±1 is 0.02 in CIE 1960 uv)",
+            ),
+        ],
+        "post/white_balance.wgsl",
+    )
+}
+
+fn cdl() -> NodeKind {
+    let slope = "ASC CDL slope (gain)";
+    let offset = "ASC CDL offset (added after the slope)";
+    let power = "ASC CDL power (applied after the offset, to values clipped at 0)";
+    post_filter(
+        "CDL",
+        Category::Color,
+        "ASC Color Decision List: out = max(in × slope + offset, 0)^power per channel, \
+         then saturation around the Rec.709 luma. The defaults change nothing.",
+        vec![
+            ParamDef::float("slope_r", 1.0, [0.0, 100.0], slope),
+            ParamDef::float("slope_g", 1.0, [0.0, 100.0], slope),
+            ParamDef::float("slope_b", 1.0, [0.0, 100.0], slope),
+            ParamDef::float("offset_r", 0.0, [-10.0, 10.0], offset),
+            ParamDef::float("offset_g", 0.0, [-10.0, 10.0], offset),
+            ParamDef::float("offset_b", 0.0, [-10.0, 10.0], offset),
+            ParamDef::float("power_r", 1.0, [0.01, 10.0], power),
+            ParamDef::float("power_g", 1.0, [0.01, 10.0], power),
+            ParamDef::float("power_b", 1.0, [0.01, 10.0], power),
+            ParamDef::float(
+                "saturation",
+                1.0,
+                [0.0, 10.0],
+                "ASC CDL saturation: 0 grey, 1 unchanged",
+            ),
+        ],
+        "post/cdl.wgsl",
+    )
+}
+
+fn contrast() -> NodeKind {
+    post_filter(
+        "Contrast",
+        Category::Color,
+        "Contrast for linear HDR color: pivot × (c / pivot)^contrast per channel (negative \
+         values clipped to 0), so the pivot stays put and ratios to it are raised to \
+         `contrast`.",
+        vec![
+            ParamDef::float(
+                "contrast",
+                1.0,
+                [0.1, 4.0],
+                "1 unchanged; above 1 more contrast",
+            ),
+            ParamDef::float(
+                "pivot",
+                0.18,
+                [1e-4, 100.0],
+                "the value that stays (mid grey)",
+            ),
+        ],
+        "post/contrast.wgsl",
+    )
+}
+
+fn hue_saturation() -> NodeKind {
+    post_filter(
+        "HueSaturation",
+        Category::Color,
+        "Rotates hues by `hue` degrees around the grey axis, scales the distance from grey \
+         (the mean of red, green and blue) by `saturation`, then the color by `value`; \
+         negative results clipped to 0.",
+        vec![
+            ParamDef::float("hue", 0.0, [-180.0, 180.0], "hue rotation in degrees"),
+            ParamDef::float("saturation", 1.0, [0.0, 10.0], "0 grey, 1 unchanged"),
+            ParamDef::float("value", 1.0, [0.0, 100.0], "brightness factor"),
+        ],
+        "post/hue_saturation.wgsl",
+    )
 }
 
 fn exposure() -> NodeKind {
@@ -73,16 +179,12 @@ fn tonemap() -> NodeKind {
         category: Category::Color,
         doc: "Maps linear scene color to display color with a tone curve, then applies the \
           sRGB transfer function.",
-        inputs: &[InputDef {
-            name: "color",
-            accepts: COLOR_TYPES,
-            doc: "linear color",
-        }],
-        outputs: &[OutputDef {
-            name: "color",
-            ty: PortType::LdrColor,
-            doc: "display-encoded color",
-        }],
+        inputs: vec![InputDef::new("color", COLOR_TYPES, "linear color")],
+        outputs: vec![OutputDef::new(
+            "color",
+            PortType::LdrColor,
+            "display-encoded color",
+        )],
         params: vec![
             ParamDef {
                 name: "operator",

@@ -17,39 +17,40 @@ fn denoise() -> NodeKind {
               multiplied back after; each tap is weighted by luminance (scaled by the \
               pixel's standard deviation when `variance_guided`), normal and depth \
               differences. Two ping-pong images are the only memory it adds.",
-        inputs: &[
-            InputDef {
-                name: "color",
-                accepts: COLOR_TYPES,
-                doc: "noisy linear color (e.g. Accumulate.color)",
-            },
-            InputDef {
-                name: "albedo",
-                accepts: &[PortType::Albedo],
-                doc: "first-hit albedo (GBuffer or PathTrace)",
-            },
-            InputDef {
-                name: "normal",
-                accepts: &[PortType::Normal],
-                doc: "first-hit world-space normal",
-            },
-            InputDef {
-                name: "depth",
-                accepts: &[PortType::Depth],
-                doc: "first-hit distance along the camera ray",
-            },
-            InputDef {
-                name: "variance",
-                accepts: &[PortType::Variance],
-                doc: "variance of the color's mean (Accumulate.variance); read only when \
-                      `variance_guided` is on, but always connected",
-            },
+        inputs: vec![
+            InputDef::new(
+                "color",
+                COLOR_TYPES,
+                "noisy linear color (e.g. Accumulate.color)",
+            ),
+            InputDef::new(
+                "albedo",
+                &[PortType::Albedo],
+                "first-hit albedo (GBuffer or PathTrace)",
+            ),
+            InputDef::new(
+                "normal",
+                &[PortType::Normal],
+                "first-hit world-space normal",
+            ),
+            InputDef::new(
+                "depth",
+                &[PortType::Depth],
+                "first-hit distance along the camera ray",
+            ),
+            InputDef::new(
+                "variance",
+                &[PortType::Variance],
+                "variance of the color's mean (Accumulate.variance); without it the \
+                 luminance tolerance is the fixed one, as with `variance_guided` off",
+            )
+            .optional(),
         ],
-        outputs: &[OutputDef {
-            name: "color",
-            ty: PortType::HdrColor,
-            doc: "filtered linear color",
-        }],
+        outputs: vec![OutputDef::new(
+            "color",
+            PortType::HdrColor,
+            "filtered linear color",
+        )],
         params: vec![
             ParamDef {
                 name: "iterations",
@@ -94,7 +95,8 @@ fn denoise() -> NodeKind {
                 name: "variance_guided",
                 ty: ParamType::Bool { default: true },
                 doc: "scale the luminance tolerance by the per-pixel standard deviation \
-                      (SVGF); off: a fixed tolerance halved every pass (Dammertz)",
+                      (SVGF) when `variance` is connected; off: a fixed tolerance halved \
+                      every pass (Dammertz)",
             },
         ],
         sink: false,

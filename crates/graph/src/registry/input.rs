@@ -13,12 +13,12 @@ fn image_input() -> NodeKind {
         category: Category::Input,
         doc: "Reads an image file. EXR and Radiance .hdr are taken as linear; PNG and JPEG are \
               decoded from sRGB to linear. The image sets the size of everything downstream.",
-        inputs: &[],
-        outputs: &[OutputDef {
-            name: "color",
-            ty: PortType::HdrColor,
-            doc: "the image, linear RGB",
-        }],
+        inputs: vec![],
+        outputs: vec![OutputDef::new(
+            "color",
+            PortType::HdrColor,
+            "the image, linear RGB",
+        )],
         params: vec![ParamDef {
             name: "path",
             ty: ParamType::Path {

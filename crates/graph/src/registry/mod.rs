@@ -6,14 +6,18 @@
 //! render crate under the same name.
 
 mod color;
+mod combine;
 mod denoise;
+mod effects;
 mod input;
 mod output;
 mod render;
+mod transform;
 
-use std::sync::LazyLock;
+use std::sync::Arc;
 
-use crate::types::{ParamType, PortType};
+use crate::compile::Params;
+use crate::types::{Extent, ParamType, PortType};
 
 /// Where a node kind sits in menus and docs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -27,6 +31,12 @@ pub enum Category {
     Denoise,
     /// Nodes that change colors of an image.
     Color,
+    /// Nodes that combine images or do arithmetic on them.
+    Combine,
+    /// Nodes that filter an image spatially, or add lens and film effects.
+    Filter,
+    /// Nodes that resample an image to another size.
+    Transform,
     /// Nodes that write results out of the graph.
     Output,
 }
@@ -39,6 +49,9 @@ impl Category {
             Self::Render => "Render",
             Self::Denoise => "Denoise",
             Self::Color => "Color",
+            Self::Combine => "Combine",
+            Self::Filter => "Filter",
+            Self::Transform => "Transform",
             Self::Output => "Output",
         }
     }
@@ -53,6 +66,77 @@ pub struct InputDef {
     pub accepts: &'static [PortType],
     /// One-line description.
     pub doc: &'static str,
+    /// Whether the node runs without it: an unconnected optional input is left out of the
+    /// pass (and `plan` says so); every other input of a live node must be connected.
+    pub optional: bool,
+}
+
+impl InputDef {
+    /// A required input.
+    pub const fn new(name: &'static str, accepts: &'static [PortType], doc: &'static str) -> Self {
+        Self {
+            name,
+            accepts,
+            doc,
+            optional: false,
+        }
+    }
+
+    /// The same input, optional (see [`InputDef::optional`]).
+    #[must_use]
+    pub const fn optional(mut self) -> Self {
+        self.optional = true;
+        self
+    }
+}
+
+/// The size of the image an output port produces.
+#[derive(Clone, Copy, Debug)]
+pub enum OutputSize {
+    /// The pass's size: its inputs' (which must agree), or for a source the size it tells.
+    Input,
+    /// The pass's size times `num / den` per axis, rounded up, at least one pixel (a
+    /// half-resolution level is `{ num: 1, den: 2 }`).
+    Scaled {
+        /// Numerator.
+        num: u32,
+        /// Denominator (not 0).
+        den: u32,
+    },
+    /// Worked out from the pass's size and the node's checked params; an `Err` is shown
+    /// located at the node. The text says what the rule is, for the docs.
+    Rule(fn(Extent, &Params) -> Result<Extent, String>, &'static str),
+}
+
+impl OutputSize {
+    /// The output's size for a pass of size `input` with `params`.
+    ///
+    /// # Errors
+    /// When the rule refuses the params (message for the user).
+    pub fn extent(&self, input: Extent, params: &Params) -> Result<Extent, String> {
+        match *self {
+            Self::Input => Ok(input),
+            Self::Scaled { num, den } => {
+                let f = |v: u32| {
+                    (u64::from(v) * u64::from(num))
+                        .div_ceil(u64::from(den.max(1)))
+                        .clamp(1, u64::from(u32::MAX))
+                };
+                #[expect(clippy::cast_possible_truncation, reason = "clamped to u32")]
+                Ok(Extent::new(f(input.width) as u32, f(input.height) as u32))
+            }
+            Self::Rule(rule, _) => rule(input, params),
+        }
+    }
+
+    /// How the size is chosen, in words (docs); `None` for [`OutputSize::Input`].
+    pub fn describe(&self) -> Option<String> {
+        match *self {
+            Self::Input => None,
+            Self::Scaled { num, den } => Some(format!("{num}/{den} of the input size")),
+            Self::Rule(_, doc) => Some(doc.to_owned()),
+        }
+    }
 }
 
 /// An output port of a node kind.
@@ -64,6 +148,27 @@ pub struct OutputDef {
     pub ty: PortType,
     /// One-line description.
     pub doc: &'static str,
+    /// Its image size.
+    pub size: OutputSize,
+}
+
+impl OutputDef {
+    /// An output of the pass's size.
+    pub const fn new(name: &'static str, ty: PortType, doc: &'static str) -> Self {
+        Self {
+            name,
+            ty,
+            doc,
+            size: OutputSize::Input,
+        }
+    }
+
+    /// The same output, sized by `size`.
+    #[must_use]
+    pub const fn sized(mut self, size: OutputSize) -> Self {
+        self.size = size;
+        self
+    }
 }
 
 /// A parameter of a node kind.
@@ -77,6 +182,50 @@ pub struct ParamDef {
     pub doc: &'static str,
 }
 
+impl ParamDef {
+    /// A float param in `[min, max]`.
+    pub const fn float(
+        name: &'static str,
+        default: f64,
+        [min, max]: [f64; 2],
+        doc: &'static str,
+    ) -> Self {
+        Self {
+            name,
+            ty: ParamType::Float { default, min, max },
+            doc,
+        }
+    }
+
+    /// An int param in `[min, max]`.
+    pub const fn int(
+        name: &'static str,
+        default: i64,
+        [min, max]: [i64; 2],
+        doc: &'static str,
+    ) -> Self {
+        Self {
+            name,
+            ty: ParamType::Int { default, min, max },
+            doc,
+        }
+    }
+
+    /// An enum param: one of `options` (name, description).
+    pub const fn choice(
+        name: &'static str,
+        default: &'static str,
+        options: &'static [(&'static str, &'static str)],
+        doc: &'static str,
+    ) -> Self {
+        Self {
+            name,
+            ty: ParamType::Enum { default, options },
+            doc,
+        }
+    }
+}
+
 /// A kind of node: what it reads, writes and is configured with.
 #[derive(Clone, Debug)]
 pub struct NodeKind {
@@ -86,10 +235,10 @@ pub struct NodeKind {
     pub category: Category,
     /// One-paragraph description.
     pub doc: &'static str,
-    /// Input ports; every one must be connected.
-    pub inputs: &'static [InputDef],
+    /// Input ports; every one that is not optional must be connected.
+    pub inputs: Vec<InputDef>,
     /// Output ports.
-    pub outputs: &'static [OutputDef],
+    pub outputs: Vec<OutputDef>,
     /// Parameters.
     pub params: Vec<ParamDef>,
     /// Whether the node is a sink: it writes results out of the graph, and the nodes
@@ -131,28 +280,64 @@ impl NodeKind {
     }
 }
 
-/// A set of node kinds.
-#[derive(Debug)]
+/// A set of node kinds: the built-in ones and any added at run time. It is an ordinary
+/// value, passed to whatever needs to look kinds up (the compiler, the docs, the editor);
+/// a compiled [`Pass`](crate::Pass) holds its kind, so executing a plan needs no registry.
+#[derive(Clone, Debug, Default)]
 pub struct Registry {
-    kinds: Vec<NodeKind>,
+    kinds: Vec<Arc<NodeKind>>,
 }
 
 impl Registry {
+    /// No kinds.
+    pub fn empty() -> Self {
+        Self::default()
+    }
+
     /// The kinds built into lumagraph.
-    pub fn builtin() -> &'static Self {
-        static BUILTIN: LazyLock<Registry> = LazyLock::new(|| Registry {
-            kinds: builtin_kinds(),
-        });
-        &BUILTIN
+    pub fn with_builtins() -> Self {
+        Self {
+            kinds: builtin_kinds().into_iter().map(Arc::new).collect(),
+        }
+    }
+
+    /// Adds a kind.
+    ///
+    /// # Errors
+    /// When a kind of that name is already registered, or the kind repeats a port or
+    /// param name.
+    pub fn add(&mut self, kind: NodeKind) -> Result<(), String> {
+        if self.get(kind.name).is_some() {
+            return Err(format!(
+                "a node kind called \"{}\" is already registered",
+                kind.name
+            ));
+        }
+        let mut names: Vec<(&str, &str)> = kind
+            .inputs
+            .iter()
+            .map(|p| ("input", p.name))
+            .chain(kind.outputs.iter().map(|p| ("output", p.name)))
+            .chain(kind.params.iter().map(|p| ("param", p.name)))
+            .collect();
+        names.sort_unstable();
+        if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
+            return Err(format!(
+                "node kind \"{}\" declares {} \"{}\" twice",
+                kind.name, w[0].0, w[0].1
+            ));
+        }
+        self.kinds.push(Arc::new(kind));
+        Ok(())
     }
 
     /// The kind called `name`.
-    pub fn get(&self, name: &str) -> Option<&NodeKind> {
+    pub fn get(&self, name: &str) -> Option<&Arc<NodeKind>> {
         self.kinds.iter().find(|k| k.name == name)
     }
 
-    /// Every kind, in registry order (grouped by category).
-    pub fn kinds(&self) -> &[NodeKind] {
+    /// Every kind, in registry order (built-ins grouped by category, then those added).
+    pub fn kinds(&self) -> &[Arc<NodeKind>] {
         &self.kinds
     }
 }
@@ -199,16 +384,12 @@ pub(crate) fn post_filter(
         name,
         category,
         doc,
-        inputs: &[InputDef {
-            name: "color",
-            accepts: COLOR_TYPES,
-            doc: "linear color",
-        }],
-        outputs: &[OutputDef {
-            name: "color",
-            ty: PortType::HdrColor,
-            doc: "the filtered linear color",
-        }],
+        inputs: vec![InputDef::new("color", COLOR_TYPES, "linear color")],
+        outputs: vec![OutputDef::new(
+            "color",
+            PortType::HdrColor,
+            "the filtered linear color",
+        )],
         params,
         sink: false,
         history: false,
@@ -223,6 +404,9 @@ fn builtin_kinds() -> Vec<NodeKind> {
         render::kinds(),
         denoise::kinds(),
         color::kinds(),
+        combine::kinds(),
+        effects::kinds(),
+        transform::kinds(),
         output::kinds(),
     ]
     .concat()

@@ -14,12 +14,8 @@ fn output() -> NodeKind {
         doc: "Writes its input to a file: PNG (8-bit sRGB) or EXR (32-bit float RGBA), chosen \
               by the extension. Linear input is sRGB-encoded (clipped) for PNG and written \
               as is to EXR; display-encoded input is written as is to both.",
-        inputs: &[InputDef {
-            name: "color",
-            accepts: ANY_IMAGE,
-            doc: "image to write",
-        }],
-        outputs: &[],
+        inputs: vec![InputDef::new("color", ANY_IMAGE, "image to write")],
+        outputs: vec![],
         params: vec![ParamDef {
             name: "path",
             ty: ParamType::Path {

@@ -16,29 +16,29 @@ fn path_trace() -> NodeKind {
           `samples_per_frame` samples per pixel and outputs their mean; feed it to \
           Accumulate for a progressive render. Image size, bounces and seed come from \
           the scene.",
-        inputs: &[],
-        outputs: &[
-            OutputDef {
-                name: "color",
-                ty: PortType::HdrColor,
-                doc: "this frame's radiance estimate",
-            },
-            OutputDef {
-                name: "albedo",
-                ty: PortType::Albedo,
-                doc: "base color at the first hit through the pixel center; alpha 2 on emitters, 1 \
+        inputs: vec![],
+        outputs: vec![
+            OutputDef::new(
+                "color",
+                PortType::HdrColor,
+                "this frame's radiance estimate",
+            ),
+            OutputDef::new(
+                "albedo",
+                PortType::Albedo,
+                "base color at the first hit through the pixel center; alpha 2 on emitters, 1 \
                   elsewhere (0 on a miss)",
-            },
-            OutputDef {
-                name: "normal",
-                ty: PortType::Normal,
-                doc: "world-space shading normal at that hit (0 on a miss)",
-            },
-            OutputDef {
-                name: "depth",
-                ty: PortType::Depth,
-                doc: "distance from the camera to that hit (0 on a miss)",
-            },
+            ),
+            OutputDef::new(
+                "normal",
+                PortType::Normal,
+                "world-space shading normal at that hit (0 on a miss)",
+            ),
+            OutputDef::new(
+                "depth",
+                PortType::Depth,
+                "distance from the camera to that hit (0 on a miss)",
+            ),
         ],
         params: vec![
             ParamDef {
@@ -135,25 +135,17 @@ fn accumulate() -> NodeKind {
           f32 with Kahan compensation, so millions of frames do not drift. Restarts when \
           the scene, the camera or anything upstream changes. Also estimates the \
           variance of the mean (for Denoise) when its `variance` output is read.",
-        inputs: &[InputDef {
-            name: "color",
-            accepts: COLOR_TYPES,
-            doc: "this frame's estimate",
-        }],
-        outputs: &[
-            OutputDef {
-                name: "color",
-                ty: PortType::HdrColor,
-                doc: "mean of all frames so far",
-            },
-            OutputDef {
-                name: "variance",
-                ty: PortType::Variance,
-                doc: "variance of that mean per pixel (rgb per channel, alpha of the \
+        inputs: vec![InputDef::new("color", COLOR_TYPES, "this frame's estimate")],
+        outputs: vec![
+            OutputDef::new("color", PortType::HdrColor, "mean of all frames so far"),
+            OutputDef::new(
+                "variance",
+                PortType::Variance,
+                "variance of that mean per pixel (rgb per channel, alpha of the \
                   luminance), from a Welford second moment over frames; after a single \
                   frame, estimated over the pixel's 3×3 neighborhood (luminance: from the median \
                   absolute deviation)",
-            },
+            ),
         ],
         params: vec![],
         sink: false,
@@ -171,26 +163,26 @@ fn gbuffer() -> NodeKind {
           their shading normals, spheres tessellated and then intersected exactly per \
           pixel. Writes what the path tracer's first hit through the pixel center sees, \
           without tracing a ray; the guides of Denoise. Image size from the scene.",
-        inputs: &[],
-        outputs: &[
-            OutputDef {
-                name: "albedo",
-                ty: PortType::Albedo,
-                doc: "material base color; alpha 2 on emitters, 1 elsewhere (0 where nothing is \
+        inputs: vec![],
+        outputs: vec![
+            OutputDef::new(
+                "albedo",
+                PortType::Albedo,
+                "material base color; alpha 2 on emitters, 1 elsewhere (0 where nothing is \
                   hit)",
-            },
-            OutputDef {
-                name: "normal",
-                ty: PortType::Normal,
-                doc: "world-space shading normal, interpolated vertex normals where the \
+            ),
+            OutputDef::new(
+                "normal",
+                PortType::Normal,
+                "world-space shading normal, interpolated vertex normals where the \
                   triangle has them (0 where nothing is hit)",
-            },
-            OutputDef {
-                name: "depth",
-                ty: PortType::Depth,
-                doc: "distance from the camera along the ray through the pixel center \
+            ),
+            OutputDef::new(
+                "depth",
+                PortType::Depth,
+                "distance from the camera along the ray through the pixel center \
                   (0 where nothing is hit)",
-            },
+            ),
         ],
         params: vec![ParamDef {
             name: "sphere_segments",

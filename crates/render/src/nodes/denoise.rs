@@ -8,9 +8,10 @@
 //! two images, created once and reused every frame, are all the memory the filter adds
 //! ([`scratch_bytes`]); with one iteration only the first is created.
 //!
-//! The `variance` input is always connected (every input is, in this graph model); with
-//! `variance_guided` off the shader never reads it and the luminance tolerance is a fixed
-//! one halved every pass, as in Dammertz et al.
+//! The `variance` input is optional: without it, or with `variance_guided` off, the
+//! luminance tolerance is a fixed one halved every pass, as in Dammertz et al., and the
+//! shader's variance binding is given the color image (its alpha fills the variance slot
+//! the filter then never reads).
 
 use lumagraph_graph::{Extent, Pass, TexFormat};
 
@@ -55,6 +56,8 @@ pub(crate) struct Denoise {
     /// pass's is the last.
     params: Vec<wgpu::Buffer>,
     iterations: u32,
+    /// How the luminance tolerance is set, for the notes.
+    guidance: &'static str,
     extent: Extent,
     ping_pong: Option<(Extent, Vec<PooledTexture>)>,
 }
@@ -92,6 +95,7 @@ impl Denoise {
             kernel,
             params,
             iterations: 1,
+            guidance: "",
             extent: pass.extent,
             ping_pong: None,
         };
@@ -110,7 +114,14 @@ impl NodeExec for Denoise {
             p.float("sigma_normal") as f32,
             p.float("sigma_depth") as f32,
         );
-        let guided = u32::from(p.bool("variance_guided"));
+        self.guidance = match (p.bool("variance_guided"), pass.input("variance").is_some()) {
+            (true, true) => "variance-guided luminance tolerance",
+            (true, false) => {
+                "fixed luminance tolerance (variance_guided is on, but no variance is connected)"
+            }
+            (false, _) => "fixed luminance tolerance (variance_guided off)",
+        };
+        let guided = u32::from(p.bool("variance_guided") && pass.input("variance").is_some());
         let demodulate = DenoiseParams {
             first: 1,
             ..DenoiseParams::default()
@@ -164,7 +175,10 @@ impl NodeExec for Denoise {
             return Ok(());
         };
         let color = io.input(pass, "color")?;
-        let variance = io.input(pass, "variance")?;
+        let variance = match pass.input("variance") {
+            Some(t) => io.texture(t),
+            None => color,
+        };
         let albedo = io.input(pass, "albedo")?;
         let normal = io.input(pass, "normal")?;
         let depth = io.input(pass, "depth")?;
@@ -207,9 +221,10 @@ impl NodeExec for Denoise {
         let bytes = scratch_bytes(self.extent, self.iterations);
         vec![format!(
             "demodulation + {} à-trous passes, ping-pong between {} node-owned rgba32f \
-             images ({bytes} bytes)",
+             images ({bytes} bytes); {}",
             self.iterations,
-            scratch_images(self.iterations)
+            scratch_images(self.iterations),
+            self.guidance
         )]
     }
 }

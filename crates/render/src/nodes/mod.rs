@@ -12,7 +12,7 @@ pub(crate) mod tonemap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use lumagraph_graph::{Extent, Pass, Plan, TextureId};
+use lumagraph_graph::{Extent, NodeKind, Pass, Plan, TextureId};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
@@ -254,25 +254,28 @@ pub static IMPLEMENTATIONS: &[NodeImpl] = &[
     output::IMPL,
 ];
 
-/// The implementation of the kind called `kind`: its own, or the generic post filter for
-/// a kind that names a shader.
-pub fn implementation(kind: &str) -> Option<&'static NodeImpl> {
-    IMPLEMENTATIONS
-        .iter()
-        .find(|i| i.kind == kind)
-        .or_else(|| post_filter::is_post_filter(kind).then_some(&post_filter::IMPL))
+/// The implementation of `kind`: the generic post filter for a kind that names a shader
+/// (built in or added at run time), else the kind's own from [`IMPLEMENTATIONS`].
+pub fn implementation(kind: &NodeKind) -> Option<&'static NodeImpl> {
+    if kind.shader.is_some() {
+        return Some(&post_filter::IMPL);
+    }
+    IMPLEMENTATIONS.iter().find(|i| i.kind == kind.name)
 }
 
 /// Memory a pass's node allocates for itself (see [`NodeImpl::owned_memory`]).
 pub fn owned_memory(pass: &Pass) -> Option<(u64, String)> {
-    implementation(pass.kind).and_then(|i| (i.owned_memory)(pass))
+    implementation(&pass.kind).and_then(|i| (i.owned_memory)(pass))
 }
 
-/// The pass of a post-processing node: `color` in, `color` out (in the format its shader
-/// declares), one uniform param block.
+/// The pass of a post-processing node: its inputs in declaration order (each a texture
+/// binding), a bilinear sampler when the shader declares one (`shaders/post/resample.wgsl`),
+/// its first output (in the format its shader declares; of the size the output port's rule
+/// gives), one uniform param block.
 pub(crate) struct FilterPass {
     kernel: crate::kernel::Kernel,
     params: wgpu::Buffer,
+    sampler: Option<wgpu::Sampler>,
 }
 
 impl FilterPass {
@@ -282,10 +285,16 @@ impl FilterPass {
     /// # Errors
     /// When the shader does not compile.
     pub(crate) fn new(ctx: &GpuContext, shader: &str, params: &[u8]) -> Result<Self> {
-        use crate::kernel::{Kernel, uniform_buffer};
+        use crate::kernel::{Binding, Kernel, linear_sampler, uniform_buffer};
+        let kernel = Kernel::new(ctx, shader)?;
+        let sampler = kernel
+            .bindings()
+            .contains(&Binding::Sampler)
+            .then(|| linear_sampler(ctx));
         Ok(Self {
-            kernel: Kernel::new(ctx, shader)?,
+            kernel,
             params: uniform_buffer(ctx, shader, params),
+            sampler,
         })
     }
 
@@ -294,22 +303,32 @@ impl FilterPass {
         ctx.queue.write_buffer(&self.params, 0, params);
     }
 
-    /// Records the pass over `pass`'s `color` ports.
+    /// Records the pass over `pass`'s ports.
     ///
     /// # Errors
-    /// When the input is not bound or the bindings do not match the kernel.
+    /// When an input is not bound or the bindings do not match the kernel.
     pub(crate) fn record(&self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
         let (ctx, encoder, io, timer) = rec.parts();
-        let input = io.input(pass, "color")?;
-        let Some(out) = pass.output("color") else {
+        let Some(out) = pass.kind.outputs.first().and_then(|o| pass.output(o.name)) else {
             return Ok(());
         };
-        self.kernel
-            .pass(&pass.node)
-            .read(&input.view)
+        let inputs = pass
+            .kind
+            .inputs
+            .iter()
+            .map(|i| io.input(pass, i.name))
+            .collect::<Result<Vec<_>>>()?;
+        let mut builder = self.kernel.pass(&pass.node);
+        for input in &inputs {
+            builder = builder.read(&input.view);
+        }
+        if let Some(sampler) = &self.sampler {
+            builder = builder.sampler(sampler);
+        }
+        builder
             .write(&io.texture(out).view)
             .uniform(&self.params)
-            .dispatch_2d(ctx, encoder, pass.extent, timer)
+            .dispatch_2d(ctx, encoder, io.plan.texture(out).extent, timer)
     }
 }
 
@@ -350,9 +369,9 @@ impl<P: ParamBlock> ColorFilter<P> {
 /// # Errors
 /// When the kind has no implementation or its setup fails; the error names the node.
 pub fn create(ctx: &GpuContext, pass: &Pass, paths: &Resources) -> Result<Box<dyn NodeExec>> {
-    let node = match implementation(pass.kind) {
+    let node = match implementation(&pass.kind) {
         Some(i) => (i.create)(ctx, pass, paths),
-        None => Err(RenderError::Unimplemented(pass.kind.to_owned())),
+        None => Err(RenderError::Unimplemented(pass.kind.name.to_owned())),
     };
     node.map_err(|e| e.in_node(&pass.node))
 }
@@ -385,7 +404,8 @@ mod tests {
     /// each once.
     #[test]
     fn every_registry_kind_has_one_implementation() {
-        let kinds: Vec<&str> = lumagraph_graph::Registry::builtin()
+        let registry = lumagraph_graph::Registry::with_builtins();
+        let kinds: Vec<&str> = registry
             .kinds()
             .iter()
             .filter(|k| k.shader.is_none())
@@ -396,13 +416,13 @@ mod tests {
         sorted.sort_unstable();
         implemented.sort_unstable();
         assert_eq!(sorted, implemented);
-        for k in lumagraph_graph::Registry::builtin().kinds() {
+        for k in registry.kinds() {
             assert!(
                 !(k.shader.is_some() && IMPLEMENTATIONS.iter().any(|i| i.kind == k.name)),
                 "{}: a post filter with an implementation of its own",
                 k.name
             );
-            let i = implementation(k.name).unwrap();
+            let i = implementation(k).unwrap();
             assert_eq!(
                 i.source_extent.is_some(),
                 k.is_source() && !k.renders_scene,
@@ -419,7 +439,7 @@ mod post_filter_tests {
     /// `Params` = the node's params by name, in order, as packed).
     #[test]
     fn every_post_filter_shader_matches_its_registry_entry() {
-        let registry = lumagraph_graph::Registry::builtin();
+        let registry = lumagraph_graph::Registry::with_builtins();
         let filters: Vec<_> = registry
             .kinds()
             .iter()
@@ -437,8 +457,8 @@ mod post_filter_tests {
     /// fails on a kind pointed at another filter's shader.
     #[test]
     fn a_shader_that_does_not_match_its_params_is_caught() {
-        let registry = lumagraph_graph::Registry::builtin();
-        let mut vignette = registry.get("Vignette").unwrap().clone();
+        let registry = lumagraph_graph::Registry::with_builtins();
+        let mut vignette = lumagraph_graph::NodeKind::clone(registry.get("Vignette").unwrap());
         vignette.shader = Some("post/exposure.wgsl");
         let e = super::post_filter::check(&vignette).unwrap_err();
         assert!(

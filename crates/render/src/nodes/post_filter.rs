@@ -1,11 +1,11 @@
-//! The generic single-input post filter: every registry kind that names a `shader` runs
-//! here. The pass reads input `color`, writes output `color` and gets the node's params in
-//! declaration order in the shader's `Params` struct (float → `f32`, int → `i32`, bool and
-//! enum option index → `u32`), so a new filter of this shape is its registry entry, its
-//! WGSL and its CPU reference test, with no Rust of its own. [`check`] holds every such
-//! kind's shader to that contract without a GPU.
+//! The generic post filter: every registry kind that names a `shader` runs here. The pass
+//! reads the kind's inputs (in declaration order, one texture binding each), writes its
+//! one output and gets the node's params in declaration order in the shader's `Params`
+//! struct (float → `f32`, int → `i32`, bool and enum option index → `u32`), so a new filter
+//! of this shape is its registry entry, its WGSL and its CPU reference test, with no Rust
+//! of its own. [`check`] holds every such kind's shader to that contract without a GPU.
 
-use lumagraph_graph::{NodeKind, ParamType, Pass, Registry};
+use lumagraph_graph::{NodeKind, ParamType, Pass};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
@@ -17,17 +17,6 @@ use crate::nodes::{FilterPass, NodeExec, NodeImpl, Recording, boxed};
 pub(crate) const IMPL: NodeImpl = NodeImpl::new("(post filter)", |ctx, pass, _| {
     boxed(PostFilter::new(ctx, pass))
 });
-
-/// The registry entry of `kind` and its shader, when it is a generic post filter.
-fn kind_and_shader(kind: &str) -> Option<(&'static NodeKind, &'static str)> {
-    let k = Registry::builtin().get(kind)?;
-    Some((k, k.shader?))
-}
-
-/// Whether `kind` runs on the generic post filter.
-pub(crate) fn is_post_filter(kind: &str) -> bool {
-    kind_and_shader(kind).is_some()
-}
 
 /// The WGSL type each kind of param is given as.
 fn wgsl_scalar(ty: &ParamType) -> Option<&'static str> {
@@ -64,23 +53,23 @@ fn pack(kind: &NodeKind, pass: &Pass) -> Result<Vec<u8>> {
 
 struct PostFilter {
     filter: FilterPass,
-    kind: &'static NodeKind,
 }
 
 impl PostFilter {
     fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
-        let (kind, shader) = kind_and_shader(pass.kind)
-            .ok_or_else(|| RenderError::Unimplemented(pass.kind.to_owned()))?;
+        let shader = pass
+            .kind
+            .shader
+            .ok_or_else(|| RenderError::Unimplemented(pass.kind.name.to_owned()))?;
         Ok(Self {
-            filter: FilterPass::new(ctx, shader, &pack(kind, pass)?)?,
-            kind,
+            filter: FilterPass::new(ctx, shader, &pack(&pass.kind, pass)?)?,
         })
     }
 }
 
 impl NodeExec for PostFilter {
     fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
-        self.filter.set_params(ctx, &pack(self.kind, pass)?);
+        self.filter.set_params(ctx, &pack(&pass.kind, pass)?);
         Ok(())
     }
 
@@ -100,17 +89,31 @@ pub fn check(kind: &NodeKind) -> std::result::Result<(), String> {
     let shader = kind.shader.ok_or("no shader")?;
     let source = crate::shader::resolve(shader).map_err(|e| e.to_string())?;
     let (bindings, _) = crate::kernel::reflect(shader, &source).map_err(|e| e.to_string())?;
-    let format = crate::pool::wgpu_format(kind.outputs[0].ty.format());
-    let want = [
-        Binding::Texture,
-        Binding::StorageTexture {
-            format,
-            access: wgpu::StorageTextureAccess::WriteOnly,
-        },
-        Binding::Uniform,
-    ];
-    if bindings != want {
-        return Err(format!("{shader}: bindings {bindings:?}, want {want:?}"));
+    let output = Binding::StorageTexture {
+        format: crate::pool::wgpu_format(kind.outputs[0].ty.format()),
+        access: wgpu::StorageTextureAccess::WriteOnly,
+    };
+    if kind.outputs.len() != 1 || kind.inputs.iter().any(|i| i.optional) {
+        return Err(format!(
+            "{}: a generic post filter has one output and no optional input",
+            kind.name
+        ));
+    }
+    let n = kind.inputs.len();
+    let filtered = Binding::FilteredTexture {
+        dim: wgpu::TextureViewDimension::D2,
+    };
+    let plain: Vec<Binding> = std::iter::repeat_n(Binding::Texture, n)
+        .chain([output, Binding::Uniform])
+        .collect();
+    let sampling: Vec<Binding> = std::iter::repeat_n(filtered, n)
+        .chain([Binding::Sampler, output, Binding::Uniform])
+        .collect();
+    if bindings != plain && bindings != sampling {
+        return Err(format!(
+            "{shader}: bindings {bindings:?}, want {plain:?} (one texture per input, as \
+             post/filter.wgsl) or {sampling:?} (with a sampler, as post/resample.wgsl)"
+        ));
     }
     let module = naga::front::wgsl::parse_str(&source).map_err(|e| e.emit_to_string(&source))?;
     let (_, params) = module
