@@ -346,15 +346,30 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
 }
 
 /// The shader features of every pass specialized to the scene: compiled in, and left out
-/// with why.
+/// with why, for the adapter `render` would use (found without opening a device).
 fn print_features(plan: &lumagraph::graph::Plan, scene: &GpuScene) {
+    let mut cpu = true;
+    let mut said = false;
     for pass in &plan.passes {
         let Some(features) =
             lumagraph::render::nodes::implementation(&pass.kind).and_then(|i| i.features)
         else {
             continue;
         };
-        let features = features(pass, scene);
+        if !said {
+            said = true;
+            match GpuContext::default_adapter_info() {
+                Ok(info) => {
+                    cpu = info.device_type == lumagraph::render::wgpu::DeviceType::Cpu;
+                    println!(
+                        "adapter: {} ({:?}); the shader choices below are made for it",
+                        info.name, info.device_type
+                    );
+                }
+                Err(e) => println!("adapter: none found ({e}); shader choices shown for a CPU one"),
+            }
+        }
+        let features = features(pass, scene, cpu);
         println!("shader features of {} for this scene:", pass.node);
         for included in [true, false] {
             println!("  {}:", if included { "compiled in" } else { "left out" });

@@ -163,6 +163,12 @@ impl fmt::Display for Plan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "passes ({}), in order:", self.passes.len())?;
         let w = self.passes.iter().map(|p| p.node.len()).max().unwrap_or(0);
+        let k = self
+            .passes
+            .iter()
+            .map(|p| p.kind.name.len())
+            .max()
+            .unwrap_or(0);
         for (i, p) in self.passes.iter().enumerate() {
             let reads: Vec<_> = p
                 .inputs
@@ -176,7 +182,7 @@ impl fmt::Display for Plan {
                 .collect();
             write!(
                 f,
-                "  {:>2}. {:<w$}  {:<12} {:>9}",
+                "  {:>2}. {:<w$}  {:<k$} {:>9}",
                 i + 1,
                 p.node,
                 p.kind.name,

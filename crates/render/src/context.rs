@@ -47,6 +47,19 @@ impl GpuContext {
     }
 
     async fn headless_async(prefer_cpu: bool) -> Result<Self> {
+        Self::from_adapter(Self::select_adapter(prefer_cpu).await?).await
+    }
+
+    /// What [`GpuContext::headless`] would run on, without opening a device (`lumagraph
+    /// plan` shows the shader choices made for it).
+    ///
+    /// # Errors
+    /// When no adapter matches.
+    pub fn default_adapter_info() -> Result<wgpu::AdapterInfo> {
+        pollster::block_on(Self::select_adapter(false)).map(|a| a.get_info())
+    }
+
+    async fn select_adapter(prefer_cpu: bool) -> Result<wgpu::Adapter> {
         let desc = Self::instance_descriptor();
         let backends = desc.backends;
         let instance = wgpu::Instance::new(desc);
@@ -82,7 +95,7 @@ impl GpuContext {
                 .await
                 .map_err(|e| RenderError::NoAdapter(format!(": {e}")))?
         };
-        Self::from_adapter(adapter).await
+        Ok(adapter)
     }
 
     /// The instance lumagraph creates: Vulkan, Metal and DX12 unless `WGPU_BACKEND` says

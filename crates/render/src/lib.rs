@@ -38,3 +38,5 @@ pub use nodes::{Counter, Resources};
 pub use pool::{PooledTexture, TexturePool, create as create_texture, wgpu_format};
 pub use scene_gpu::SceneBuffers;
 pub use timing::GpuTimer;
+/// The wgpu this crate is built on (its types appear in [`Binding`] and [`GpuContext`]).
+pub use wgpu;

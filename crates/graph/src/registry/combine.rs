@@ -12,7 +12,8 @@ fn mix() -> NodeKind {
         Category::Combine,
         "Blends `b` over `a` with a blend mode, then mixes that with `a` by `factor`: \
          lerp(a, blend(a, b), factor) per channel; alpha from `a`. Screen and overlay are \
-         the [0, 1] formulas applied as they are to HDR values.",
+         the [0, 1] formulas applied as they are: on HDR values above 1 they go negative \
+         (tone map first, or use `add` for glows).",
         vec![
             ParamDef::choice(
                 "mode",

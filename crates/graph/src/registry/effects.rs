@@ -11,7 +11,9 @@ fn sharpen() -> NodeKind {
         "Sharpen",
         Category::Filter,
         "Unsharp mask: c + amount × (c − blur(c)), blur a Gaussian of `sigma` pixels \
-         (taps within 3 sigma, clamped to the edge), negative results clipped to 0.",
+         (taps within 3 sigma, clamped to the edge), negative results clipped to 0. Around \
+         very bright HDR detail (a sun against the sky) the mask undershoots to black: a \
+         dark ring; keep `amount` small there.",
         vec![
             ParamDef::float(
                 "amount",

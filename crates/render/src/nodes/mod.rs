@@ -158,6 +158,10 @@ pub trait NodeExec {
     }
 }
 
+/// What a pass of a kind specialized to the scene compiles in and leaves out, for a CPU
+/// adapter (`true`) or a GPU.
+pub type Features = fn(&Pass, &lumagraph_scene::GpuScene, bool) -> Vec<crate::specialize::Feature>;
+
 /// The size of the image a source produces from its params (paths relative to the folder
 /// given), or why it cannot tell.
 pub type SourceExtent = fn(&Path, &lumagraph_graph::Params) -> std::result::Result<Extent, String>;
@@ -180,7 +184,8 @@ pub struct NodeImpl {
     pub source_extent: Option<SourceExtent>,
     /// For a kind whose shader is specialized to the scene: what a pass of it compiles in
     /// and leaves out for `scene` (with the default resources), for `lumagraph plan`.
-    pub features: Option<fn(&Pass, &lumagraph_scene::GpuScene) -> Vec<crate::specialize::Feature>>,
+    /// The `bool` says whether the adapter is a CPU one (lavapipe), where other choices pay.
+    pub features: Option<Features>,
 }
 
 impl std::fmt::Debug for NodeImpl {
@@ -223,10 +228,7 @@ impl NodeImpl {
 
     /// With shader features to list for a scene.
     #[must_use]
-    pub const fn with_features(
-        mut self,
-        features: fn(&Pass, &lumagraph_scene::GpuScene) -> Vec<crate::specialize::Feature>,
-    ) -> Self {
+    pub const fn with_features(mut self, features: Features) -> Self {
         self.features = Some(features);
         self
     }

@@ -22,15 +22,20 @@ const STATS: u64 = 4;
 pub(crate) const IMPL: NodeImpl = NodeImpl::new("PathTrace", |ctx, pass, resources| {
     boxed(PathTrace::new(ctx, pass, resources))
 })
-.with_features(|pass, scene| {
-    crate::specialize::features(scene, options(pass, &Resources::default()))
+.with_features(|pass, scene, cpu_adapter| {
+    crate::specialize::features(scene, options(pass, &Resources::default(), cpu_adapter))
 });
 
 /// How a pass's shader is specialized: to the scene unless the resources ask for the
-/// general shader, with first-hit AOVs when something reads them.
-fn options(pass: &Pass, resources: &Resources) -> crate::specialize::PathTraceOptions {
+/// general shader, to the kind of adapter, with first-hit AOVs when something reads them.
+fn options(
+    pass: &Pass,
+    resources: &Resources,
+    cpu_adapter: bool,
+) -> crate::specialize::PathTraceOptions {
     crate::specialize::PathTraceOptions {
         specialize: !resources.general_shaders,
+        cpu_adapter,
         data_in_buffers: resources.scene_data_in_buffers,
         aovs: ["albedo", "normal", "depth"]
             .iter()
@@ -94,7 +99,8 @@ impl PathTrace {
         let scene = resources.scene.clone().ok_or_else(|| {
             RenderError::Gpu("PathTrace needs a scene (lumagraph render --scene FILE)".into())
         })?;
-        let (source, how) = crate::specialize::pathtrace_source(&scene, options(pass, resources))?;
+        let (source, how) =
+            crate::specialize::pathtrace_source(&scene, options(pass, resources, ctx.is_cpu()))?;
         let kernel = Kernel::from_source(ctx, "pathtrace/pathtrace.wgsl", &source)?;
         let env = match &scene.environment_map {
             Some(path) => crate::env_map::EnvMap::load(
