@@ -74,6 +74,8 @@ pub const BLOCKS: &[BlockLayout] = &[
     <crate::nodes::denoise::DenoiseParams as ParamBlock>::LAYOUT,
     <crate::nodes::pathtrace::Frame as ParamBlock>::LAYOUT,
     <crate::nodes::gbuffer::RasterCamera as ParamBlock>::LAYOUT,
+    <crate::nodes::blur::BlurParams as ParamBlock>::LAYOUT,
+    <crate::nodes::bloom::BloomParams as ParamBlock>::LAYOUT,
 ];
 
 /// Whether `layout` matches naga's layout of its WGSL twin: the same size (the WGSL

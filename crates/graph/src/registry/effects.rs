@@ -1,9 +1,59 @@
 //! Filter nodes: sharpening, lens and film effects.
 
-use super::{Category, NodeKind, ParamDef, post_filter};
+use super::{Category, NodeKind, ParamDef, post_filter, post_node};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
-    vec![sharpen(), chromatic_aberration(), film_grain()]
+    vec![
+        blur(),
+        sharpen(),
+        bloom(),
+        chromatic_aberration(),
+        film_grain(),
+    ]
+}
+
+fn blur() -> NodeKind {
+    post_node(
+        "Blur",
+        Category::Filter,
+        "Gaussian blur of standard deviation `sigma` pixels, separable: a horizontal pass \
+         into a node-owned image, then a vertical one, each with the taps within \
+         ceil(3 sigma) pixels, normalized, clamped to the edge. Cost grows with sigma: 6 \
+         sigma + 1 taps per pixel and pass.",
+        vec![ParamDef::float(
+            "sigma",
+            2.0,
+            [0.3, 64.0],
+            "standard deviation in pixels",
+        )],
+    )
+}
+
+fn bloom() -> NodeKind {
+    post_node(
+        "Bloom",
+        Category::Filter,
+        "Energy-conserving multi-scale bloom (after Jimenez 2014): the image is halved \
+         `levels` times with a [1 3 3 1]/8 filter per axis, then the levels are added back \
+         from the smallest up, each upsampled bilinearly; the sum over the levels, divided \
+         by their number, is the glow. out = (1 − intensity) × color + intensity × glow: \
+         light is spread, never added (the image's mean is kept, up to the edges). The \
+         pyramid's images are node-owned.",
+        vec![
+            ParamDef::float(
+                "intensity",
+                0.04,
+                [0.0, 1.0],
+                "fraction of the light spread into the glow",
+            ),
+            ParamDef::int(
+                "levels",
+                6,
+                [1, 12],
+                "how far the glow reaches: level i is 2^i pixels wide",
+            ),
+        ],
+    )
 }
 
 fn sharpen() -> NodeKind {

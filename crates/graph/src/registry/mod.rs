@@ -381,6 +381,20 @@ pub(crate) fn post_filter(
     shader: &'static str,
 ) -> NodeKind {
     NodeKind {
+        shader: Some(shader),
+        ..post_node(name, category, doc, params)
+    }
+}
+
+/// A post node of the same ports with an implementation of its own (several passes,
+/// node-owned images) in the render crate.
+pub(crate) fn post_node(
+    name: &'static str,
+    category: Category,
+    doc: &'static str,
+    params: Vec<ParamDef>,
+) -> NodeKind {
+    NodeKind {
         name,
         category,
         doc,
@@ -394,7 +408,7 @@ pub(crate) fn post_filter(
         sink: false,
         history: false,
         renders_scene: false,
-        shader: Some(shader),
+        shader: None,
     }
 }
 

@@ -1,6 +1,8 @@
 //! GPU implementations of the node kinds, one file per kind, each named as in the registry.
 
 pub(crate) mod accumulate;
+pub(crate) mod bloom;
+pub(crate) mod blur;
 pub(crate) mod denoise;
 pub(crate) mod gbuffer;
 mod image_input;
@@ -252,6 +254,8 @@ pub static IMPLEMENTATIONS: &[NodeImpl] = &[
     accumulate::IMPL,
     gbuffer::IMPL,
     denoise::IMPL,
+    blur::IMPL,
+    bloom::IMPL,
     tonemap::IMPL,
     output::IMPL,
 ];
