@@ -2,6 +2,7 @@
 
 mod bench;
 mod converge;
+mod gallery;
 mod plot;
 
 use std::path::{Path, PathBuf};
@@ -95,6 +96,19 @@ enum Command {
         /// Timed runs; the best is reported.
         #[arg(long, default_value_t = 3)]
         runs: u32,
+    },
+    /// Render one image per node kind into OUT/gallery/ and the page that shows them,
+    /// OUT/gallery.md (the docs' node gallery).
+    #[command(
+        after_help = "Examples:\n  lumagraph gallery --out docs\n  lumagraph gallery --out /tmp/g --kind Bloom --kind Mix"
+    )]
+    Gallery {
+        /// Folder for gallery.md and the gallery/ images.
+        #[arg(long, default_value = "docs")]
+        out: PathBuf,
+        /// Only these kinds (the page is written only when all are made).
+        #[arg(long = "kind")]
+        kinds: Vec<String>,
     },
     /// Open the node editor, optionally on a graph file and a scene.
     #[command(
@@ -453,6 +467,10 @@ fn run(cli: Cli) -> Result<()> {
                 }
             );
             Ok(())
+        }
+        Command::Gallery { out, kinds } => {
+            let ctx = GpuContext::headless()?;
+            gallery::run(&ctx, &out, &kinds)
         }
         Command::Bench { scene, spp, runs } => {
             let loaded = load_scene(Some(&scene))?.context("no scene")?;

@@ -591,3 +591,58 @@ fn firefly_clamp_is_reported_when_on() {
     assert!(o.status.success(), "{stderr}");
     assert!(stdout.contains("firefly clamp ON"), "{stdout}");
 }
+
+/// The gallery in the docs has one image per registry kind and no image of a kind that is
+/// gone: a kind added without running `lumagraph gallery --out docs` fails here.
+#[test]
+fn docs_gallery_is_complete() {
+    let page = std::fs::read_to_string(common::repo("docs/gallery.md")).unwrap();
+    let registry = lumagraph::graph::Registry::with_builtins();
+    for k in registry.kinds() {
+        let image = format!("gallery/{}.png", k.name);
+        assert!(
+            page.contains(&format!("![{}]({image})", k.name)),
+            "docs/gallery.md does not show {}: run `lumagraph gallery --out docs`",
+            k.name
+        );
+        assert!(
+            common::repo("docs").join(&image).is_file(),
+            "docs/{image} is missing"
+        );
+    }
+    for entry in std::fs::read_dir(common::repo("docs/gallery")).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        let kind = name.strip_suffix(".png").unwrap_or(&name);
+        assert!(
+            registry.get(kind).is_some(),
+            "docs/gallery/{name}: no such kind"
+        );
+    }
+}
+
+/// `gallery --kind` renders the kinds named, one PNG each, and refuses an unknown one.
+#[test]
+fn gallery_renders_the_kinds_asked_for() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let o = lumagraph(&[
+        "gallery", "--out", out, "--kind", "Bloom", "--kind", "Output",
+    ]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    for k in ["Bloom", "Output"] {
+        let png = dir.path().join("gallery").join(format!("{k}.png"));
+        let img = lumagraph::render::image_io::load(&png).unwrap();
+        assert_eq!((img.width, img.height), (384, 192), "{k}");
+    }
+    assert!(!dir.path().join("gallery.md").exists());
+    let o = lumagraph(&["gallery", "--out", out, "--kind", "Nope"]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o).1.contains("no node kind called \"Nope\""),
+        "{:?}",
+        text(&o)
+    );
+}

@@ -534,6 +534,7 @@ fn sized_registry() -> Registry {
         history: false,
         renders_scene: false,
         shader: None,
+        example: Vec::new(),
     })
     .unwrap();
     r
@@ -659,4 +660,19 @@ fn registry_is_an_owned_value() {
     assert!(compile_with(&g, &registry).is_ok());
     let m = compile_graph(&g).unwrap_err().to_string();
     assert!(m.contains("unknown node kind \"Pyramid\""), "{m}");
+}
+
+/// Every kind's gallery example is a valid set of its params.
+#[test]
+fn gallery_examples_are_valid_params() {
+    let registry = Registry::with_builtins();
+    for kind in registry.kinds() {
+        let node = kind
+            .example
+            .iter()
+            .fold(Node::new("n", kind.name), |n, (k, v)| n.with(k, v.clone()));
+        if let Err(e) = lumagraph_graph::resolve_params(&node, kind) {
+            panic!("{}: {e:?}", kind.name);
+        }
+    }
 }

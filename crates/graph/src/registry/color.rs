@@ -3,7 +3,7 @@
 use super::{
     COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, TONEMAP_OPERATORS, post_filter,
 };
-use crate::types::{ParamType, PortType};
+use crate::types::{ParamType, ParamValue, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
     vec![
@@ -42,6 +42,7 @@ fn white_balance() -> NodeKind {
         ],
         "post/white_balance.wgsl",
     )
+    .with_example(&[("temperature", ParamValue::Float(4000.0))])
 }
 
 fn cdl() -> NodeKind {
@@ -72,6 +73,12 @@ fn cdl() -> NodeKind {
         ],
         "post/cdl.wgsl",
     )
+    .with_example(&[
+        ("slope_r", ParamValue::Float(1.2)),
+        ("slope_b", ParamValue::Float(0.85)),
+        ("power_g", ParamValue::Float(1.1)),
+        ("saturation", ParamValue::Float(0.7)),
+    ])
 }
 
 fn contrast() -> NodeKind {
@@ -97,6 +104,7 @@ fn contrast() -> NodeKind {
         ],
         "post/contrast.wgsl",
     )
+    .with_example(&[("contrast", ParamValue::Float(1.5))])
 }
 
 fn hue_saturation() -> NodeKind {
@@ -113,6 +121,7 @@ fn hue_saturation() -> NodeKind {
         ],
         "post/hue_saturation.wgsl",
     )
+    .with_example(&[("hue", ParamValue::Float(90.0))])
 }
 
 fn exposure() -> NodeKind {
@@ -131,6 +140,7 @@ fn exposure() -> NodeKind {
         }],
         "post/exposure.wgsl",
     )
+    .with_example(&[("ev", ParamValue::Float(1.0))])
 }
 
 fn vignette() -> NodeKind {
@@ -208,5 +218,6 @@ fn tonemap() -> NodeKind {
         history: false,
         renders_scene: false,
         shader: None,
+        example: Vec::new(),
     }
 }

@@ -1,6 +1,7 @@
 //! Combine nodes: two images blended, arithmetic on one.
 
 use super::{COLOR_TYPES, Category, InputDef, NodeKind, ParamDef, post_filter};
+use crate::types::ParamValue;
 
 pub(super) fn kinds() -> Vec<NodeKind> {
     vec![mix(), math()]
@@ -37,7 +38,10 @@ fn mix() -> NodeKind {
         InputDef::new("a", COLOR_TYPES, "the base image"),
         InputDef::new("b", COLOR_TYPES, "the image blended over it (same size)"),
     ];
-    kind
+    kind.with_example(&[
+        ("mode", ParamValue::Str("multiply".into())),
+        ("factor", ParamValue::Float(1.0)),
+    ])
 }
 
 fn math() -> NodeKind {
@@ -63,4 +67,8 @@ fn math() -> NodeKind {
         ],
         "post/math.wgsl",
     )
+    .with_example(&[
+        ("operation", ParamValue::Str("power".into())),
+        ("value", ParamValue::Float(2.0)),
+    ])
 }

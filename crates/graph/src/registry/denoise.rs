@@ -103,5 +103,6 @@ fn denoise() -> NodeKind {
         history: false,
         renders_scene: false,
         shader: None,
+        example: Vec::new(),
     }
 }

@@ -1,6 +1,7 @@
 //! Filter nodes: sharpening, lens and film effects.
 
 use super::{Category, NodeKind, ParamDef, post_filter, post_node};
+use crate::types::ParamValue;
 
 pub(super) fn kinds() -> Vec<NodeKind> {
     vec![
@@ -27,6 +28,7 @@ fn blur() -> NodeKind {
             "standard deviation in pixels",
         )],
     )
+    .with_example(&[("sigma", ParamValue::Float(3.0))])
 }
 
 fn bloom() -> NodeKind {
@@ -54,6 +56,7 @@ fn bloom() -> NodeKind {
             ),
         ],
     )
+    .with_example(&[("intensity", ParamValue::Float(0.3))])
 }
 
 fn sharpen() -> NodeKind {
@@ -80,6 +83,7 @@ fn sharpen() -> NodeKind {
         ],
         "post/sharpen.wgsl",
     )
+    .with_example(&[("amount", ParamValue::Float(2.0))])
 }
 
 fn chromatic_aberration() -> NodeKind {
@@ -98,6 +102,7 @@ fn chromatic_aberration() -> NodeKind {
         )],
         "post/chromatic_aberration.wgsl",
     )
+    .with_example(&[("strength", ParamValue::Float(0.02))])
 }
 
 fn film_grain() -> NodeKind {
@@ -123,4 +128,5 @@ fn film_grain() -> NodeKind {
         ],
         "post/film_grain.wgsl",
     )
+    .with_example(&[("intensity", ParamValue::Float(0.2))])
 }

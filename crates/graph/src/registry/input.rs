@@ -31,5 +31,6 @@ fn image_input() -> NodeKind {
         history: false,
         renders_scene: false,
         shader: None,
+        example: Vec::new(),
     }
 }

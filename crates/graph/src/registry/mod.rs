@@ -17,7 +17,7 @@ mod transform;
 use std::sync::Arc;
 
 use crate::compile::Params;
-use crate::types::{Extent, ParamType, PortType};
+use crate::types::{Extent, ParamType, ParamValue, PortType};
 
 /// Where a node kind sits in menus and docs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -256,9 +256,19 @@ pub struct NodeKind {
     /// bool and enum option index → `u32`). `None`: the kind has an implementation of its
     /// own in the render crate.
     pub shader: Option<&'static str>,
+    /// Params that show what the node does, for the gallery (`lumagraph gallery`); empty:
+    /// its defaults (which for a grading node change nothing).
+    pub example: Vec<(&'static str, ParamValue)>,
 }
 
 impl NodeKind {
+    /// The same kind with `example` params for the gallery.
+    #[must_use]
+    pub fn with_example(mut self, example: &[(&'static str, ParamValue)]) -> Self {
+        self.example = example.to_vec();
+        self
+    }
+
     /// The input port called `name`.
     pub fn input(&self, name: &str) -> Option<&InputDef> {
         self.inputs.iter().find(|p| p.name == name)
@@ -409,6 +419,7 @@ pub(crate) fn post_node(
         history: false,
         renders_scene: false,
         shader: None,
+        example: Vec::new(),
     }
 }
 

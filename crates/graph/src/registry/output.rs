@@ -28,5 +28,6 @@ fn output() -> NodeKind {
         history: false,
         renders_scene: false,
         shader: None,
+        example: Vec::new(),
     }
 }

@@ -124,6 +124,7 @@ fn path_trace() -> NodeKind {
         history: false,
         renders_scene: true,
         shader: None,
+        example: Vec::new(),
     }
 }
 
@@ -152,6 +153,7 @@ fn accumulate() -> NodeKind {
         history: true,
         renders_scene: false,
         shader: None,
+        example: Vec::new(),
     }
 }
 
@@ -198,5 +200,6 @@ fn gbuffer() -> NodeKind {
         history: false,
         renders_scene: true,
         shader: None,
+        example: Vec::new(),
     }
 }

@@ -2,7 +2,7 @@
 
 use super::{Category, NodeKind, OutputSize, ParamDef, post_filter};
 use crate::compile::Params;
-use crate::types::{Extent, ParamType};
+use crate::types::{Extent, ParamType, ParamValue};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
     vec![resize(), crop()]
@@ -36,7 +36,12 @@ fn crop() -> NodeKind {
         crop_extent,
         "`width` × `height` (0: to the input's edge); the rectangle must lie inside the input",
     );
-    kind
+    kind.with_example(&[
+        ("x", ParamValue::Int(96)),
+        ("y", ParamValue::Int(48)),
+        ("width", ParamValue::Int(192)),
+        ("height", ParamValue::Int(96)),
+    ])
 }
 
 /// The output size of a Crop of an `input`-sized image.
