@@ -33,6 +33,8 @@ pub enum Binding {
         /// 2D or 3D.
         dim: wgpu::TextureViewDimension,
     },
+    /// `texture_3d<f32>` read with `textureLoad` (no sampler in the shader).
+    Texture3d,
     /// `sampler` (filtering; comparison samplers are not supported).
     Sampler,
     /// `texture_storage_2d<format, access>`.
@@ -65,6 +67,11 @@ impl Binding {
                 multisampled: false,
             },
             Self::Sampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            Self::Texture3d => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D3,
+                multisampled: false,
+            },
             Self::StorageTexture { format, access } => wgpu::BindingType::StorageTexture {
                 access,
                 format,
@@ -87,6 +94,7 @@ impl Binding {
     fn builder_method(self) -> &'static str {
         match self {
             Self::Texture
+            | Self::Texture3d
             | Self::FilteredTexture { .. }
             | Self::StorageTexture {
                 access: wgpu::StorageTextureAccess::ReadOnly,
@@ -168,9 +176,15 @@ pub fn reflect(label: &str, source: &str) -> Result<(Vec<Binding>, [u32; 3])> {
                             multi: false,
                         },
                 },
-            ) if filtering => Binding::FilteredTexture {
-                dim: wgpu::TextureViewDimension::D3,
-            },
+            ) => {
+                if filtering {
+                    Binding::FilteredTexture {
+                        dim: wgpu::TextureViewDimension::D3,
+                    }
+                } else {
+                    Binding::Texture3d
+                }
+            }
             (
                 naga::AddressSpace::Handle,
                 naga::TypeInner::Image {

@@ -76,6 +76,7 @@ pub const BLOCKS: &[BlockLayout] = &[
     <crate::nodes::gbuffer::RasterCamera as ParamBlock>::LAYOUT,
     <crate::nodes::blur::BlurParams as ParamBlock>::LAYOUT,
     <crate::nodes::bloom::BloomParams as ParamBlock>::LAYOUT,
+    <crate::nodes::lut::LutParams as ParamBlock>::LAYOUT,
 ];
 
 /// Whether `layout` matches naga's layout of its WGSL twin: the same size (the WGSL

@@ -2,6 +2,7 @@
 
 use super::{
     COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, TONEMAP_OPERATORS, post_filter,
+    post_node,
 };
 use crate::types::{ParamType, ParamValue, PortType};
 
@@ -12,6 +13,7 @@ pub(super) fn kinds() -> Vec<NodeKind> {
         cdl(),
         contrast(),
         hue_saturation(),
+        lut(),
         vignette(),
         tonemap(),
     ]
@@ -79,6 +81,47 @@ fn cdl() -> NodeKind {
         ("power_g", ParamValue::Float(1.1)),
         ("saturation", ParamValue::Float(0.7)),
     ])
+}
+
+fn lut() -> NodeKind {
+    NodeKind {
+        params: vec![
+            ParamDef {
+                name: "path",
+                ty: ParamType::Path {
+                    default: "look.cube",
+                    extensions: &["cube"],
+                },
+                doc: "the .cube file (LUT_3D_SIZE, optional DOMAIN_MIN/MAX or \
+                      LUT_3D_INPUT_RANGE), relative to the graph file's folder",
+            },
+            ParamDef::choice(
+                "interpolation",
+                "tetrahedral",
+                &[
+                    ("trilinear", "the 8 entries around the value"),
+                    (
+                        "tetrahedral",
+                        "the 4 entries of the cube's tetrahedron that holds the value \
+                         (keeps greys grey)",
+                    ),
+                ],
+                "how entries between the grid points are found",
+            ),
+        ],
+        ..post_node(
+            "LUT",
+            Category::Color,
+            "Applies a 3D colour lookup table from a .cube file (Adobe/Resolve format): each \
+             pixel's rgb, mapped from the file's domain to the grid (clamped), is \
+             interpolated between the grid's entries; alpha is kept. The values are looked \
+             up as they are: a LUT made for display-referred input belongs where the \
+             values are in its domain (e.g. after Exposure and a Math clamp). A bad file \
+             is refused with its line number.",
+            Vec::new(),
+        )
+    }
+    .with_example(&[("path", ParamValue::Str("assets/luts/film.cube".into()))])
 }
 
 fn contrast() -> NodeKind {

@@ -6,6 +6,7 @@ pub(crate) mod blur;
 pub(crate) mod denoise;
 pub(crate) mod gbuffer;
 mod image_input;
+pub mod lut;
 mod output;
 pub(crate) mod pathtrace;
 pub mod post_filter;
@@ -256,6 +257,7 @@ pub static IMPLEMENTATIONS: &[NodeImpl] = &[
     denoise::IMPL,
     blur::IMPL,
     bloom::IMPL,
+    lut::IMPL,
     tonemap::IMPL,
     output::IMPL,
 ];
