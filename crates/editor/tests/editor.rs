@@ -240,14 +240,14 @@ fn a_bad_file_opens_with_errors_not_a_crash() {
     let odd = dir.path().join("odd.ron");
     std::fs::write(
         &odd,
-        "(version: 1, nodes: [(id: \"x\", kind: \"Blur\"), (id: \"e\", kind: \"Exposure\", params: {\"ev\": 99.0})])",
+        "(version: 1, nodes: [(id: \"x\", kind: \"Smudge\"), (id: \"e\", kind: \"Exposure\", params: {\"ev\": 99.0})])",
     )
     .unwrap();
     h.state_mut().open(&odd);
     h.run_ok();
     let ed = h.state();
     assert!(
-        ed.errors["x"][0].contains("unknown node kind \"Blur\""),
+        ed.errors["x"][0].contains("unknown node kind \"Smudge\""),
         "{:?}",
         ed.errors
     );
