@@ -17,7 +17,7 @@ py=${MITSUBA_PYTHON:-.venv-mitsuba/bin/python}
 . scripts/env.sh
 cargo build --release -q
 lg=$(target/release/lumagraph bench --scene assets/bench/mesh_env.ron --spp "$spp" --runs 3 \
-    | tee /dev/stderr | awk '$1 == "specialized" {print $2}')
+    | tee /dev/stderr | awk '$1 == "specialized" && $3 == "M" {print $2}')
 mi=$("$py" scripts/bench/mesh_env.py mitsuba assets/bench/blob.obj --spp "$spp" --runs 3 \
     | tee /dev/stderr | python3 -c 'import json, sys; print(json.load(sys.stdin)["paths_per_s"] / 1e6)')
 python3 -c "lg, mi = $lg, $mi; print(f'mesh scene, {$spp} spp: lumagraph {lg:.3f} M paths/s, Mitsuba {mi:.3f} M paths/s: {lg / mi:.3f}x')"
