@@ -313,8 +313,7 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
         base_dir: graph.base_dir(),
         out_dir: args.out.to_owned(),
         scene: scene.as_ref().map(|s| Arc::clone(&s.gpu)),
-        general_shaders: false,
-        scene_data_in_buffers: false,
+        ..Resources::default()
     };
     let left_out = plan.left_out.clone();
     let mut exec = Executor::new(&ctx, plan, &resources)?;

@@ -37,6 +37,9 @@ pub struct Resources {
     /// In the specialized shader, keep materials, lights and shading data in their storage
     /// buffers even where they could be written into the code (tests and benchmarks).
     pub scene_data_in_buffers: bool,
+    /// Traverse the BVH even where a CPU adapter would intersect a small scene inline: what
+    /// GPU adapters run (tests compare the two on lavapipe).
+    pub traverse_bvh: bool,
 }
 
 /// A named count a node keeps (samples, rays, dropped samples), since its last reset.

@@ -99,8 +99,10 @@ impl PathTrace {
         let scene = resources.scene.clone().ok_or_else(|| {
             RenderError::Gpu("PathTrace needs a scene (lumagraph render --scene FILE)".into())
         })?;
-        let (source, how) =
-            crate::specialize::pathtrace_source(&scene, options(pass, resources, ctx.is_cpu()))?;
+        let (source, how) = crate::specialize::pathtrace_source(
+            &scene,
+            options(pass, resources, ctx.is_cpu() && !resources.traverse_bvh),
+        )?;
         let kernel = Kernel::from_source(ctx, "pathtrace/pathtrace.wgsl", &source)?;
         let env = match &scene.environment_map {
             Some(path) => crate::env_map::EnvMap::load(
