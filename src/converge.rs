@@ -60,17 +60,7 @@ struct Row {
 fn prepare(graph: &mut Graph) -> Result<Vec<(String, bool)>> {
     let registry = Registry::with_builtins();
     let kind = |n: &lumagraph::graph::Node| registry.get(&n.kind);
-    let sinks: Vec<String> = graph
-        .nodes
-        .iter()
-        .filter(|n| kind(n).is_some_and(|k| k.sink))
-        .map(|n| n.id.clone())
-        .collect();
-    graph.nodes.retain(|n| !sinks.contains(&n.id));
-    graph.edges.retain(|e| {
-        let to = e.to.rsplit_once('.').map_or(e.to.as_str(), |(n, _)| n);
-        !sinks.iter().any(|s| s == to)
-    });
+    graph.remove_sinks(&registry);
     let mut ports = Vec::new();
     for n in &mut graph.nodes {
         let Some(k) = kind(n) else { continue };

@@ -50,7 +50,11 @@ fn sources() -> Graph {
 
 /// How the gallery shows `kind`: the graph, the port shown, what it holds, and how many
 /// frames to run.
-fn recipe(kind: &NodeKind, root: &Path) -> Result<(Graph, String, PortType, u32)> {
+fn recipe(
+    kind: &NodeKind,
+    registry: &Registry,
+    root: &Path,
+) -> Result<(Graph, String, PortType, u32)> {
     let hdr_in = kind
         .inputs
         .iter()
@@ -58,12 +62,7 @@ fn recipe(kind: &NodeKind, root: &Path) -> Result<(Graph, String, PortType, u32)
     if kind.renders_scene || kind.history || !hdr_in {
         // A node of the path-tracing graph: its first output there.
         let mut g = Graph::load(&root.join(RENDER_GRAPH))?;
-        let registry = Registry::with_builtins();
-        g.nodes
-            .retain(|n| registry.get(&n.kind).is_none_or(|k| !k.sink));
-        let ids: Vec<String> = g.nodes.iter().map(|n| n.id.clone()).collect();
-        g.edges
-            .retain(|e| ids.iter().any(|id| e.to.starts_with(&format!("{id}."))));
+        g.remove_sinks(registry);
         let n = g
             .nodes
             .iter()
@@ -71,7 +70,7 @@ fn recipe(kind: &NodeKind, root: &Path) -> Result<(Graph, String, PortType, u32)
             .with_context(|| format!("{RENDER_GRAPH} has no {} node to show", kind.name))?;
         let out = kind.outputs.first().context("no output")?;
         let port = format!("{}.{}", n.id, out.name);
-        return Ok((g.clone(), port, out.ty, RENDER_FRAMES));
+        return Ok((g, port, out.ty, RENDER_FRAMES));
     }
     let mut g = sources();
     if kind.inputs.is_empty() {
@@ -132,7 +131,7 @@ pub fn run(ctx: &GpuContext, out: &Path, only: &[String]) -> Result<()> {
         if !only.is_empty() && !only.iter().any(|o| o == kind.name) {
             continue;
         }
-        let (graph, port, ty, frames) = recipe(kind, &root)?;
+        let (graph, port, ty, frames) = recipe(kind, &registry, &root)?;
         let keep: Vec<String> = [port.clone()]
             .into_iter()
             .filter(|p| !p.is_empty())

@@ -361,27 +361,32 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
 /// The shader features of every pass specialized to the scene: compiled in, and left out
 /// with why, for the adapter `render` would use (found without opening a device).
 fn print_features(plan: &lumagraph::graph::Plan, scene: &GpuScene) {
-    let mut cpu = true;
-    let mut said = false;
-    for pass in &plan.passes {
-        let Some(features) =
-            lumagraph::render::nodes::implementation(&pass.kind).and_then(|i| i.features)
-        else {
-            continue;
-        };
-        if !said {
-            said = true;
-            match GpuContext::default_adapter_info() {
-                Ok(info) => {
-                    cpu = info.device_type == lumagraph::render::wgpu::DeviceType::Cpu;
-                    println!(
-                        "adapter: {} ({:?}); the shader choices below are made for it",
-                        info.name, info.device_type
-                    );
-                }
-                Err(e) => println!("adapter: none found ({e}); shader choices shown for a CPU one"),
-            }
+    let specialized: Vec<_> = plan
+        .passes
+        .iter()
+        .filter_map(|p| {
+            lumagraph::render::nodes::implementation(&p.kind)
+                .and_then(|i| i.features)
+                .map(|f| (p, f))
+        })
+        .collect();
+    if specialized.is_empty() {
+        return;
+    }
+    let cpu = match GpuContext::default_adapter_info() {
+        Ok(info) => {
+            println!(
+                "adapter: {} ({:?}); the shader choices below are made for it",
+                info.name, info.device_type
+            );
+            info.device_type == lumagraph::render::wgpu::DeviceType::Cpu
         }
+        Err(e) => {
+            println!("adapter: none found ({e}); shader choices shown for a CPU one");
+            true
+        }
+    };
+    for (pass, features) in specialized {
         let features = features(pass, scene, cpu);
         println!("shader features of {} for this scene:", pass.node);
         for included in [true, false] {

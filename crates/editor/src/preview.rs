@@ -112,16 +112,8 @@ impl std::fmt::Debug for Preview {
 
 /// The graph the preview runs: `graph` without its sinks (nothing is written to disk).
 pub fn preview_graph(reg: &Registry, graph: &Graph) -> Graph {
-    let is_sink = |id: &str| {
-        graph
-            .node(id)
-            .and_then(|n| reg.get(&n.kind))
-            .is_some_and(|k| k.sink)
-    };
     let mut g = graph.clone();
-    g.nodes.retain(|n| !is_sink(&n.id));
-    g.edges
-        .retain(|e| lumagraph_graph::split_port_ref(&e.to).is_some_and(|(n, _)| !is_sink(n)));
+    g.remove_sinks(reg);
     for n in &mut g.nodes {
         n.pos = None;
     }

@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{ErrorKind, GraphError, Pos};
+use crate::registry::Registry;
 use crate::types::ParamValue;
 
 /// The graph file version this build reads and writes.
@@ -256,6 +257,20 @@ impl Graph {
     /// The node with id `id`.
     pub fn node(&self, id: &str) -> Option<&Node> {
         self.nodes.iter().find(|n| n.id == id)
+    }
+
+    /// Removes the sinks (nodes of kinds that write out of the graph, as `registry` says)
+    /// and the edges into them: the graph a preview or a measurement runs, writing no file.
+    pub fn remove_sinks(&mut self, registry: &Registry) {
+        let sinks: Vec<String> = self
+            .nodes
+            .iter()
+            .filter(|n| registry.get(&n.kind).is_some_and(|k| k.sink))
+            .map(|n| n.id.clone())
+            .collect();
+        self.nodes.retain(|n| !sinks.contains(&n.id));
+        self.edges
+            .retain(|e| split_port_ref(&e.to).is_none_or(|(n, _)| !sinks.iter().any(|s| s == n)));
     }
 
     /// The node with id `id`, mutably.

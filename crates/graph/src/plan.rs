@@ -54,11 +54,6 @@ impl Pass {
             .map(|(_, t)| *t)
     }
 
-    /// The kind's name.
-    pub fn kind_name(&self) -> &'static str {
-        self.kind.name
-    }
-
     /// The texture bound to output `port`, if anything reads it.
     pub fn output(&self, port: &str) -> Option<TextureId> {
         self.outputs

@@ -369,8 +369,8 @@ impl Kernel {
 /// A pass being declared: its resources in binding order, then the dispatch. Each resource
 /// is given by the method of its binding's kind — `read` (a sampled or read-only storage
 /// texture), `write` (a writable storage texture), `sampler`, `uniform`, `buffer`
-/// (storage) — and the
-/// dispatch refuses any other order or kind, naming the pass and the binding.
+/// (storage) — and the dispatch refuses any other order or kind, naming the pass and the
+/// binding.
 #[derive(Debug)]
 pub struct PassBuilder<'a> {
     kernel: &'a Kernel,

@@ -299,11 +299,6 @@ pub struct Registry {
 }
 
 impl Registry {
-    /// No kinds.
-    pub fn empty() -> Self {
-        Self::default()
-    }
-
     /// The kinds built into lumagraph.
     pub fn with_builtins() -> Self {
         Self {

@@ -2,7 +2,7 @@
 
 use super::{Category, NodeKind, OutputSize, ParamDef, post_filter};
 use crate::compile::Params;
-use crate::types::{Extent, ParamType, ParamValue};
+use crate::types::{Extent, ParamValue};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
     vec![resize(), crop()]
@@ -52,14 +52,12 @@ fn crop_extent(input: Extent, params: &Params) -> Result<Extent, String> {
     if x >= iw || y >= ih {
         return Err(format!("corner ({x}, {y}) is outside the {input} input"));
     }
-    let w = match side("width") {
-        0 => iw - x,
-        w => w,
-    };
-    let h = match side("height") {
-        0 => ih - y,
-        h => h,
-    };
+    // 0: to the input's edge.
+    let or_rest = |v: u32, rest: u32| if v == 0 { rest } else { v };
+    let (w, h) = (
+        or_rest(side("width"), iw - x),
+        or_rest(side("height"), ih - y),
+    );
     if u64::from(x) + u64::from(w) > u64::from(iw) || u64::from(y) + u64::from(h) > u64::from(ih) {
         return Err(format!(
             "{w}x{h} at ({x}, {y}) reaches past the {input} input"
@@ -82,46 +80,35 @@ fn resize() -> NodeKind {
          when shrinking, so no aliasing) by the Lanczos-3 kernel, normalized, and clips the \
          negative values its lobes can give to 0.",
         vec![
-            ParamDef {
-                name: "width",
-                ty: ParamType::Int {
-                    default: 0,
-                    min: 0,
-                    max: MAX_SIDE,
-                },
-                doc: "output width in pixels; 0: from `height` keeping the aspect ratio, or \
-                      from `scale` when both are 0",
-            },
-            ParamDef {
-                name: "height",
-                ty: ParamType::Int {
-                    default: 0,
-                    min: 0,
-                    max: MAX_SIDE,
-                },
-                doc: "output height in pixels; 0: from `width` keeping the aspect ratio, or \
-                      from `scale` when both are 0",
-            },
-            ParamDef {
-                name: "scale",
-                ty: ParamType::Float {
-                    default: 0.5,
-                    min: 0.01,
-                    max: 16.0,
-                },
-                doc: "size factor on both axes, used when `width` and `height` are 0",
-            },
-            ParamDef {
-                name: "kernel",
-                ty: ParamType::Enum {
-                    default: "lanczos3",
-                    options: &[
-                        ("bilinear", "4 texels through the filtering sampler"),
-                        ("lanczos3", "Lanczos-3, widened when shrinking"),
-                    ],
-                },
-                doc: "resampling kernel",
-            },
+            ParamDef::int(
+                "width",
+                0,
+                [0, MAX_SIDE],
+                "output width in pixels; 0: from `height` keeping the aspect ratio, or from \
+                 `scale` when both are 0",
+            ),
+            ParamDef::int(
+                "height",
+                0,
+                [0, MAX_SIDE],
+                "output height in pixels; 0: from `width` keeping the aspect ratio, or from \
+                 `scale` when both are 0",
+            ),
+            ParamDef::float(
+                "scale",
+                0.5,
+                [0.01, 16.0],
+                "size factor on both axes, used when `width` and `height` are 0",
+            ),
+            ParamDef::choice(
+                "kernel",
+                "lanczos3",
+                &[
+                    ("bilinear", "4 texels through the filtering sampler"),
+                    ("lanczos3", "Lanczos-3, widened when shrinking"),
+                ],
+                "resampling kernel",
+            ),
         ],
         "post/resize.wgsl",
     );

@@ -60,10 +60,48 @@ pub fn level_sizes(extent: Extent, levels: usize) -> Vec<Extent> {
 
 struct Pyramid {
     extent: Extent,
+    /// The sizes of levels 1…n.
+    sizes: Vec<Extent>,
     /// Levels 1…n.
     down: Vec<PooledTexture>,
     /// Partial sums of levels 1…n−1 (sum i holds levels i…n).
     sums: Vec<PooledTexture>,
+}
+
+/// The pyramid in `slot` for an image of `extent`, made anew when the size or the number of
+/// levels changed.
+fn pyramid<'p>(
+    slot: &'p mut Option<Pyramid>,
+    ctx: &GpuContext,
+    extent: Extent,
+    levels: usize,
+) -> &'p Pyramid {
+    let sizes = level_sizes(extent, levels);
+    if slot
+        .as_ref()
+        .is_some_and(|p| p.extent == extent && p.sizes == sizes)
+    {
+        return slot.as_ref().expect("checked above");
+    }
+    let make = |what: &str, (i, e): (usize, &Extent)| {
+        create(
+            ctx,
+            &format!("bloom {what} {}", i + 1),
+            TexFormat::Rgba32Float,
+            *e,
+        )
+    };
+    let n = sizes.len();
+    slot.insert(Pyramid {
+        extent,
+        down: sizes.iter().enumerate().map(|l| make("level", l)).collect(),
+        sums: sizes[..n.saturating_sub(1)]
+            .iter()
+            .enumerate()
+            .map(|l| make("sum", l))
+            .collect(),
+        sizes,
+    })
 }
 
 struct Bloom {
@@ -89,35 +127,6 @@ impl Bloom {
         };
         node.update(ctx, pass)?;
         Ok(node)
-    }
-
-    fn pyramid(&mut self, ctx: &GpuContext, extent: Extent) -> &Pyramid {
-        let sizes = level_sizes(extent, self.levels);
-        let stale = self
-            .pyramid
-            .as_ref()
-            .is_none_or(|p| p.extent != extent || p.down.len() != sizes.len());
-        if stale {
-            let make = |what: &str, (i, e): (usize, &Extent)| {
-                create(
-                    ctx,
-                    &format!("bloom {what} {}", i + 1),
-                    TexFormat::Rgba32Float,
-                    *e,
-                )
-            };
-            let n = sizes.len();
-            self.pyramid = Some(Pyramid {
-                extent,
-                down: sizes.iter().enumerate().map(|l| make("level", l)).collect(),
-                sums: sizes[..n.saturating_sub(1)]
-                    .iter()
-                    .enumerate()
-                    .map(|l| make("sum", l))
-                    .collect(),
-            });
-        }
-        self.pyramid.as_ref().expect("made above")
     }
 }
 
@@ -152,12 +161,8 @@ impl NodeExec for Bloom {
             return Ok(());
         };
         let input = io.input(pass, "color")?;
-        self.pyramid(ctx, pass.extent);
-        let (Some(p), down, up, params) = (&self.pyramid, &self.down, &self.up, &self.params)
-        else {
-            return Ok(());
-        };
-        let sizes = level_sizes(pass.extent, self.levels);
+        let p = pyramid(&mut self.pyramid, ctx, pass.extent, self.levels);
+        let (down, up, params, sizes) = (&self.down, &self.up, &self.params, &p.sizes);
         for (i, level) in p.down.iter().enumerate() {
             let src = if i == 0 {
                 &input.view

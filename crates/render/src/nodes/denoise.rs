@@ -114,14 +114,15 @@ impl NodeExec for Denoise {
             p.float("sigma_normal") as f32,
             p.float("sigma_depth") as f32,
         );
-        self.guidance = match (p.bool("variance_guided"), pass.input("variance").is_some()) {
+        let has_variance = pass.input("variance").is_some();
+        self.guidance = match (p.bool("variance_guided"), has_variance) {
             (true, true) => "variance-guided luminance tolerance",
             (true, false) => {
                 "fixed luminance tolerance (variance_guided is on, but no variance is connected)"
             }
             (false, _) => "fixed luminance tolerance (variance_guided off)",
         };
-        let guided = u32::from(p.bool("variance_guided") && pass.input("variance").is_some());
+        let guided = u32::from(p.bool("variance_guided") && has_variance);
         let demodulate = DenoiseParams {
             first: 1,
             ..DenoiseParams::default()

@@ -203,7 +203,14 @@ struct LutNode {
     kernel: Kernel,
     params: wgpu::Buffer,
     resources: Resources,
-    loaded: Option<(PathBuf, wgpu::TextureView)>,
+    loaded: Option<Loaded>,
+}
+
+/// The file a LUT node has loaded: its table on the GPU, its size and domain.
+struct Loaded {
+    path: PathBuf,
+    block: LutParams,
+    view: wgpu::TextureView,
 }
 
 impl LutNode {
@@ -258,25 +265,37 @@ fn upload(ctx: &GpuContext, lut: &Lut) -> wgpu::TextureView {
 impl NodeExec for LutNode {
     fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
         let path = self.resources.input(pass.params.str("path"));
-        let lut = Lut::load(&path)?;
+        if self.loaded.as_ref().is_none_or(|l| l.path != path) {
+            // Parsed and uploaded only when the file changes, not on every param edit.
+            let lut = Lut::load(&path)?;
+            let d = |v: [f32; 3], w| [v[0], v[1], v[2], w];
+            self.loaded = Some(Loaded {
+                block: LutParams {
+                    size: u32::try_from(lut.size).unwrap_or(2),
+                    domain_min: d(lut.domain_min, 0.0),
+                    domain_max: d(lut.domain_max, 1.0),
+                    ..LutParams::default()
+                },
+                view: upload(ctx, &lut),
+                path,
+            });
+        }
+        let Some(loaded) = &self.loaded else {
+            return Ok(());
+        };
         let block = LutParams {
-            size: u32::try_from(lut.size).unwrap_or(2),
             tetrahedral: crate::params::enum_index(pass, "interpolation")?,
-            domain_min: [lut.domain_min[0], lut.domain_min[1], lut.domain_min[2], 0.0],
-            domain_max: [lut.domain_max[0], lut.domain_max[1], lut.domain_max[2], 1.0],
-            ..LutParams::default()
+            ..loaded.block
         };
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&block));
-        if self.loaded.as_ref().is_none_or(|(p, _)| *p != path) {
-            self.loaded = Some((path, upload(ctx, &lut)));
-        }
         Ok(())
     }
 
     fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
         let (ctx, encoder, io, timer) = rec.parts();
-        let (Some(out), Some((_, lut))) = (pass.output("color"), &self.loaded) else {
+        let (Some(out), Some(Loaded { view: lut, .. })) = (pass.output("color"), &self.loaded)
+        else {
             return Ok(());
         };
         self.kernel
