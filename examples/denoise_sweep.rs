@@ -25,6 +25,7 @@ fn graph(params: &[(&str, ParamValue)]) -> Graph {
         dn = dn.with(k, v.clone());
     }
     Graph {
+        kinds: Vec::new(),
         nodes: vec![
             Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(1)),
             Node::new("acc", "Accumulate"),

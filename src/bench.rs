@@ -21,6 +21,7 @@ fn measure(
 ) -> Result<(f64, String)> {
     let spf = spp.min(16);
     let graph = Graph {
+        kinds: Vec::new(),
         nodes: vec![
             Node::new("pathtrace", "PathTrace")
                 .with("samples_per_frame", ParamValue::Int(i64::from(spf))),

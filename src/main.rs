@@ -77,11 +77,16 @@ enum Command {
         scene: Option<PathBuf>,
     },
     /// List every node kind with its ports and params.
-    #[command(after_help = "Example:\n  lumagraph nodes --markdown > nodes.md")]
+    #[command(
+        after_help = "Examples:\n  lumagraph nodes --markdown > nodes.md\n  lumagraph nodes --graph graphs/custom_kinds.ron"
+    )]
     Nodes {
         /// Print the Markdown reference used in docs/graph-format.md.
         #[arg(long)]
         markdown: bool,
+        /// Also list the node kinds this graph file declares.
+        #[arg(long)]
+        graph: Option<PathBuf>,
     },
     /// Measure path tracing speed (paths/s) on the current adapter, specialized and general
     /// shaders side by side.
@@ -349,6 +354,9 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
         }
         None => println!("GPU time per pass: not available (adapter has no timestamp queries)"),
     }
+    for (node, m) in exec.measurements()? {
+        println!("measured {node}.{}: {:.6e}", m.name, m.value);
+    }
     for path in &report.written {
         println!("wrote {}", path.display());
     }
@@ -406,6 +414,31 @@ struct RenderArgs<'a> {
     overrides: &'a [String],
 }
 
+/// `lumagraph plan`: the plan, node-owned memory, and the shader features per pass.
+fn plan(graph: &Path, scene: Option<&Path>, overrides: &[String]) -> Result<()> {
+    let g = load(graph, overrides)?;
+    let scene = load_scene(scene)?;
+    let plan = compile(&g, &[], scene.as_ref().map(|s| &*s.gpu))?;
+    print!("{plan}");
+    let owned: Vec<_> = plan
+        .passes
+        .iter()
+        .filter_map(|p| lumagraph::render::nodes::owned_memory(p).map(|m| (p, m)))
+        .collect();
+    if !owned.is_empty() {
+        println!("node-owned memory (outside the textures above):");
+        for (p, (bytes, what)) in owned {
+            #[expect(clippy::cast_precision_loss, reason = "report figures")]
+            let mib = bytes as f64 / (1024.0 * 1024.0);
+            println!("  {:<16} {bytes:>10} bytes ({mib:.2} MiB): {what}", p.node);
+        }
+    }
+    if let Some(scene) = &scene {
+        print_features(&plan, &scene.gpu);
+    }
+    Ok(())
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Render {
@@ -425,29 +458,7 @@ fn run(cli: Cli) -> Result<()> {
             graph,
             scene,
             overrides,
-        } => {
-            let g = load(&graph, &overrides)?;
-            let scene = load_scene(scene.as_deref())?;
-            let plan = compile(&g, &[], scene.as_ref().map(|s| &*s.gpu))?;
-            print!("{plan}");
-            let owned: Vec<_> = plan
-                .passes
-                .iter()
-                .filter_map(|p| lumagraph::render::nodes::owned_memory(p).map(|m| (p, m)))
-                .collect();
-            if !owned.is_empty() {
-                println!("node-owned memory (outside the textures above):");
-                for (p, (bytes, what)) in owned {
-                    #[expect(clippy::cast_precision_loss, reason = "report figures")]
-                    let mib = bytes as f64 / (1024.0 * 1024.0);
-                    println!("  {:<16} {bytes:>10} bytes ({mib:.2} MiB): {what}", p.node);
-                }
-            }
-            if let Some(scene) = &scene {
-                print_features(&plan, &scene.gpu);
-            }
-            Ok(())
-        }
+        } => plan(&graph, scene.as_deref(), &overrides),
         Command::Validate { graph, scene } => {
             let g = load(&graph, &[])?;
             let scene = load_scene(scene.as_deref())?;
@@ -460,8 +471,11 @@ fn run(cli: Cli) -> Result<()> {
             );
             Ok(())
         }
-        Command::Nodes { markdown } => {
-            let r = Registry::with_builtins();
+        Command::Nodes { markdown, graph } => {
+            let r = match graph {
+                Some(g) => lumagraph::render::custom::registry(&load(&g, &[])?)?,
+                None => Registry::with_builtins(),
+            };
             print!(
                 "{}",
                 if markdown {

@@ -9,6 +9,7 @@ use lumagraph::render::{Executor, Resources, compile, image_io};
 
 fn acc_graph(input: &std::path::Path) -> Graph {
     Graph {
+        kinds: Vec::new(),
         nodes: vec![
             Node::new("input", "ImageInput")
                 .with("path", ParamValue::Str(input.display().to_string())),
@@ -114,6 +115,7 @@ fn variance_of_the_mean_matches_cpu_and_keeps_the_mean_exact() {
     let scene = lumagraph::scene::Scene::load(&common::repo("assets/cornell.ron")).unwrap();
     let scene = Arc::new(lumagraph::scene::GpuScene::build(&scene).unwrap());
     let graph = Graph {
+        kinds: Vec::new(),
         nodes: vec![
             Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(1)),
             Node::new("acc", "Accumulate"),

@@ -31,6 +31,7 @@ fn scene(name: &str) -> Arc<GpuScene> {
 fn render(scene: &Arc<GpuScene>) -> Option<([Image; 3], [Image; 3])> {
     let ctx = common::gpu()?;
     let graph = Graph {
+        kinds: Vec::new(),
         nodes: vec![
             Node::new("gb", "GBuffer"),
             Node::new("pt", "PathTrace")

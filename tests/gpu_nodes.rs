@@ -22,6 +22,7 @@ fn chart() -> Image {
 
 fn post_graph(ev: f64, operator: &str) -> Graph {
     Graph {
+        kinds: Vec::new(),
         nodes: vec![
             Node::new("input", "ImageInput")
                 .with("path", ParamValue::Str("assets/test_chart.exr".into())),

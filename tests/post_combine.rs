@@ -106,3 +106,75 @@ fn math_matches_cpu() {
         });
     }
 }
+
+/// Split gives each channel as a grey image with alpha 1; Combine puts red channels back,
+/// here with red and blue swapped, with and without alpha. Both only move f32 values:
+/// bit-exact.
+#[test]
+fn split_and_combine_move_channels_exactly() {
+    // The chart with an alpha that varies over the image.
+    let image = map_pixels(&chart(), |i, p| [p[0], p[1], p[2], (i % 13) as f64 / 12.0]);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("alpha.exr");
+    std::fs::write(&path, image_io::encode_exr(&image, false).unwrap()).unwrap();
+    let path = path.to_str().unwrap();
+    use lumagraph::graph::{Edge, Graph, Node};
+    let graph = Graph {
+        kinds: Vec::new(),
+        nodes: vec![
+            Node::new("in", "ImageInput").with("path", ParamValue::Str(path.into())),
+            Node::new("split", "Split"),
+            Node::new("swap", "Combine"),
+            Node::new("opaque", "Combine"),
+        ],
+        edges: vec![
+            Edge::new("in.color", "split.color"),
+            Edge::new("split.b", "swap.r"),
+            Edge::new("split.g", "swap.g"),
+            Edge::new("split.r", "swap.b"),
+            Edge::new("split.a", "swap.a"),
+            Edge::new("split.r", "opaque.r"),
+            Edge::new("split.g", "opaque.g"),
+            Edge::new("split.b", "opaque.b"),
+        ],
+        origin: None,
+    };
+    let keep = [
+        "split.r",
+        "split.g",
+        "split.b",
+        "split.a",
+        "swap.color",
+        "opaque.color",
+    ];
+    let Some(got) = common::run_graph(&graph, &keep, dir.path()) else {
+        return;
+    };
+    for (c, channel) in got[..4].iter().enumerate() {
+        let want = image.map(|p| [p[c], p[c], p[c], 1.0]);
+        assert_eq!(channel, &want, "{}", keep[c]);
+    }
+    assert_eq!(got[4], image.map(|p| [p[2], p[1], p[0], p[3]]), "swap");
+    assert_eq!(got[5], image.map(|p| [p[0], p[1], p[2], 1.0]), "opaque");
+}
+
+/// An output of Split that nothing reads is not computed into the plan, and the node
+/// still runs (its store goes to a stand-in).
+#[test]
+fn split_runs_with_one_output_used() {
+    use lumagraph::graph::{Edge, Graph, Node};
+    let graph = Graph {
+        kinds: Vec::new(),
+        nodes: vec![
+            Node::new("in", "ImageInput").with("path", ParamValue::Str(CHART.into())),
+            Node::new("split", "Split"),
+        ],
+        edges: vec![Edge::new("in.color", "split.color")],
+        origin: None,
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let Some(got) = common::run_graph(&graph, &["split.g"], dir.path()) else {
+        return;
+    };
+    assert_eq!(got[0], chart().map(|p| [p[1], p[1], p[1], 1.0]));
+}

@@ -121,6 +121,7 @@ fn graph(params: &[(&str, ParamValue)]) -> Graph {
         r = r.with(k, v.clone());
     }
     Graph {
+        kinds: Vec::new(),
         nodes: vec![
             Node::new("input", "ImageInput")
                 .with("path", ParamValue::Str("assets/test_chart.exr".into())),

@@ -40,6 +40,7 @@ fn graph(path: &str, params: &[(&str, f64)]) -> Graph {
         v = v.with(k, ParamValue::Float(*x));
     }
     Graph {
+        kinds: Vec::new(),
         nodes: vec![
             Node::new("input", "ImageInput").with("path", ParamValue::Str(path.into())),
             v,

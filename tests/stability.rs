@@ -39,6 +39,7 @@ fn render(scene: &Scene, spp: u32) -> Option<(Image, Image, u64)> {
     let ctx = common::gpu()?;
     let gpu = Arc::new(GpuScene::build(scene).unwrap());
     let graph = Graph {
+        kinds: Vec::new(),
         nodes: vec![
             Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(16)),
             Node::new("acc", "Accumulate"),
@@ -400,6 +401,7 @@ fn render_with(scene: &Scene, spp: u32, params: &[(&str, ParamValue)]) -> Option
         pt = pt.with(k, v.clone());
     }
     let graph = Graph {
+        kinds: Vec::new(),
         nodes: vec![pt, Node::new("acc", "Accumulate")],
         edges: vec![Edge::new("pt.color", "acc.color")],
         origin: None,

@@ -65,6 +65,7 @@ pub fn denoise_graph(
     }
     let color = format!("{}.color", source.id);
     Graph {
+        kinds: Vec::new(),
         nodes: vec![
             source,
             Node::new("acc", "Accumulate"),
@@ -104,6 +105,7 @@ pub fn progressive_graph(
         pt = pt.with(k, v.clone());
     }
     Graph {
+        kinds: Vec::new(),
         nodes: vec![pt, Node::new("acc", "Accumulate")],
         edges: vec![Edge::new("pt.color", "acc.color")],
         origin: None,
@@ -166,6 +168,7 @@ pub fn independent_frames(
         pt = pt.with(k, v.clone());
     }
     let graph = Graph {
+        kinds: Vec::new(),
         nodes: vec![pt],
         edges: Vec::new(),
         origin: None,
@@ -293,6 +296,7 @@ pub fn run_node(
         node = node.with(k, v.clone());
     }
     let mut graph = Graph {
+        kinds: Vec::new(),
         nodes: vec![node],
         edges: Vec::new(),
         origin: None,

@@ -98,6 +98,8 @@ pub struct Editor {
     pub canvas: Canvas,
     /// The live preview.
     pub preview: Preview,
+    /// The scope under the preview.
+    pub scope: crate::scope::ScopeView,
     /// Selected node ids.
     pub selected: Vec<String>,
     /// The port chosen for preview (`"node.port"`); `None` follows the selection.
@@ -148,6 +150,7 @@ impl Editor {
             doc: Document::default(),
             canvas: Canvas::default(),
             preview: Preview::new(gpu),
+            scope: crate::scope::ScopeView::default(),
             selected: Vec::new(),
             preview_port: None,
             errors: BTreeMap::new(),
@@ -197,6 +200,13 @@ impl Editor {
         self.graph_errors.clear();
         let base = self.doc.base_dir();
         let scene = self.scene.as_ref().map(|s| &*s.preview.gpu);
+        if !self.doc.graph.kinds.is_empty()
+            && let Err(errs) = lumagraph_render::custom::registry(&self.doc.graph)
+        {
+            // Declared kinds that fail (their nodes are then of an unknown kind).
+            self.graph_errors
+                .extend(errs.0.iter().map(ToString::to_string));
+        }
         let result = compile_with(&key.0, self.doc.registry(), &base, &[], scene);
         if let Err(errs) = result {
             for e in errs.0 {

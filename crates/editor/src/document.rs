@@ -36,9 +36,13 @@ impl Default for Document {
 const NODE_SPACING: f32 = 220.0;
 
 impl Document {
-    /// A document for `graph`, as if just opened from `path`, with the built-in kinds.
+    /// A document for `graph`, as if just opened from `path`, with the built-in kinds and
+    /// those the graph declares (when they all compile; else the built-in ones, and the
+    /// editor shows why).
     pub fn new(graph: Graph, path: Option<PathBuf>) -> Self {
-        Self::with_registry(graph, path, Arc::new(Registry::with_builtins()))
+        let registry = lumagraph_render::custom::registry(&graph)
+            .unwrap_or_else(|_| Registry::with_builtins());
+        Self::with_registry(graph, path, Arc::new(registry))
     }
 
     /// A document for `graph` checked against `registry`.

@@ -6,7 +6,8 @@
 //!   registry, compile errors and GPU times on the nodes).
 //! - [`inspector`]: a widget per param, chosen by the param's type.
 //! - [`preview`]: the selected output rendered on the editor's own wgpu device through
-//!   the render crate's `Executor`; param edits update nodes in place.
+//!   the render crate's `Executor`; param edits update nodes in place; what its nodes
+//!   measure; [`scope`]: histogram and waveform of the previewed image.
 //! - [`files`]: open, save (atomic), save as, recent files.
 //! - [`app`]: the window tying them together.
 //!
@@ -19,6 +20,7 @@ pub mod document;
 pub mod files;
 pub mod inspector;
 pub mod preview;
+pub mod scope;
 pub mod undo;
 
 use std::path::PathBuf;

@@ -95,6 +95,9 @@ pub struct Preview {
     /// Milliseconds per node of the last frame (see `FrameReport::pass_clock`; empty when
     /// the adapter cannot time passes).
     pub pass_ms: BTreeMap<String, f64>,
+    /// What the nodes measured on the last frame (`(node id, measurement)`: a `Difference`
+    /// node's error, an `AutoExposure` node's exposure).
+    pub measurements: Vec<(String, lumagraph_render::Measurement)>,
     /// Why there is no preview, when there is none.
     pub error: Option<String>,
     /// Counters.
@@ -202,6 +205,7 @@ impl Preview {
             texture: None,
             texture_stale: false,
             pass_ms: BTreeMap::new(),
+            measurements: Vec::new(),
             error: None,
             stats: PreviewStats::default(),
         }
@@ -258,6 +262,7 @@ impl Preview {
         self.image = None;
         self.texture = None;
         self.pass_ms.clear();
+        self.measurements.clear();
         self.samples = None;
         self.progressive = false;
         self.error = error;
@@ -396,7 +401,8 @@ impl Preview {
         Ok(())
     }
 
-    /// Reads `port` back after `report`'s frame and keeps it as the image to show.
+    /// Reads `port` back after `report`'s frame and keeps it as the image to show, with what
+    /// the nodes measured.
     fn show(&mut self, report: &FrameReport, port: &str) -> Result<(), String> {
         let exec = self.exec.as_ref().ok_or("nothing to run")?;
         let t = Instant::now();
@@ -425,6 +431,9 @@ impl Preview {
             rgba,
         });
         self.texture_stale = true;
+        if let Some(exec) = &mut self.exec {
+            self.measurements = exec.measurements().map_err(|e| e.to_string())?;
+        }
         Ok(())
     }
 

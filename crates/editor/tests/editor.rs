@@ -730,3 +730,68 @@ fn snapshot_of_the_path_traced_graph() {
     h.run_ok();
     h.snapshot_options("editor_pathtrace_denoise", &snapshot_options());
 }
+
+/// What nodes measure shows under the preview (`AutoExposure`'s exposure, `Difference`'s
+/// error), and the histogram scope counts the previewed image's pixels.
+#[test]
+fn measurements_and_the_histogram_scope_show_under_the_preview() {
+    let Some(mut ed) = editor(None, None) else {
+        return;
+    };
+    let chart = repo("assets/test_chart.exr").display().to_string();
+    let input = ed.doc.add_node("ImageInput", None).unwrap();
+    ed.doc
+        .set_param(&input, "path", ParamValue::Str(chart.clone()));
+    let auto = ed.doc.add_node("AutoExposure", None).unwrap();
+    let tonemap = ed.doc.add_node("Tonemap", None).unwrap();
+    let diff = ed.doc.add_node("Difference", None).unwrap();
+    for (from, to) in [
+        (format!("{input}.color"), format!("{auto}.color")),
+        (format!("{auto}.color"), format!("{tonemap}.color")),
+        (format!("{input}.color"), format!("{diff}.color")),
+        (format!("{auto}.color"), format!("{diff}.reference")),
+    ] {
+        ed.doc.connect(&from, &to).unwrap();
+    }
+    ed.preview_port = Some(format!("{tonemap}.color"));
+    let mut h = harness(ed);
+    let ed = h.state();
+    assert!(ed.errors.is_empty(), "{:?}", ed.errors);
+    let ev = ed
+        .preview
+        .measurements
+        .iter()
+        .find(|(n, m)| *n == auto && m.name == "exposure_ev")
+        .map(|(_, m)| m.value)
+        .expect("the exposure is measured");
+    let label = format!("{auto}.exposure_ev: {ev:.4e}");
+    h.get_by_label(&label);
+
+    // The histogram: every previewed pixel counted once per channel.
+    h.get_by_role_and_label(Role::ComboBox, "scope").click();
+    h.run_ok();
+    h.get_by_label("histogram").click();
+    h.run_ok();
+    let ed = h.state();
+    let img = ed.preview.image.as_ref().unwrap();
+    let hist = ed.scope.drawn_histogram().expect("a histogram");
+    for channel in hist {
+        assert_eq!(
+            u64::from(channel.iter().sum::<u32>()),
+            u64::from(img.width) * u64::from(img.height)
+        );
+    }
+
+    // The heat map previewed: the error of the chart against its exposed self.
+    h.state_mut().preview_port = Some(format!("{diff}.heat"));
+    h.run_ok();
+    let ed = h.state();
+    let relmse = ed
+        .preview
+        .measurements
+        .iter()
+        .find(|(n, m)| *n == diff && m.name == "relmse")
+        .map(|(_, m)| m.value)
+        .expect("the error is measured");
+    assert!(relmse > 0.0, "{relmse}");
+}

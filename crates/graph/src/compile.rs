@@ -420,6 +420,10 @@ fn check_edges<'g>(
     inputs
 }
 
+#[expect(
+    clippy::too_many_lines,
+    reason = "one walk over the live nodes; split up, its state would be threaded through"
+)]
 fn build_plan(
     graph: &Graph,
     checked: &Checked<'_>,
@@ -430,6 +434,9 @@ fn build_plan(
     let position: HashMap<usize, usize> = order.iter().enumerate().map(|(p, &i)| (i, p)).collect();
     let mut textures: Vec<TextureDesc> = Vec::new();
     let mut texture_of: HashMap<(usize, &str), TextureId> = HashMap::new();
+    // Textures of unknown size (a source that could not tell, and what is computed from
+    // it) are not compared, so that one error is reported.
+    let mut size_unknown: HashSet<TextureId> = HashSet::new();
     let mut passes = Vec::with_capacity(order.len());
     let mut left_out = Vec::new();
 
@@ -446,6 +453,7 @@ fn build_plan(
         };
         let mut inputs = Vec::new();
         let mut extent = None;
+        let mut unknown = false;
         for input in &kind.inputs {
             let Some(&(from, port)) = checked.inputs.get(&(i, input.name)) else {
                 left_out.push(LeftOut {
@@ -455,31 +463,35 @@ fn build_plan(
                 continue;
             };
             let t = texture_of[&(from, port)];
-            let e = textures[t.0].extent;
-            match extent {
-                None => extent = Some(e),
-                Some(prev) if prev != e => errors.push(located(
-                    format!(
-                        "inputs differ in size: {prev} and {e} (input \"{}\")",
-                        input.name
-                    ),
-                    None,
-                )),
-                Some(_) => {}
-            }
             textures[t.0].last = textures[t.0].last.max(p);
             inputs.push((input.name, t));
-        }
-        let extent = match extent {
-            Some(e) => e,
-            None => match (options.source_extent)(kind, &params) {
-                Ok(e) => e,
-                Err(m) => {
-                    errors.push(located(m, Some("path")));
-                    Extent::new(1, 1)
+            let e = textures[t.0].extent;
+            unknown |= size_unknown.contains(&t);
+            match extent {
+                _ if size_unknown.contains(&t) => {}
+                None => extent = Some(e),
+                Some(prev) if prev != e => {
+                    let m = format!(
+                        "inputs differ in size: {prev} and {e} (input \"{}\")",
+                        input.name
+                    );
+                    errors.push(located(m, None));
                 }
-            },
-        };
+                Some(_) => {}
+            }
+        }
+        let extent = extent.unwrap_or_else(|| {
+            let sized = if unknown {
+                Ok(Extent::new(1, 1))
+            } else {
+                (options.source_extent)(kind, &params)
+            };
+            sized.unwrap_or_else(|m| {
+                errors.push(located(m, Some("path")));
+                unknown = true;
+                Extent::new(1, 1)
+            })
+        });
 
         let mut outputs = Vec::new();
         for output in &kind.outputs {
@@ -497,6 +509,7 @@ fn build_plan(
             }
             let size = match output.size.extent(extent, &params) {
                 Ok(e) => e,
+                Err(_) if unknown => extent,
                 Err(m) => {
                     errors.push(located(format!("output \"{}\": {m}", output.name), None));
                     extent
@@ -514,6 +527,9 @@ fn build_plan(
                 slot: 0,
             });
             texture_of.insert((i, output.name), id);
+            if unknown {
+                size_unknown.insert(id);
+            }
             outputs.push((output.name, id));
         }
         passes.push(Pass {

@@ -30,7 +30,7 @@ pub enum ErrorKind {
     #[error("syntax error: {0}")]
     Syntax(String),
     /// The file's version is not one this build reads.
-    #[error("unsupported graph version {found} (this build reads version {supported})")]
+    #[error("unsupported graph version {found}: this build reads versions 1 to {supported}{}", if *found > *supported { " (the file was written by a newer lumagraph)" } else { "" })]
     Version {
         /// Version in the file.
         found: u32,

@@ -11,12 +11,15 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::custom::KindDecl;
 use crate::error::{ErrorKind, GraphError, Pos};
 use crate::registry::Registry;
 use crate::types::ParamValue;
 
-/// The graph file version this build reads and writes.
-pub const VERSION: u32 = 1;
+/// The newest graph file version this build reads and writes. Version 2 added node kinds
+/// declared in the file (`kinds`); a graph without them is written as version 1, which
+/// every build reads.
+pub const VERSION: u32 = 2;
 
 /// A node: an instance of a node kind with its params.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -83,6 +86,8 @@ pub fn split_port_ref(r: &str) -> Option<(&str, &str)> {
 #[serde(deny_unknown_fields)]
 struct GraphFile {
     version: u32,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    kinds: Vec<KindDecl>,
     nodes: Vec<Node>,
     #[serde(default)]
     edges: Vec<Edge>,
@@ -131,6 +136,34 @@ impl Origin {
         Some(self.pos_of_offset(start + found.unwrap_or(0)))
     }
 
+    /// Where the declared kind called `name` is written (its `name:` field).
+    pub fn kind_pos(&self, name: &str) -> Option<Pos> {
+        let needle = format!("\"{name}\"");
+        self.text
+            .match_indices(&needle)
+            .map(|(i, _)| i)
+            .find(|&i| self.text[..i].trim_end().ends_with("name:"))
+            .map(|o| self.pos_of_offset(o))
+    }
+
+    /// The file line of line 1 of `code`, a string written in the file, when its lines
+    /// appear there as they are (a raw string); `None` when they do not (escapes).
+    pub fn code_first_line(&self, code: &str) -> Option<usize> {
+        let (index, line) = code
+            .lines()
+            .enumerate()
+            .find(|(_, l)| !l.trim().is_empty())?;
+        let found = self.text.find(line)?;
+        // Every later line must follow in the file, too.
+        let rest = &self.text[found..];
+        let all_there = code
+            .lines()
+            .skip(index)
+            .zip(rest.lines())
+            .all(|(a, b)| a == b);
+        all_there.then(|| self.pos_of_offset(found).line.saturating_sub(index).max(1))
+    }
+
     /// Where the `index`-th edge is written.
     pub fn edge_pos(&self, index: usize) -> Option<Pos> {
         let edges = self.text.find("edges")?;
@@ -139,9 +172,12 @@ impl Origin {
     }
 }
 
-/// A render graph: nodes and the edges between their ports.
+/// A render graph: nodes and the edges between their ports, and the node kinds the file
+/// declares for them.
 #[derive(Clone, Debug, Default)]
 pub struct Graph {
+    /// Node kinds declared in the file (version 2), in file order.
+    pub kinds: Vec<KindDecl>,
     /// Nodes, in file order.
     pub nodes: Vec<Node>,
     /// Edges, in file order.
@@ -152,7 +188,7 @@ pub struct Graph {
 
 impl PartialEq for Graph {
     fn eq(&self, other: &Self) -> bool {
-        self.nodes == other.nodes && self.edges == other.edges
+        self.kinds == other.kinds && self.nodes == other.nodes && self.edges == other.edges
     }
 }
 
@@ -199,14 +235,20 @@ impl Graph {
             ..GraphError::new(ErrorKind::Syntax(e.code.to_string()))
         };
         let probe: VersionProbe = ron::from_str(text).map_err(syntax)?;
-        if probe.version != VERSION {
+        if !(1..=VERSION).contains(&probe.version) {
             return Err(GraphError::new(ErrorKind::Version {
                 found: probe.version,
                 supported: VERSION,
             }));
         }
         let file: GraphFile = ron::from_str(text).map_err(syntax)?;
+        if probe.version < 2 && !file.kinds.is_empty() {
+            return Err(GraphError::new(ErrorKind::Source(
+                "node kinds declared in the file (`kinds`) need `version: 2`".into(),
+            )));
+        }
         Ok(Self {
+            kinds: file.kinds,
             nodes: file.nodes,
             edges: file.edges,
             origin: None,
@@ -216,7 +258,8 @@ impl Graph {
     /// The graph as RON text, in the canonical layout `save` writes.
     pub fn to_ron(&self) -> String {
         let file = GraphFile {
-            version: VERSION,
+            version: if self.kinds.is_empty() { 1 } else { VERSION },
+            kinds: self.kinds.clone(),
             nodes: self.nodes.clone(),
             edges: self.edges.clone(),
         };

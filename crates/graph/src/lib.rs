@@ -8,6 +8,7 @@
 //! Everything here runs anywhere in microseconds, so it is tested without a GPU.
 
 mod compile;
+pub mod custom;
 pub mod docs;
 mod error;
 mod graph;

@@ -22,6 +22,7 @@ fn compile_graph(g: &Graph) -> Result<Plan, GraphErrors> {
 
 fn chain() -> Graph {
     Graph {
+        kinds: Vec::new(),
         nodes: vec![
             Node::new("input", "ImageInput").with("path", ParamValue::Str("in.exr".into())),
             Node::new("exposure", "Exposure").with("ev", ParamValue::Float(1.0)),
@@ -162,7 +163,19 @@ fn shipped_graphs_round_trip_and_compile() {
             let g = Graph::load(&path).unwrap();
             let again = Graph::from_ron(&g.to_ron()).unwrap();
             assert_eq!(g, again, "{}", path.display());
-            compile_graph(&g).unwrap_or_else(|e| panic!("{e}"));
+            // Declared kinds get their shaders in the render crate; here a placeholder.
+            let mut registry = Registry::with_builtins();
+            for decl in &g.kinds {
+                let kind = decl
+                    .to_kind(lumagraph_graph::custom::Shader::File("(declared)"))
+                    .unwrap();
+                registry.add(kind).unwrap();
+            }
+            let options = CompileOptions {
+                source_extent: &extent,
+                keep: &[],
+            };
+            compile(&g, &registry, &options).unwrap_or_else(|e| panic!("{e}"));
             n += 1;
         }
     }
@@ -675,4 +688,50 @@ fn gallery_examples_are_valid_params() {
             panic!("{}: {e:?}", kind.name);
         }
     }
+}
+
+/// A source that cannot tell its size gives one error: nodes computed from it are not
+/// also reported for inputs of different sizes.
+#[test]
+fn an_unsized_source_is_reported_once() {
+    let graph = Graph::from_ron(
+        r#"(
+            version: 1,
+            nodes: [
+                (id: "a", kind: "ImageInput", params: {"path": "missing.exr"}),
+                (id: "b", kind: "ImageInput", params: {"path": "chart.exr"}),
+                (id: "mix", kind: "Mix"),
+                (id: "out", kind: "Output"),
+            ],
+            edges: [
+                (from: "a.color", to: "mix.a"),
+                (from: "b.color", to: "mix.b"),
+                (from: "mix.color", to: "out.color"),
+            ],
+        )"#,
+    )
+    .unwrap();
+    let registry = Registry::with_builtins();
+    let sized = |kind: &NodeKind, params: &lumagraph_graph::Params| -> Result<Extent, String> {
+        if params.str("path").contains("missing") {
+            Err(format!("{}: cannot read {}", kind.name, params.str("path")))
+        } else {
+            Ok(Extent::new(8, 8))
+        }
+    };
+    let errors = compile(
+        &graph,
+        &registry,
+        &CompileOptions {
+            source_extent: &sized,
+            keep: &[],
+        },
+    )
+    .unwrap_err();
+    let messages: Vec<String> = errors.0.iter().map(ToString::to_string).collect();
+    assert_eq!(messages.len(), 1, "{messages:#?}");
+    assert!(
+        messages.iter().all(|m| m.contains("cannot read")),
+        "{messages:#?}"
+    );
 }

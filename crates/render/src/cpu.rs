@@ -396,3 +396,82 @@ pub fn denoise(
         pixels: cur,
     }
 }
+
+/// Bins of the `AutoExposure` histogram, and the log2 luminance range they cover
+/// (`shaders/post/luminance_bins.wgsl`).
+pub const HISTOGRAM_BINS: usize = 256;
+const LOG2_LUMINANCE_MIN: f32 = -24.0;
+const LOG2_LUMINANCE_MAX: f32 = 16.0;
+
+/// The histogram bin of linear color `c`, or `None` when its luminance is not finite.
+pub fn luminance_bin(c: V3) -> Option<usize> {
+    let l = luminance(map3(c, |v| v.max(0.0)));
+    if !l.is_finite() {
+        return None;
+    }
+    if l <= LOG2_LUMINANCE_MIN.exp2() {
+        return Some(0);
+    }
+    let t = (l.log2() - LOG2_LUMINANCE_MIN) / (LOG2_LUMINANCE_MAX - LOG2_LUMINANCE_MIN);
+    #[expect(clippy::cast_precision_loss, reason = "256")]
+    let top = (HISTOGRAM_BINS - 1) as f32;
+    #[expect(clippy::cast_possible_truncation, reason = "clamped to [0, 255]")]
+    #[expect(clippy::cast_sign_loss, reason = "clamped to [0, 255]")]
+    Some((t * HISTOGRAM_BINS as f32).clamp(0.0, top) as usize)
+}
+
+/// The log2 luminance at the middle of histogram bin `i`.
+#[expect(clippy::cast_precision_loss, reason = "i < 256")]
+pub fn bin_center(i: usize) -> f32 {
+    let width = (LOG2_LUMINANCE_MAX - LOG2_LUMINANCE_MIN) / HISTOGRAM_BINS as f32;
+    LOG2_LUMINANCE_MIN + (i as f32 + 0.5) * width
+}
+
+/// The luminance histogram of `image` (pixels whose luminance is not finite left out).
+pub fn luminance_histogram(image: &Image) -> Vec<u32> {
+    let mut bins = vec![0; HISTOGRAM_BINS];
+    for p in &image.pixels {
+        if let Some(b) = luminance_bin(rgb(*p)) {
+            bins[b] += 1;
+        }
+    }
+    bins
+}
+
+/// The exposure, in stops, `AutoExposure` aims for on `bins`: the mean log2 luminance of
+/// the pixels between the `low` and `high` fractions of the count mapped to `key`, clamped
+/// to `[min_ev, max_ev]`; `None` for an empty histogram (the node keeps its last value).
+/// The node passes `high ≥ low` and `max_ev ≥ min_ev` ([`auto_exposure_ranges`]).
+pub fn auto_exposure_target(
+    bins: &[u32],
+    key: f32,
+    [low, high]: [f32; 2],
+    [min_ev, max_ev]: [f32; 2],
+) -> Option<f32> {
+    #[expect(clippy::cast_precision_loss, reason = "as the shader: f32 counts")]
+    let counts: Vec<f32> = bins.iter().map(|&n| n as f32).collect();
+    let total: f32 = counts.iter().sum();
+    if total == 0.0 {
+        return None;
+    }
+    let (lo, hi) = (total * low, total * high);
+    let (mut below, mut sum, mut weight) = (0.0_f32, 0.0_f32, 0.0_f32);
+    for (i, n) in counts.iter().enumerate() {
+        let take = (below + n).clamp(lo, hi) - below.clamp(lo, hi);
+        sum += take * bin_center(i);
+        weight += take;
+        below += n;
+    }
+    let mean = if weight > 0.0 {
+        sum / weight
+    } else {
+        bin_center(0)
+    };
+    Some((key.log2() - mean).clamp(min_ev, max_ev))
+}
+
+/// The percentile and exposure ranges as `AutoExposure` uses them: a `high` below `low` is
+/// taken as `low`, a `max_ev` below `min_ev` as `min_ev`.
+pub fn auto_exposure_ranges(low: f32, high: f32, min_ev: f32, max_ev: f32) -> [[f32; 2]; 2] {
+    [[low, high.max(low)], [min_ev, max_ev.max(min_ev)]]
+}

@@ -13,7 +13,7 @@ use lumagraph_scene::GpuScene;
 use crate::context::GpuContext;
 use crate::cpu::Image;
 use crate::error::{RenderError, Result};
-use crate::nodes::{self, Counter, FrameIo, NodeExec, Recording, Resources};
+use crate::nodes::{self, Counter, FrameIo, Measurement, NodeExec, Recording, Resources};
 use crate::pool::{PooledTexture, TexturePool};
 use crate::timing::GpuTimer;
 
@@ -40,11 +40,12 @@ pub fn source_extent(
     }
 }
 
-/// Compiles `graph` with the built-in node kinds ([`compile_with`] takes a registry),
-/// sizing sources from their files and from the scene.
+/// Compiles `graph` with the built-in node kinds and those the graph file declares
+/// ([`crate::custom`]; [`compile_with`] takes a registry), sizing sources from their files
+/// and from the scene.
 ///
 /// # Errors
-/// Every problem found in the graph.
+/// Every problem found in the graph (first in its declared kinds).
 pub fn compile(
     graph: &Graph,
     keep: &[String],
@@ -52,7 +53,7 @@ pub fn compile(
 ) -> std::result::Result<Plan, GraphErrors> {
     compile_with(
         graph,
-        &Registry::with_builtins(),
+        &crate::custom::registry(graph)?,
         &graph.base_dir(),
         keep,
         scene,
@@ -480,6 +481,23 @@ impl Executor {
                 .map_err(|e| e.in_node(&pass.node))?
             {
                 out.push((pass.node.clone(), c));
+            }
+        }
+        Ok(out)
+    }
+
+    /// What every node measured on the last frame it ran, as `(node id, measurement)`.
+    ///
+    /// # Errors
+    /// When a readback fails.
+    pub fn measurements(&mut self) -> Result<Vec<(String, Measurement)>> {
+        let mut out = Vec::new();
+        for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
+            for m in node
+                .measurements(&self.ctx)
+                .map_err(|e| e.in_node(&pass.node))?
+            {
+                out.push((pass.node.clone(), m));
             }
         }
         Ok(out)

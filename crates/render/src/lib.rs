@@ -8,11 +8,13 @@
 //! - [`GpuTimer`]: per-pass GPU time from timestamp queries.
 //! - [`Executor`]: runs a [`lumagraph_graph::Plan`] frame by frame.
 //! - [`image_io`] and [`cpu`]: image files, and plain-Rust references of every post node.
+//! - [`custom`]: node kinds declared in graph files, their shaders generated and checked.
 
 pub mod bsdf_check;
 pub mod bsdf_tables;
 mod context;
 pub mod cpu;
+pub mod custom;
 pub mod env_map;
 mod error;
 mod executor;
@@ -34,7 +36,7 @@ pub use context::{GPU_TIMEOUT, GpuContext};
 pub use error::{RenderError, Result};
 pub use executor::{Executor, FrameReport, PassClock, compile, compile_with, source_extent};
 pub use kernel::{Binding, Kernel, PassBuilder, uniform_buffer};
-pub use nodes::{Counter, Resources};
+pub use nodes::{Counter, Measurement, Resources};
 pub use pool::{PooledTexture, TexturePool, create as create_texture, wgpu_format};
 pub use scene_gpu::SceneBuffers;
 pub use timing::GpuTimer;

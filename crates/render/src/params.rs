@@ -77,6 +77,8 @@ pub const BLOCKS: &[BlockLayout] = &[
     <crate::nodes::blur::BlurParams as ParamBlock>::LAYOUT,
     <crate::nodes::bloom::BloomParams as ParamBlock>::LAYOUT,
     <crate::nodes::lut::LutParams as ParamBlock>::LAYOUT,
+    <crate::nodes::difference::DifferenceParams as ParamBlock>::LAYOUT,
+    <crate::nodes::auto_exposure::AutoExposureParams as ParamBlock>::LAYOUT,
 ];
 
 /// Whether `layout` matches naga's layout of its WGSL twin: the same size (the WGSL

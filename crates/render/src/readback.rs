@@ -154,3 +154,47 @@ pub fn to_image(bytes: &[u8], format: TexFormat, extent: Extent) -> Image {
         pixels,
     }
 }
+
+/// A storage buffer a node's passes write and the node reads back now and then (a
+/// measurement): the buffer (`STORAGE | COPY_SRC | COPY_DST`) and its `MAP_READ` copy.
+#[derive(Debug)]
+pub struct ReadableBuffer {
+    /// The buffer the passes bind.
+    pub buffer: wgpu::Buffer,
+    staging: wgpu::Buffer,
+}
+
+impl ReadableBuffer {
+    /// A zeroed buffer of `size` bytes and its readback copy.
+    pub fn new(ctx: &GpuContext, label: &str, size: u64) -> Self {
+        use wgpu::BufferUsages as U;
+        let make = |label: &str, usage| {
+            ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        Self {
+            buffer: make(label, U::STORAGE | U::COPY_SRC | U::COPY_DST),
+            staging: make(&format!("{label} readback"), U::MAP_READ | U::COPY_DST),
+        }
+    }
+
+    /// Copies the buffer back after the work submitted so far and passes its bytes to `f`.
+    ///
+    /// # Errors
+    /// When mapping fails or the GPU does not finish.
+    pub fn read<T>(&self, ctx: &GpuContext, f: impl FnOnce(&[u8]) -> T) -> Result<T> {
+        let size = self.buffer.size();
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("readback"),
+            });
+        encoder.copy_buffer_to_buffer(&self.buffer, 0, &self.staging, 0, size);
+        ctx.queue.submit([encoder.finish()]);
+        map_read(ctx, &self.staging, size, f)
+    }
+}

@@ -58,6 +58,18 @@ pub fn resolve(name: &str) -> Result<String> {
     resolve_with(name, &[])
 }
 
+/// The whole text of a generic filter's shader: a file's with its imports resolved, or the
+/// module generated for a kind declared in a graph file.
+///
+/// # Errors
+/// As [`resolve`].
+pub fn source_of(shader: &lumagraph_graph::registry::Shader) -> Result<String> {
+    match shader {
+        lumagraph_graph::registry::Shader::File(name) => resolve(name),
+        lumagraph_graph::registry::Shader::Generated(g) => Ok(g.text.clone()),
+    }
+}
+
 /// Like [`resolve`], with some files replaced by generated text (`(name, text)` pairs):
 /// how shaders are specialized to a scene.
 ///

@@ -100,6 +100,14 @@ impl Editor {
                     }
                 }
             });
+            for (node, m) in &self.preview.measurements {
+                ui.label(format!("{node}.{}: {:.4e}", m.name, m.value))
+                    .on_hover_text("measured by the node on the last frame");
+            }
+            let frame = self.preview.stats.frames;
+            let width = ui.available_width();
+            self.scope
+                .show(ui, self.preview.image.as_ref(), frame, width);
         }
         ui.separator();
         ui.heading("Inspector");

@@ -9,6 +9,7 @@ use crate::types::{ParamType, ParamValue, PortType};
 pub(super) fn kinds() -> Vec<NodeKind> {
     vec![
         exposure(),
+        auto_exposure(),
         white_balance(),
         cdl(),
         contrast(),
@@ -184,6 +185,61 @@ fn exposure() -> NodeKind {
         "post/exposure.wgsl",
     )
     .with_example(&[("ev", ParamValue::Float(1.0))])
+}
+
+fn auto_exposure() -> NodeKind {
+    post_node(
+        "AutoExposure",
+        Category::Color,
+        "Exposes the image so its mean log luminance maps to `key`, as a camera's meter \
+         does: a luminance histogram computed on the GPU (256 bins of log2 luminance over \
+         [-24, 16] EV), the mean of its pixels between the `low` and `high` percentiles \
+         (so a few bright lights or black borders do not pull it), clamped to \
+         [`min_ev`, `max_ev`]. Over frames (the editor's live preview) the exposure moves \
+         `adaptation` of the way to that target each frame; the first frame, and the first \
+         after accumulation restarts, takes the target at once, so a headless render does \
+         not depend on it. The exposure used is measured (`exposure_ev`).",
+        vec![
+            ParamDef::float(
+                "key",
+                0.18,
+                [1e-4, 1e4],
+                "the luminance the mean maps to (0.18: middle grey)",
+            ),
+            ParamDef::float(
+                "low",
+                0.1,
+                [0.0, 1.0],
+                "fraction of the pixels, darkest first, left out of the mean",
+            ),
+            ParamDef::float(
+                "high",
+                0.9,
+                [0.0, 1.0],
+                "fraction of the pixels, darkest first, up to which the mean runs (below \
+                 `low`: `low`)",
+            ),
+            ParamDef::float(
+                "min_ev",
+                -10.0,
+                [-30.0, 30.0],
+                "the lowest exposure, in stops",
+            ),
+            ParamDef::float(
+                "max_ev",
+                10.0,
+                [-30.0, 30.0],
+                "the highest exposure, in stops (below `min_ev`: `min_ev`)",
+            ),
+            ParamDef::float(
+                "adaptation",
+                0.25,
+                [0.0, 1.0],
+                "fraction of the way to the target exposure taken each frame (1: at once)",
+            ),
+        ],
+    )
+    .with_example(&[("key", ParamValue::Float(0.5))])
 }
 
 fn vignette() -> NodeKind {

@@ -1,10 +1,60 @@
-//! Combine nodes: two images blended, arithmetic on one.
+//! Combine nodes: two images blended, arithmetic on one, channels split and combined.
 
-use super::{COLOR_TYPES, Category, InputDef, NodeKind, ParamDef, post_filter};
-use crate::types::ParamValue;
+use super::{
+    ANY_IMAGE, COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, post_filter,
+};
+use crate::types::{ParamValue, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
-    vec![mix(), math()]
+    vec![mix(), math(), split(), combine()]
+}
+
+fn split() -> NodeKind {
+    let mut kind = post_filter(
+        "Split",
+        Category::Combine,
+        "Splits an image into its four channels, each a grey image (the channel's value in \
+         red, green and blue; alpha 1), to be changed on its own and put back with Combine. \
+         Depth images hold their value in red.",
+        Vec::new(),
+        "post/split.wgsl",
+    );
+    kind.inputs = vec![InputDef::new("color", ANY_IMAGE, "the image split")];
+    kind.outputs = ["r", "g", "b", "a"]
+        .into_iter()
+        .zip([
+            "red, as a grey image",
+            "green, as a grey image",
+            "blue, as a grey image",
+            "alpha, as a grey image",
+        ])
+        .map(|(name, doc)| OutputDef::new(name, PortType::HdrColor, doc))
+        .collect();
+    kind
+}
+
+fn combine() -> NodeKind {
+    let mut kind = post_filter(
+        "Combine",
+        Category::Combine,
+        "Makes an image from four: the red channel of `r`, `g` and `b` becomes its red, green \
+         and blue, and that of `a` its alpha (1 when `a` is not connected). The inverse of \
+         Split; the red channel is the value of Split's grey images and of a depth.",
+        Vec::new(),
+        "post/combine.wgsl",
+    );
+    kind.inputs = vec![
+        InputDef::new("r", ANY_IMAGE, "red: this image's red channel"),
+        InputDef::new("g", ANY_IMAGE, "green: this image's red channel"),
+        InputDef::new("b", ANY_IMAGE, "blue: this image's red channel"),
+        InputDef::new("a", ANY_IMAGE, "alpha: this image's red channel (else 1)").optional(),
+    ];
+    kind.outputs = vec![OutputDef::new(
+        "color",
+        PortType::HdrColor,
+        "the combined image",
+    )];
+    kind
 }
 
 fn mix() -> NodeKind {

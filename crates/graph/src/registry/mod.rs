@@ -5,6 +5,7 @@
 //! described in exactly one place. The GPU implementation of each kind lives in the
 //! render crate under the same name.
 
+mod analysis;
 mod color;
 mod combine;
 mod denoise;
@@ -17,6 +18,7 @@ mod transform;
 use std::sync::Arc;
 
 use crate::compile::Params;
+pub use crate::custom::Shader;
 use crate::types::{Extent, ParamType, ParamValue, PortType};
 
 /// Where a node kind sits in menus and docs.
@@ -37,11 +39,29 @@ pub enum Category {
     Filter,
     /// Nodes that resample an image to another size.
     Transform,
+    /// Nodes that measure images: error against a reference.
+    Analysis,
+    /// Kinds declared in a graph file that name no other category.
+    Custom,
     /// Nodes that write results out of the graph.
     Output,
 }
 
 impl Category {
+    /// Every category, in menu order.
+    pub const ALL: [Self; 10] = [
+        Self::Input,
+        Self::Render,
+        Self::Denoise,
+        Self::Color,
+        Self::Combine,
+        Self::Filter,
+        Self::Transform,
+        Self::Analysis,
+        Self::Custom,
+        Self::Output,
+    ];
+
     /// Display name.
     pub fn name(self) -> &'static str {
         match self {
@@ -52,6 +72,8 @@ impl Category {
             Self::Combine => "Combine",
             Self::Filter => "Filter",
             Self::Transform => "Transform",
+            Self::Analysis => "Analysis",
+            Self::Custom => "Custom",
             Self::Output => "Output",
         }
     }
@@ -251,11 +273,12 @@ pub struct NodeKind {
     /// images are the scene's size.
     pub renders_scene: bool,
     /// A post filter run by the generic implementation: this WGSL file (under `shaders/`)
-    /// reads input `color`, writes output `color`, and gets the params in declaration order
-    /// in its `Params` struct, member names as the params' (float → `f32`, int → `i32`,
-    /// bool and enum option index → `u32`). `None`: the kind has an implementation of its
-    /// own in the render crate.
-    pub shader: Option<&'static str>,
+    /// binds one texture per input and one storage texture per output, in declaration
+    /// order, and gets the params in declaration order in its `Params` struct, member names
+    /// as the params' (float → `f32`, int → `i32`, bool and enum option index → `u32`),
+    /// then `has_<input>: u32` per optional input. `None`: the kind has an implementation
+    /// of its own in the render crate.
+    pub shader: Option<Shader>,
     /// Params that show what the node does, for the gallery (`lumagraph gallery`); empty:
     /// its defaults (which for a grading node change nothing).
     pub example: Vec<(&'static str, ParamValue)>,
@@ -386,7 +409,7 @@ pub(crate) fn post_filter(
     shader: &'static str,
 ) -> NodeKind {
     NodeKind {
-        shader: Some(shader),
+        shader: Some(Shader::File(shader)),
         ..post_node(name, category, doc, params)
     }
 }
@@ -427,6 +450,7 @@ fn builtin_kinds() -> Vec<NodeKind> {
         combine::kinds(),
         effects::kinds(),
         transform::kinds(),
+        analysis::kinds(),
         output::kinds(),
     ]
     .concat()

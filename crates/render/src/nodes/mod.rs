@@ -1,9 +1,11 @@
 //! GPU implementations of the node kinds, one file per kind, each named as in the registry.
 
 pub(crate) mod accumulate;
+pub(crate) mod auto_exposure;
 pub(crate) mod bloom;
 pub(crate) mod blur;
 pub(crate) mod denoise;
+pub mod difference;
 pub(crate) mod gbuffer;
 mod image_input;
 pub mod lut;
@@ -54,6 +56,24 @@ pub struct Counter {
 impl Counter {
     /// A counter.
     pub fn new(name: &'static str, value: u64) -> Self {
+        Self { name, value }
+    }
+}
+
+/// A value a node measures on its images (an error against a reference, the exposure it
+/// chose), read back after a frame: the CLI prints them after a render, the editor shows
+/// them beside the preview.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Measurement {
+    /// What is measured (`relmse`, `exposure_ev`).
+    pub name: &'static str,
+    /// The value.
+    pub value: f64,
+}
+
+impl Measurement {
+    /// A measurement.
+    pub fn new(name: &'static str, value: f64) -> Self {
         Self { name, value }
     }
 }
@@ -152,6 +172,15 @@ pub trait NodeExec {
     /// # Errors
     /// When the readback fails.
     fn counters(&mut self, _ctx: &GpuContext) -> Result<Vec<Counter>> {
+        Ok(Vec::new())
+    }
+
+    /// What the node measured on the last frame it ran (may read back from the GPU); empty
+    /// before it ran.
+    ///
+    /// # Errors
+    /// When the readback fails.
+    fn measurements(&mut self, _ctx: &GpuContext) -> Result<Vec<Measurement>> {
         Ok(Vec::new())
     }
 
@@ -261,6 +290,8 @@ pub static IMPLEMENTATIONS: &[NodeImpl] = &[
     blur::IMPL,
     bloom::IMPL,
     lut::IMPL,
+    difference::IMPL,
+    auto_exposure::IMPL,
     tonemap::IMPL,
     output::IMPL,
 ];
@@ -280,13 +311,17 @@ pub fn owned_memory(pass: &Pass) -> Option<(u64, String)> {
 }
 
 /// The pass of a post-processing node: its inputs in declaration order (each a texture
-/// binding), a bilinear sampler when the shader declares one (`shaders/post/resample.wgsl`),
-/// its first output (in the format its shader declares; of the size the output port's rule
-/// gives), one uniform param block.
+/// binding; an unconnected optional input gets a 1×1 texture of zeros), a bilinear sampler
+/// when the shader declares one (`shaders/post/resample.wgsl`), its outputs in declaration
+/// order (each a storage texture of the size the port's rule gives; an output nothing reads
+/// gets a 1×1 stand-in, so stores there are dropped), one uniform param block (none when the kind has nothing to pass). The dispatch
+/// covers the first output's size.
 pub(crate) struct FilterPass {
     kernel: crate::kernel::Kernel,
     params: wgpu::Buffer,
     sampler: Option<wgpu::Sampler>,
+    /// 1×1 stand-ins for unbound ports, by format, made when first needed.
+    stand_ins: Vec<(lumagraph_graph::TexFormat, PooledTexture)>,
 }
 
 impl FilterPass {
@@ -295,17 +330,26 @@ impl FilterPass {
     ///
     /// # Errors
     /// When the shader does not compile.
-    pub(crate) fn new(ctx: &GpuContext, shader: &str, params: &[u8]) -> Result<Self> {
+    pub(crate) fn new(
+        ctx: &GpuContext,
+        shader: &lumagraph_graph::registry::Shader,
+        params: &[u8],
+    ) -> Result<Self> {
         use crate::kernel::{Binding, Kernel, linear_sampler, uniform_buffer};
-        let kernel = Kernel::new(ctx, shader)?;
+        use lumagraph_graph::registry::Shader;
+        let kernel = match shader {
+            Shader::File(name) => Kernel::new(ctx, name)?,
+            Shader::Generated(g) => Kernel::from_source(ctx, &g.label, &g.text)?,
+        };
         let sampler = kernel
             .bindings()
             .contains(&Binding::Sampler)
             .then(|| linear_sampler(ctx));
         Ok(Self {
             kernel,
-            params: uniform_buffer(ctx, shader, params),
+            params: uniform_buffer(ctx, shader.label(), params),
             sampler,
+            stand_ins: Vec::new(),
         })
     }
 
@@ -314,32 +358,79 @@ impl FilterPass {
         ctx.queue.write_buffer(&self.params, 0, params);
     }
 
-    /// Records the pass over `pass`'s ports.
-    ///
-    /// # Errors
-    /// When an input is not bound or the bindings do not match the kernel.
-    pub(crate) fn record(&self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
-        let (ctx, encoder, io, timer) = rec.parts();
-        let Some(out) = pass.kind.outputs.first().and_then(|o| pass.output(o.name)) else {
-            return Ok(());
-        };
-        let inputs = pass
+    /// Makes the 1×1 stand-ins `pass` needs (zeros: GPU textures start cleared).
+    fn make_stand_ins(&mut self, ctx: &GpuContext, pass: &Pass) {
+        let missing_inputs = pass
             .kind
             .inputs
             .iter()
-            .map(|i| io.input(pass, i.name))
-            .collect::<Result<Vec<_>>>()?;
+            .filter(|i| pass.input(i.name).is_none())
+            .map(|_| lumagraph_graph::TexFormat::Rgba32Float);
+        let missing_outputs = pass
+            .kind
+            .outputs
+            .iter()
+            .filter(|o| pass.output(o.name).is_none())
+            .map(|o| o.ty.format());
+        for format in missing_inputs.chain(missing_outputs) {
+            if !self.stand_ins.iter().any(|(f, _)| *f == format) {
+                let t = crate::pool::create(
+                    ctx,
+                    "unbound port",
+                    format,
+                    lumagraph_graph::Extent::new(1, 1),
+                );
+                self.stand_ins.push((format, t));
+            }
+        }
+    }
+
+    /// Records the pass over `pass`'s ports.
+    ///
+    /// # Errors
+    /// When a required input is not bound or the bindings do not match the kernel.
+    pub(crate) fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
+        let (ctx, encoder, io, timer) = rec.parts();
+        let Some(size) = pass
+            .kind
+            .outputs
+            .iter()
+            .find_map(|o| pass.output(o.name))
+            .map(|t| io.plan.texture(t).extent)
+        else {
+            return Ok(());
+        };
+        self.make_stand_ins(ctx, pass);
+        let stand_in = |format| {
+            self.stand_ins
+                .iter()
+                .find(|(f, _)| *f == format)
+                .map(|(_, t)| &t.view)
+                .ok_or_else(|| RenderError::Gpu("no stand-in texture".into()))
+        };
         let mut builder = self.kernel.pass(&pass.node);
-        for input in &inputs {
-            builder = builder.read(&input.view);
+        for i in &pass.kind.inputs {
+            builder = match pass.input(i.name) {
+                Some(t) => builder.read(&io.texture(t).view),
+                None if i.optional => {
+                    builder.read(stand_in(lumagraph_graph::TexFormat::Rgba32Float)?)
+                }
+                None => builder.read(&io.input(pass, i.name)?.view),
+            };
         }
         if let Some(sampler) = &self.sampler {
             builder = builder.sampler(sampler);
         }
-        builder
-            .write(&io.texture(out).view)
-            .uniform(&self.params)
-            .dispatch_2d(ctx, encoder, io.plan.texture(out).extent, timer)
+        for o in &pass.kind.outputs {
+            builder = match pass.output(o.name) {
+                Some(t) => builder.write(&io.texture(t).view),
+                None => builder.write(stand_in(o.ty.format())?),
+            };
+        }
+        if self.kernel.bindings().last() == Some(&crate::kernel::Binding::Uniform) {
+            builder = builder.uniform(&self.params);
+        }
+        builder.dispatch_2d(ctx, encoder, size, timer)
     }
 }
 
@@ -356,7 +447,11 @@ impl<P: ParamBlock> ColorFilter<P> {
     /// When the shader does not compile.
     pub(crate) fn new(ctx: &GpuContext) -> Result<Self> {
         Ok(Self {
-            pass: FilterPass::new(ctx, P::LAYOUT.shader, bytemuck::bytes_of(&P::zeroed()))?,
+            pass: FilterPass::new(
+                ctx,
+                &lumagraph_graph::registry::Shader::File(P::LAYOUT.shader),
+                bytemuck::bytes_of(&P::zeroed()),
+            )?,
             block: std::marker::PhantomData,
         })
     }
@@ -370,7 +465,7 @@ impl<P: ParamBlock> ColorFilter<P> {
     ///
     /// # Errors
     /// As [`FilterPass::record`].
-    pub(crate) fn record(&self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
+    pub(crate) fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
         self.pass.record(pass, rec)
     }
 }
@@ -470,7 +565,9 @@ mod post_filter_tests {
     fn a_shader_that_does_not_match_its_params_is_caught() {
         let registry = lumagraph_graph::Registry::with_builtins();
         let mut vignette = lumagraph_graph::NodeKind::clone(registry.get("Vignette").unwrap());
-        vignette.shader = Some("post/exposure.wgsl");
+        vignette.shader = Some(lumagraph_graph::registry::Shader::File(
+            "post/exposure.wgsl",
+        ));
         let e = super::post_filter::check(&vignette).unwrap_err();
         assert!(
             e.contains("struct Params has") && e.contains("strength"),

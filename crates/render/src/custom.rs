@@ -1,0 +1,337 @@
+//! Node kinds declared in graph files: the shader written around the declared function,
+//! validated with naga when the graph loads, errors located in the file that holds the
+//! WGSL.
+//!
+//! The function is `fn node(pixel: vec2u, size: vec2u) -> vec4f` (one output) or
+//! `-> Outputs` (several: a generated struct with one `vec4f` member per output, in
+//! declaration order). Around it the kind's inputs are textures named as the ports, with
+//! `load_<input>(p: vec2i) -> vec4f` reading one clamped to the image; the params are
+//! `params.<name>` (f32, i32, u32 for bools and enum option indices) and an optional input
+//! adds `params.has_<input>` (1 when connected). `#import "common/color.wgsl"` lines bring
+//! in the shared WGSL helpers. The module then runs on the generic post filter
+//! ([`crate::nodes::post_filter`]).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use lumagraph_graph::custom::{GeneratedShader, KindDecl, Shader};
+use lumagraph_graph::{
+    ErrorKind, Graph, GraphError, GraphErrors, NodeKind, ParamType, Pos, Registry,
+};
+
+/// Where the declared function's text comes from, for locating errors.
+struct Code {
+    text: String,
+    /// The file holding it.
+    file: PathBuf,
+    /// The file line of the code's line 1, when known.
+    first_line: Option<usize>,
+}
+
+/// `base` with the kinds `graph` declares added, each with its shader generated and
+/// validated (see the module docs).
+///
+/// # Errors
+/// Every declaration that fails: a bad declaration located at the kind in the graph file,
+/// a missing `.wgsl` file, WGSL that does not compile located at its file, line and column
+/// and naming the nodes of that kind, a name a kind of `base` already has.
+pub fn registry_for(graph: &Graph, base: &Registry) -> Result<Registry, GraphErrors> {
+    let mut registry = base.clone();
+    let mut errors = Vec::new();
+    for decl in &graph.kinds {
+        match declared_kind(graph, decl) {
+            Ok(kind) => {
+                if let Err(m) = registry.add(kind) {
+                    errors.push(at_decl(graph, decl, m));
+                }
+            }
+            Err(e) => errors.push(e),
+        }
+    }
+    if errors.is_empty() {
+        Ok(registry)
+    } else {
+        Err(GraphErrors(errors))
+    }
+}
+
+/// An error about declaration `decl`, located at it in the graph file.
+fn at_decl(graph: &Graph, decl: &KindDecl, message: impl std::fmt::Display) -> GraphError {
+    GraphError {
+        file: graph.origin.as_ref().map(|o| o.path.clone()),
+        pos: graph.origin.as_ref().and_then(|o| o.kind_pos(&decl.name)),
+        ..GraphError::new(ErrorKind::Source(format!(
+            "kind \"{}\": {message}",
+            decl.name
+        )))
+    }
+}
+
+fn declared_kind(graph: &Graph, decl: &KindDecl) -> Result<NodeKind, GraphError> {
+    let placeholder = Shader::File("");
+    let mut kind = decl
+        .to_kind(placeholder)
+        .map_err(|m| at_decl(graph, decl, m))?;
+    let graph_file = graph
+        .origin
+        .as_ref()
+        .map_or_else(|| PathBuf::from("(graph)"), |o| o.path.clone());
+    let code = if decl.code.trim().is_empty() {
+        {
+            let file = graph.base_dir().join(&decl.wgsl);
+            let text = std::fs::read_to_string(&file).map_err(|e| {
+                at_decl(graph, decl, format!("cannot read {}: {e}", file.display()))
+            })?;
+            Code {
+                text,
+                file,
+                first_line: Some(1),
+            }
+        }
+    } else {
+        Code {
+            text: decl.code.clone(),
+            first_line: graph
+                .origin
+                .as_ref()
+                .and_then(|o| o.code_first_line(&decl.code)),
+            file: graph_file,
+        }
+    };
+    let nodes: Vec<&str> = graph
+        .nodes
+        .iter()
+        .filter(|n| n.kind == decl.name)
+        .map(|n| n.id.as_str())
+        .collect();
+    let generated = generate(&kind, &code).map_err(|(message, pos)| {
+        let used_by = match nodes.as_slice() {
+            [] => String::new(),
+            ids => format!(" (used by node {})", ids.join(", ")),
+        };
+        GraphError {
+            file: Some(code.file.clone()),
+            pos,
+            ..GraphError::new(ErrorKind::Source(format!(
+                "kind \"{}\"{used_by}: {message}",
+                decl.name
+            )))
+        }
+    })?;
+    kind.shader = Some(Shader::Generated(Arc::new(generated)));
+    // The generic filter's contract holds by construction; checked all the same.
+    crate::nodes::post_filter::check(&kind).map_err(|m| at_decl(graph, decl, m))?;
+    Ok(kind)
+}
+
+fn wgsl_format(ty: lumagraph_graph::PortType) -> &'static str {
+    match ty.format() {
+        lumagraph_graph::TexFormat::Rgba32Float => "rgba32float",
+        lumagraph_graph::TexFormat::Rgba8Unorm => "rgba8unorm",
+        lumagraph_graph::TexFormat::R32Float => "r32float",
+    }
+}
+
+/// The module for `kind` around `code`, validated; or the first error and where it is in
+/// the code's file.
+/// The bindings, params, helpers and entry point generated around a declared function.
+fn generated_head(kind: &NodeKind) -> String {
+    let mut head = format!(
+        "// Generated by lumagraph for the node kind \"{}\" declared in a graph file.\n",
+        kind.name
+    );
+    let members: Vec<String> = kind
+        .params
+        .iter()
+        .map(|p| {
+            let ty = match p.ty {
+                ParamType::Float { .. } => "f32",
+                ParamType::Int { .. } => "i32",
+                _ => "u32",
+            };
+            format!("    {}: {ty},\n", p.name)
+        })
+        .chain(
+            kind.inputs
+                .iter()
+                .filter(|i| i.optional)
+                .map(|i| format!("    has_{}: u32,\n", i.name)),
+        )
+        .collect();
+    let mut binding = 0;
+    for i in &kind.inputs {
+        let _ = writeln!(
+            head,
+            "@group(0) @binding({binding}) var {}: texture_2d<f32>;",
+            i.name
+        );
+        binding += 1;
+    }
+    for o in &kind.outputs {
+        let _ = writeln!(
+            head,
+            "@group(0) @binding({binding}) var out_{}: texture_storage_2d<{}, write>;",
+            o.name,
+            wgsl_format(o.ty)
+        );
+        binding += 1;
+    }
+    if !members.is_empty() {
+        let _ = writeln!(head, "struct Params {{\n{}}}", members.concat());
+        let _ = writeln!(
+            head,
+            "@group(0) @binding({binding}) var<uniform> params: Params;"
+        );
+    }
+    for i in &kind.inputs {
+        let _ = writeln!(
+            head,
+            "fn load_{0}(p: vec2i) -> vec4f {{\n    let last = vec2i(textureDimensions({0})) - 1;\n    return textureLoad({0}, clamp(p, vec2i(0), last), 0);\n}}",
+            i.name
+        );
+    }
+    let several = kind.outputs.len() > 1;
+    if several {
+        let fields: String = kind
+            .outputs
+            .iter()
+            .map(|o| format!("    {}: vec4f,\n", o.name))
+            .collect();
+        let _ = writeln!(head, "struct Outputs {{\n{fields}}}");
+    }
+    let first = kind.outputs[0].name;
+    let stores: String = if several {
+        kind.outputs
+            .iter()
+            .map(|o| format!("    textureStore(out_{0}, id.xy, r.{0});\n", o.name))
+            .collect()
+    } else {
+        format!("    textureStore(out_{first}, id.xy, r);\n")
+    };
+    let _ = writeln!(
+        head,
+        "@compute @workgroup_size(8, 8)\nfn main(@builtin(global_invocation_id) id: vec3u) {{\n    let size = textureDimensions(out_{first});\n    if id.x >= size.x || id.y >= size.y {{\n        return;\n    }}\n    let r = node(id.xy, size);\n{stores}}}"
+    );
+    head
+}
+
+/// Parses and validates `text` with naga; an error is located in the code's file when it
+/// falls in the code (which starts at line `code_start + 1`).
+fn validate(
+    text: &str,
+    code_start: usize,
+    code: &Code,
+    several: bool,
+) -> Result<(), (String, Option<Pos>)> {
+    let located = |loc: Option<naga::SourceLocation>, message: String| {
+        let Some(loc) = loc else {
+            return (message, None);
+        };
+        let line = loc.line_number as usize;
+        if line > code_start {
+            let code_line = line - code_start;
+            match code.first_line {
+                Some(first) => (
+                    message,
+                    Some(Pos {
+                        line: first + code_line - 1,
+                        col: loc.line_position as usize,
+                    }),
+                ),
+                None => (format!("line {code_line} of its code: {message}"), None),
+            }
+        } else {
+            (
+                format!(
+                    "{message} (in the code generated around the function: it must define \
+                     `fn node(pixel: vec2u, size: vec2u) -> {}`)",
+                    if several { "Outputs" } else { "vec4f" }
+                ),
+                None,
+            )
+        }
+    };
+    let module = naga::front::wgsl::parse_str(text)
+        .map_err(|e| located(e.location(text), e.message().to_owned()))?;
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    .map_err(|e| {
+        let mut message = e.as_inner().to_string();
+        let mut source = std::error::Error::source(e.as_inner());
+        while let Some(s) = source {
+            let _ = write!(message, ": {s}");
+            source = s.source();
+        }
+        // The innermost span (the expression, not the whole function) says most.
+        let loc = e
+            .spans()
+            .filter(|(span, _)| span.is_defined())
+            .last()
+            .map(|(span, _)| span.location(text));
+        located(loc, message)
+    })?;
+    Ok(())
+}
+
+fn generate(kind: &NodeKind, code: &Code) -> Result<GeneratedShader, (String, Option<Pos>)> {
+    let several = kind.outputs.len() > 1;
+    let head = generated_head(kind);
+    // The code's #import lines are resolved ahead of it and blanked in place, so its lines
+    // keep their numbers.
+    let mut imports = String::new();
+    let mut body = String::new();
+    for line in code.text.lines() {
+        if line.trim_start().starts_with("#import") {
+            imports.push_str(line.trim());
+            imports.push('\n');
+            body.push('\n');
+        } else {
+            body.push_str(line);
+            body.push('\n');
+        }
+    }
+    let imported = if imports.is_empty() {
+        String::new()
+    } else {
+        const NAME: &str = "(imports of a declared kind)";
+        crate::shader::resolve_with(NAME, &[(NAME, imports)]).map_err(|e| (e.to_string(), None))?
+    };
+    let mut text = head;
+    text.push_str(&imported);
+    if !text.ends_with('\n') {
+        text.push('\n');
+    }
+    let code_start = text.lines().count();
+    text.push_str(&body);
+
+    validate(&text, code_start, code, several)?;
+    Ok(GeneratedShader {
+        label: format!("{} ({})", kind.name, code.file.display()),
+        text,
+    })
+}
+
+/// [`registry_for`] the graph, or the built-in kinds when it declares none; the folder
+/// relative `.wgsl` paths are read from is the graph's.
+///
+/// # Errors
+/// As [`registry_for`].
+pub fn registry(graph: &Graph) -> Result<Registry, GraphErrors> {
+    registry_for(graph, &Registry::with_builtins())
+}
+
+/// Whether `path` is a `.wgsl` file a kind of `graph` reads (the editor reloads the graph's
+/// kinds when one changes).
+pub fn shader_files(graph: &Graph) -> Vec<PathBuf> {
+    let base: &Path = &graph.base_dir();
+    graph
+        .kinds
+        .iter()
+        .filter(|k| !k.wgsl.is_empty())
+        .map(|k| base.join(&k.wgsl))
+        .collect()
+}
