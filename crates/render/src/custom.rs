@@ -12,7 +12,7 @@
 //! ([`crate::nodes::post_filter`]).
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use lumagraph_graph::custom::{GeneratedShader, KindDecl, Shader};
@@ -322,16 +322,4 @@ fn generate(kind: &NodeKind, code: &Code) -> Result<GeneratedShader, (String, Op
 /// As [`registry_for`].
 pub fn registry(graph: &Graph) -> Result<Registry, GraphErrors> {
     registry_for(graph, &Registry::with_builtins())
-}
-
-/// Whether `path` is a `.wgsl` file a kind of `graph` reads (the editor reloads the graph's
-/// kinds when one changes).
-pub fn shader_files(graph: &Graph) -> Vec<PathBuf> {
-    let base: &Path = &graph.base_dir();
-    graph
-        .kinds
-        .iter()
-        .filter(|k| !k.wgsl.is_empty())
-        .map(|k| base.join(&k.wgsl))
-        .collect()
 }
