@@ -25,7 +25,6 @@ fn graph(params: &[(&str, ParamValue)]) -> Graph {
         dn = dn.with(k, v.clone());
     }
     Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(1)),
             Node::new("acc", "Accumulate"),
@@ -40,7 +39,7 @@ fn graph(params: &[(&str, ParamValue)]) -> Graph {
             Edge::new("gb.normal", "dn.normal"),
             Edge::new("gb.depth", "dn.depth"),
         ],
-        origin: None,
+        ..Graph::default()
     }
 }
 

@@ -21,14 +21,13 @@ fn measure(
 ) -> Result<(f64, String)> {
     let spf = spp.min(16);
     let graph = Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("pathtrace", "PathTrace")
                 .with("samples_per_frame", ParamValue::Int(i64::from(spf))),
             Node::new("accumulate", "Accumulate"),
         ],
         edges: vec![Edge::new("pathtrace.color", "accumulate.color")],
-        origin: None,
+        ..Graph::default()
     };
     let plan = compile(&graph, &["accumulate.color".into()], Some(scene))?;
     let resources = Resources {

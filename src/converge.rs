@@ -26,7 +26,7 @@ use std::time::Instant;
 
 use anyhow::{Context as _, Result, bail};
 use lumagraph::graph::registry::SAMPLES_PER_FRAME;
-use lumagraph::graph::{Category, Graph, ParamValue, Registry};
+use lumagraph::graph::{Category, Graph, ParamValue};
 use lumagraph::render::cpu::Image;
 use lumagraph::render::{Executor, GpuContext, Resources, compile, image_io, metrics};
 use lumagraph::scene::GpuScene;
@@ -55,10 +55,13 @@ struct Row {
     gpu_ms: Option<f64>,
 }
 
-/// The graph without sinks, 1 spp per frame; returns it with the ports scored, as
-/// `(port, is_denoised)`.
+/// The graph without sinks (groups flattened, so theirs too), 1 spp per frame; returns it
+/// with the ports scored, as `(port, is_denoised)`.
 fn prepare(graph: &mut Graph) -> Result<Vec<(String, bool)>> {
-    let registry = Registry::with_builtins();
+    let flat =
+        lumagraph::graph::group::flatten(graph, &lumagraph::render::custom::registry(graph)?)?;
+    *graph = flat.graph;
+    let registry = flat.registry;
     let kind = |n: &lumagraph::graph::Node| registry.get(&n.kind);
     graph.remove_sinks(&registry);
     let mut ports = Vec::new();

@@ -439,6 +439,39 @@ fn plan(graph: &Path, scene: Option<&Path>, overrides: &[String]) -> Result<()> 
     Ok(())
 }
 
+/// `lumagraph validate`: compiles the graph, or checks a group file on its own.
+fn validate(graph: &Path, scene: Option<&Path>) -> Result<()> {
+    let g = load(graph, &[])?;
+    let registry = lumagraph::render::custom::registry(&g)?;
+    if !g.interface.is_empty()
+        && !g
+            .nodes
+            .iter()
+            .any(|n| registry.get(&n.kind).is_some_and(|k| k.sink))
+    {
+        let kind = lumagraph::render::custom::check_group(&g)?;
+        let count = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
+        println!(
+            "{}: ok, a node group ({}, {}, {}, {}); it compiles inside a graph that uses it",
+            graph.display(),
+            count(kind.inputs.len(), "input"),
+            count(kind.outputs.len(), "output"),
+            count(kind.params.len(), "param"),
+            count(g.nodes.len(), "node")
+        );
+        return Ok(());
+    }
+    let scene = load_scene(scene)?;
+    let plan = compile(&g, &[], scene.as_ref().map(|s| &*s.gpu))?;
+    println!(
+        "{}: ok ({} passes, {} left out)",
+        graph.display(),
+        plan.passes.len(),
+        plan.left_out.len()
+    );
+    Ok(())
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Render {
@@ -459,18 +492,7 @@ fn run(cli: Cli) -> Result<()> {
             scene,
             overrides,
         } => plan(&graph, scene.as_deref(), &overrides),
-        Command::Validate { graph, scene } => {
-            let g = load(&graph, &[])?;
-            let scene = load_scene(scene.as_deref())?;
-            let plan = compile(&g, &[], scene.as_ref().map(|s| &*s.gpu))?;
-            println!(
-                "{}: ok ({} passes, {} left out)",
-                graph.display(),
-                plan.passes.len(),
-                plan.left_out.len()
-            );
-            Ok(())
-        }
+        Command::Validate { graph, scene } => validate(&graph, scene.as_deref()),
         Command::Nodes { markdown, graph } => {
             let r = match graph {
                 Some(g) => lumagraph::render::custom::registry(&load(&g, &[])?)?,

@@ -9,14 +9,13 @@ use lumagraph::render::{Executor, Resources, compile, image_io};
 
 fn acc_graph(input: &std::path::Path) -> Graph {
     Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("input", "ImageInput")
                 .with("path", ParamValue::Str(input.display().to_string())),
             Node::new("acc", "Accumulate"),
         ],
         edges: vec![Edge::new("input.color", "acc.color")],
-        origin: None,
+        ..Graph::default()
     }
 }
 
@@ -115,13 +114,12 @@ fn variance_of_the_mean_matches_cpu_and_keeps_the_mean_exact() {
     let scene = lumagraph::scene::Scene::load(&common::repo("assets/cornell.ron")).unwrap();
     let scene = Arc::new(lumagraph::scene::GpuScene::build(&scene).unwrap());
     let graph = Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(1)),
             Node::new("acc", "Accumulate"),
         ],
         edges: vec![Edge::new("pt.color", "acc.color")],
-        origin: None,
+        ..Graph::default()
     };
     let resources = Resources {
         scene: Some(Arc::clone(&scene)),

@@ -31,14 +31,13 @@ fn scene(name: &str) -> Arc<GpuScene> {
 fn render(scene: &Arc<GpuScene>) -> Option<([Image; 3], [Image; 3])> {
     let ctx = common::gpu()?;
     let graph = Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("gb", "GBuffer"),
             Node::new("pt", "PathTrace")
                 .with("samples_per_frame", lumagraph::graph::ParamValue::Int(1)),
         ],
         edges: Vec::new(),
-        origin: None,
+        ..Graph::default()
     };
     let keep: Vec<String> = ["gb", "pt"]
         .iter()

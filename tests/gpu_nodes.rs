@@ -22,7 +22,6 @@ fn chart() -> Image {
 
 fn post_graph(ev: f64, operator: &str) -> Graph {
     Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("input", "ImageInput")
                 .with("path", ParamValue::Str("assets/test_chart.exr".into())),
@@ -35,7 +34,7 @@ fn post_graph(ev: f64, operator: &str) -> Graph {
             Edge::new("exposure.color", "tonemap.color"),
             Edge::new("tonemap.color", "out.color"),
         ],
-        origin: None,
+        ..Graph::default()
     }
 }
 

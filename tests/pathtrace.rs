@@ -160,10 +160,9 @@ fn first_hit_aovs_see_the_back_wall() {
     let cornell = scene("cornell.ron");
     let Some(ctx) = common::gpu() else { return };
     let graph = Graph {
-        kinds: Vec::new(),
         nodes: vec![Node::new("pt", "PathTrace")],
         edges: Vec::new(),
-        origin: None,
+        ..Graph::default()
     };
     let keep = [
         "pt.albedo".to_owned(),

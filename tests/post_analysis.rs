@@ -33,10 +33,9 @@ fn run(
         node = node.with(k, v.clone());
     }
     let mut graph = Graph {
-        kinds: Vec::new(),
         nodes: vec![node],
         edges: Vec::new(),
-        origin: None,
+        ..Graph::default()
     };
     for (to, path) in inputs {
         let id = format!("in_{to}");
@@ -155,7 +154,6 @@ fn difference_refuses_a_reference_of_another_size() {
     let dir = tempfile::tempdir().unwrap();
     let ref_path = write_exr(dir.path(), "small.exr", &small);
     let graph = Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("in", "ImageInput").with("path", ParamValue::Str(CHART.into())),
             Node::new("ref", "ImageInput").with("path", ParamValue::Str(ref_path)),
@@ -165,7 +163,7 @@ fn difference_refuses_a_reference_of_another_size() {
             Edge::new("in.color", "diff.color"),
             Edge::new("ref.color", "diff.reference"),
         ],
-        origin: None,
+        ..Graph::default()
     };
     let e = lumagraph::render::compile_with(
         &graph,
@@ -236,7 +234,6 @@ fn auto_exposure_adapts_over_frames_and_restarts_at_the_target() {
         return;
     };
     let graph = |key: f64| Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("in", "ImageInput").with("path", ParamValue::Str(CHART.into())),
             Node::new("ae", "AutoExposure")
@@ -244,7 +241,7 @@ fn auto_exposure_adapts_over_frames_and_restarts_at_the_target() {
                 .with("adaptation", ParamValue::Float(0.25)),
         ],
         edges: vec![Edge::new("in.color", "ae.color")],
-        origin: None,
+        ..Graph::default()
     };
     let keep = ["ae.color".to_owned()];
     let resources = Resources {

@@ -120,7 +120,6 @@ fn split_and_combine_move_channels_exactly() {
     let path = path.to_str().unwrap();
     use lumagraph::graph::{Edge, Graph, Node};
     let graph = Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("in", "ImageInput").with("path", ParamValue::Str(path.into())),
             Node::new("split", "Split"),
@@ -137,7 +136,7 @@ fn split_and_combine_move_channels_exactly() {
             Edge::new("split.g", "opaque.g"),
             Edge::new("split.b", "opaque.b"),
         ],
-        origin: None,
+        ..Graph::default()
     };
     let keep = [
         "split.r",
@@ -164,13 +163,12 @@ fn split_and_combine_move_channels_exactly() {
 fn split_runs_with_one_output_used() {
     use lumagraph::graph::{Edge, Graph, Node};
     let graph = Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("in", "ImageInput").with("path", ParamValue::Str(CHART.into())),
             Node::new("split", "Split"),
         ],
         edges: vec![Edge::new("in.color", "split.color")],
-        origin: None,
+        ..Graph::default()
     };
     let dir = tempfile::tempdir().unwrap();
     let Some(got) = common::run_graph(&graph, &["split.g"], dir.path()) else {

@@ -121,14 +121,13 @@ fn graph(params: &[(&str, ParamValue)]) -> Graph {
         r = r.with(k, v.clone());
     }
     Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("input", "ImageInput")
                 .with("path", ParamValue::Str("assets/test_chart.exr".into())),
             r,
         ],
         edges: vec![Edge::new("input.color", "r.color")],
-        origin: None,
+        ..Graph::default()
     }
 }
 

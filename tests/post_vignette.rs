@@ -40,13 +40,12 @@ fn graph(path: &str, params: &[(&str, f64)]) -> Graph {
         v = v.with(k, ParamValue::Float(*x));
     }
     Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("input", "ImageInput").with("path", ParamValue::Str(path.into())),
             v,
         ],
         edges: vec![Edge::new("input.color", "v.color")],
-        origin: None,
+        ..Graph::default()
     }
 }
 

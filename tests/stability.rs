@@ -39,13 +39,12 @@ fn render(scene: &Scene, spp: u32) -> Option<(Image, Image, u64)> {
     let ctx = common::gpu()?;
     let gpu = Arc::new(GpuScene::build(scene).unwrap());
     let graph = Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(16)),
             Node::new("acc", "Accumulate"),
         ],
         edges: vec![Edge::new("pt.color", "acc.color")],
-        origin: None,
+        ..Graph::default()
     };
     let plan = compile(&graph, &["acc.color".into(), "pt.depth".into()], Some(&gpu)).unwrap();
     let resources = Resources {
@@ -401,10 +400,9 @@ fn render_with(scene: &Scene, spp: u32, params: &[(&str, ParamValue)]) -> Option
         pt = pt.with(k, v.clone());
     }
     let graph = Graph {
-        kinds: Vec::new(),
         nodes: vec![pt, Node::new("acc", "Accumulate")],
         edges: vec![Edge::new("pt.color", "acc.color")],
-        origin: None,
+        ..Graph::default()
     };
     let plan = compile(&graph, &["acc.color".into()], Some(&gpu)).unwrap();
     let resources = Resources {

@@ -279,13 +279,12 @@ fn scene_file(
 fn render(scene: &Arc<GpuScene>, spp: i64) -> Option<[Image; 5]> {
     let ctx = common::gpu()?;
     let graph = Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("gb", "GBuffer"),
             Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(spp)),
         ],
         edges: Vec::new(),
-        origin: None,
+        ..Graph::default()
     };
     let ports = [
         "pt.color",

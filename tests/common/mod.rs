@@ -65,7 +65,6 @@ pub fn denoise_graph(
     }
     let color = format!("{}.color", source.id);
     Graph {
-        kinds: Vec::new(),
         nodes: vec![
             source,
             Node::new("acc", "Accumulate"),
@@ -80,7 +79,7 @@ pub fn denoise_graph(
             Edge::new("gb.normal", "dn.normal"),
             Edge::new("gb.depth", "dn.depth"),
         ],
-        origin: None,
+        ..Graph::default()
     }
 }
 
@@ -105,10 +104,9 @@ pub fn progressive_graph(
         pt = pt.with(k, v.clone());
     }
     Graph {
-        kinds: Vec::new(),
         nodes: vec![pt, Node::new("acc", "Accumulate")],
         edges: vec![Edge::new("pt.color", "acc.color")],
-        origin: None,
+        ..Graph::default()
     }
 }
 
@@ -168,10 +166,9 @@ pub fn independent_frames(
         pt = pt.with(k, v.clone());
     }
     let graph = Graph {
-        kinds: Vec::new(),
         nodes: vec![pt],
         edges: Vec::new(),
-        origin: None,
+        ..Graph::default()
     };
     let mut exec = executor(&graph, &["pt.color"], &std::sync::Arc::new(scene))?;
     Some(
@@ -296,10 +293,9 @@ pub fn run_node(
         node = node.with(k, v.clone());
     }
     let mut graph = Graph {
-        kinds: Vec::new(),
         nodes: vec![node],
         edges: Vec::new(),
-        origin: None,
+        ..Graph::default()
     };
     for (i, (port, path)) in inputs.iter().enumerate() {
         let id = format!("in{i}");

@@ -21,6 +21,7 @@ use crate::document::Document;
 use crate::files::Recent;
 use crate::preview::{Preview, PreviewScene};
 
+mod groups;
 mod io;
 mod menus;
 mod panels;
@@ -74,6 +75,8 @@ pub enum Pick {
     Scene,
     /// A path param: node id and param name.
     Param(String, String),
+    /// The file of a group made from the selected nodes.
+    GroupFile,
 }
 
 /// A question waiting in a modal dialog.
@@ -94,6 +97,9 @@ enum Then {
 pub struct Editor {
     /// The graph being edited and its file.
     pub doc: Document,
+    /// The graphs around the group being edited, the outermost first (empty when no
+    /// group is open).
+    pub outer: Vec<groups::Outer>,
     /// The node canvas.
     pub canvas: Canvas,
     /// The live preview.
@@ -148,6 +154,7 @@ impl Editor {
     pub fn new(gpu: GpuContext, graph: Option<&Path>, config: &EditorConfig) -> Self {
         let mut editor = Self {
             doc: Document::default(),
+            outer: Vec::new(),
             canvas: Canvas::default(),
             preview: Preview::new(gpu),
             scope: crate::scope::ScopeView::default(),
@@ -207,11 +214,30 @@ impl Editor {
             self.graph_errors
                 .extend(errs.0.iter().map(ToString::to_string));
         }
-        let result = compile_with(&key.0, self.doc.registry(), &base, &[], scene);
+        let context = self.group_context();
+        let result = match &context {
+            Some(Ok(c)) => compile_with(&c.graph, &c.registry, &c.base, &[], scene).map(|_| ()),
+            Some(Err(e)) => {
+                self.graph_errors.push(e.clone());
+                Ok(())
+            }
+            None => compile_with(&key.0, self.doc.registry(), &base, &[], scene).map(|_| ()),
+        };
+        let prefix = match &context {
+            Some(Ok(c)) => c.prefix.as_str(),
+            _ => "",
+        };
         if let Err(errs) = result {
             for e in errs.0 {
-                match e.node {
-                    Some(n) => self.errors.entry(n).or_default().push(e.kind.to_string()),
+                // Inside a group: errors of its nodes, by their ids in the group.
+                let node = e.node.as_deref().map(|n| n.strip_prefix(prefix).ok_or(n));
+                match node {
+                    Some(Ok(n)) => self
+                        .errors
+                        .entry(n.to_owned())
+                        .or_default()
+                        .push(e.kind.to_string()),
+                    Some(Err(n)) => self.graph_errors.push(format!("{n}: {}", e.kind)),
                     None => self.graph_errors.push(e.kind.to_string()),
                 }
             }
@@ -254,6 +280,12 @@ impl Editor {
         if ctx.input_mut(|i| i.consume_key(cmd, Key::O)) {
             self.ask(Then::Open(PathBuf::new()));
         }
+        if !typing && ctx.input_mut(|i| i.consume_key(cmd, Key::G)) {
+            self.ask_group_selection();
+        }
+        if !typing && ctx.input_mut(|i| i.consume_key(Modifiers::NONE, Key::Tab)) {
+            self.toggle_group();
+        }
         if !typing
             && ctx.input_mut(|i| {
                 i.consume_key(Modifiers::NONE, Key::Delete)
@@ -276,15 +308,30 @@ impl Editor {
         }
         self.refresh_errors();
         let port = self.effective_port();
-        let base = self.doc.base_dir();
         let scene = self.scene.as_ref().map(|s| &s.preview);
-        let ran = self.preview.update(
-            self.doc.registry(),
-            &self.doc.graph,
-            &base,
-            port.as_deref(),
-            scene,
-        );
+        // Inside a group, the preview runs the graph around it.
+        let ran = match self.group_context() {
+            Some(Ok(c)) => {
+                let inner = port.as_deref().map(|p| format!("{}{p}", c.prefix));
+                let ran =
+                    self.preview
+                        .update(&c.registry, &c.graph, &c.base, inner.as_deref(), scene);
+                if let Some(p) = inner.as_deref()
+                    && !ran
+                    && self.preview.wants_frames()
+                {
+                    let _ = self.preview.step(p);
+                }
+                true
+            }
+            _ => self.preview.update(
+                self.doc.registry(),
+                &self.doc.graph,
+                &self.doc.base_dir(),
+                port.as_deref(),
+                scene,
+            ),
+        };
         if let Some(p) = port.as_deref()
             && !ran
             && self.preview.wants_frames()
@@ -329,9 +376,11 @@ impl Editor {
 
     /// Handles a close request from the window: returns whether to let it close.
     pub fn on_close_requested(&mut self) -> bool {
-        if self.quit_confirmed || !self.doc.is_dirty() {
+        let dirty = self.doc.is_dirty() || self.outer.iter().any(|o| o.doc.is_dirty());
+        if self.quit_confirmed || !dirty {
             return true;
         }
+        while self.leave_group() {}
         self.dialog = Some(Dialog::Unsaved(Then::Quit));
         false
     }

@@ -389,6 +389,39 @@ impl Document {
         new_ids
     }
 
+    /// `graph` with this document's file as its origin when it has none, so the files it
+    /// names are found beside the document's.
+    pub fn with_origin(&self, graph: &Graph) -> Graph {
+        let mut g = graph.clone();
+        if g.origin.is_none()
+            && let Some(p) = &self.path
+        {
+            g.origin = Some(lumagraph_graph::Origin::new(p.clone(), String::new()));
+        }
+        g
+    }
+
+    /// Replaces the graph by `graph` (one undo step) checked against `registry`.
+    pub fn set_graph(&mut self, graph: Graph, registry: Arc<Registry>) {
+        self.record(None);
+        let origin = self.graph.origin.take();
+        self.graph = graph;
+        self.graph.origin = origin;
+        self.registry = registry;
+    }
+
+    /// Reads the kinds the graph declares and its group files again (a group file was
+    /// edited); keeps the registry, and returns why, when they do not load.
+    ///
+    /// # Errors
+    /// The loading errors, one a line.
+    pub fn reload_registry(&mut self) -> Result<(), String> {
+        let registry = lumagraph_render::custom::registry(&self.with_origin(&self.graph))
+            .map_err(|e| e.to_string())?;
+        self.registry = Arc::new(registry);
+        Ok(())
+    }
+
     /// Replaces the whole graph (for example a file opened in place), clearing history.
     pub fn replace(&mut self, graph: Graph, path: Option<PathBuf>) {
         *self = Self::new(graph, path);

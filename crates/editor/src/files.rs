@@ -127,6 +127,14 @@ fn normalize(p: &Path) -> PathBuf {
     out
 }
 
+/// `target` written relative to the folder `base` (either may be relative to the current
+/// folder), with `/` separators: how a graph file names another file.
+pub fn relative_path(target: &Path, base: &Path) -> String {
+    relative_to(&absolute(target), &absolute(base))
+        .to_string_lossy()
+        .replace('\\', "/")
+}
+
 /// `target` written relative to `base` (both absolute and normalized).
 fn relative_to(target: &Path, base: &Path) -> PathBuf {
     let t: Vec<_> = target.components().collect();
@@ -142,10 +150,26 @@ fn relative_to(target: &Path, base: &Path) -> PathBuf {
     out
 }
 
-/// Rewrites the relative path params of input nodes (non-sinks; sink paths are relative
-/// to the output folder) from `old_base` to `new_base`.
+/// Rewrites the relative paths of a graph from `old_base` to `new_base`: the path params
+/// of input nodes (non-sinks; sink paths are relative to the output folder), the `.wgsl`
+/// files of declared kinds and the files of group kinds.
 pub fn rebase_inputs(registry: &Registry, graph: &mut Graph, old_base: &Path, new_base: &Path) {
     let (old_base, new_base) = (absolute(old_base), absolute(new_base));
+    let rebase = |p: &mut String| {
+        if p.is_empty() || Path::new(p.as_str()).is_absolute() {
+            return;
+        }
+        let target = normalize(&old_base.join(p.as_str()));
+        *p = relative_to(&target, &new_base)
+            .to_string_lossy()
+            .replace('\\', "/");
+    };
+    for decl in &mut graph.kinds {
+        rebase(&mut decl.wgsl);
+    }
+    for decl in &mut graph.groups {
+        rebase(&mut decl.file);
+    }
     for node in &mut graph.nodes {
         let Some(kind) = registry.get(&node.kind) else {
             continue;
@@ -154,20 +178,11 @@ pub fn rebase_inputs(registry: &Registry, graph: &mut Graph, old_base: &Path, ne
             continue;
         }
         for def in &kind.params {
-            if !matches!(def.ty, ParamType::Path { .. }) {
-                continue;
+            if matches!(def.ty, ParamType::Path { .. })
+                && let Some(ParamValue::Str(p)) = node.params.get_mut(def.name)
+            {
+                rebase(p);
             }
-            let Some(ParamValue::Str(p)) = node.params.get(def.name) else {
-                continue;
-            };
-            if Path::new(p).is_absolute() {
-                continue;
-            }
-            let target = normalize(&old_base.join(p));
-            let rel = relative_to(&target, &new_base);
-            let text = rel.to_string_lossy().replace('\\', "/");
-            node.params
-                .insert(def.name.to_owned(), ParamValue::Str(text));
         }
     }
 }

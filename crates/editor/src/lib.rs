@@ -18,6 +18,7 @@ pub mod app;
 pub mod canvas;
 pub mod document;
 pub mod files;
+pub mod grouping;
 pub mod inspector;
 pub mod preview;
 pub mod scope;

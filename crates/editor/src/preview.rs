@@ -171,9 +171,7 @@ pub fn compile_preview(
     port: &str,
     scene: Option<&GpuScene>,
 ) -> Result<Plan, String> {
-    let g = preview_graph(registry, graph);
-    let keep = preview_keep(registry, graph, port);
-    compile_with(&g, registry, base, &keep, scene).map_err(|e| {
+    let messages = |e: lumagraph_graph::GraphErrors| {
         e.0.iter()
             .map(|e| match &e.node {
                 Some(n) => format!("{n}: {}", e.kind),
@@ -181,7 +179,15 @@ pub fn compile_preview(
             })
             .collect::<Vec<_>>()
             .join("\n")
-    })
+    };
+    // Groups are flattened first, so the sinks inside them are left out too.
+    let flat = lumagraph_graph::group::flatten(graph, registry).map_err(messages)?;
+    let port = flat.resolve(port);
+    let g = preview_graph(&flat.registry, &flat.graph);
+    let keep = preview_keep(&flat.registry, &flat.graph, port);
+    let mut plan = compile_with(&g, &flat.registry, base, &keep, scene).map_err(messages)?;
+    plan.aliases.clone_from(&flat.aliases);
+    Ok(plan)
 }
 
 /// Converts read-back texels to 8-bit RGBA the way the Output node writes a PNG.
@@ -231,7 +237,14 @@ impl Preview {
             self.clear(Some("select a node with an output to preview it".into()));
             return false;
         };
-        let mut g = preview_graph(registry, graph);
+        // Flattened, so an edit inside a group changes the key.
+        let mut g = match lumagraph_graph::group::flatten(graph, registry) {
+            Ok(flat) => preview_graph(&flat.registry, &flat.graph),
+            Err(e) => {
+                self.clear(Some(e.to_string()));
+                return false;
+            }
+        };
         g.origin = None;
         let generation = scene.map_or(0, |s| s.generation);
         let key = (g, port.to_owned(), base.to_owned(), generation);
@@ -408,9 +421,7 @@ impl Preview {
         let t = Instant::now();
         let ty = exec
             .plan()
-            .textures
-            .iter()
-            .find(|t| t.name == port)
+            .texture_named(port)
             .map(|t| t.ty)
             .ok_or_else(|| format!("{port} is not computed"))?;
         let image = exec.read_port(port).map_err(|e| e.to_string())?;

@@ -795,3 +795,105 @@ fn measurements_and_the_histogram_scope_show_under_the_preview() {
         .expect("the error is measured");
     assert!(relmse > 0.0, "{relmse}");
 }
+
+/// Ctrl+G's action on two selected nodes: they move to a group file, one group node takes
+/// their place, and the graph renders the same image; Tab opens the group, where an edit
+/// shows in the preview of the graph around it, and Tab leaves it, saving the file.
+#[test]
+fn group_nodes_open_the_group_edit_it_and_leave() {
+    let Some(ed) = editor(None, None) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let main = dir.path().join("main.ron");
+    let text = std::fs::read_to_string(post_tonemap())
+        .unwrap()
+        .replace("../assets/", &format!("{}/", repo("assets").display()));
+    std::fs::write(&main, text).unwrap();
+    let mut h = harness(ed);
+    h.state_mut().open(&main);
+    h.run_ok();
+    let before = h.state().preview.image.clone().expect("preview");
+
+    // Group exposure and tonemap.
+    let ed = h.state_mut();
+    ed.select(vec!["exposure".into(), "tonemap".into()]);
+    let group_file = dir.path().join("groups/look.ron");
+    std::fs::create_dir_all(group_file.parent().unwrap()).unwrap();
+    ed.group_selection(&group_file);
+    assert_eq!(ed.selected, ["look"], "{:?}", ed.message);
+    let g = &ed.doc.graph;
+    assert_eq!(g.groups[0].file, "groups/look.ron");
+    let ids: Vec<&str> = g.nodes.iter().map(|n| n.id.as_str()).collect();
+    assert_eq!(ids, ["input", "out", "look"]);
+    let group = Graph::load(&group_file).unwrap();
+    assert_eq!(group.nodes.len(), 2);
+    assert_eq!(group.interface.inputs[0].to, ["exposure.color"]);
+    assert_eq!(group.interface.outputs[0].from, "tonemap.color");
+    let params: Vec<&str> = group
+        .interface
+        .params
+        .iter()
+        .map(|p| p.name.as_str())
+        .collect();
+    assert_eq!(params, ["exposure_ev", "tonemap_operator"]);
+    h.run_ok();
+    let ed = h.state();
+    assert!(
+        ed.errors.is_empty() && ed.graph_errors.is_empty(),
+        "{:?} {:?}",
+        ed.errors,
+        ed.graph_errors
+    );
+    let grouped = ed.preview.image.clone().expect("preview");
+    assert_eq!(grouped.rgba, before.rgba, "grouping changed the image");
+
+    // Open it, raise the exposure inside, and the preview of the graph around it follows.
+    let ed = h.state_mut();
+    ed.select(vec!["look".into()]);
+    ed.toggle_group();
+    assert_eq!(ed.doc.path.as_deref(), Some(group_file.as_path()));
+    assert!(
+        ed.title().contains("look.ron in main.ron (look)"),
+        "{}",
+        ed.title()
+    );
+    ed.select(vec!["tonemap".into()]);
+    ed.doc.set_param("exposure", "ev", ParamValue::Float(1.0));
+    h.run_ok();
+    let ed = h.state();
+    assert!(ed.graph_errors.is_empty(), "{:?}", ed.graph_errors);
+    let inside = ed
+        .preview
+        .image
+        .clone()
+        .expect("a preview inside the group");
+    let mean = |i: &lumagraph_editor::preview::PreviewImage| {
+        i.rgba.iter().map(|&p| f64::from(p)).sum::<f64>() / i.rgba.len() as f64
+    };
+    assert!(
+        mean(&inside) > mean(&before) + 1.0,
+        "{} vs {}",
+        mean(&inside),
+        mean(&before)
+    );
+
+    // Leave: the group file is saved with the edit, and the outer graph uses it.
+    let ed = h.state_mut();
+    ed.toggle_group();
+    assert!(ed.outer.is_empty());
+    assert_eq!(ed.doc.path.as_deref(), Some(main.as_path()));
+    let saved = Graph::load(&group_file).unwrap();
+    assert_eq!(
+        saved.node("exposure").unwrap().params["ev"],
+        ParamValue::Float(1.0)
+    );
+    h.run_ok();
+    let ed = h.state();
+    let after = ed.preview.image.clone().expect("preview");
+    assert_eq!(after.rgba, inside.rgba);
+    // Undo brings the nodes back (the group file stays).
+    let ed = h.state_mut();
+    assert!(ed.doc.undo());
+    assert!(ed.doc.graph.node("exposure").is_some());
+}

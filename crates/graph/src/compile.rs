@@ -138,7 +138,9 @@ struct Checked<'g> {
     inputs: HashMap<(usize, &'g str), (usize, &'g str)>,
 }
 
-/// Validates and compiles a graph into a plan.
+/// Validates and compiles a graph into a plan. Group nodes are flattened first
+/// ([`crate::group::flatten`]): the plan names their inner nodes `group/inner`, and
+/// [`Plan::aliases`] maps the group outputs (also those in `options.keep`) to inner ones.
 ///
 /// # Errors
 /// Every problem found, each naming its node and, for a graph loaded from a file, the line.
@@ -147,6 +149,24 @@ pub fn compile(
     registry: &Registry,
     options: &CompileOptions<'_>,
 ) -> Result<Plan, GraphErrors> {
+    if crate::group::has_groups(graph, registry) {
+        let flat = crate::group::flatten(graph, registry)?;
+        let keep: Vec<String> = options
+            .keep
+            .iter()
+            .map(|k| flat.resolve(k).to_owned())
+            .collect();
+        let mut plan = compile(
+            &flat.graph,
+            &flat.registry,
+            &CompileOptions {
+                keep: &keep,
+                ..*options
+            },
+        )?;
+        plan.aliases = flat.aliases;
+        return Ok(plan);
+    }
     let mut errors = Vec::new();
     let checked = check(graph, registry, &mut errors);
     let n = graph.nodes.len();
@@ -274,7 +294,7 @@ fn check_nodes<'g>(
             || !node
                 .id
                 .chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '/')
         {
             errors.push(err(ErrorKind::InvalidId(node.id.clone()), None));
         }
@@ -559,6 +579,7 @@ fn build_plan(
         textures,
         slots,
         left_out,
+        aliases: Vec::new(),
     }
 }
 

@@ -30,7 +30,7 @@ pub fn intern(s: &str) -> &'static str {
 }
 
 /// The `'static` copy of a list of port types or enum options, made once per distinct list.
-fn intern_slice<T: Clone + Eq + std::hash::Hash + Send + Sync + 'static>(
+pub(crate) fn intern_slice<T: Clone + Eq + std::hash::Hash + Send + Sync + 'static>(
     items: Vec<T>,
 ) -> &'static [T] {
     use std::any::Any;

@@ -41,7 +41,9 @@ pub enum ErrorKind {
     #[error("duplicate node id \"{0}\"")]
     DuplicateId(String),
     /// A node id is empty or contains a character edges cannot name.
-    #[error("invalid node id \"{0}\": use letters, digits, '_' and '-'")]
+    #[error(
+        "invalid node id \"{0}\": use letters, digits, '_' and '-' ('/' separates a group node's id from its inner nodes')"
+    )]
     InvalidId(String),
     /// No kind of that name is registered.
     #[error("unknown node kind \"{kind}\" (known kinds: {known})")]

@@ -13,13 +13,15 @@ use serde::{Deserialize, Serialize};
 
 use crate::custom::KindDecl;
 use crate::error::{ErrorKind, GraphError, Pos};
+use crate::group::{GroupDecl, Interface};
 use crate::registry::Registry;
 use crate::types::ParamValue;
 
 /// The newest graph file version this build reads and writes. Version 2 added node kinds
-/// declared in the file (`kinds`); a graph without them is written as version 1, which
+/// declared in the file (`kinds`), version 3 node groups (`groups`, `interface`). A graph
+/// is written with the oldest version that holds it: without either, version 1, which
 /// every build reads.
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 
 /// A node: an instance of a node kind with its params.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -86,6 +88,10 @@ pub fn split_port_ref(r: &str) -> Option<(&str, &str)> {
 #[serde(deny_unknown_fields)]
 struct GraphFile {
     version: u32,
+    #[serde(default, skip_serializing_if = "Interface::is_empty")]
+    interface: Interface,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    groups: Vec<GroupDecl>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     kinds: Vec<KindDecl>,
     nodes: Vec<Node>,
@@ -107,6 +113,11 @@ pub struct Origin {
 }
 
 impl Origin {
+    /// The origin of a graph read from `path`, whose text was `text`.
+    pub fn new(path: PathBuf, text: String) -> Self {
+        Self { path, text }
+    }
+
     fn pos_of_offset(&self, offset: usize) -> Pos {
         let before = &self.text[..offset];
         let line = before.matches('\n').count() + 1;
@@ -176,6 +187,10 @@ impl Origin {
 /// declares for them.
 #[derive(Clone, Debug, Default)]
 pub struct Graph {
+    /// What the graph shows when used as a node group (version 3).
+    pub interface: Interface,
+    /// Group kinds: graph files used as nodes (version 3), in file order.
+    pub groups: Vec<GroupDecl>,
     /// Node kinds declared in the file (version 2), in file order.
     pub kinds: Vec<KindDecl>,
     /// Nodes, in file order.
@@ -188,7 +203,11 @@ pub struct Graph {
 
 impl PartialEq for Graph {
     fn eq(&self, other: &Self) -> bool {
-        self.kinds == other.kinds && self.nodes == other.nodes && self.edges == other.edges
+        self.interface == other.interface
+            && self.groups == other.groups
+            && self.kinds == other.kinds
+            && self.nodes == other.nodes
+            && self.edges == other.edges
     }
 }
 
@@ -247,7 +266,14 @@ impl Graph {
                 "node kinds declared in the file (`kinds`) need `version: 2`".into(),
             )));
         }
+        if probe.version < 3 && !(file.groups.is_empty() && file.interface.is_empty()) {
+            return Err(GraphError::new(ErrorKind::Source(
+                "node groups (`groups`, `interface`) need `version: 3`".into(),
+            )));
+        }
         Ok(Self {
+            interface: file.interface,
+            groups: file.groups,
             kinds: file.kinds,
             nodes: file.nodes,
             edges: file.edges,
@@ -257,8 +283,17 @@ impl Graph {
 
     /// The graph as RON text, in the canonical layout `save` writes.
     pub fn to_ron(&self) -> String {
+        let version = if !(self.groups.is_empty() && self.interface.is_empty()) {
+            3
+        } else if !self.kinds.is_empty() {
+            2
+        } else {
+            1
+        };
         let file = GraphFile {
-            version: if self.kinds.is_empty() { 1 } else { VERSION },
+            version,
+            interface: self.interface.clone(),
+            groups: self.groups.clone(),
             kinds: self.kinds.clone(),
             nodes: self.nodes.clone(),
             edges: self.edges.clone(),

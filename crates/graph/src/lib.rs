@@ -2,6 +2,7 @@
 //!
 //! - [`registry`]: the node kinds, their typed ports and params, with docs.
 //! - [`Graph`]: nodes and edges, loaded from and saved to versioned RON files.
+//! - [`group`]: graph files used as nodes, flattened before compiling.
 //! - [`compile`]: validation, topological order, pruning and texture assignment,
 //!   giving a [`Plan`] that the render crate executes.
 //!
@@ -12,6 +13,7 @@ pub mod custom;
 pub mod docs;
 mod error;
 mod graph;
+pub mod group;
 mod plan;
 pub mod registry;
 mod types;

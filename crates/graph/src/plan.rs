@@ -122,12 +122,25 @@ pub struct Plan {
     pub slots: Vec<Slot>,
     /// Everything left out.
     pub left_out: Vec<LeftOut>,
+    /// Outputs of group nodes (`"glow.color"`) with the inner output each shows
+    /// (`"glow/tonemap.output"`); see [`crate::group`].
+    pub aliases: Vec<(String, String)>,
 }
 
 impl Plan {
     /// The pass of node `id`.
     pub fn pass(&self, id: &str) -> Option<&Pass> {
         self.passes.iter().find(|p| p.node == id)
+    }
+
+    /// The texture on output `"node.port"` (a group node's output is its inner one's).
+    pub fn texture_named(&self, port: &str) -> Option<&TextureDesc> {
+        let port = self
+            .aliases
+            .iter()
+            .find(|(a, _)| a == port)
+            .map_or(port, |(_, b)| b.as_str());
+        self.textures.iter().find(|t| t.name == port)
     }
 
     /// The logical texture `id`.

@@ -22,7 +22,6 @@ fn compile_graph(g: &Graph) -> Result<Plan, GraphErrors> {
 
 fn chain() -> Graph {
     Graph {
-        kinds: Vec::new(),
         nodes: vec![
             Node::new("input", "ImageInput").with("path", ParamValue::Str("in.exr".into())),
             Node::new("exposure", "Exposure").with("ev", ParamValue::Float(1.0)),
@@ -34,7 +33,7 @@ fn chain() -> Graph {
             Edge::new("exposure.color", "tonemap.color"),
             Edge::new("tonemap.color", "out.color"),
         ],
-        origin: None,
+        ..Graph::default()
     }
 }
 
@@ -170,6 +169,16 @@ fn shipped_graphs_round_trip_and_compile() {
                     .to_kind(lumagraph_graph::custom::Shader::File("(declared)"))
                     .unwrap();
                 registry.add(kind).unwrap();
+            }
+            // Group files (of built-in kinds only here), loaded as the render crate does.
+            for decl in &g.groups {
+                let inner = Graph::load(&g.base_dir().join(&decl.file)).unwrap();
+                let group = lumagraph_graph::group::Group {
+                    name: lumagraph_graph::custom::intern(&decl.name),
+                    graph: inner,
+                    registry: Registry::with_builtins(),
+                };
+                registry.add_group(group).unwrap();
             }
             let options = CompileOptions {
                 source_extent: &extent,

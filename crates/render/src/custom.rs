@@ -16,6 +16,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use lumagraph_graph::custom::{GeneratedShader, KindDecl, Shader};
+use lumagraph_graph::group::{Group, GroupDecl};
 use lumagraph_graph::{
     ErrorKind, Graph, GraphError, GraphErrors, NodeKind, ParamType, Pos, Registry,
 };
@@ -30,13 +31,30 @@ struct Code {
 }
 
 /// `base` with the kinds `graph` declares added, each with its shader generated and
-/// validated (see the module docs).
+/// validated (see the module docs), and its group kinds (graph files used as nodes, see
+/// [`lumagraph_graph::group`]) loaded, each with the kinds it declares and its own groups.
 ///
 /// # Errors
 /// Every declaration that fails: a bad declaration located at the kind in the graph file,
 /// a missing `.wgsl` file, WGSL that does not compile located at its file, line and column
-/// and naming the nodes of that kind, a name a kind of `base` already has.
+/// and naming the nodes of that kind, a name a kind of `base` already has; a group file
+/// that cannot be loaded or whose interface is wrong, or a group that contains itself
+/// (named with the chain of files).
 pub fn registry_for(graph: &Graph, base: &Registry) -> Result<Registry, GraphErrors> {
+    let mut chain = Vec::new();
+    if let Some(o) = &graph.origin {
+        chain.push(std::fs::canonicalize(&o.path).unwrap_or_else(|_| o.path.clone()));
+    }
+    registry_in(graph, base, &mut chain)
+}
+
+/// [`registry_for`] a graph reached through the group files in `chain` (the outermost
+/// first, this graph's file last).
+fn registry_in(
+    graph: &Graph,
+    base: &Registry,
+    chain: &mut Vec<PathBuf>,
+) -> Result<Registry, GraphErrors> {
     let mut registry = base.clone();
     let mut errors = Vec::new();
     for decl in &graph.kinds {
@@ -49,10 +67,75 @@ pub fn registry_for(graph: &Graph, base: &Registry) -> Result<Registry, GraphErr
             Err(e) => errors.push(e),
         }
     }
+    for decl in &graph.groups {
+        match load_group(graph, decl, base, chain) {
+            Ok(group) => {
+                if let Err(m) = registry.add_group(group) {
+                    errors.push(at_group(graph, decl, m));
+                }
+            }
+            Err(mut e) => errors.append(&mut e.0),
+        }
+    }
     if errors.is_empty() {
         Ok(registry)
     } else {
         Err(GraphErrors(errors))
+    }
+}
+
+/// The group `decl` of `graph` declares, loaded with the kinds its nodes use.
+fn load_group(
+    graph: &Graph,
+    decl: &GroupDecl,
+    base: &Registry,
+    chain: &mut Vec<PathBuf>,
+) -> Result<Group, GraphErrors> {
+    let path = graph.base_dir().join(&decl.file);
+    let canonical = std::fs::canonicalize(&path).map_err(|e| {
+        GraphErrors(vec![at_group(
+            graph,
+            decl,
+            format!("cannot read {}: {e}", path.display()),
+        )])
+    })?;
+    if chain.contains(&canonical) || chain.len() > lumagraph_graph::group::MAX_DEPTH {
+        let files: Vec<String> = chain
+            .iter()
+            .chain([&canonical])
+            .map(|p| p.display().to_string())
+            .collect();
+        let why = if chain.contains(&canonical) {
+            "contains itself"
+        } else {
+            "nests too deep"
+        };
+        return Err(GraphErrors(vec![at_group(
+            graph,
+            decl,
+            format!("the group {why}: {}", files.join(" -> ")),
+        )]));
+    }
+    let inner = Graph::load(&canonical).map_err(|e| GraphErrors(vec![e]))?;
+    chain.push(canonical);
+    let registry = registry_in(&inner, base, chain);
+    chain.pop();
+    Ok(Group {
+        name: lumagraph_graph::custom::intern(&decl.name),
+        graph: inner,
+        registry: registry?,
+    })
+}
+
+/// An error about group declaration `decl`, located at it in the graph file.
+fn at_group(graph: &Graph, decl: &GroupDecl, message: impl std::fmt::Display) -> GraphError {
+    GraphError {
+        file: graph.origin.as_ref().map(|o| o.path.clone()),
+        pos: graph.origin.as_ref().and_then(|o| o.kind_pos(&decl.name)),
+        ..GraphError::new(ErrorKind::Source(format!(
+            "group \"{}\" ({}): {message}",
+            decl.name, decl.file
+        )))
     }
 }
 
@@ -322,4 +405,56 @@ fn generate(kind: &NodeKind, code: &Code) -> Result<GeneratedShader, (String, Op
 /// As [`registry_for`].
 pub fn registry(graph: &Graph) -> Result<Registry, GraphErrors> {
     registry_for(graph, &Registry::with_builtins())
+}
+
+/// Checks a graph file meant as a node group on its own (it has an `interface` and no
+/// sink, so it cannot be compiled without a graph around it): its declared kinds and
+/// groups, its interface, and every node's kind and params. Returns the kind a node of it
+/// would be.
+///
+/// # Errors
+/// Everything found, located in the file.
+pub fn check_group(graph: &Graph) -> Result<NodeKind, GraphErrors> {
+    let registry = registry(graph)?;
+    let file = graph.origin.as_ref().map(|o| o.path.clone());
+    let mut errors = Vec::new();
+    for node in &graph.nodes {
+        let Some(kind) = registry.get(&node.kind) else {
+            let e = GraphError::new(ErrorKind::Source(format!(
+                "unknown node kind \"{}\"",
+                node.kind
+            )))
+            .at_node(&node.id);
+            errors.push(graph.locate(e, None, None));
+            continue;
+        };
+        if registry.group(&node.kind).is_some() {
+            continue;
+        }
+        if let Err(found) = lumagraph_graph::resolve_params(node, kind) {
+            for (param, kind) in found {
+                let e = GraphError::new(kind).at_node(&node.id);
+                errors.push(graph.locate(e, None, Some(&param)));
+            }
+        }
+    }
+    let name = graph
+        .origin
+        .as_ref()
+        .and_then(|o| o.path.file_stem())
+        .map_or_else(|| "Group".to_owned(), |s| s.to_string_lossy().into_owned());
+    let group = Group {
+        name: lumagraph_graph::custom::intern(&name),
+        graph: graph.clone(),
+        registry,
+    };
+    match group.kind() {
+        Ok(kind) if errors.is_empty() => return Ok(kind),
+        Ok(_) => {}
+        Err(m) => errors.push(GraphError {
+            file,
+            ..GraphError::new(ErrorKind::Source(format!("interface: {m}")))
+        }),
+    }
+    Err(GraphErrors(errors))
 }

@@ -523,9 +523,7 @@ impl Executor {
     pub fn read_port(&self, port: &str) -> Result<Image> {
         let t = self
             .plan
-            .textures
-            .iter()
-            .find(|t| t.name == port)
+            .texture_named(port)
             .ok_or_else(|| RenderError::Gpu(format!("no planned texture for {port}")))?;
         self.read(t.id)
     }

@@ -28,6 +28,11 @@ impl Editor {
                 start(self.doc.path.as_deref()),
                 vec!["ron"],
             ),
+            Pick::GroupFile => (
+                "Save the group as",
+                start(self.doc.path.as_deref()),
+                vec!["ron"],
+            ),
             Pick::Scene => (
                 "Open scene",
                 start(self.scene.as_ref().map(|s| s.path.as_path())),
@@ -74,21 +79,23 @@ impl Editor {
                 .add_file_filter_extensions(&name, extensions.clone())
                 .default_file_filter(&name);
         }
-        if pick == Pick::SaveGraph {
+        if matches!(pick, Pick::SaveGraph | Pick::GroupFile) {
+            let name = if pick == Pick::GroupFile {
+                "group.ron".to_owned()
+            } else {
+                self.doc
+                    .path
+                    .as_deref()
+                    .and_then(Path::file_name)
+                    .map_or_else(
+                        || "untitled.ron".to_owned(),
+                        |n| n.to_string_lossy().into_owned(),
+                    )
+            };
             dialog = dialog
                 .add_save_extension("graph", "ron")
                 .default_save_extension("graph")
-                .default_file_name(
-                    &self
-                        .doc
-                        .path
-                        .as_deref()
-                        .and_then(Path::file_name)
-                        .map_or_else(
-                            || "untitled.ron".to_owned(),
-                            |n| n.to_string_lossy().into_owned(),
-                        ),
-                );
+                .default_file_name(&name);
             dialog.save_file();
         } else {
             dialog.pick_file();
@@ -115,6 +122,7 @@ impl Editor {
             Pick::Scene => {
                 self.load_scene(path);
             }
+            Pick::GroupFile => self.group_selection(path),
             Pick::Param(node, param) => {
                 let base = std::path::absolute(self.doc.base_dir()).unwrap_or_default();
                 let value = path
@@ -149,6 +157,7 @@ impl Editor {
 
     /// Opens a graph file in place of the current one (no unsaved-changes check).
     pub fn open(&mut self, path: &Path) {
+        self.outer.clear();
         match files::open(path) {
             Ok(graph) => {
                 self.doc.replace(graph, Some(path.to_owned()));
@@ -208,7 +217,20 @@ impl Editor {
             },
         );
         let dirty = if self.doc.is_dirty() { "● " } else { "" };
-        format!("{dirty}{name} — lumagraph editor")
+        // Inside a group: the graphs around it, outermost first.
+        let around: String = self
+            .outer
+            .iter()
+            .rev()
+            .map(|o| {
+                let file = o.doc.path.as_deref().and_then(Path::file_name).map_or_else(
+                    || "untitled".to_owned(),
+                    |n| n.to_string_lossy().into_owned(),
+                );
+                format!(" in {file} ({})", o.node)
+            })
+            .collect();
+        format!("{dirty}{name}{around} — lumagraph editor")
     }
 
     pub(super) fn save_or_ask(&mut self) {
@@ -223,6 +245,12 @@ impl Editor {
 
     /// Runs `then`, first asking about unsaved changes when there are some.
     pub(super) fn ask(&mut self, then: Then) {
+        // Inside a group: leave it (saving it) first, so the question is about the graph
+        // around it.
+        while self.leave_group() {}
+        if !self.outer.is_empty() {
+            return;
+        }
         if self.doc.is_dirty() && then != Then::Open(PathBuf::new()) {
             self.dialog = Some(Dialog::Unsaved(then));
         } else {

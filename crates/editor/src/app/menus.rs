@@ -67,6 +67,39 @@ impl Editor {
                 if ui.add_enabled(any, egui::Button::new("Delete")).clicked() {
                     self.delete_selection();
                 }
+                ui.separator();
+                if ui
+                    .add_enabled(
+                        any,
+                        egui::Button::new("Group selected nodes…").shortcut_text("Ctrl+G"),
+                    )
+                    .clicked()
+                {
+                    self.ask_group_selection();
+                }
+                let group = match self.selected.as_slice() {
+                    [one] => self.group_file(one).map(|_| one.clone()),
+                    _ => None,
+                };
+                if ui
+                    .add_enabled(
+                        group.is_some(),
+                        egui::Button::new("Open group").shortcut_text("Tab"),
+                    )
+                    .clicked()
+                    && let Some(id) = group
+                {
+                    self.open_group(&id);
+                }
+                if ui
+                    .add_enabled(
+                        !self.outer.is_empty(),
+                        egui::Button::new("Leave group").shortcut_text("Tab"),
+                    )
+                    .clicked()
+                {
+                    self.leave_group();
+                }
             });
             ui.menu_button("Scene", |ui| {
                 if ui.button("Open scene…").clicked() {

@@ -19,6 +19,7 @@ use std::sync::Arc;
 
 use crate::compile::Params;
 pub use crate::custom::Shader;
+use crate::group::Group;
 use crate::types::{Extent, ParamType, ParamValue, PortType};
 
 /// Where a node kind sits in menus and docs.
@@ -43,13 +44,15 @@ pub enum Category {
     Analysis,
     /// Kinds declared in a graph file that name no other category.
     Custom,
+    /// Graph files used as nodes (node groups).
+    Group,
     /// Nodes that write results out of the graph.
     Output,
 }
 
 impl Category {
     /// Every category, in menu order.
-    pub const ALL: [Self; 10] = [
+    pub const ALL: [Self; 11] = [
         Self::Input,
         Self::Render,
         Self::Denoise,
@@ -59,6 +62,7 @@ impl Category {
         Self::Transform,
         Self::Analysis,
         Self::Custom,
+        Self::Group,
         Self::Output,
     ];
 
@@ -74,6 +78,7 @@ impl Category {
             Self::Transform => "Transform",
             Self::Analysis => "Analysis",
             Self::Custom => "Custom",
+            Self::Group => "Group",
             Self::Output => "Output",
         }
     }
@@ -319,6 +324,8 @@ impl NodeKind {
 #[derive(Clone, Debug, Default)]
 pub struct Registry {
     kinds: Vec<Arc<NodeKind>>,
+    /// The graphs of the group kinds among `kinds`.
+    groups: Vec<Arc<Group>>,
 }
 
 impl Registry {
@@ -326,6 +333,7 @@ impl Registry {
     pub fn with_builtins() -> Self {
         Self {
             kinds: builtin_kinds().into_iter().map(Arc::new).collect(),
+            groups: Vec::new(),
         }
     }
 
@@ -357,6 +365,35 @@ impl Registry {
         }
         self.kinds.push(Arc::new(kind));
         Ok(())
+    }
+
+    /// Adds a group kind: its node kind made from its interface ([`Group::kind`]).
+    ///
+    /// # Errors
+    /// As [`Registry::add`] and [`Group::kind`].
+    pub fn add_group(&mut self, group: Group) -> Result<(), String> {
+        self.add(group.kind()?)?;
+        self.groups.push(Arc::new(group));
+        Ok(())
+    }
+
+    /// Adds a group kind, or replaces the one of that name (its file was edited).
+    ///
+    /// # Errors
+    /// As [`Registry::add_group`]; the registry is unchanged then.
+    pub fn set_group(&mut self, group: Group) -> Result<(), String> {
+        let kind = group.kind()?;
+        let name = group.name;
+        self.kinds.retain(|k| k.name != name);
+        self.groups.retain(|g| g.name != name);
+        self.add(kind)?;
+        self.groups.push(Arc::new(group));
+        Ok(())
+    }
+
+    /// The group of the group kind called `name`.
+    pub fn group(&self, name: &str) -> Option<&Arc<Group>> {
+        self.groups.iter().find(|g| g.name == name)
     }
 
     /// The kind called `name`.
