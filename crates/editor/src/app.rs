@@ -25,6 +25,7 @@ mod groups;
 mod io;
 mod menus;
 mod panels;
+mod reload;
 mod selection;
 
 /// The largest preview side, in pixels, for nodes that render a scene, unless
@@ -97,6 +98,8 @@ enum Then {
 pub struct Editor {
     /// The graph being edited and its file.
     pub doc: Document,
+    /// The files the kinds come from, checked for changes (live reload).
+    pub watch: reload::Watch,
     /// The graphs around the group being edited, the outermost first (empty when no
     /// group is open).
     pub outer: Vec<groups::Outer>,
@@ -155,6 +158,7 @@ impl Editor {
         let mut editor = Self {
             doc: Document::default(),
             outer: Vec::new(),
+            watch: reload::Watch::default(),
             canvas: Canvas::default(),
             preview: Preview::new(gpu),
             scope: crate::scope::ScopeView::default(),
@@ -205,15 +209,18 @@ impl Editor {
         }
         self.errors.clear();
         self.graph_errors.clear();
-        let base = self.doc.base_dir();
-        let scene = self.scene.as_ref().map(|s| &*s.preview.gpu);
-        if !self.doc.graph.kinds.is_empty()
+        if !self.watch.errors.is_empty() {
+            // A reload failed: the last good kinds are in use, the errors on their nodes.
+            self.add_reload_errors();
+        } else if !self.doc.graph.kinds.is_empty()
             && let Err(errs) = lumagraph_render::custom::registry(&self.doc.graph)
         {
             // Declared kinds that fail (their nodes are then of an unknown kind).
             self.graph_errors
                 .extend(errs.0.iter().map(ToString::to_string));
         }
+        let base = self.doc.base_dir();
+        let scene = self.scene.as_ref().map(|s| &*s.preview.gpu);
         let context = self.group_context();
         let result = match &context {
             Some(Ok(c)) => compile_with(&c.graph, &c.registry, &c.base, &[], scene).map(|_| ()),
@@ -306,6 +313,7 @@ impl Editor {
         if !ui.input(|i| i.pointer.any_down()) {
             self.doc.end_gesture();
         }
+        self.poll_files(now);
         self.refresh_errors();
         let port = self.effective_port();
         let scene = self.scene.as_ref().map(|s| &s.preview);

@@ -410,6 +410,11 @@ impl Document {
         self.registry = registry;
     }
 
+    /// Checks the graph against `registry` from now on (the kinds were read again).
+    pub fn set_registry(&mut self, registry: Arc<Registry>) {
+        self.registry = registry;
+    }
+
     /// Reads the kinds the graph declares and its group files again (a group file was
     /// edited); keeps the registry, and returns why, when they do not load.
     ///

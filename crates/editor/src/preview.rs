@@ -270,6 +270,13 @@ impl Preview {
         }
     }
 
+    /// Drops the executor, so the next update builds every pipeline again (the kinds
+    /// were read again and a shader may have changed).
+    pub fn rebuild(&mut self) {
+        self.key = None;
+        self.exec = None;
+    }
+
     fn clear(&mut self, error: Option<String>) {
         self.key = None;
         self.image = None;

@@ -897,3 +897,83 @@ fn group_nodes_open_the_group_edit_it_and_leave() {
     assert!(ed.doc.undo());
     assert!(ed.doc.graph.node("exposure").is_some());
 }
+
+/// Live reload: a declared kind's `.wgsl` file changed on disk is read again and the
+/// preview follows; a change that does not compile keeps the last good pipeline (the
+/// preview stays as it was) and marks the kind's node with the located error; fixing the
+/// file clears it.
+#[test]
+fn a_changed_wgsl_file_reloads_and_a_broken_one_keeps_the_last_good_pipeline() {
+    let Some(ed) = editor(None, None) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let graph = dir.path().join("custom.ron");
+    let text = std::fs::read_to_string(repo("graphs/custom_kinds.ron"))
+        .unwrap()
+        .replace("../assets/", &format!("{}/", repo("assets").display()));
+    std::fs::write(&graph, text).unwrap();
+    let wgsl = dir.path().join("posterize.wgsl");
+    let original = std::fs::read_to_string(repo("graphs/posterize.wgsl")).unwrap();
+    std::fs::write(&wgsl, &original).unwrap();
+    let mut h = harness(ed);
+    h.state_mut().open(&graph);
+    h.state_mut().select(vec!["posterize".into()]);
+    h.run_ok();
+    let first = h.state().preview.image.clone().expect("preview");
+    assert!(h.state().errors.is_empty(), "{:?}", h.state().errors);
+
+    // Touch the file with new content: the poll notices (its time changed) and reloads.
+    let poll = |h: &mut egui_kittest::Harness<'static, lumagraph_editor::Editor>, at: f64| {
+        assert!(h.state_mut().poll_files(at), "no change seen");
+        h.run_ok();
+    };
+    let set = |text: &str, seconds: u64| {
+        std::fs::write(&wgsl, text).unwrap();
+        let t = std::time::SystemTime::UNIX_EPOCH + std::time::Duration::from_secs(seconds);
+        std::fs::File::options()
+            .write(true)
+            .open(&wgsl)
+            .unwrap()
+            .set_modified(t)
+            .unwrap();
+    };
+    set(&original.replace("round(", "floor("), 1_000_000);
+    poll(&mut h, 1e9);
+    let ed = h.state();
+    assert!(ed.errors.is_empty(), "{:?}", ed.errors);
+    let floored = ed.preview.image.clone().expect("preview");
+    assert_ne!(
+        floored.rgba, first.rgba,
+        "the preview did not follow the new WGSL"
+    );
+
+    // Broken: the last good pipeline stays, the node shows where the error is.
+    set(
+        &original.replace("return vec4f(", "return vec3f("),
+        2_000_000,
+    );
+    poll(&mut h, 2e9);
+    let ed = h.state();
+    let marks = ed
+        .errors
+        .get("posterize")
+        .expect("an error on the node")
+        .join("\n");
+    assert!(marks.contains("posterize.wgsl:"), "{marks}");
+    assert_eq!(
+        ed.preview.image.as_ref().map(|i| &i.rgba),
+        Some(&floored.rgba)
+    );
+    assert!(ed.preview.error.is_none(), "{:?}", ed.preview.error);
+
+    // Fixed: the marks go, the original image is back.
+    set(&original, 3_000_000);
+    poll(&mut h, 3e9);
+    let ed = h.state();
+    assert!(ed.errors.is_empty(), "{:?}", ed.errors);
+    assert_eq!(
+        ed.preview.image.as_ref().map(|i| &i.rgba),
+        Some(&first.rgba)
+    );
+}

@@ -550,6 +550,8 @@ fn same_structure(a: &Plan, b: &Plan) -> bool {
         && a.passes.iter().zip(&b.passes).all(|(p, q)| {
             p.node == q.node
                 && p.kind.name == q.kind.name
+                // A kind declared in a file whose WGSL changed needs its pipeline again.
+                && p.kind.shader == q.kind.shader
                 && p.inputs == q.inputs
                 && p.outputs == q.outputs
                 && p.extent == q.extent
