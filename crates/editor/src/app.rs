@@ -11,10 +11,11 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use egui::{Key, Modifiers, Ui, ViewportCommand};
 use lumagraph_graph::Graph;
-use lumagraph_render::{GpuContext, compile_with};
+use lumagraph_render::{GpuContext, NodeLibrary};
 
 use crate::canvas::{Canvas, CanvasEvent, NodeInfo};
 use crate::document::Document;
@@ -40,6 +41,9 @@ pub struct EditorConfig {
     /// The preview renders scenes with their longer side at most this many pixels (the
     /// scene's aspect kept); `lumagraph render` uses the scene's full resolution.
     pub preview_max: u32,
+    /// The node kinds the menus offer and the preview runs (with those a graph file
+    /// declares); the default is the built-in ones.
+    pub library: Arc<NodeLibrary>,
 }
 
 impl Default for EditorConfig {
@@ -48,6 +52,7 @@ impl Default for EditorConfig {
             recent_store: None,
             scene: None,
             preview_max: DEFAULT_PREVIEW_MAX,
+            library: Arc::new(NodeLibrary::builtins().clone()),
         }
     }
 }
@@ -147,9 +152,9 @@ impl Editor {
     /// opened leaves an empty graph and the error in the status line.
     pub fn new(gpu: GpuContext, graph: Option<&Path>, config: &EditorConfig) -> Self {
         let mut editor = Self {
-            doc: Document::default(),
+            doc: Document::with_library(Graph::new(), None, Arc::clone(&config.library)),
             canvas: Canvas::default(),
-            preview: Preview::new(gpu),
+            preview: Preview::with_library(gpu, Arc::clone(&config.library)),
             scope: crate::scope::ScopeView::default(),
             selected: Vec::new(),
             preview_port: None,
@@ -201,13 +206,14 @@ impl Editor {
         let base = self.doc.base_dir();
         let scene = self.scene.as_ref().map(|s| &*s.preview.gpu);
         if !self.doc.graph.kinds.is_empty()
-            && let Err(errs) = lumagraph_render::custom::registry(&self.doc.graph)
+            && let Err(errs) = self.doc.library().registry_for(&self.doc.graph)
         {
             // Declared kinds that fail (their nodes are then of an unknown kind).
             self.graph_errors
                 .extend(errs.0.iter().map(ToString::to_string));
         }
-        let result = compile_with(&key.0, self.doc.registry(), &base, &[], scene);
+        let library = self.doc.library();
+        let result = library.compile_with(&key.0, self.doc.registry(), &base, &[], scene);
         if let Err(errs) = result {
             for e in errs.0 {
                 match e.node {

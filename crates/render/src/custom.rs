@@ -315,11 +315,12 @@ fn generate(kind: &NodeKind, code: &Code) -> Result<GeneratedShader, (String, Op
     })
 }
 
-/// [`registry_for`] the graph, or the built-in kinds when it declares none; the folder
+/// [`registry_for`] the graph over the built-in kinds (a program with kinds of its own
+/// uses [`NodeLibrary::registry_for`](crate::NodeLibrary::registry_for)); the folder
 /// relative `.wgsl` paths are read from is the graph's.
 ///
 /// # Errors
 /// As [`registry_for`].
 pub fn registry(graph: &Graph) -> Result<Registry, GraphErrors> {
-    registry_for(graph, &Registry::with_builtins())
+    crate::NodeLibrary::builtins().registry_for(graph)
 }
