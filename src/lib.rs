@@ -3,10 +3,17 @@
 //! This facade re-exports the workspace crates so a program can depend on one crate:
 //! - [`graph`]: node kinds, graph files, validation and compilation (no GPU);
 //! - [`scene`]: scene files, glTF/OBJ import, BVH and the GPU layout (no GPU);
-//! - [`render`]: the wgpu executor, node implementations and image files.
+//! - [`render`]: the wgpu executor, node implementations and image files;
+//! - [`editor`]: the node editor.
 //!
-//! The `lumagraph` binary is the command-line front end; see `lumagraph --help`.
+//! [`cli`] is the `lumagraph` command line (see `lumagraph --help`). A program that adds
+//! node kinds of its own to a [`render::NodeLibrary`] runs it with
+//! [`cli::main_with`] and gets every subcommand, the editor included, with its kinds in it
+//! (`docs/extending.md`, `examples/custom-node/`).
 
+pub mod cli;
+
+pub use lumagraph_editor as editor;
 pub use lumagraph_graph as graph;
 pub use lumagraph_render as render;
 pub use lumagraph_scene as scene;

@@ -11,10 +11,11 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use egui::{Key, Modifiers, Ui, ViewportCommand};
 use lumagraph_graph::Graph;
-use lumagraph_render::{GpuContext, compile_with};
+use lumagraph_render::{GpuContext, NodeLibrary};
 
 use crate::canvas::{Canvas, CanvasEvent, NodeInfo};
 use crate::document::Document;
@@ -42,6 +43,9 @@ pub struct EditorConfig {
     /// The preview renders scenes with their longer side at most this many pixels (the
     /// scene's aspect kept); `lumagraph render` uses the scene's full resolution.
     pub preview_max: u32,
+    /// The node kinds the menus offer and the preview runs (with those a graph file
+    /// declares); the default is the built-in ones.
+    pub library: Arc<NodeLibrary>,
 }
 
 impl Default for EditorConfig {
@@ -50,6 +54,7 @@ impl Default for EditorConfig {
             recent_store: None,
             scene: None,
             preview_max: DEFAULT_PREVIEW_MAX,
+            library: Arc::new(NodeLibrary::builtins().clone()),
         }
     }
 }
@@ -156,11 +161,11 @@ impl Editor {
     /// opened leaves an empty graph and the error in the status line.
     pub fn new(gpu: GpuContext, graph: Option<&Path>, config: &EditorConfig) -> Self {
         let mut editor = Self {
-            doc: Document::default(),
+            doc: Document::with_library(Graph::new(), None, Arc::clone(&config.library)),
             outer: Vec::new(),
             watch: reload::Watch::default(),
             canvas: Canvas::default(),
-            preview: Preview::new(gpu),
+            preview: Preview::with_library(gpu, Arc::clone(&config.library)),
             scope: crate::scope::ScopeView::default(),
             selected: Vec::new(),
             preview_port: None,
@@ -213,7 +218,7 @@ impl Editor {
             // A reload failed: the last good kinds are in use, the errors on their nodes.
             self.add_reload_errors();
         } else if !self.doc.graph.kinds.is_empty()
-            && let Err(errs) = lumagraph_render::custom::registry(&self.doc.graph)
+            && let Err(errs) = self.doc.library().registry_for(&self.doc.graph)
         {
             // Declared kinds that fail (their nodes are then of an unknown kind).
             self.graph_errors
@@ -221,14 +226,19 @@ impl Editor {
         }
         let base = self.doc.base_dir();
         let scene = self.scene.as_ref().map(|s| &*s.preview.gpu);
+        let library = self.doc.library().clone();
         let context = self.group_context();
         let result = match &context {
-            Some(Ok(c)) => compile_with(&c.graph, &c.registry, &c.base, &[], scene).map(|_| ()),
+            Some(Ok(c)) => library
+                .compile_with(&c.graph, &c.registry, &c.base, &[], scene)
+                .map(|_| ()),
             Some(Err(e)) => {
                 self.graph_errors.push(e.clone());
                 Ok(())
             }
-            None => compile_with(&key.0, self.doc.registry(), &base, &[], scene).map(|_| ()),
+            None => library
+                .compile_with(&key.0, self.doc.registry(), &base, &[], scene)
+                .map(|_| ()),
         };
         let prefix = match &context {
             Some(Ok(c)) => c.prefix.as_str(),

@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use lumagraph_graph::{Edge, ErrorKind, Graph, Node, ParamValue, Registry, split_port_ref};
+use lumagraph_render::NodeLibrary;
 
 use crate::undo::History;
 
@@ -22,6 +23,8 @@ pub struct Document {
     pub path: Option<PathBuf>,
     /// The node kinds the graph is checked against.
     registry: Arc<Registry>,
+    /// The kinds the program knows and how they run, under those the graph declares.
+    library: Arc<NodeLibrary>,
     saved: Graph,
     history: History,
 }
@@ -40,19 +43,32 @@ impl Document {
     /// those the graph declares (when they all compile; else the built-in ones, and the
     /// editor shows why).
     pub fn new(graph: Graph, path: Option<PathBuf>) -> Self {
-        let registry = lumagraph_render::custom::registry(&graph)
-            .unwrap_or_else(|_| Registry::with_builtins());
-        Self::with_registry(graph, path, Arc::new(registry))
+        Self::with_library(graph, path, Arc::new(NodeLibrary::builtins().clone()))
     }
 
-    /// A document for `graph` checked against `registry`.
-    pub fn with_registry(graph: Graph, path: Option<PathBuf>, registry: Arc<Registry>) -> Self {
+    /// A document for `graph`, as if just opened from `path`, with the kinds of `library`
+    /// and those the graph declares (when they all compile; else the library's, and the
+    /// editor shows why).
+    pub fn with_library(graph: Graph, path: Option<PathBuf>, library: Arc<NodeLibrary>) -> Self {
+        let registry = library
+            .registry_for(&graph)
+            .unwrap_or_else(|_| library.registry().clone());
         Self {
             saved: graph.clone(),
             graph,
             path,
-            registry,
+            registry: Arc::new(registry),
+            library,
             history: History::default(),
+        }
+    }
+
+    /// A document for `graph` checked against `registry`, run with the built-in
+    /// implementations.
+    pub fn with_registry(graph: Graph, path: Option<PathBuf>, registry: Arc<Registry>) -> Self {
+        Self {
+            registry,
+            ..Self::new(graph, path)
         }
     }
 
@@ -79,6 +95,12 @@ impl Document {
     /// The node kinds the document is checked against.
     pub fn registry(&self) -> &Registry {
         &self.registry
+    }
+
+    /// The node library the document was opened with: the kinds the program knows (those
+    /// the graph declares aside) and how they run.
+    pub fn library(&self) -> &Arc<NodeLibrary> {
+        &self.library
     }
 
     fn record(&mut self, key: Option<&str>) {
@@ -421,7 +443,9 @@ impl Document {
     /// # Errors
     /// The loading errors, one a line.
     pub fn reload_registry(&mut self) -> Result<(), String> {
-        let registry = lumagraph_render::custom::registry(&self.with_origin(&self.graph))
+        let registry = self
+            .library
+            .registry_for(&self.with_origin(&self.graph))
             .map_err(|e| e.to_string())?;
         self.registry = Arc::new(registry);
         Ok(())
@@ -429,6 +453,6 @@ impl Document {
 
     /// Replaces the whole graph (for example a file opened in place), clearing history.
     pub fn replace(&mut self, graph: Graph, path: Option<PathBuf>) {
-        *self = Self::new(graph, path);
+        *self = Self::with_library(graph, path, Arc::clone(&self.library));
     }
 }

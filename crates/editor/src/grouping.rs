@@ -110,7 +110,9 @@ impl Document {
 
         let mut next = self.graph.clone();
         next.groups.push(decl_file);
-        let registry = lumagraph_render::custom::registry(&self.with_origin(&next))
+        let registry = self
+            .library()
+            .registry_for(&self.with_origin(&next))
             .map_err(|e| e.to_string())?;
 
         let positions: Vec<(f32, f32)> = next

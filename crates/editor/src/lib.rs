@@ -62,8 +62,9 @@ pub fn wgpu_setup() -> egui_wgpu::WgpuSetup {
     egui_wgpu::WgpuSetup::CreateNew(setup)
 }
 
-/// Opens the editor window, with `graph` loaded when given and the scene and preview size
-/// of `config`; returns when it closes.
+/// Opens the editor window, with `graph` loaded when given and the scene, preview size and
+/// node library of `config` (a program with node kinds of its own passes its library
+/// there); returns when it closes.
 ///
 /// # Errors
 /// When the window or its GPU device cannot be created.

@@ -28,7 +28,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use lumagraph_graph::{Graph, Plan, PortType, Registry};
-use lumagraph_render::{Executor, FrameReport, GpuContext, Resources, compile_with};
+use lumagraph_render::{Executor, FrameReport, GpuContext, NodeLibrary, Resources};
 use lumagraph_scene::GpuScene;
 
 /// The scene the preview renders, already at the preview's resolution.
@@ -77,6 +77,7 @@ pub struct PreviewStats {
 /// The preview state.
 pub struct Preview {
     gpu: GpuContext,
+    library: Arc<NodeLibrary>,
     exec: Option<Executor>,
     key: Option<(Graph, String, PathBuf, u64)>,
     scene: Option<Arc<GpuScene>>,
@@ -159,12 +160,14 @@ pub fn preview_keep(reg: &Registry, graph: &Graph, port: &str) -> Vec<String> {
     keep
 }
 
-/// Compiles the preview graph of `graph`, keeping `port` (and the outputs upstream of it,
-/// see [`preview_keep`]), with `scene` for the nodes that render one.
+/// Compiles the preview graph of `graph` against `registry` (`library`'s kinds and those
+/// the graph declares), keeping `port` (and the outputs upstream of it, see
+/// [`preview_keep`]), with `scene` for the nodes that render one.
 ///
 /// # Errors
 /// The compiler's messages, one a line.
 pub fn compile_preview(
+    library: &NodeLibrary,
     registry: &Registry,
     graph: &Graph,
     base: &Path,
@@ -185,7 +188,9 @@ pub fn compile_preview(
     let port = flat.resolve(port);
     let g = preview_graph(&flat.registry, &flat.graph);
     let keep = preview_keep(&flat.registry, &flat.graph, port);
-    let mut plan = compile_with(&g, &flat.registry, base, &keep, scene).map_err(messages)?;
+    let mut plan = library
+        .compile_with(&g, &flat.registry, base, &keep, scene)
+        .map_err(messages)?;
     plan.aliases.clone_from(&flat.aliases);
     Ok(plan)
 }
@@ -196,10 +201,16 @@ pub fn encode_rgba8(image: &lumagraph_render::cpu::Image, ty: PortType) -> Vec<u
 }
 
 impl Preview {
-    /// A preview rendering on `gpu` (the editor's device).
+    /// A preview rendering on `gpu` (the editor's device) with the built-in node kinds.
     pub fn new(gpu: GpuContext) -> Self {
+        Self::with_library(gpu, Arc::new(NodeLibrary::builtins().clone()))
+    }
+
+    /// A preview rendering on `gpu`, running nodes with the implementations of `library`.
+    pub fn with_library(gpu: GpuContext, library: Arc<NodeLibrary>) -> Self {
         Self {
             gpu,
+            library,
             exec: None,
             key: None,
             scene: None,
@@ -295,7 +306,14 @@ impl Preview {
         base: &Path,
         port: &str,
     ) -> Result<(), String> {
-        let plan = compile_preview(registry, graph, base, port, self.scene.as_deref())?;
+        let plan = compile_preview(
+            &self.library,
+            registry,
+            graph,
+            base,
+            port,
+            self.scene.as_deref(),
+        )?;
         let changed: Vec<String> = match &self.exec {
             Some(exec) => exec
                 .plan()
@@ -336,7 +354,8 @@ impl Preview {
                 scene: self.scene.clone(),
                 ..Resources::default()
             };
-            let exec = Executor::new(&self.gpu, plan, &paths).map_err(|e| e.to_string())?;
+            let exec = Executor::with_library(&self.gpu, plan, &paths, &self.library)
+                .map_err(|e| e.to_string())?;
             self.progressive = exec.plan().passes.iter().any(|p| p.kind.history);
             self.target_spp = self
                 .scene

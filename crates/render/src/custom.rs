@@ -398,24 +398,24 @@ fn generate(kind: &NodeKind, code: &Code) -> Result<GeneratedShader, (String, Op
     })
 }
 
-/// [`registry_for`] the graph, or the built-in kinds when it declares none; the folder
+/// [`registry_for`] the graph over the built-in kinds (a program with kinds of its own
+/// uses [`NodeLibrary::registry_for`](crate::NodeLibrary::registry_for)); the folder
 /// relative `.wgsl` paths are read from is the graph's.
 ///
 /// # Errors
 /// As [`registry_for`].
 pub fn registry(graph: &Graph) -> Result<Registry, GraphErrors> {
-    registry_for(graph, &Registry::with_builtins())
+    crate::NodeLibrary::builtins().registry_for(graph)
 }
 
 /// Checks a graph file meant as a node group on its own (it has an `interface` and no
-/// sink, so it cannot be compiled without a graph around it): its declared kinds and
-/// groups, its interface, and every node's kind and params. Returns the kind a node of it
-/// would be.
+/// sink, so it cannot be compiled without a graph around it): its interface, and every
+/// node's kind and params against `registry` (the graph's, with its declared kinds and
+/// groups). Returns the kind a node of it would be.
 ///
 /// # Errors
 /// Everything found, located in the file.
-pub fn check_group(graph: &Graph) -> Result<NodeKind, GraphErrors> {
-    let registry = registry(graph)?;
+pub fn check_group(graph: &Graph, registry: Registry) -> Result<NodeKind, GraphErrors> {
     let file = graph.origin.as_ref().map(|o| o.path.clone());
     let mut errors = Vec::new();
     for node in &graph.nodes {

@@ -50,6 +50,10 @@ pub enum RenderError {
     /// A node kind has no GPU implementation in this build.
     #[error("node kind {0} has no implementation")]
     Unimplemented(String),
+    /// A node kind could not be added to a [`NodeLibrary`](crate::NodeLibrary); the
+    /// message names it.
+    #[error("{0}")]
+    Library(String),
 }
 
 impl RenderError {

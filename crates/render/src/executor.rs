@@ -1,87 +1,18 @@
 //! Executes a plan: one command encoder per frame, every pass recorded in plan order,
 //! one submission, then the sinks write their files.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use lumagraph_graph::{
-    CompileOptions, Extent, Graph, GraphErrors, NodeKind, Params, Plan, Registry, TextureId,
-};
-
-use lumagraph_scene::GpuScene;
+use lumagraph_graph::{Plan, TextureId};
 
 use crate::context::GpuContext;
 use crate::cpu::Image;
 use crate::error::{RenderError, Result};
-use crate::nodes::{self, Counter, FrameIo, Measurement, NodeExec, Recording, Resources};
+use crate::library::NodeLibrary;
+use crate::nodes::{Counter, FrameIo, Measurement, NodeExec, Recording, Resources};
 use crate::pool::{PooledTexture, TexturePool};
 use crate::timing::GpuTimer;
-
-/// The image size each source kind produces; used by [`compile`].
-///
-/// # Errors
-/// A message naming the file when a source cannot tell its size.
-pub fn source_extent(
-    base_dir: &Path,
-    scene: Option<&GpuScene>,
-    kind: &NodeKind,
-    params: &Params,
-) -> std::result::Result<Extent, String> {
-    if kind.renders_scene {
-        return scene
-            .map(|s| Extent::new(s.settings.width, s.settings.height))
-            .ok_or_else(|| {
-                "renders a scene, but none was given (lumagraph render --scene FILE)".to_owned()
-            });
-    }
-    match nodes::implementation(kind).and_then(|i| i.source_extent) {
-        Some(extent) => extent(base_dir, params),
-        None => Err(format!("{} is not a source", kind.name)),
-    }
-}
-
-/// Compiles `graph` with the built-in node kinds and those the graph file declares
-/// ([`crate::custom`]; [`compile_with`] takes a registry), sizing sources from their files
-/// and from the scene.
-///
-/// # Errors
-/// Every problem found in the graph (first in its declared kinds).
-pub fn compile(
-    graph: &Graph,
-    keep: &[String],
-    scene: Option<&GpuScene>,
-) -> std::result::Result<Plan, GraphErrors> {
-    compile_with(
-        graph,
-        &crate::custom::registry(graph)?,
-        &graph.base_dir(),
-        keep,
-        scene,
-    )
-}
-
-/// Compiles `graph` against `registry`, sizing sources from their files (relative to
-/// `base_dir`) and from the scene.
-///
-/// # Errors
-/// Every problem found in the graph.
-pub fn compile_with(
-    graph: &Graph,
-    registry: &Registry,
-    base_dir: &Path,
-    keep: &[String],
-    scene: Option<&GpuScene>,
-) -> std::result::Result<Plan, GraphErrors> {
-    let extent = |kind: &NodeKind, params: &Params| source_extent(base_dir, scene, kind, params);
-    lumagraph_graph::compile(
-        graph,
-        registry,
-        &CompileOptions {
-            source_extent: &extent,
-            keep,
-        },
-    )
-}
 
 /// Which passes a batch of frames records.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -164,16 +95,32 @@ impl std::fmt::Debug for Executor {
 }
 
 impl Executor {
-    /// Creates every pass's GPU resources and the plan's textures.
+    /// Creates every pass's GPU resources and the plan's textures, with the built-in
+    /// implementations ([`Executor::with_library`] takes a library).
     ///
     /// # Errors
-    /// When a node cannot be set up (missing input file, unwritable output, shader error);
-    /// the error names the node.
+    /// When a node cannot be set up (missing input file, unwritable output, shader error,
+    /// a kind that is not built in); the error names the node.
     pub fn new(ctx: &GpuContext, plan: Plan, paths: &Resources) -> Result<Self> {
+        Self::with_library(ctx, plan, paths, NodeLibrary::builtins())
+    }
+
+    /// Creates every pass's GPU resources, each node by its kind's implementation in
+    /// `library`, and the plan's textures.
+    ///
+    /// # Errors
+    /// When a node cannot be set up (missing input file, unwritable output, shader error,
+    /// a kind `library` has no implementation of); the error names the node.
+    pub fn with_library(
+        ctx: &GpuContext,
+        plan: Plan,
+        paths: &Resources,
+        library: &NodeLibrary,
+    ) -> Result<Self> {
         let nodes = plan
             .passes
             .iter()
-            .map(|pass| nodes::create(ctx, pass, paths))
+            .map(|pass| library.create(ctx, pass, paths))
             .collect::<Result<Vec<_>>>()?;
         let mut pool = TexturePool::new();
         let slots = pool.acquire(ctx, &plan);

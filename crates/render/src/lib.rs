@@ -6,6 +6,8 @@
 //!   small builder that reads like their declaration.
 //! - [`TexturePool`]: the plan's texture slots as GPU textures, reused across plans.
 //! - [`GpuTimer`]: per-pass GPU time from timestamp queries.
+//! - [`NodeLibrary`]: the node kinds a program knows and their implementations; the
+//!   built-in ones, to which a program adds its own.
 //! - [`Executor`]: runs a [`lumagraph_graph::Plan`] frame by frame.
 //! - [`image_io`] and [`cpu`]: image files, and plain-Rust references of every post node.
 //! - [`custom`]: node kinds declared in graph files, their shaders generated and checked.
@@ -20,6 +22,7 @@ mod error;
 mod executor;
 pub mod image_io;
 pub mod kernel;
+mod library;
 pub mod metrics;
 pub mod nodes;
 pub mod params;
@@ -34,8 +37,9 @@ mod timing;
 
 pub use context::{GPU_TIMEOUT, GpuContext};
 pub use error::{RenderError, Result};
-pub use executor::{Executor, FrameReport, PassClock, compile, compile_with, source_extent};
+pub use executor::{Executor, FrameReport, PassClock};
 pub use kernel::{Binding, Kernel, PassBuilder, uniform_buffer};
+pub use library::{NodeLibrary, compile, compile_with};
 pub use nodes::{Counter, Measurement, Resources};
 pub use pool::{PooledTexture, TexturePool, create as create_texture, wgpu_format};
 pub use scene_gpu::SceneBuffers;

@@ -14,7 +14,8 @@ use crate::error::{RenderError, Result};
 pub struct BlockLayout {
     /// The Rust struct's name.
     pub name: &'static str,
-    /// The shader file (under `shaders/`) that declares the twin.
+    /// The shader file (under `shaders/`) that declares the twin; for a block of a kind
+    /// defined outside this crate, its own file, checked with [`check_layout_in`].
     pub shader: &'static str,
     /// The WGSL struct's name.
     pub wgsl: &'static str,
@@ -81,15 +82,25 @@ pub const BLOCKS: &[BlockLayout] = &[
     <crate::nodes::auto_exposure::AutoExposureParams as ParamBlock>::LAYOUT,
 ];
 
-/// Whether `layout` matches naga's layout of its WGSL twin: the same size (the WGSL
-/// struct's span) and the same field names at the same offsets.
+/// Whether `layout` matches naga's layout of its WGSL twin in its shader file under
+/// `shaders/`: the same size (the WGSL struct's span) and the same field names at the same
+/// offsets.
 ///
 /// # Errors
 /// What differs, naming the block and the field.
 pub fn check_layout(layout: &BlockLayout) -> std::result::Result<(), String> {
     let source = crate::shader::resolve(layout.shader).map_err(|e| e.to_string())?;
-    let module = naga::front::wgsl::parse_str(&source)
-        .map_err(|e| format!("{}: {}", layout.shader, e.emit_to_string(&source)))?;
+    check_layout_in(layout, &source)
+}
+
+/// [`check_layout`] against the WGSL text `source` (the shader of a node kind defined
+/// outside this crate, with its imports resolved).
+///
+/// # Errors
+/// What differs, naming the block and the field.
+pub fn check_layout_in(layout: &BlockLayout, source: &str) -> std::result::Result<(), String> {
+    let module = naga::front::wgsl::parse_str(source)
+        .map_err(|e| format!("{}: {}", layout.shader, e.emit_to_string(source)))?;
     let mut layouter = naga::proc::Layouter::default();
     layouter
         .update(module.to_ctx())

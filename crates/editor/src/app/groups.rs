@@ -92,7 +92,11 @@ impl Editor {
                 return;
             }
         };
-        let doc = std::mem::replace(&mut self.doc, Document::new(graph, Some(file.clone())));
+        let library = std::sync::Arc::clone(self.doc.library());
+        let doc = std::mem::replace(
+            &mut self.doc,
+            Document::with_library(graph, Some(file.clone()), library),
+        );
         self.errors_for = None;
         self.outer.push(Outer {
             doc,

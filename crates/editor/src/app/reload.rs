@@ -110,8 +110,10 @@ impl Editor {
     /// the current ones and the preview rebuilds its pipelines; when they do not, the
     /// current ones stay in use and the errors show on the nodes of the failing kinds.
     pub fn reload_kinds(&mut self) {
-        let result: Result<Registry, GraphErrors> =
-            lumagraph_render::custom::registry(&self.doc.with_origin(&self.doc.graph));
+        let result: Result<Registry, GraphErrors> = self
+            .doc
+            .library()
+            .registry_for(&self.doc.with_origin(&self.doc.graph));
         match result {
             Ok(registry) => {
                 let had_errors = !self.watch.errors.is_empty();

@@ -17,7 +17,7 @@ pub(crate) mod tonemap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use lumagraph_graph::{Extent, NodeKind, Pass, Plan, TextureId};
+use lumagraph_graph::{Extent, Pass, Plan, TextureId};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
@@ -201,10 +201,11 @@ pub type Features = fn(&Pass, &lumagraph_scene::GpuScene, bool) -> Vec<crate::sp
 /// given), or why it cannot tell.
 pub type SourceExtent = fn(&Path, &lumagraph_graph::Params) -> std::result::Result<Extent, String>;
 
-/// How a node kind of the registry runs: one entry per kind, declared in the kind's own
-/// file (`IMPL`) and listed in [`IMPLEMENTATIONS`]. Nothing else in the program matches kind
-/// names: what the rest needs to know of a kind is on its registry entry (and copied onto
-/// its [`Pass`]) or here.
+/// How a node kind runs: one entry per kind, declared in the kind's own file (`IMPL`; the
+/// built-in ones are listed in [`IMPLEMENTATIONS`]) and held with the kind in a
+/// [`NodeLibrary`](crate::NodeLibrary). Nothing else in the program matches kind names:
+/// what the rest needs to know of a kind is on its registry entry (and copied onto its
+/// [`Pass`]) or here.
 #[derive(Clone, Copy)]
 pub struct NodeImpl {
     /// The registry kind it implements.
@@ -275,12 +276,16 @@ fn owns_nothing(_: &Pass) -> Option<(u64, String)> {
 }
 
 /// Boxes a node's GPU side for [`NodeImpl::create`].
-pub(crate) fn boxed<N: NodeExec + 'static>(node: Result<N>) -> Result<Box<dyn NodeExec>> {
+///
+/// # Errors
+/// `node`'s error, unchanged.
+pub fn boxed<N: NodeExec + 'static>(node: Result<N>) -> Result<Box<dyn NodeExec>> {
     node.map(|n| Box::new(n) as Box<dyn NodeExec>)
 }
 
-/// Every kind with an implementation of its own; a test checks that with the generic post
-/// filters ([`post_filter`]) they are exactly the registry's kinds.
+/// Every built-in kind with an implementation of its own; with the generic post filters
+/// ([`post_filter`]) they are exactly the built-in registry's kinds (a test checks it).
+/// [`NodeLibrary::with_builtins`](crate::NodeLibrary::with_builtins) starts from them.
 pub static IMPLEMENTATIONS: &[NodeImpl] = &[
     image_input::IMPL,
     pathtrace::IMPL,
@@ -295,20 +300,6 @@ pub static IMPLEMENTATIONS: &[NodeImpl] = &[
     tonemap::IMPL,
     output::IMPL,
 ];
-
-/// The implementation of `kind`: the generic post filter for a kind that names a shader
-/// (built in or added at run time), else the kind's own from [`IMPLEMENTATIONS`].
-pub fn implementation(kind: &NodeKind) -> Option<&'static NodeImpl> {
-    if kind.shader.is_some() {
-        return Some(&post_filter::IMPL);
-    }
-    IMPLEMENTATIONS.iter().find(|i| i.kind == kind.name)
-}
-
-/// Memory a pass's node allocates for itself (see [`NodeImpl::owned_memory`]).
-pub fn owned_memory(pass: &Pass) -> Option<(u64, String)> {
-    implementation(&pass.kind).and_then(|i| (i.owned_memory)(pass))
-}
 
 /// The pass of a post-processing node: its inputs in declaration order (each a texture
 /// binding; an unconnected optional input gets a 1×1 texture of zeros), a bilinear sampler
@@ -470,18 +461,6 @@ impl<P: ParamBlock> ColorFilter<P> {
     }
 }
 
-/// Creates the GPU side of the node a pass runs.
-///
-/// # Errors
-/// When the kind has no implementation or its setup fails; the error names the node.
-pub fn create(ctx: &GpuContext, pass: &Pass, paths: &Resources) -> Result<Box<dyn NodeExec>> {
-    let node = match implementation(&pass.kind) {
-        Some(i) => (i.create)(ctx, pass, paths),
-        None => Err(RenderError::Unimplemented(pass.kind.name.to_owned())),
-    };
-    node.map_err(|e| e.in_node(&pass.node))
-}
-
 /// Checks that `path` can be written, by creating and removing a temporary file beside it
 /// (creating missing folders first), so a long render does not fail at the very end.
 ///
@@ -500,43 +479,6 @@ pub fn check_writable(path: &Path) -> Result<()> {
                 .map(|_| ())
         })
         .map_err(|e| RenderError::image(path, format!("cannot write output: {e}")))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The registry's kinds are the implementation table's and the generic post filters,
-    /// each once.
-    #[test]
-    fn every_registry_kind_has_one_implementation() {
-        let registry = lumagraph_graph::Registry::with_builtins();
-        let kinds: Vec<&str> = registry
-            .kinds()
-            .iter()
-            .filter(|k| k.shader.is_none())
-            .map(|k| k.name)
-            .collect();
-        let mut implemented: Vec<&str> = IMPLEMENTATIONS.iter().map(|i| i.kind).collect();
-        let mut sorted = kinds.clone();
-        sorted.sort_unstable();
-        implemented.sort_unstable();
-        assert_eq!(sorted, implemented);
-        for k in registry.kinds() {
-            assert!(
-                !(k.shader.is_some() && IMPLEMENTATIONS.iter().any(|i| i.kind == k.name)),
-                "{}: a post filter with an implementation of its own",
-                k.name
-            );
-            let i = implementation(k).unwrap();
-            assert_eq!(
-                i.source_extent.is_some(),
-                k.is_source() && !k.renders_scene,
-                "{}: a source that does not render the scene tells its size, no other kind does",
-                k.name
-            );
-        }
-    }
 }
 
 #[cfg(test)]

@@ -2,17 +2,18 @@
 //! graph, and `gallery.md`, the page that shows them. Post nodes run on the Venice map
 //! (resized to 384×192, the test chart as a second input) with their registry `example`
 //! params and are tone-mapped (`agx`) for display; the nodes of a path-tracing graph show
-//! their first output on the Cornell box after 64 frames of `graphs/pathtrace_denoise.ron`.
+//! their first output on the Cornell box after 64 frames of `graphs/pathtrace_denoise.ron`;
+//! a source that reads no file shows its first output with its `example` params.
 
 use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::Arc;
 
+use crate::graph::{Edge, Graph, Node, NodeKind, ParamType, ParamValue, PortType, Registry};
+use crate::render::cpu::Image;
+use crate::render::{Executor, GpuContext, NodeLibrary, Resources, image_io};
+use crate::scene::{GpuScene, Scene};
 use anyhow::{Context, Result, bail};
-use lumagraph::graph::{Edge, Graph, Node, NodeKind, ParamType, ParamValue, PortType, Registry};
-use lumagraph::render::cpu::Image;
-use lumagraph::render::{Executor, GpuContext, Resources, compile_with, image_io};
-use lumagraph::scene::{GpuScene, Scene};
 
 const SOURCE: &str = "assets/hdri/venice_sunset_1k.hdr";
 const SECOND: &str = "assets/test_chart.exr";
@@ -73,8 +74,12 @@ fn recipe(
         return Ok((g, port, out.ty, RENDER_FRAMES));
     }
     let mut g = sources();
-    if kind.inputs.is_empty() {
-        // A source: the image it reads, resized.
+    let reads_file = kind
+        .params
+        .iter()
+        .any(|p| matches!(p.ty, ParamType::Path { .. }));
+    if kind.inputs.is_empty() && reads_file {
+        // A source that reads a file: the image it reads, resized.
         return Ok((g, "src.color".into(), PortType::HdrColor, 1));
     }
     let example: Vec<(&str, ParamValue)> =
@@ -110,14 +115,14 @@ fn recipe(
     Ok((g, format!("n.{}", out.name), out.ty, 1))
 }
 
-/// Renders the gallery image of every kind (or of those named in `only`) into
+/// Renders the gallery image of every kind of `library` (or of those named in `only`) into
 /// `out/gallery/`, and writes `out/gallery.md` when all were made.
 ///
 /// # Errors
 /// When a kind has no way to be shown, or a render or a write fails.
-pub fn run(ctx: &GpuContext, out: &Path, only: &[String]) -> Result<()> {
+pub fn run(ctx: &GpuContext, library: &NodeLibrary, out: &Path, only: &[String]) -> Result<()> {
     let root = std::env::current_dir()?;
-    let registry = Registry::with_builtins();
+    let registry = library.registry();
     let images = out.join("gallery");
     std::fs::create_dir_all(&images)
         .with_context(|| format!("cannot create {}", images.display()))?;
@@ -131,12 +136,13 @@ pub fn run(ctx: &GpuContext, out: &Path, only: &[String]) -> Result<()> {
         if !only.is_empty() && !only.iter().any(|o| o == kind.name) {
             continue;
         }
-        let (graph, port, ty, frames) = recipe(kind, &registry, &root)?;
+        let (graph, port, ty, frames) = recipe(kind, registry, &root)?;
         let keep: Vec<String> = [port.clone()]
             .into_iter()
             .filter(|p| !p.is_empty())
             .collect();
-        let plan = compile_with(&graph, &registry, &root, &keep, Some(&scene))
+        let plan = library
+            .compile_with(&graph, registry, &root, &keep, Some(&scene))
             .map_err(|e| anyhow::anyhow!("{}: {e}", kind.name))?;
         let resources = Resources {
             base_dir: root.clone(),
@@ -144,7 +150,7 @@ pub fn run(ctx: &GpuContext, out: &Path, only: &[String]) -> Result<()> {
             scene: Some(Arc::clone(&scene)),
             ..Resources::default()
         };
-        let mut exec = Executor::new(ctx, plan, &resources)?;
+        let mut exec = Executor::with_library(ctx, plan, &resources, library)?;
         let report = exec.run_frames(frames, true)?;
         if port.is_empty() {
             for path in report.written {
@@ -166,8 +172,8 @@ pub fn run(ctx: &GpuContext, out: &Path, only: &[String]) -> Result<()> {
         println!("wrote {} ({port})", path.display());
     }
     if only.is_empty() {
-        let page = markdown(&registry);
-        lumagraph::graph::write_atomic(&out.join("gallery.md"), page.as_bytes())?;
+        let page = markdown(registry);
+        crate::graph::write_atomic(&out.join("gallery.md"), page.as_bytes())?;
         println!("wrote {}", out.join("gallery.md").display());
     }
     Ok(())

@@ -12,7 +12,7 @@ use std::sync::OnceLock;
 use anyhow::{Result, anyhow, bail};
 use plotters::prelude::*;
 
-use crate::converge::Compare;
+use super::converge::Compare;
 
 const FONT_PATHS: &[&str] = &[
     "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
@@ -141,6 +141,6 @@ pub fn write(
         .chunks_exact(3)
         .flat_map(|p| [p[0], p[1], p[2], 255])
         .collect();
-    lumagraph::render::image_io::write_png(path, w, h, &rgba)?;
+    crate::render::image_io::write_png(path, w, h, &rgba)?;
     Ok(())
 }

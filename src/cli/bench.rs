@@ -5,10 +5,10 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use crate::graph::{Edge, Graph, Node, ParamValue};
+use crate::render::{Executor, GpuContext, Resources, compile};
+use crate::scene::GpuScene;
 use anyhow::Result;
-use lumagraph::graph::{Edge, Graph, Node, ParamValue};
-use lumagraph::render::{Executor, GpuContext, Resources, compile};
-use lumagraph::scene::GpuScene;
 
 /// Best paths/s of `runs` renders of `spp` samples per pixel.
 fn measure(

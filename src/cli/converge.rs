@@ -24,12 +24,12 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
+use crate::graph::registry::SAMPLES_PER_FRAME;
+use crate::graph::{Category, Graph, ParamValue};
+use crate::render::cpu::Image;
+use crate::render::{Executor, GpuContext, NodeLibrary, Resources, image_io, metrics};
+use crate::scene::GpuScene;
 use anyhow::{Context as _, Result, bail};
-use lumagraph::graph::registry::SAMPLES_PER_FRAME;
-use lumagraph::graph::{Category, Graph, ParamValue};
-use lumagraph::render::cpu::Image;
-use lumagraph::render::{Executor, GpuContext, Resources, compile, image_io, metrics};
-use lumagraph::scene::GpuScene;
 
 /// What `converge` was asked.
 pub struct Args<'a> {
@@ -41,6 +41,7 @@ pub struct Args<'a> {
     pub compare: Option<&'a Path>,
     pub out: &'a Path,
     pub overrides: &'a [String],
+    pub library: &'a NodeLibrary,
 }
 
 /// One scored output at one checkpoint.
@@ -57,12 +58,11 @@ struct Row {
 
 /// The graph without sinks (groups flattened, so theirs too), 1 spp per frame; returns it
 /// with the ports scored, as `(port, is_denoised)`.
-fn prepare(graph: &mut Graph) -> Result<Vec<(String, bool)>> {
-    let flat =
-        lumagraph::graph::group::flatten(graph, &lumagraph::render::custom::registry(graph)?)?;
+fn prepare(graph: &mut Graph, library: &NodeLibrary) -> Result<Vec<(String, bool)>> {
+    let flat = crate::graph::group::flatten(graph, &library.registry_for(graph)?)?;
     *graph = flat.graph;
     let registry = flat.registry;
-    let kind = |n: &lumagraph::graph::Node| registry.get(&n.kind);
+    let kind = |n: &crate::graph::Node| registry.get(&n.kind);
     graph.remove_sinks(&registry);
     let mut ports = Vec::new();
     for n in &mut graph.nodes {
@@ -84,21 +84,23 @@ fn prepare(graph: &mut Graph) -> Result<Vec<(String, bool)>> {
 
 fn executor(
     ctx: &GpuContext,
+    library: &NodeLibrary,
     graph: &Graph,
     keep: &[String],
     scene: &Arc<GpuScene>,
 ) -> Result<Executor> {
-    let plan = compile(graph, keep, Some(scene))?;
+    let plan = library.compile(graph, keep, Some(scene))?;
     let resources = Resources {
         base_dir: graph.base_dir(),
         scene: Some(Arc::clone(scene)),
         ..Resources::default()
     };
-    Ok(Executor::new(ctx, plan, &resources)?)
+    Ok(Executor::with_library(ctx, plan, &resources, library)?)
 }
 
 fn render_reference(
     ctx: &GpuContext,
+    library: &NodeLibrary,
     graph: &Graph,
     port: &str,
     scene: &GpuScene,
@@ -107,7 +109,7 @@ fn render_reference(
     let mut other = scene.clone();
     other.settings.seed ^= 0x9e37_79b9;
     let other = Arc::new(other);
-    let mut exec = executor(ctx, graph, &[port.to_owned()], &other)?;
+    let mut exec = executor(ctx, library, graph, &[port.to_owned()], &other)?;
     let start = Instant::now();
     let mut done = 0;
     while done < spp {
@@ -129,7 +131,7 @@ pub fn run(args: &Args<'_>) -> Result<()> {
     for o in args.overrides {
         graph.apply_override(o)?;
     }
-    let ports = prepare(&mut graph)?;
+    let ports = prepare(&mut graph, args.library)?;
     let scene = super::load_scene(Some(args.scene))?.context("no scene")?;
     let ctx = GpuContext::headless()?;
     println!("adapter: {}", ctx.describe());
@@ -140,11 +142,13 @@ pub fn run(args: &Args<'_>) -> Result<()> {
         .unwrap_or_default();
     let reference = match (args.reference, args.reference_spp) {
         (Some(path), _) => image_io::load(path)?,
-        (None, Some(spp)) => render_reference(&ctx, &graph, &raw_port, &scene.gpu, spp)?,
+        (None, Some(spp)) => {
+            render_reference(&ctx, args.library, &graph, &raw_port, &scene.gpu, spp)?
+        }
         (None, None) => bail!("give --reference FILE.exr or --reference-spp N"),
     };
     let keep: Vec<String> = ports.iter().map(|(p, _)| p.clone()).collect();
-    let mut exec = executor(&ctx, &graph, &keep, &scene.gpu)?;
+    let mut exec = executor(&ctx, args.library, &graph, &keep, &scene.gpu)?;
     let extent = exec.plan().passes.first().map(|p| p.extent);
     if extent.is_some_and(|e| (e.width, e.height) != (reference.width, reference.height)) {
         bail!(
@@ -205,12 +209,12 @@ pub fn run(args: &Args<'_>) -> Result<()> {
     std::fs::create_dir_all(args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let csv = args.out.join("converge.csv");
-    lumagraph::graph::write_atomic(&csv, csv_text(&rows).as_bytes())
+    crate::graph::write_atomic(&csv, csv_text(&rows).as_bytes())
         .with_context(|| format!("cannot write {}", csv.display()))?;
     println!("wrote {}", csv.display());
     let compare = args.compare.map(read_compare).transpose()?;
     let png = args.out.join("converge.png");
-    match crate::plot::write(&png, &rows_by_output(&rows), compare.as_ref()) {
+    match super::plot::write(&png, &rows_by_output(&rows), compare.as_ref()) {
         Ok(()) => println!("wrote {}", png.display()),
         Err(e) => println!("plot not written: {e:#}"),
     }

@@ -1,0 +1,629 @@
+//! The `lumagraph` command line: render, plan, validate, bench, list nodes, open the
+//! editor. [`main_with`] runs it over a [`NodeLibrary`], so a program that adds node kinds
+//! of its own is the whole `lumagraph` command with its kinds in it:
+//!
+//! ```no_run
+//! use lumagraph::render::NodeLibrary;
+//!
+//! fn main() -> std::process::ExitCode {
+//!     // NodeLibrary::with_builtins().with_kind(…) for kinds of its own.
+//!     lumagraph::cli::main_with(NodeLibrary::with_builtins())
+//! }
+//! ```
+
+mod bench;
+mod converge;
+mod gallery;
+mod plot;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context as _, Result};
+use clap::{Parser, Subcommand};
+
+use crate::graph::{Graph, docs};
+use crate::render::{Executor, GpuContext, NodeLibrary, Resources, image_io};
+use crate::scene::{GpuScene, Scene};
+
+const EXAMPLES: &str = "\
+Examples:
+  lumagraph render graphs/post_tonemap.ron --out out
+  lumagraph render graphs/post_tonemap.ron --set exposure.ev=1.5 --set tonemap.operator=agx
+  lumagraph plan graphs/post_tonemap.ron
+  lumagraph validate my_graph.ron
+  lumagraph nodes";
+
+/// A modular node-graph renderer: load a graph file and render it headless.
+#[derive(Parser, Debug)]
+#[command(name = "lumagraph", version, about, after_help = EXAMPLES)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render a graph: run it once on the GPU and write every Output node's file.
+    #[command(
+        after_help = "Example:\n  lumagraph render graphs/post_tonemap.ron --out out --set exposure.ev=-1"
+    )]
+    Render {
+        /// The graph file (RON).
+        graph: PathBuf,
+        /// Scene file for nodes that render a scene.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Folder Output paths are relative to (created if missing).
+        #[arg(long, default_value = ".")]
+        out: PathBuf,
+        /// Samples per pixel for graphs that render the scene (default: the scene's `spp`).
+        #[arg(long)]
+        spp: Option<u32>,
+        /// Override a param: `node.param=value` (RON value, or a bare word for names).
+        #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
+        overrides: Vec<String>,
+    },
+    /// Print the compiled plan: passes in order, textures and shared memory, what is left out.
+    #[command(after_help = "Example:\n  lumagraph plan graphs/post_tonemap.ron")]
+    Plan {
+        /// The graph file (RON).
+        graph: PathBuf,
+        /// Scene file for nodes that render a scene.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Override a param: `node.param=value`.
+        #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
+        overrides: Vec<String>,
+    },
+    /// Check a graph file without rendering it; prints every error found.
+    #[command(after_help = "Example:\n  lumagraph validate graphs/post_tonemap.ron")]
+    Validate {
+        /// The graph file (RON).
+        graph: PathBuf,
+        /// Scene file for nodes that render a scene.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+    },
+    /// List every node kind with its ports and params.
+    #[command(
+        after_help = "Examples:\n  lumagraph nodes --markdown > nodes.md\n  lumagraph nodes --graph graphs/custom_kinds.ron"
+    )]
+    Nodes {
+        /// Print the Markdown reference used in docs/graph-format.md.
+        #[arg(long)]
+        markdown: bool,
+        /// Also list the node kinds this graph file declares.
+        #[arg(long)]
+        graph: Option<PathBuf>,
+    },
+    /// Measure path tracing speed (paths/s) on the current adapter, specialized and general
+    /// shaders side by side.
+    #[command(after_help = "Example:\n  lumagraph bench --scene assets/cornell.ron --spp 64")]
+    Bench {
+        /// Scene to trace.
+        #[arg(long, default_value = "assets/cornell.ron")]
+        scene: PathBuf,
+        /// Samples per pixel per timed run.
+        #[arg(long, default_value_t = 64)]
+        spp: u32,
+        /// Timed runs; the best is reported.
+        #[arg(long, default_value_t = 3)]
+        runs: u32,
+    },
+    /// Render one image per node kind into OUT/gallery/ and the page that shows them,
+    /// OUT/gallery.md (the docs' node gallery).
+    #[command(
+        after_help = "Examples:\n  lumagraph gallery --out docs\n  lumagraph gallery --out /tmp/g --kind Bloom --kind Mix"
+    )]
+    Gallery {
+        /// Folder for gallery.md and the gallery/ images.
+        #[arg(long, default_value = "docs")]
+        out: PathBuf,
+        /// Only these kinds (the page is written only when all are made).
+        #[arg(long = "kind")]
+        kinds: Vec<String>,
+    },
+    /// Open the node editor, optionally on a graph file and a scene.
+    #[command(
+        after_help = "Examples:\n  lumagraph edit graphs/post_tonemap.ron\n  lumagraph edit graphs/pathtrace_denoise.ron --scene assets/cornell.ron"
+    )]
+    Edit {
+        /// The graph file (RON) to open.
+        graph: Option<PathBuf>,
+        /// Scene file for nodes that render a scene (also: Scene → Open scene… in the
+        /// editor).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// The preview renders scenes with their longer side at most this many pixels.
+        #[arg(long, default_value_t = crate::editor::DEFAULT_PREVIEW_MAX)]
+        preview_size: u32,
+    },
+    /// Error against run time: render progressively at 1, 2, 4… spp and score the raw
+    /// accumulation and every Denoise output against a reference (RMSE, relMSE, SSIM);
+    /// writes a CSV and a log-log plot.
+    #[command(
+        after_help = "Example:\n  lumagraph converge graphs/pathtrace_denoise.ron --scene assets/cornell.ron \\\n    --reference tests/reference/cornell_ref.exr --seconds 10 \\\n    --compare tests/reference/cornell_converge.csv --out converge"
+    )]
+    Converge {
+        /// The graph file (RON); its Output nodes are ignored.
+        graph: PathBuf,
+        /// Scene file.
+        #[arg(long)]
+        scene: PathBuf,
+        /// Reference image (EXR, linear, same size as the render).
+        #[arg(long, conflicts_with = "reference_spp")]
+        reference: Option<PathBuf>,
+        /// Render the reference first with the same graph at this many spp (another seed).
+        #[arg(long)]
+        reference_spp: Option<u32>,
+        /// Time budget in seconds: no checkpoint is started that is predicted to pass it
+        /// (twice the render time so far plus the last denoise time).
+        #[arg(long, default_value_t = 10.0)]
+        seconds: f64,
+        /// CSV with Mitsuba (and OIDN) figures per spp to plot beside ours.
+        #[arg(long)]
+        compare: Option<PathBuf>,
+        /// Folder for converge.csv and converge.png (created if missing).
+        #[arg(long, default_value = "converge")]
+        out: PathBuf,
+        /// Override a param: `node.param=value`.
+        #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
+        overrides: Vec<String>,
+    },
+    /// Write the resolved scene for other renderers: scene.json (camera, materials, spheres,
+    /// lights, environment, settings) and OBJ files of its triangles; scripts/references/
+    /// builds Mitsuba 3 scenes from it.
+    #[command(after_help = "Example:\n  lumagraph export assets/cornell.ron --out cornell_export")]
+    Export {
+        /// Scene file.
+        scene: PathBuf,
+        /// Folder to write into (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Write the generated HDR test chart (the source of `assets/test_chart.exr`).
+    #[command(hide = true)]
+    TestChart {
+        /// EXR file to write.
+        out: PathBuf,
+    },
+}
+
+fn load(path: &Path, overrides: &[String]) -> Result<Graph> {
+    let mut graph = Graph::load(path)?;
+    for o in overrides {
+        graph.apply_override(o)?;
+    }
+    Ok(graph)
+}
+
+/// A scene loaded and flattened for the GPU.
+struct LoadedScene {
+    scene: Scene,
+    gpu: Arc<GpuScene>,
+}
+
+fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
+    let Some(path) = path else { return Ok(None) };
+    let start = Instant::now();
+    let scene = Scene::load(path)?;
+    let r = &scene.report;
+    if r.degenerate_triangles + r.non_finite_triangles + r.replaced_normals > 0 {
+        println!(
+            "scene warning: dropped {} zero-area and {} non-finite triangles, replaced {} unusable normals",
+            r.degenerate_triangles, r.non_finite_triangles, r.replaced_normals
+        );
+    }
+    for w in &r.warnings {
+        println!("scene warning: {w}");
+    }
+    let gpu = GpuScene::build(&scene)?;
+    println!(
+        "scene {}: {} triangles, {} spheres, {} lights, {} textures, {} BVH nodes ({:.0} ms)",
+        path.display(),
+        gpu.tri_positions.len(),
+        gpu.spheres.len(),
+        gpu.lights.len(),
+        scene.textures.len(),
+        gpu.bvh_nodes.len(),
+        start.elapsed().as_secs_f64() * 1e3
+    );
+    Ok(Some(LoadedScene {
+        scene,
+        gpu: Arc::new(gpu),
+    }))
+}
+
+fn uses_scene(plan: &crate::graph::Plan) -> bool {
+    plan.passes.iter().any(|p| p.kind.renders_scene)
+}
+
+/// The pass the render's samples come from (it has `samples_per_frame`), if any.
+fn progressive_source(plan: &crate::graph::Plan) -> Option<&crate::graph::Pass> {
+    plan.passes
+        .iter()
+        .find(|p| p.params.has(crate::graph::registry::SAMPLES_PER_FRAME))
+}
+
+/// Runs the progressive part of the graph for `spp` samples per pixel, then the rest once,
+/// with a progress bar once the render has taken more than a second.
+fn render_progressive(exec: &mut Executor, spp: u32) -> Result<crate::render::FrameReport> {
+    let spf = progressive_source(exec.plan()).map_or(1, |p| {
+        u32::try_from(p.params.int(crate::graph::registry::SAMPLES_PER_FRAME)).unwrap_or(1)
+    });
+    let frames = spp.div_ceil(spf).max(1);
+    // Warm-up: drivers compile pipelines at their first dispatch; keep that out of the timing.
+    let warm = Instant::now();
+    exec.warm_up()?;
+    println!(
+        "warm-up (shader compilation): {:.0} ms",
+        warm.elapsed().as_secs_f64() * 1e3
+    );
+
+    let bar = indicatif::ProgressBar::with_draw_target(
+        Some(u64::from(frames)),
+        indicatif::ProgressDrawTarget::hidden(),
+    );
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} frames, {elapsed} (eta {eta})",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let start = Instant::now();
+    let mut done = 0;
+    let mut batch = 1;
+    while done + 1 < frames {
+        let n = batch.min(frames - 1 - done);
+        let t = Instant::now();
+        exec.run_frames(n, false)?;
+        done += n;
+        if t.elapsed() < Duration::from_millis(200) {
+            batch = (batch * 2).min(256);
+        }
+        if bar.is_hidden() && start.elapsed() > Duration::from_secs(1) {
+            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+        bar.set_position(u64::from(done));
+    }
+    let report = exec.run_frames(1, true)?;
+    bar.finish_and_clear();
+    let wall = start.elapsed();
+    let counters = exec.counters()?;
+    let get = |name: &str| {
+        counters
+            .iter()
+            .find(|(_, c)| c.name == name)
+            .map_or(0, |(_, c)| c.value)
+    };
+    let samples = get("samples_per_pixel");
+    let extent = progressive_source(exec.plan()).map(|p| p.extent);
+    let pixels = extent.map_or(0, crate::graph::Extent::pixels);
+    let secs = wall.as_secs_f64();
+    #[expect(clippy::cast_precision_loss, reason = "report figures")]
+    let (paths, rays) = ((pixels * samples) as f64, get("rays") as f64);
+    println!(
+        "rendered {samples} spp at {} in {secs:.2} s: {:.3} M paths/s, {:.3} M rays/s, {} NaN/Inf samples dropped",
+        extent.map_or_else(String::new, |e| e.to_string()),
+        paths / secs / 1e6,
+        rays / secs / 1e6,
+        get("dropped_samples")
+    );
+    Ok(report)
+}
+
+fn render(args: &RenderArgs<'_>) -> Result<()> {
+    let graph = load(args.graph, args.overrides)?;
+    let scene = load_scene(args.scene)?;
+    let plan = args
+        .library
+        .compile(&graph, &[], scene.as_ref().map(|s| &*s.gpu))?;
+    let progressive = uses_scene(&plan);
+    if scene.is_some() && !progressive {
+        println!("scene not used: no node of this graph renders a scene");
+    }
+    let ctx = GpuContext::headless()?;
+    println!("adapter: {}", ctx.describe());
+    let resources = Resources {
+        base_dir: graph.base_dir(),
+        out_dir: args.out.to_owned(),
+        scene: scene.as_ref().map(|s| Arc::clone(&s.gpu)),
+        ..Resources::default()
+    };
+    let left_out = plan.left_out.clone();
+    let mut exec = Executor::with_library(&ctx, plan, &resources, args.library)?;
+    for (node, note) in exec.notes() {
+        println!("{node}: {note}");
+    }
+    let report = if progressive {
+        let spp = args
+            .spp
+            .or(scene.as_ref().map(|s| s.scene.settings.spp))
+            .unwrap_or(1);
+        render_progressive(&mut exec, spp)?
+    } else {
+        // The first frame includes pipeline compilation inside the driver; time a second one.
+        let first = exec.run_frame()?;
+        let report = exec.run_frame()?;
+        println!(
+            "frame: {:.1} ms wall (first frame, with shader compilation: {:.1} ms)",
+            report.wall.as_secs_f64() * 1e3,
+            first.wall.as_secs_f64() * 1e3
+        );
+        report
+    };
+    match &report.pass_ms {
+        Some(times) => {
+            println!(
+                "time per pass (last frame; {}):",
+                report.pass_clock.describe()
+            );
+            for (name, ms) in times {
+                println!("  {name:<16} {ms:>9.3} ms");
+            }
+        }
+        None => println!("GPU time per pass: not available (adapter has no timestamp queries)"),
+    }
+    for (node, m) in exec.measurements()? {
+        println!("measured {node}.{}: {:.6e}", m.name, m.value);
+    }
+    for path in &report.written {
+        println!("wrote {}", path.display());
+    }
+    for l in &left_out {
+        println!("left out {}: {}", l.what, l.reason);
+    }
+    Ok(())
+}
+
+/// The shader features of every pass specialized to the scene: compiled in, and left out
+/// with why, for the adapter `render` would use (found without opening a device).
+fn print_features(plan: &crate::graph::Plan, scene: &GpuScene, library: &NodeLibrary) {
+    let specialized: Vec<_> = plan
+        .passes
+        .iter()
+        .filter_map(|p| {
+            library
+                .implementation(&p.kind)
+                .and_then(|i| i.features)
+                .map(|f| (p, f))
+        })
+        .collect();
+    if specialized.is_empty() {
+        return;
+    }
+    let cpu = match GpuContext::default_adapter_info() {
+        Ok(info) => {
+            println!(
+                "adapter: {} ({:?}); the shader choices below are made for it",
+                info.name, info.device_type
+            );
+            info.device_type == crate::render::wgpu::DeviceType::Cpu
+        }
+        Err(e) => {
+            println!("adapter: none found ({e}); shader choices shown for a CPU one");
+            true
+        }
+    };
+    for (pass, features) in specialized {
+        let features = features(pass, scene, cpu);
+        println!("shader features of {} for this scene:", pass.node);
+        for included in [true, false] {
+            println!("  {}:", if included { "compiled in" } else { "left out" });
+            for f in features.iter().filter(|f| f.included == included) {
+                println!("    {:<28} {}", f.name, f.reason);
+            }
+        }
+    }
+}
+
+struct RenderArgs<'a> {
+    library: &'a NodeLibrary,
+    graph: &'a Path,
+    scene: Option<&'a Path>,
+    out: &'a Path,
+    spp: Option<u32>,
+    overrides: &'a [String],
+}
+
+/// `lumagraph plan`: the plan, node-owned memory, and the shader features per pass.
+fn plan(
+    library: &NodeLibrary,
+    graph: &Path,
+    scene: Option<&Path>,
+    overrides: &[String],
+) -> Result<()> {
+    let g = load(graph, overrides)?;
+    let scene = load_scene(scene)?;
+    let plan = library.compile(&g, &[], scene.as_ref().map(|s| &*s.gpu))?;
+    print!("{plan}");
+    let owned: Vec<_> = plan
+        .passes
+        .iter()
+        .filter_map(|p| library.owned_memory(p).map(|m| (p, m)))
+        .collect();
+    if !owned.is_empty() {
+        println!("node-owned memory (outside the textures above):");
+        for (p, (bytes, what)) in owned {
+            #[expect(clippy::cast_precision_loss, reason = "report figures")]
+            let mib = bytes as f64 / (1024.0 * 1024.0);
+            println!("  {:<16} {bytes:>10} bytes ({mib:.2} MiB): {what}", p.node);
+        }
+    }
+    if let Some(scene) = &scene {
+        print_features(&plan, &scene.gpu, library);
+    }
+    Ok(())
+}
+
+/// `lumagraph validate`: compiles the graph and says how many passes it has.
+fn validate(library: &NodeLibrary, graph: &Path, scene: Option<&Path>) -> Result<()> {
+    let g = load(graph, &[])?;
+    let registry = library.registry_for(&g)?;
+    let has_sink = g
+        .nodes
+        .iter()
+        .any(|n| registry.get(&n.kind).is_some_and(|k| k.sink));
+    if !g.interface.is_empty() && !has_sink {
+        // A group file: checked on its own, it compiles inside a graph that uses it.
+        let kind = crate::render::custom::check_group(&g, registry)?;
+        let count = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
+        println!(
+            "{}: ok, a node group ({}, {}, {}, {}); it compiles inside a graph that uses it",
+            graph.display(),
+            count(kind.inputs.len(), "input"),
+            count(kind.outputs.len(), "output"),
+            count(kind.params.len(), "param"),
+            count(g.nodes.len(), "node")
+        );
+        return Ok(());
+    }
+    let scene = load_scene(scene)?;
+    let plan = library.compile(&g, &[], scene.as_ref().map(|s| &*s.gpu))?;
+    println!(
+        "{}: ok ({} passes, {} left out)",
+        graph.display(),
+        plan.passes.len(),
+        plan.left_out.len()
+    );
+    Ok(())
+}
+
+/// `lumagraph nodes`: the library's kinds, and those `graph` declares when given.
+fn nodes(library: &NodeLibrary, markdown: bool, graph: Option<&Path>) -> Result<()> {
+    let r = match graph {
+        Some(g) => library.registry_for(&load(g, &[])?)?,
+        None => library.registry().clone(),
+    };
+    print!(
+        "{}",
+        if markdown {
+            docs::markdown(&r)
+        } else {
+            docs::text(&r)
+        }
+    );
+    Ok(())
+}
+
+fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
+    match cli.command {
+        Command::Render {
+            graph,
+            scene,
+            out,
+            spp,
+            overrides,
+        } => render(&RenderArgs {
+            library,
+            graph: &graph,
+            scene: scene.as_deref(),
+            out: &out,
+            spp,
+            overrides: &overrides,
+        }),
+        Command::Plan {
+            graph,
+            scene,
+            overrides,
+        } => plan(library, &graph, scene.as_deref(), &overrides),
+        Command::Validate { graph, scene } => validate(library, &graph, scene.as_deref()),
+        Command::Nodes { markdown, graph } => nodes(library, markdown, graph.as_deref()),
+        Command::Gallery { out, kinds } => {
+            let ctx = GpuContext::headless()?;
+            gallery::run(&ctx, library, &out, &kinds)
+        }
+        Command::Bench { scene, spp, runs } => {
+            let loaded = load_scene(Some(&scene))?.context("no scene")?;
+            bench::run(&loaded.gpu, spp, runs)
+        }
+        Command::Edit {
+            graph,
+            scene,
+            preview_size,
+        } => Ok(crate::editor::run(
+            graph,
+            crate::editor::EditorConfig {
+                scene,
+                preview_max: preview_size,
+                library: Arc::clone(library),
+                ..Default::default()
+            },
+        )?),
+        Command::Converge {
+            graph,
+            scene,
+            reference,
+            reference_spp,
+            seconds,
+            compare,
+            out,
+            overrides,
+        } => converge::run(&converge::Args {
+            graph: &graph,
+            scene: &scene,
+            reference: reference.as_deref(),
+            reference_spp,
+            seconds,
+            compare: compare.as_deref(),
+            out: &out,
+            overrides: &overrides,
+            library,
+        }),
+        Command::Export { scene, out } => {
+            let loaded = load_scene(Some(&scene))?.context("no scene")?;
+            for path in crate::scene::export::export(&loaded.scene, &loaded.gpu, &out)? {
+                println!("wrote {}", path.display());
+            }
+            Ok(())
+        }
+        Command::TestChart { out } => {
+            let chart = image_io::test_chart();
+            let bytes = image_io::encode_exr(&chart, true)?;
+            crate::graph::write_atomic(&out, &bytes)
+                .with_context(|| format!("cannot write {}", out.display()))?;
+            println!("wrote {}", out.display());
+            Ok(())
+        }
+    }
+}
+
+/// Runs the `lumagraph` command line (arguments from the process) with the node kinds of
+/// `library`: they can be rendered, planned, validated, listed by `nodes`, shown by
+/// `gallery` and used in the editor (`edit`). Errors are printed with their causes.
+///
+/// Returns the process's exit code: success, or failure after an error.
+pub fn main_with(library: NodeLibrary) -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli, &Arc::new(library)) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // Library errors already spell out their causes; print a cause only when it
+            // adds something.
+            let mut shown = e.to_string();
+            eprintln!("error: {shown}");
+            let mut source = e.source();
+            while let Some(s) = source {
+                let text = s.to_string();
+                if !shown.contains(&text) {
+                    eprintln!("  caused by: {text}");
+                    shown = text;
+                }
+                source = s.source();
+            }
+            ExitCode::FAILURE
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn cli_is_well_formed() {
+        use clap::CommandFactory as _;
+        super::Cli::command().debug_assert();
+    }
+}
