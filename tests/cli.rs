@@ -712,3 +712,26 @@ fn render_prints_the_error_against_a_reference() {
         assert!(out.path().join(heat).is_file(), "{heat}");
     }
 }
+
+/// A successful render prints no line starting with `error:`, also where the session has
+/// no `XDG_RUNTIME_DIR` (Mesa's device-select layer asks Wayland for a display there, and
+/// libwayland complains on stderr; the CLI switches that layer off).
+#[test]
+fn a_successful_render_prints_no_error_line() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let out = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_lumagraph"))
+        .args(["render", "graphs/post_tonemap.ron", "--out"])
+        .arg(out.path())
+        .current_dir(common::root())
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("NODEVICE_SELECT")
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stdout}\n{stderr}");
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
+    assert!(errors.is_empty(), "{errors:?}");
+}
