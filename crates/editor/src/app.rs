@@ -297,6 +297,19 @@ impl Editor {
         if ctx.input_mut(|i| i.consume_key(cmd, Key::O)) {
             self.ask(Then::Open(PathBuf::new()));
         }
+        if !typing && ctx.input_mut(|i| i.consume_key(Modifiers::NONE, Key::Home)) {
+            self.canvas.request_frame(crate::canvas::Frame::All);
+        }
+        if !typing && ctx.input_mut(|i| i.consume_key(Modifiers::NONE, Key::F)) {
+            self.canvas.request_frame(if self.selected.is_empty() {
+                crate::canvas::Frame::All
+            } else {
+                crate::canvas::Frame::Nodes(self.selected.clone())
+            });
+        }
+        if !typing && ctx.input_mut(|i| i.consume_key(cmd, Key::D)) {
+            self.duplicate_selection();
+        }
         if !typing && ctx.input_mut(|i| i.consume_key(cmd, Key::G)) {
             self.ask_group_selection();
         }

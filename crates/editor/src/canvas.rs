@@ -9,7 +9,8 @@
 use std::collections::{BTreeMap, HashMap};
 use std::sync::Arc;
 
-use egui::{Color32, Pos2, RichText, Ui, pos2};
+use egui::emath::TSTransform;
+use egui::{Color32, Pos2, Rect, RichText, Ui, pos2, vec2};
 use egui_snarl::ui::{PinInfo, SnarlPin, SnarlStyle, SnarlViewer, SnarlWidget};
 use egui_snarl::{InPin, InPinId, NodeId, OutPin, OutPinId, Snarl};
 use lumagraph_graph::{Category, Graph, NodeKind, PortType, Registry, split_port_ref};
@@ -47,7 +48,27 @@ pub struct Canvas {
     last_selection: Vec<NodeId>,
     /// The add-node menu's search text.
     pub search: String,
+    /// Graph to screen, as last drawn.
+    view: Option<TSTransform>,
+    /// Where the canvas was on screen, as last drawn.
+    screen: Option<Rect>,
+    /// Each node's rectangle in graph space, as last drawn.
+    node_rects: HashMap<String, Rect>,
+    /// What to frame on the next draw.
+    frame: Option<Frame>,
 }
+
+/// What [`Canvas::request_frame`] brings into view.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Frame {
+    /// Every node.
+    All,
+    /// These nodes.
+    Nodes(Vec<String>),
+}
+
+/// The size assumed for a node not drawn yet, in graph units.
+const NODE_SIZE: egui::Vec2 = vec2(180.0, 120.0);
 
 impl std::fmt::Debug for Canvas {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -96,6 +117,57 @@ fn edges(graph: &Graph) -> Vec<(String, String)> {
 }
 
 impl Canvas {
+    /// Frames `what` on the next draw: the view is panned and zoomed (never beyond 1:1)
+    /// so it fills the canvas with a margin.
+    pub fn request_frame(&mut self, what: Frame) {
+        self.frame = Some(what);
+    }
+
+    /// The part of the graph visible on the canvas, in graph space (`None` before the
+    /// first draw).
+    pub fn visible_rect(&self) -> Option<Rect> {
+        Some(self.view?.inverse() * self.screen?)
+    }
+
+    /// Where a new node goes so that it shows in the middle of the canvas: its top-left
+    /// corner in graph space (`None` before the first draw).
+    pub fn new_node_pos(&self) -> Option<(f32, f32)> {
+        let c = self.visible_rect()?.center() - NODE_SIZE / 2.0;
+        Some((c.x, c.y))
+    }
+
+    /// The graph-space rectangle around the nodes `ids` of `graph` (all when `None`).
+    fn bounds(&self, graph: &Graph, ids: Option<&[String]>) -> Option<Rect> {
+        let rects = graph
+            .nodes
+            .iter()
+            .filter(|n| ids.is_none_or(|ids| ids.contains(&n.id)))
+            .map(|n| {
+                self.node_rects.get(&n.id).copied().unwrap_or_else(|| {
+                    let p = n.pos.map_or_else(
+                        || self.auto_pos.get(&n.id).copied().unwrap_or_default(),
+                        |(x, y)| pos2(x, y),
+                    );
+                    Rect::from_min_size(p, NODE_SIZE)
+                })
+            });
+        rects.reduce(Rect::union)
+    }
+
+    /// The view that shows `target` (graph space) in the middle of `screen`, filling it
+    /// with a margin, zoomed no closer than 1:1 and no further out than the canvas allows
+    /// (1:5, egui-snarl's default).
+    fn framing(target: Rect, screen: Rect) -> TSTransform {
+        let target = target.expand(40.0);
+        let scale = (screen.width() / target.width())
+            .min(screen.height() / target.height())
+            .clamp(0.2, 1.0);
+        TSTransform::new(
+            screen.center().to_vec2() - target.center().to_vec2() * scale,
+            scale,
+        )
+    }
+
     /// Rebuilds the snarl when the graph's nodes, positions or edges changed.
     fn sync(&mut self, registry: &Registry, graph: &Graph) {
         let s = structure(graph);
@@ -106,6 +178,8 @@ impl Canvas {
         let mut snarl = Snarl::new();
         let mut ids = HashMap::new();
         self.auto_pos.clear();
+        // Sizes of another graph's nodes (one opened in place) must not frame this one.
+        self.node_rects.retain(|id, _| graph.node(id).is_some());
         for (i, n) in graph.nodes.iter().enumerate() {
             #[expect(clippy::cast_precision_loss, reason = "node counts are small")]
             let pos = n
@@ -158,6 +232,13 @@ impl Canvas {
         info: &NodeInfo<'_>,
     ) -> Vec<CanvasEvent> {
         self.sync(doc.registry(), &doc.graph);
+        let screen = ui.max_rect();
+        self.screen = Some(screen);
+        let frame = match self.frame.take() {
+            Some(Frame::All) => self.bounds(&doc.graph, None),
+            Some(Frame::Nodes(ids)) => self.bounds(&doc.graph, Some(&ids)),
+            None => None,
+        };
         let mut events = Vec::new();
         let mut viewer = Viewer {
             doc,
@@ -165,6 +246,9 @@ impl Canvas {
             events: &mut events,
             search: &mut self.search,
             rects: Vec::new(),
+            graph_rects: Vec::new(),
+            frame: frame.map(|r| Self::framing(r, screen)),
+            view: None,
         };
         let style = SnarlStyle {
             collapsible: Some(false),
@@ -179,6 +263,10 @@ impl Canvas {
             .style(style)
             .show(&mut self.snarl, &mut viewer, ui);
         let rects = std::mem::take(&mut viewer.rects);
+        self.view = viewer.view.or(self.view);
+        self.node_rects = std::mem::take(&mut viewer.graph_rects)
+            .into_iter()
+            .collect();
 
         // A plain click selects a node (shift or ctrl adds or removes it); a click on
         // empty canvas clears the selection. Snarl's own rectangle selection is followed
@@ -273,6 +361,12 @@ struct Viewer<'a, 'i> {
     search: &'a mut String,
     /// Each node's rectangle on screen, in drawing order (topmost last).
     rects: Vec<(String, egui::Rect)>,
+    /// Each node's rectangle in graph space.
+    graph_rects: Vec<(String, egui::Rect)>,
+    /// A view to take (framing), applied when the snarl asks.
+    frame: Option<TSTransform>,
+    /// The view the snarl is drawn with.
+    view: Option<TSTransform>,
 }
 
 impl Viewer<'_, '_> {
@@ -497,6 +591,14 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
             .layer_transform_to_global(ui.layer_id())
             .map_or(rect, |t| t * rect);
         self.rects.push((snarl[node].clone(), global));
+        self.graph_rects.push((snarl[node].clone(), rect));
+    }
+
+    fn current_transform(&mut self, to_global: &mut TSTransform, _snarl: &mut Snarl<String>) {
+        if let Some(frame) = self.frame.take() {
+            *to_global = frame;
+        }
+        self.view = Some(*to_global);
     }
 
     fn has_graph_menu(&mut self, _pos: Pos2, _snarl: &mut Snarl<String>) -> bool {

@@ -977,3 +977,112 @@ fn a_changed_wgsl_file_reloads_and_a_broken_one_keeps_the_last_good_pipeline() {
         Some(&first.rgba)
     );
 }
+
+/// A graph opens framed (every node in view); a node added from the menu bar appears in
+/// the middle of the view, selected; Frame selected (F) brings a node far away into view,
+/// Frame all (Home) every node (as far as the canvas zooms out: 1:5).
+#[test]
+fn new_nodes_appear_in_view_and_framing_brings_nodes_into_view() {
+    let Some(ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    let mut h = harness(ed);
+    h.run_ok();
+    let inside = |ed: &lumagraph_editor::Editor, id: &str| {
+        let view = ed.canvas.visible_rect().expect("drawn");
+        let (x, y) = ed
+            .doc
+            .graph
+            .node(id)
+            .and_then(|n| n.pos)
+            .expect("a position");
+        view.contains(egui::pos2(x, y))
+    };
+    let ed = h.state();
+    for n in &ed.doc.graph.nodes {
+        assert!(inside(ed, &n.id), "{} is out of view", n.id);
+    }
+    // Add from the menu bar: in view, selected.
+    h.state_mut().add_node_in_view("Blur");
+    h.run_ok();
+    let ed = h.state();
+    assert_eq!(ed.selected, ["blur"]);
+    assert!(inside(ed, "blur"), "the new node is out of view");
+    let view = ed.canvas.visible_rect().unwrap();
+    let (x, y) = ed.doc.graph.node("blur").unwrap().pos.unwrap();
+    assert!(
+        (x - view.center().x).abs() < 200.0 && (y - view.center().y).abs() < 200.0,
+        "not near the middle: ({x}, {y}) in {view:?}"
+    );
+    // A node far away: out of view until framed.
+    let ed = h.state_mut();
+    ed.doc
+        .move_nodes(&[("blur".to_owned(), (2_500.0, 1_200.0))]);
+    h.run_ok();
+    assert!(!inside(h.state(), "blur"));
+    h.state_mut().select(vec!["blur".into()]);
+    h.key_press(egui::Key::F);
+    h.run_ok();
+    assert!(
+        inside(h.state(), "blur"),
+        "Frame selected did not bring it into view"
+    );
+    h.key_press(egui::Key::Home);
+    h.run_ok();
+    let ed = h.state();
+    for n in &ed.doc.graph.nodes {
+        assert!(inside(ed, &n.id), "Frame all left {} out", n.id);
+    }
+}
+
+/// The keyboard shortcuts the menus show, sent as key presses: Ctrl+D duplicates, Delete
+/// deletes, Ctrl+Z undoes, Ctrl+Y and Ctrl+Shift+Z redo, Ctrl+S saves.
+#[test]
+fn keyboard_shortcuts_work() {
+    use egui::{Key, Modifiers};
+    let Some(ed) = editor(None, None) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("g.ron");
+    let text = std::fs::read_to_string(post_tonemap())
+        .unwrap()
+        .replace("../assets/", &format!("{}/", repo("assets").display()));
+    std::fs::write(&path, text).unwrap();
+    let mut h = harness(ed);
+    h.state_mut().open(&path);
+    h.state_mut().select(vec!["exposure".into()]);
+    h.run_ok();
+    let nodes = |h: &egui_kittest::Harness<'static, lumagraph_editor::Editor>| {
+        h.state().doc.graph.nodes.len()
+    };
+    h.key_press_modifiers(Modifiers::COMMAND, Key::D);
+    h.run_ok();
+    assert_eq!(nodes(&h), 5, "Ctrl+D");
+    assert_eq!(h.state().selected, ["exposure_2"]);
+    h.key_press(Key::Delete);
+    h.run_ok();
+    assert_eq!(nodes(&h), 4, "Delete");
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run_ok();
+    assert_eq!(nodes(&h), 5, "Ctrl+Z");
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Y);
+    h.run_ok();
+    assert_eq!(nodes(&h), 4, "Ctrl+Y");
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    h.run_ok();
+    assert_eq!(nodes(&h), 4, "Ctrl+Shift+Z");
+    h.state_mut()
+        .doc
+        .set_param("exposure", "ev", ParamValue::Float(0.75));
+    assert!(h.state().title().starts_with('●'));
+    h.key_press_modifiers(Modifiers::COMMAND, Key::S);
+    h.run_ok();
+    assert!(!h.state().title().starts_with('●'), "Ctrl+S did not save");
+    let saved = Graph::load(&path).unwrap();
+    assert_eq!(
+        saved.node("exposure").unwrap().params["ev"],
+        ParamValue::Float(0.75)
+    );
+}

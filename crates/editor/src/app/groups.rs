@@ -98,6 +98,7 @@ impl Editor {
             Document::with_library(graph, Some(file.clone()), library),
         );
         self.errors_for = None;
+        self.canvas.request_frame(crate::canvas::Frame::All);
         self.outer.push(Outer {
             doc,
             node: id.to_owned(),
@@ -127,6 +128,8 @@ impl Editor {
         };
         self.doc = outer.doc;
         self.errors_for = None;
+        self.canvas
+            .request_frame(crate::canvas::Frame::Nodes(vec![outer.node.clone()]));
         self.selected = outer.selected;
         self.preview_port = outer.preview_port;
         match self.doc.reload_registry() {

@@ -161,6 +161,11 @@ impl Editor {
         match files::open(path) {
             Ok(graph) => {
                 self.doc.replace(graph, Some(path.to_owned()));
+                // The canvas frames the nodes by itself on its first draw; later it keeps
+                // its view, so a graph opened in place is framed here.
+                if self.canvas.visible_rect().is_some() {
+                    self.canvas.request_frame(crate::canvas::Frame::All);
+                }
                 self.selected.clear();
                 self.preview_port = None;
                 if let Err(e) = self.recent.add(path) {

@@ -7,16 +7,28 @@ use std::path::PathBuf;
 use egui::Ui;
 
 use super::{Dialog, Editor, Pick, Then};
-use crate::canvas::add_node_menu;
+use crate::canvas::{Frame, add_node_menu};
 
 impl Editor {
+    /// Adds a node of `kind` in the middle of the canvas's view and selects it (the Add
+    /// node menu).
+    pub fn add_node_in_view(&mut self, kind: &str) {
+        match self.doc.add_node(kind, self.canvas.new_node_pos()) {
+            Ok(id) => self.select(vec![id]),
+            Err(e) => self.say(e, true),
+        }
+    }
+
     pub(super) fn menu_bar(&mut self, ui: &mut Ui) {
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("File", |ui| {
                 if ui.button("New").clicked() {
                     self.ask(Then::New);
                 }
-                if ui.button("Open…").clicked() {
+                if ui
+                    .add(egui::Button::new("Open…").shortcut_text("Ctrl+O"))
+                    .clicked()
+                {
                     self.ask(Then::Open(PathBuf::new()));
                 }
                 ui.menu_button("Open recent", |ui| {
@@ -29,7 +41,10 @@ impl Editor {
                         }
                     }
                 });
-                if ui.button("Save").clicked() {
+                if ui
+                    .add(egui::Button::new("Save").shortcut_text("Ctrl+S"))
+                    .clicked()
+                {
                     self.save_or_ask();
                 }
                 if ui.button("Save as…").clicked() {
@@ -40,67 +55,7 @@ impl Editor {
                     self.ask(Then::Quit);
                 }
             });
-            ui.menu_button("Edit", |ui| {
-                let (can_undo, can_redo) = self.doc.can_undo_redo();
-                if ui
-                    .add_enabled(can_undo, egui::Button::new("Undo"))
-                    .clicked()
-                {
-                    self.doc.undo();
-                }
-                if ui
-                    .add_enabled(can_redo, egui::Button::new("Redo"))
-                    .clicked()
-                {
-                    self.doc.redo();
-                }
-                ui.separator();
-                let any = !self.selected.is_empty();
-                if ui.add_enabled(any, egui::Button::new("Copy")).clicked()
-                    && let Some(t) = self.copy_selection()
-                {
-                    ui.ctx().copy_text(t);
-                }
-                if ui.button("Paste").clicked() {
-                    self.paste(None);
-                }
-                if ui.add_enabled(any, egui::Button::new("Delete")).clicked() {
-                    self.delete_selection();
-                }
-                ui.separator();
-                if ui
-                    .add_enabled(
-                        any,
-                        egui::Button::new("Group selected nodes…").shortcut_text("Ctrl+G"),
-                    )
-                    .clicked()
-                {
-                    self.ask_group_selection();
-                }
-                let group = match self.selected.as_slice() {
-                    [one] => self.group_file(one).map(|_| one.clone()),
-                    _ => None,
-                };
-                if ui
-                    .add_enabled(
-                        group.is_some(),
-                        egui::Button::new("Open group").shortcut_text("Tab"),
-                    )
-                    .clicked()
-                    && let Some(id) = group
-                {
-                    self.open_group(&id);
-                }
-                if ui
-                    .add_enabled(
-                        !self.outer.is_empty(),
-                        egui::Button::new("Leave group").shortcut_text("Tab"),
-                    )
-                    .clicked()
-                {
-                    self.leave_group();
-                }
-            });
+            ui.menu_button("Edit", |ui| self.edit_menu(ui));
             ui.menu_button("Scene", |ui| {
                 if ui.button("Open scene…").clicked() {
                     self.open_file_dialog(Pick::Scene);
@@ -120,16 +75,103 @@ impl Editor {
                     self.close_scene();
                 }
             });
+            ui.menu_button("View", |ui| {
+                if ui
+                    .add(egui::Button::new("Frame all").shortcut_text("Home"))
+                    .clicked()
+                {
+                    self.canvas.request_frame(Frame::All);
+                }
+                let any = !self.selected.is_empty();
+                if ui
+                    .add_enabled(any, egui::Button::new("Frame selected").shortcut_text("F"))
+                    .clicked()
+                {
+                    self.canvas
+                        .request_frame(Frame::Nodes(self.selected.clone()));
+                }
+            });
             ui.menu_button("Add node", |ui| {
                 if let Some(kind) = add_node_menu(ui, self.doc.registry(), &mut self.canvas.search)
                 {
-                    match self.doc.add_node(kind, None) {
-                        Ok(id) => self.select(vec![id]),
-                        Err(e) => self.say(e, true),
-                    }
+                    self.add_node_in_view(kind);
                 }
             });
         });
+    }
+
+    /// The Edit menu: undo, clipboard, duplicate, delete, groups.
+    fn edit_menu(&mut self, ui: &mut Ui) {
+        let (can_undo, can_redo) = self.doc.can_undo_redo();
+        if ui
+            .add_enabled(can_undo, egui::Button::new("Undo").shortcut_text("Ctrl+Z"))
+            .clicked()
+        {
+            self.doc.undo();
+        }
+        if ui
+            .add_enabled(
+                can_redo,
+                egui::Button::new("Redo").shortcut_text("Ctrl+Shift+Z"),
+            )
+            .clicked()
+        {
+            self.doc.redo();
+        }
+        ui.separator();
+        let any = !self.selected.is_empty();
+        if ui
+            .add_enabled(any, egui::Button::new("Copy").shortcut_text("Ctrl+C"))
+            .clicked()
+            && let Some(t) = self.copy_selection()
+        {
+            ui.ctx().copy_text(t);
+        }
+        if ui
+            .add(egui::Button::new("Paste").shortcut_text("Ctrl+V"))
+            .clicked()
+        {
+            self.paste(None);
+        }
+        if ui
+            .add_enabled(any, egui::Button::new("Delete").shortcut_text("Del"))
+            .clicked()
+        {
+            self.delete_selection();
+        }
+        ui.separator();
+        if ui
+            .add_enabled(
+                any,
+                egui::Button::new("Group selected nodes…").shortcut_text("Ctrl+G"),
+            )
+            .clicked()
+        {
+            self.ask_group_selection();
+        }
+        let group = match self.selected.as_slice() {
+            [one] => self.group_file(one).map(|_| one.clone()),
+            _ => None,
+        };
+        if ui
+            .add_enabled(
+                group.is_some(),
+                egui::Button::new("Open group").shortcut_text("Tab"),
+            )
+            .clicked()
+            && let Some(id) = group
+        {
+            self.open_group(&id);
+        }
+        if ui
+            .add_enabled(
+                !self.outer.is_empty(),
+                egui::Button::new("Leave group").shortcut_text("Tab"),
+            )
+            .clicked()
+        {
+            self.leave_group();
+        }
     }
 
     pub(super) fn dialogs(&mut self, ui: &Ui) {

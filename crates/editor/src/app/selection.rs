@@ -87,6 +87,18 @@ impl Editor {
         }
     }
 
+    /// Duplicates the selected nodes (and the edges between them) beside themselves and
+    /// selects the copies; the clipboard is left alone.
+    pub fn duplicate_selection(&mut self) {
+        if self.selected.is_empty() {
+            return;
+        }
+        let clip = self.doc.copy(&self.selected);
+        let ids = self.doc.paste(&clip, (40.0, 40.0));
+        self.say(format!("duplicated as {}", ids.join(", ")), false);
+        self.selected = ids;
+    }
+
     /// Deletes the selected nodes.
     pub fn delete_selection(&mut self) {
         let ids = std::mem::take(&mut self.selected);
