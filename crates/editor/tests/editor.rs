@@ -1086,3 +1086,44 @@ fn keyboard_shortcuts_work() {
         ParamValue::Float(0.75)
     );
 }
+
+/// Saving keeps what the user wrote: the header comment of a shipped graph survives an
+/// edit and a save from the editor, and nodes stay one per line.
+#[test]
+fn save_keeps_the_comments_of_the_file() {
+    let Some(ed) = editor(None, None) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("g.ron");
+    let text = std::fs::read_to_string(post_tonemap())
+        .unwrap()
+        .replace("../assets/", &format!("{}/", repo("assets").display()))
+        .replace(
+            "        (id: \"tonemap\"",
+            "        // The curve: try agx.\n        (id: \"tonemap\"",
+        );
+    std::fs::write(&path, &text).unwrap();
+    let mut h = harness(ed);
+    h.state_mut().open(&path);
+    h.state_mut()
+        .doc
+        .set_param("exposure", "ev", ParamValue::Float(0.5));
+    h.state_mut().save().unwrap();
+    let saved = std::fs::read_to_string(&path).unwrap();
+    let header: Vec<&str> = text.lines().take_while(|l| l.starts_with("//")).collect();
+    assert!(!header.is_empty());
+    for line in header {
+        assert!(saved.contains(line), "lost {line:?}:\n{saved}");
+    }
+    assert!(
+        saved.contains("        // The curve: try agx.\n        (id: \"tonemap\""),
+        "{saved}"
+    );
+    assert!(
+        saved.contains("(id: \"exposure\", kind: \"Exposure\", params: {\"ev\": 0.5}"),
+        "{saved}"
+    );
+    // Nothing else changed.
+    assert_eq!(saved.replace("\"ev\": 0.5", "\"ev\": 0.0"), text);
+}

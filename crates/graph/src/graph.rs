@@ -113,6 +113,11 @@ pub struct Origin {
 }
 
 impl Origin {
+    /// The text the graph was read from.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
     /// The origin of a graph read from `path`, whose text was `text`.
     pub fn new(path: PathBuf, text: String) -> Self {
         Self { path, text }
@@ -281,7 +286,9 @@ impl Graph {
         })
     }
 
-    /// The graph as RON text, in the canonical layout `save` writes.
+    /// The graph as RON text, in the canonical layout `save` writes (one node and one
+    /// edge per line), with the comments of the file it was loaded from where they belong
+    /// (see [`crate::layout`]).
     pub fn to_ron(&self) -> String {
         let version = if !(self.groups.is_empty() && self.interface.is_empty()) {
             3
@@ -290,22 +297,7 @@ impl Graph {
         } else {
             1
         };
-        let file = GraphFile {
-            version,
-            interface: self.interface.clone(),
-            groups: self.groups.clone(),
-            kinds: self.kinds.clone(),
-            nodes: self.nodes.clone(),
-            edges: self.edges.clone(),
-        };
-        let config = ron::ser::PrettyConfig::new()
-            .depth_limit(3)
-            .struct_names(false)
-            .indentor("    ");
-        let mut text = ron::ser::to_string_pretty(&file, config)
-            .expect("a graph always serializes: it holds only strings, numbers and maps");
-        text.push('\n');
-        text
+        crate::layout::write(self, version)
     }
 
     /// Writes the graph to `path` atomically: a temporary file in the same folder,

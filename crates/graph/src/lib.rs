@@ -14,6 +14,7 @@ pub mod docs;
 mod error;
 mod graph;
 pub mod group;
+pub mod layout;
 mod plan;
 pub mod registry;
 mod types;
