@@ -114,6 +114,8 @@ pub struct Editor {
     pub preview: Preview,
     /// The scope under the preview.
     pub scope: crate::scope::ScopeView,
+    /// The preview's image viewer: zoom, readout, exposure, A/B compare.
+    pub view: crate::viewer::ImageView,
     /// Selected node ids.
     pub selected: Vec<String>,
     /// The port chosen for preview (`"node.port"`); `None` follows the selection.
@@ -167,6 +169,7 @@ impl Editor {
             canvas: Canvas::default(),
             preview: Preview::with_library(gpu, Arc::clone(&config.library)),
             scope: crate::scope::ScopeView::default(),
+            view: crate::viewer::ImageView::new(),
             selected: Vec::new(),
             preview_port: None,
             errors: BTreeMap::new(),

@@ -23,6 +23,7 @@ pub mod inspector;
 pub mod preview;
 pub mod scope;
 pub mod undo;
+pub mod viewer;
 
 use std::path::PathBuf;
 use std::sync::Arc;

@@ -91,6 +91,9 @@ pub struct Preview {
     pub paused: bool,
     /// The last image.
     pub image: Option<PreviewImage>,
+    /// The last image as read back (linear values for HDR ports) with its port type: what
+    /// the viewer shows and reads values from.
+    pub linear: Option<(lumagraph_render::cpu::Image, PortType)>,
     texture: Option<egui::TextureHandle>,
     texture_stale: bool,
     /// Milliseconds per node of the last frame (see `FrameReport::pass_clock`; empty when
@@ -219,6 +222,7 @@ impl Preview {
             target_spp: 0,
             paused: false,
             image: None,
+            linear: None,
             texture: None,
             texture_stale: false,
             pass_ms: BTreeMap::new(),
@@ -291,6 +295,7 @@ impl Preview {
     fn clear(&mut self, error: Option<String>) {
         self.key = None;
         self.image = None;
+        self.linear = None;
         self.texture = None;
         self.pass_ms.clear();
         self.measurements.clear();
@@ -467,6 +472,7 @@ impl Preview {
             height: image.height,
             rgba,
         });
+        self.linear = Some((image, ty));
         self.texture_stale = true;
         if let Some(exec) = &mut self.exec {
             self.measurements = exec.measurements().map_err(|e| e.to_string())?;

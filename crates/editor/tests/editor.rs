@@ -1127,3 +1127,107 @@ fn save_keeps_the_comments_of_the_file() {
     // Nothing else changed.
     assert_eq!(saved.replace("\"ev\": 0.5", "\"ev\": 0.0"), text);
 }
+
+/// The preview's viewer: the readout under the pointer is the port's linear value (the
+/// chart × 2^ev, against the CPU, to 1e-5 relative); a pinned snapshot compared with a wipe shows the live
+/// image left of the line and the snapshot right of it, on screen and in the readout.
+#[test]
+fn pixel_readout_and_a_b_wipe() {
+    let Some(ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    let chart = lumagraph_render::image_io::load(&repo("assets/test_chart.exr")).unwrap();
+    let mut h = harness(ed);
+    h.state_mut().select(vec!["exposure".into()]);
+    h.state_mut()
+        .doc
+        .set_param("exposure", "ev", ParamValue::Float(-3.0));
+    h.run_ok();
+    // Zoomed in (nearest-neighbour pixels), centred on the image.
+    let view = &mut h.state_mut().view;
+    view.zoom = Some(4.0);
+    view.center = egui::vec2(chart.width as f32 / 2.0, chart.height as f32 / 2.0);
+    h.run_ok();
+    // Where pixel (x, y) is on screen as the viewer last drew the image (the panel's
+    // layout changes with its controls, so this is asked each time).
+    let screen = |h: &egui_kittest::Harness<'static, lumagraph_editor::Editor>, x: u32, y: u32| {
+        let rect = h.state().view.rect.expect("drawn");
+        let scale = rect.width() / chart.width as f32;
+        rect.min + egui::vec2(x as f32 + 0.5, y as f32 + 0.5) * scale
+    };
+    let (x, y) = (chart.width / 2 - 3, chart.height / 2 + 10);
+    h.hover_at(screen(&h, x, y));
+    h.run_ok();
+    let r = h.state().view.hover.expect("a readout");
+    assert_eq!((r.x, r.y), (x, y));
+    let want = chart.pixels[(y * chart.width + x) as usize];
+    for c in 0..3 {
+        assert!(
+            (r.rgba[c] - 0.125 * want[c]).abs() <= 1e-5 * want[c].abs().max(1.0),
+            "channel {c}: {} vs 2^-3 × {}",
+            r.rgba[c],
+            want[c]
+        );
+    }
+    assert!(!r.from_snapshot);
+
+    // Pin at ev -3, go to ev -1: the live image is 4× the snapshot.
+    let ed = h.state_mut();
+    let (image, ty) = ed.preview.linear.clone().expect("an image");
+    ed.view.pin("exposure.color", image, ty, None);
+    ed.view.compare = lumagraph_editor::viewer::Compare::Wipe;
+    ed.view.wipe = 0.5;
+    ed.doc.set_param("exposure", "ev", ParamValue::Float(-1.0));
+    h.run_ok();
+    h.run_ok();
+    let live = h.state().preview.linear.clone().unwrap().0;
+    let snap = h.state().view.pinned.as_ref().unwrap().image.clone();
+    let snap = &snap;
+    // The wipe is at the middle of the view, which is centred on the image.
+    let wipe_x = screen(&h, chart.width / 2, 0).x;
+    let (xl, xr) = (chart.width / 2 - 4, chart.width / 2 + 3);
+    assert!(screen(&h, xl, y).x < wipe_x && screen(&h, xr, y).x > wipe_x);
+    h.hover_at(screen(&h, xr, y));
+    h.run_ok();
+    let right = h.state().view.hover.expect("a readout");
+    assert!(right.from_snapshot);
+    assert_eq!((right.x, right.y), (xr, y));
+    assert_eq!(right.rgba, snap.pixels[(y * chart.width + xr) as usize]);
+    h.hover_at(screen(&h, xl, y));
+    h.run_ok();
+    let left = h.state().view.hover.expect("a readout");
+    assert!(!left.from_snapshot);
+    assert_eq!(left.rgba, live.pixels[(y * chart.width + xl) as usize]);
+    // On screen: the displayed bytes of each side.
+    // The pointer away, so its arrow does not cover the pixels looked at.
+    h.hover_at(egui::pos2(300.0, 500.0));
+    h.run_ok();
+    let (pl, pr) = (screen(&h, xl, y), screen(&h, xr, y));
+    let shot = h.render().expect("a rendering");
+    let shown = |p: egui::Pos2| {
+        let px = shot.get_pixel(p.x as u32, p.y as u32).0;
+        [px[0], px[1], px[2]]
+    };
+    let bytes = |img: &lumagraph_render::cpu::Image, x: u32| {
+        let rgba = lumagraph_editor::viewer::display_rgba(img, ty, 0.0, false);
+        let i = 4 * (y * chart.width + x) as usize;
+        [rgba[i], rgba[i + 1], rgba[i + 2]]
+    };
+    let close = |a: [u8; 3], b: [u8; 3]| a.iter().zip(&b).all(|(a, b)| a.abs_diff(*b) <= 2);
+    let (l_live, l_snap) = (bytes(&live, xl), bytes(snap, xl));
+    let (r_live, r_snap) = (bytes(&live, xr), bytes(snap, xr));
+    assert!(
+        !close(r_live, r_snap),
+        "pick pixels where the images differ"
+    );
+    assert!(
+        close(shown(pl), l_live),
+        "{:?} vs live {l_live:?} / snapshot {l_snap:?}",
+        shown(pl)
+    );
+    assert!(
+        close(shown(pr), r_snap),
+        "{:?} vs snapshot {r_snap:?} / live {r_live:?}",
+        shown(pr)
+    );
+}

@@ -61,14 +61,15 @@ impl Editor {
             Some(p) => ui.weak(p),
             None => ui.weak("nothing to preview"),
         };
-        let ctx = ui.ctx().clone();
         if let Some(err) = &self.preview.error {
             ui.colored_label(Color32::from_rgb(240, 90, 90), err);
-        } else if let Some(tex) = self.preview.texture(&ctx) {
-            let size = tex.size_vec2();
-            let w = ui.available_width().min(size.x.max(1.0) * 2.0);
-            let h = w * size.y / size.x.max(1.0);
-            ui.add(egui::Image::new((tex.id(), egui::vec2(w, h))));
+        } else if let Some((image, ty)) = &self.preview.linear {
+            // Fitted, an image is shown at most at twice its size, in at most 320 points.
+            let aspect = image.height as f32 / image.width.max(1) as f32;
+            let w = ui.available_width().min(2.0 * image.width as f32);
+            let h = (w * aspect).clamp(64.0, 320.0);
+            self.view.show(ui, image, *ty, self.preview.stats.frames, h);
+            self.viewer_controls(ui, port);
             let size = self
                 .preview
                 .image
@@ -128,6 +129,99 @@ impl Editor {
                 ui.label(format!("{} nodes selected", many.len()));
             }
         });
+    }
+
+    /// Under the preview image: zoom, display exposure and false colour (HDR ports), the
+    /// snapshot and compare mode, and the values under the pointer.
+    fn viewer_controls(&mut self, ui: &mut Ui, port: Option<&str>) {
+        use crate::viewer::Compare;
+        let hdr = self
+            .preview
+            .linear
+            .as_ref()
+            .is_some_and(|(_, ty)| *ty != lumagraph_graph::PortType::LdrColor);
+        let v = &mut self.view;
+        ui.horizontal_wrapped(|ui| {
+            let zoom = v
+                .zoom
+                .map_or_else(|| "fit".to_owned(), |z| format!("{:.0} %", z * 100.0));
+            ui.weak(zoom)
+                .on_hover_text("scroll to zoom, drag to pan, double-click to fit");
+            if ui.small_button("fit").clicked() {
+                v.zoom = None;
+            }
+            if ui.small_button("1:1").clicked() {
+                v.zoom = Some(1.0);
+            }
+            if hdr {
+                ui.add(
+                    egui::Slider::new(&mut v.exposure, -10.0..=10.0)
+                        .step_by(0.25)
+                        .text("EV"),
+                )
+                .on_hover_text("display exposure: changes what is shown, not the graph");
+                ui.checkbox(&mut v.false_colour, "false colour")
+                    .on_hover_text(
+                        "luminance in stops around middle grey: blue −6, green 0, red +4, white +6",
+                    );
+            }
+        });
+        ui.horizontal_wrapped(|ui| {
+            if ui
+                .button("📌 pin")
+                .on_hover_text("keep this image to compare the live one against")
+                .clicked()
+                && let (Some((image, ty)), Some(p)) = (&self.preview.linear, port)
+            {
+                self.view.pin(p, image.clone(), *ty, self.preview.samples);
+            }
+            let v = &mut self.view;
+            if let Some(s) = &v.pinned {
+                ui.weak(format!(
+                    "snapshot: {}{}",
+                    s.port,
+                    s.spp.map_or_else(String::new, |n| format!(", {n} spp"))
+                ));
+                egui::ComboBox::from_id_salt("compare")
+                    .selected_text(match v.compare {
+                        Compare::Off => "live only",
+                        Compare::Wipe => "wipe",
+                        Compare::SideBySide => "side by side",
+                    })
+                    .show_ui(ui, |ui| {
+                        ui.selectable_value(&mut v.compare, Compare::Off, "live only");
+                        ui.selectable_value(&mut v.compare, Compare::Wipe, "wipe");
+                        ui.selectable_value(&mut v.compare, Compare::SideBySide, "side by side");
+                    });
+                if v.compare == Compare::Wipe {
+                    ui.add(egui::Slider::new(&mut v.wipe, 0.0..=1.0).show_value(false))
+                        .on_hover_text("where the live image (left) gives way to the snapshot");
+                }
+                if ui.small_button("unpin").clicked() {
+                    v.pinned = None;
+                    v.compare = Compare::Off;
+                }
+            }
+        });
+        match self.view.hover {
+            Some(r) => {
+                let [red, g, b, a] = r.rgba;
+                let from = if r.from_snapshot { " (snapshot)" } else { "" };
+                let spp = self
+                    .preview
+                    .samples
+                    .filter(|_| !r.from_snapshot)
+                    .map_or_else(String::new, |n| format!("  {n} spp"));
+                let text = format!(
+                    "({}, {}){from}  R {red:.5}  G {g:.5}  B {b:.5}  A {a:.3}  Y {:.5}{spp}",
+                    r.x, r.y, r.luminance
+                );
+                ui.add(egui::Label::new(egui::RichText::new(text).monospace()).wrap());
+            }
+            None => {
+                ui.weak("point at the image for its values");
+            }
+        }
     }
 
     pub(super) fn scene_line(&mut self, ui: &mut Ui) {
