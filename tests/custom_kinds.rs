@@ -6,7 +6,6 @@
 mod common;
 
 use std::path::Path;
-use std::process::Command;
 
 use common::{map_pixels, repo};
 use lumagraph::graph::{Graph, ParamValue};
@@ -42,18 +41,7 @@ fn run(path: &Path, keep: &[&str]) -> Option<Vec<lumagraph::render::cpu::Image>>
     Some(keep.iter().map(|k| exec.read_port(k).unwrap()).collect())
 }
 
-fn lumagraph(args: &[&str]) -> (bool, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_lumagraph"))
-        .args(args)
-        .current_dir(common::root())
-        .output()
-        .unwrap();
-    (
-        o.status.success(),
-        String::from_utf8_lossy(&o.stdout).into_owned(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
-}
+use common::cli as lumagraph;
 
 const MY_EXPOSURE: &str = r#"        (
             name: "MyExposure",

@@ -7,7 +7,6 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use lumagraph::graph::{Graph, Registry};
 use lumagraph::render::{Executor, Resources, compile};
@@ -21,18 +20,7 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     path
 }
 
-fn lumagraph(args: &[&str]) -> (bool, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_lumagraph"))
-        .args(args)
-        .current_dir(common::root())
-        .output()
-        .unwrap();
-    (
-        o.status.success(),
-        String::from_utf8_lossy(&o.stdout).into_owned(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
-}
+use common::cli as lumagraph;
 
 /// `graphs/node_group.ron` written out by hand without its group: the Lens group's nodes
 /// named `lens/…`, the group node's `vignette` param on `lens/vignette`.

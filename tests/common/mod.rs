@@ -356,3 +356,17 @@ pub fn map_pixels(
     }
     out
 }
+
+/// Runs the `lumagraph` binary from the repository root: (success, stdout, stderr).
+pub fn cli(args: &[&str]) -> (bool, String, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_lumagraph"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .unwrap();
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}

@@ -16,6 +16,14 @@ fn post_tonemap() -> std::path::PathBuf {
     repo("graphs/post_tonemap.ron")
 }
 
+/// The text of the shipped graph `name` with its asset paths made absolute, so a copy
+/// works from any folder.
+fn shipped_text(name: &str) -> String {
+    std::fs::read_to_string(repo(&format!("graphs/{name}")))
+        .unwrap()
+        .replace("../assets/", &format!("{}/", repo("assets").display()))
+}
+
 #[test]
 fn loads_a_graph_and_previews_it() {
     let Some(ed) = editor(Some(&post_tonemap()), None) else {
@@ -806,9 +814,7 @@ fn group_nodes_open_the_group_edit_it_and_leave() {
     };
     let dir = tempfile::tempdir().unwrap();
     let main = dir.path().join("main.ron");
-    let text = std::fs::read_to_string(post_tonemap())
-        .unwrap()
-        .replace("../assets/", &format!("{}/", repo("assets").display()));
+    let text = shipped_text("post_tonemap.ron");
     std::fs::write(&main, text).unwrap();
     let mut h = harness(ed);
     h.state_mut().open(&main);
@@ -909,9 +915,7 @@ fn a_changed_wgsl_file_reloads_and_a_broken_one_keeps_the_last_good_pipeline() {
     };
     let dir = tempfile::tempdir().unwrap();
     let graph = dir.path().join("custom.ron");
-    let text = std::fs::read_to_string(repo("graphs/custom_kinds.ron"))
-        .unwrap()
-        .replace("../assets/", &format!("{}/", repo("assets").display()));
+    let text = shipped_text("custom_kinds.ron");
     std::fs::write(&graph, text).unwrap();
     let wgsl = dir.path().join("posterize.wgsl");
     let original = std::fs::read_to_string(repo("graphs/posterize.wgsl")).unwrap();
@@ -1045,9 +1049,7 @@ fn keyboard_shortcuts_work() {
     };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("g.ron");
-    let text = std::fs::read_to_string(post_tonemap())
-        .unwrap()
-        .replace("../assets/", &format!("{}/", repo("assets").display()));
+    let text = shipped_text("post_tonemap.ron");
     std::fs::write(&path, text).unwrap();
     let mut h = harness(ed);
     h.state_mut().open(&path);
@@ -1096,13 +1098,10 @@ fn save_keeps_the_comments_of_the_file() {
     };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("g.ron");
-    let text = std::fs::read_to_string(post_tonemap())
-        .unwrap()
-        .replace("../assets/", &format!("{}/", repo("assets").display()))
-        .replace(
-            "        (id: \"tonemap\"",
-            "        // The curve: try agx.\n        (id: \"tonemap\"",
-        );
+    let text = shipped_text("post_tonemap.ron").replace(
+        "        (id: \"tonemap\"",
+        "        // The curve: try agx.\n        (id: \"tonemap\"",
+    );
     std::fs::write(&path, &text).unwrap();
     let mut h = harness(ed);
     h.state_mut().open(&path);
