@@ -252,13 +252,22 @@ impl Preview {
             self.clear(Some("select a node with an output to preview it".into()));
             return false;
         };
-        // Flattened, so an edit inside a group changes the key.
-        let mut g = match lumagraph_graph::group::flatten(graph, registry) {
-            Ok(flat) => preview_graph(&flat.registry, &flat.graph),
-            Err(e) => {
-                self.clear(Some(e.to_string()));
-                return false;
+        // With groups, flattened, so an edit inside a group changes the key (this runs
+        // every UI frame: a graph without groups is not copied for it).
+        let flat = if lumagraph_graph::group::has_groups(graph, registry) {
+            match lumagraph_graph::group::flatten(graph, registry) {
+                Ok(flat) => Some(flat),
+                Err(e) => {
+                    self.clear(Some(e.to_string()));
+                    return false;
+                }
             }
+        } else {
+            None
+        };
+        let mut g = match &flat {
+            Some(flat) => preview_graph(&flat.registry, &flat.graph),
+            None => preview_graph(registry, graph),
         };
         g.origin = None;
         let generation = scene.map_or(0, |s| s.generation);

@@ -188,3 +188,38 @@ impl GpuContext {
             .map_err(|e| RenderError::Gpu(e.to_string()))
     }
 }
+
+/// The rule every GPU test follows for the device `made` for it (`ctx` gives its context):
+/// with an adapter, use it, but with `CI` set only a CPU one (lavapipe), so a test never
+/// runs silently on another device than its references; without one, fail, unless
+/// `LUMAGRAPH_ALLOW_NO_GPU=1` is set, then return `None` (the test returns early) and say so.
+///
+/// # Panics
+/// When there is no adapter and skipping is not allowed, or `CI` is set and the adapter is
+/// not a CPU one.
+pub fn for_tests<T, E: std::fmt::Display>(
+    made: std::result::Result<T, E>,
+    ctx: impl Fn(&T) -> &GpuContext,
+) -> Option<T> {
+    match made {
+        Ok(made) => {
+            let c = ctx(&made);
+            if std::env::var_os("CI").is_some() {
+                assert!(
+                    c.is_cpu(),
+                    "CI must run GPU tests on a CPU adapter (lavapipe), got {}",
+                    c.describe()
+                );
+            }
+            eprintln!("GPU tests on {}", c.describe());
+            Some(made)
+        }
+        Err(e) if std::env::var("LUMAGRAPH_ALLOW_NO_GPU").as_deref() == Ok("1") => {
+            eprintln!("skipping GPU test (LUMAGRAPH_ALLOW_NO_GPU=1): {e}");
+            None
+        }
+        Err(e) => {
+            panic!("{e}\nGPU tests need an adapter; set LUMAGRAPH_ALLOW_NO_GPU=1 to skip them")
+        }
+    }
+}

@@ -35,7 +35,7 @@ pub mod shader;
 pub mod specialize;
 mod timing;
 
-pub use context::{GPU_TIMEOUT, GpuContext};
+pub use context::{GPU_TIMEOUT, GpuContext, for_tests};
 pub use error::{RenderError, Result};
 pub use executor::{Executor, FrameReport, PassClock};
 pub use kernel::{Binding, Kernel, PassBuilder, uniform_buffer};

@@ -17,26 +17,7 @@ use lumagraph_example_custom_node::{SHADER, ZonePlateParams, library, reference}
 /// The shared GPU context, or `None` when there is no GPU and that is allowed.
 fn gpu() -> Option<&'static GpuContext> {
     static CTX: LazyLock<Option<GpuContext>> =
-        LazyLock::new(|| match GpuContext::headless_prefer_cpu() {
-            Ok(ctx) => {
-                if std::env::var_os("CI").is_some() {
-                    assert!(
-                        ctx.is_cpu(),
-                        "CI must run GPU tests on a CPU adapter (lavapipe), got {}",
-                        ctx.describe()
-                    );
-                }
-                eprintln!("GPU tests on {}", ctx.describe());
-                Some(ctx)
-            }
-            Err(e) if std::env::var("LUMAGRAPH_ALLOW_NO_GPU").as_deref() == Ok("1") => {
-                eprintln!("skipping GPU test (LUMAGRAPH_ALLOW_NO_GPU=1): {e}");
-                None
-            }
-            Err(e) => {
-                panic!("{e}\nGPU tests need an adapter; set LUMAGRAPH_ALLOW_NO_GPU=1 to skip them")
-            }
-        });
+        LazyLock::new(|| lumagraph::render::for_tests(GpuContext::headless_prefer_cpu(), |c| c));
     CTX.as_ref()
 }
 

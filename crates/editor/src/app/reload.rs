@@ -63,13 +63,22 @@ impl Editor {
         (self.doc.path.clone(), g)
     }
 
+    /// Whether the watch list was made for the document as it is (checked every frame,
+    /// so without copying anything).
+    fn watching_current(&self) -> bool {
+        self.watch.key.as_ref().is_some_and(|(path, g)| {
+            *path == self.doc.path
+                && g.kinds == self.doc.graph.kinds
+                && g.groups == self.doc.graph.groups
+        })
+    }
+
     /// Checks the watched files (at most every half second of `now`, egui's clock) and
     /// reloads the kinds when one changed. Returns whether it reloaded.
     pub fn poll_files(&mut self, now: f64) -> bool {
-        let key = self.watch_key();
-        if self.watch.key.as_ref() != Some(&key) {
+        if !self.watching_current() {
             // Another document, or its declarations were edited: watch what it names now.
-            self.watch.key = Some(key);
+            self.watch.key = Some(self.watch_key());
             self.rewatch();
             return false;
         }

@@ -49,26 +49,7 @@ fn shared() -> Option<&'static Shared> {
                 .map_err(|e| e.to_string())?;
             Ok::<_, String>(Shared { instance, ctx })
         });
-        match made {
-            Ok(s) => {
-                if std::env::var_os("CI").is_some() {
-                    assert!(
-                        s.ctx.is_cpu(),
-                        "CI must use lavapipe, got {}",
-                        s.ctx.describe()
-                    );
-                }
-                eprintln!("editor tests on {}", s.ctx.describe());
-                Some(s)
-            }
-            Err(e) if std::env::var("LUMAGRAPH_ALLOW_NO_GPU").as_deref() == Ok("1") => {
-                eprintln!("skipping GPU test (LUMAGRAPH_ALLOW_NO_GPU=1): {e}");
-                None
-            }
-            Err(e) => {
-                panic!("{e}\nGPU tests need an adapter; set LUMAGRAPH_ALLOW_NO_GPU=1 to skip them")
-            }
-        }
+        lumagraph_render::for_tests(made, |s: &Shared| &s.ctx)
     });
     GPU.as_ref()
 }
