@@ -41,7 +41,7 @@ pub const VERSION: u32 = 2;
 pub type V3 = [f32; 3];
 
 /// The whole file.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
     /// [`VERSION`], or 1.
@@ -64,7 +64,7 @@ pub struct SceneFile {
 }
 
 /// Where the camera comes from.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 #[non_exhaustive]
 pub enum CameraDesc {
@@ -114,7 +114,7 @@ fn default_up() -> V3 {
 }
 
 /// A material; every field has a default, so a diffuse material is just `base_color`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MaterialDesc {
     /// Diffuse albedo, or metal reflectance (linear RGB). Default 0.8 grey.
@@ -174,7 +174,7 @@ impl Default for MaterialDesc {
 
 /// A placement: either scale, then rotations in the order listed, then translation; or a
 /// full row-major 4×4 `matrix` acting on column vectors (Mitsuba's `to_world`).
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TransformDesc {
     /// Translation, applied last.
@@ -189,7 +189,7 @@ pub struct TransformDesc {
 }
 
 /// A rotation about an axis through the origin.
-#[derive(Clone, Copy, Debug, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Rotation {
     /// The axis (normalized on load).
@@ -199,7 +199,7 @@ pub struct Rotation {
 }
 
 /// One shape of the scene.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 #[non_exhaustive]
 pub enum ShapeDesc {
@@ -351,7 +351,7 @@ impl ShapeDesc {
 
 /// A light that is not a surface: a point, a spot or a direction. None of them is seen by
 /// rays (they have no area); they light the scene through light sampling only.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 #[non_exhaustive]
 pub enum LightDesc {

@@ -383,6 +383,36 @@ impl Scene {
     /// # Errors
     /// As [`Scene::load`], without the file name for errors in the text itself.
     pub fn from_ron(text: &str, base_dir: &Path) -> Result<Self, SceneError> {
+        let file = SceneFile::from_ron(text)?;
+        Self::build(&file, text, base_dir)
+    }
+
+    /// Builds a scene from a parsed (and perhaps edited) file; mesh paths are relative to
+    /// `base_dir`. Errors have no line and column (there is no text to point into).
+    ///
+    /// # Errors
+    /// As [`Scene::load`].
+    pub fn from_file(file: &SceneFile, base_dir: &Path) -> Result<Self, SceneError> {
+        Self::build(file, "", base_dir)
+    }
+
+    fn build(file: &SceneFile, text: &str, base_dir: &Path) -> Result<Self, SceneError> {
+        if file.version == 1 {
+            let mut file = file.clone();
+            file.environment = environment_from_v1(file.environment);
+            return Builder::new(text, base_dir).build(&file);
+        }
+        Builder::new(text, base_dir).build(file)
+    }
+}
+
+impl SceneFile {
+    /// Parses a scene file's text as written (a version 1 file keeps its version 1
+    /// environment angles; [`Scene::from_file`] converts them).
+    ///
+    /// # Errors
+    /// Syntax errors and unknown versions, with line and column.
+    pub fn from_ron(text: &str) -> Result<Self, SceneError> {
         let syntax = |e: ron::error::SpannedError| {
             SceneError::new(ErrorKind::Syntax(e.code.to_string())).at(Some(Pos {
                 line: e.span.start.line,
@@ -399,11 +429,7 @@ impl Scene {
             })
             .at(loc.find("version")));
         }
-        let mut file: SceneFile = options.from_str(text).map_err(syntax)?;
-        if file.version == 1 {
-            file.environment = environment_from_v1(file.environment);
-        }
-        Builder::new(text, base_dir).build(&file)
+        options.from_str(text).map_err(syntax)
     }
 }
 
