@@ -80,6 +80,20 @@ pub enum ErrorKind {
     /// More primitives than the GPU layout can index.
     #[error("too many primitives ({0}); the GPU layout indexes at most 2^28")]
     TooManyPrimitives(usize),
+    /// A scene file could not be written.
+    #[error("cannot write scene file: {source}")]
+    Write {
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// An edit changes a part of a scene file that the editor does not write: `"version"`,
+    /// `"shapes"` or `"lights"`.
+    #[error("the editor cannot change the {0} of a scene file")]
+    NotEditable(&'static str),
+    /// An edited scene could not be written over the text it was read from.
+    #[error("cannot write the edited scene: {0}")]
+    Unwritable(String),
 }
 
 impl From<gltf::Error> for ErrorKind {

@@ -6,6 +6,8 @@
 //! - [`import`]: glTF 2.0 and OBJ + MTL meshes, cameras, materials and
 //!   (`KHR_lights_punctual`) lights.
 //! - [`conductor`]: measured metals (complex index of refraction) and their Fresnel.
+//! - [`save`]: an edited [`file::SceneFile`] written back over the text it was read from,
+//!   keeping comments, layout and number spelling wherever a value did not change.
 //! - [`export`]: the resolved scene as JSON + OBJ for other renderers (Mitsuba references).
 //! - [`GpuScene`]: the scene flattened into `#[repr(C)]` arrays laid out as WGSL lays out
 //!   storage buffers ([`gpu`]), with a BVH built by obvhs ([`bvh`]), lights and an alias
@@ -27,6 +29,7 @@ mod flatten;
 pub mod gpu;
 pub mod import;
 mod load;
+pub mod save;
 mod scene;
 pub mod texture;
 pub mod traverse;
