@@ -251,10 +251,7 @@ fn progressive_source(plan: &crate::graph::Plan) -> Option<&crate::graph::Pass> 
 /// Runs the progressive part of the graph for `spp` samples per pixel, then the rest once,
 /// with a progress bar once the render has taken more than a second.
 fn render_progressive(exec: &mut Executor, spp: u32) -> Result<crate::render::FrameReport> {
-    let spf = progressive_source(exec.plan()).map_or(1, |p| {
-        u32::try_from(p.params.int(crate::graph::registry::SAMPLES_PER_FRAME)).unwrap_or(1)
-    });
-    let frames = spp.div_ceil(spf).max(1);
+    let frames = exec.frames_for(spp);
     // Warm-up: drivers compile pipelines at their first dispatch; keep that out of the timing.
     let warm = Instant::now();
     exec.warm_up()?;
@@ -274,22 +271,15 @@ fn render_progressive(exec: &mut Executor, spp: u32) -> Result<crate::render::Fr
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     let start = Instant::now();
-    let mut done = 0;
-    let mut batch = 1;
-    while done + 1 < frames {
-        let n = batch.min(frames - 1 - done);
-        let t = Instant::now();
-        exec.run_frames(n, false)?;
-        done += n;
-        if t.elapsed() < Duration::from_millis(200) {
-            batch = (batch * 2).min(256);
-        }
-        if bar.is_hidden() && start.elapsed() > Duration::from_secs(1) {
-            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
-        }
-        bar.set_position(u64::from(done));
-    }
-    let report = exec.run_frames(1, true)?;
+    let report = exec
+        .render(frames, |done, _| {
+            if bar.is_hidden() && start.elapsed() > Duration::from_secs(1) {
+                bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            }
+            bar.set_position(u64::from(done));
+            true
+        })?
+        .ok_or_else(|| anyhow::anyhow!("the render stopped"))?;
     bar.finish_and_clear();
     let wall = start.elapsed();
     let counters = exec.counters()?;

@@ -27,7 +27,10 @@ mod io;
 mod menus;
 mod panels;
 mod reload;
+mod scene_panel;
 mod selection;
+
+pub use scene_panel::{RenderForm, SideTab};
 
 /// The largest preview side, in pixels, for nodes that render a scene, unless
 /// [`EditorConfig::preview_max`] says otherwise.
@@ -46,6 +49,9 @@ pub struct EditorConfig {
     /// The node kinds the menus offer and the preview runs (with those a graph file
     /// declares); the default is the built-in ones.
     pub library: Arc<NodeLibrary>,
+    /// Show a picture of each node's output on the node; `None`: on unless the adapter
+    /// is a CPU one (reading every output back costs there).
+    pub thumbnails: Option<bool>,
 }
 
 impl Default for EditorConfig {
@@ -55,6 +61,7 @@ impl Default for EditorConfig {
             scene: None,
             preview_max: DEFAULT_PREVIEW_MAX,
             library: Arc::new(NodeLibrary::builtins().clone()),
+            thumbnails: None,
         }
     }
 }
@@ -68,6 +75,10 @@ pub struct EditorScene {
     pub full: (u32, u32),
     /// The scene as the preview renders it (resolution capped).
     pub preview: PreviewScene,
+    /// The file's text and values, as edited in the scene panel.
+    pub doc: crate::scene_doc::SceneDoc,
+    /// The values and furnace view `preview` was built from.
+    built: (lumagraph_scene::file::SceneFile, bool),
 }
 
 /// What a file picked in the file dialog is for.
@@ -83,6 +94,8 @@ pub enum Pick {
     Param(String, String),
     /// The file of a group made from the selected nodes.
     GroupFile,
+    /// The scene's environment map.
+    EnvironmentMap,
 }
 
 /// A question waiting in a modal dialog.
@@ -147,6 +160,12 @@ pub struct Editor {
     preview_max: u32,
     /// The open file dialog and what its pick is for.
     pub file_dialog: Option<(Pick, egui_file_dialog::FileDialog)>,
+    /// The tab shown under the preview.
+    pub side_tab: SideTab,
+    /// The Render to file settings.
+    pub render_form: RenderForm,
+    /// The last Render to file, running or ended.
+    pub render_job: Option<crate::render_job::RenderJob>,
 }
 
 impl std::fmt::Debug for Editor {
@@ -188,7 +207,13 @@ impl Editor {
             preview_max: config.preview_max.max(1),
             file_dialog: None,
             after_save: None,
+            side_tab: SideTab::default(),
+            render_form: RenderForm::default(),
+            render_job: None,
         };
+        editor.preview.thumbnails_on = config.thumbnails.unwrap_or_else(|| {
+            editor.preview.gpu().adapter.get_info().device_type != wgpu::DeviceType::Cpu
+        });
         if let Some(p) = graph {
             editor.open(p);
         }
@@ -294,6 +319,12 @@ impl Editor {
         if ctx.input_mut(|i| i.consume_key(cmd, Key::Z)) {
             self.doc.undo();
         }
+        if ctx.input_mut(|i| i.consume_key(cmd | Modifiers::SHIFT, Key::S)) {
+            self.save_scene();
+        }
+        if ctx.input_mut(|i| i.consume_key(cmd, Key::R)) {
+            self.side_tab = SideTab::Scene;
+        }
         if ctx.input_mut(|i| i.consume_key(cmd, Key::S)) {
             self.save_or_ask();
         }
@@ -340,6 +371,8 @@ impl Editor {
             self.doc.end_gesture();
         }
         self.poll_files(now);
+        let dragging = ui.input(|i| i.pointer.any_down());
+        self.apply_scene_edits(dragging);
         self.refresh_errors();
         let port = self.effective_port();
         let scene = self.scene.as_ref().map(|s| &s.preview);
@@ -383,7 +416,9 @@ impl Editor {
             .resizable(true)
             .show(ui, |ui| self.side_panel(ui, port.as_deref()));
         egui::CentralPanel::default().show(ui, |ui| {
+            let thumbnails = self.preview.thumbnail_textures(ui.ctx());
             let info = NodeInfo {
+                thumbnails: &thumbnails,
                 errors: &self.errors,
                 pass_ms: &self.preview.pass_ms,
                 preview: port.as_deref(),
@@ -410,7 +445,9 @@ impl Editor {
 
     /// Handles a close request from the window: returns whether to let it close.
     pub fn on_close_requested(&mut self) -> bool {
-        let dirty = self.doc.is_dirty() || self.outer.iter().any(|o| o.doc.is_dirty());
+        let dirty = self.doc.is_dirty()
+            || self.outer.iter().any(|o| o.doc.is_dirty())
+            || self.scene.as_ref().is_some_and(|s| s.doc.is_dirty());
         if self.quit_confirmed || !dirty {
             return true;
         }

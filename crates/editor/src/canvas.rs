@@ -352,6 +352,8 @@ pub struct NodeInfo<'a> {
     pub preview: Option<&'a str>,
     /// Nodes selected in the app (highlighted header).
     pub selected: &'a [String],
+    /// Pictures of the nodes' outputs (texture, size in points), when they are on.
+    pub thumbnails: &'a BTreeMap<String, (egui::TextureId, egui::Vec2)>,
 }
 
 struct Viewer<'a, 'i> {
@@ -540,7 +542,7 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
     }
 
     fn has_body(&mut self, node: &String) -> bool {
-        self.info.errors.contains_key(node)
+        self.info.errors.contains_key(node) || self.info.thumbnails.contains_key(node)
     }
 
     fn show_body(
@@ -556,6 +558,9 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
             for e in errs {
                 ui.colored_label(Color32::from_rgb(230, 80, 80), e);
             }
+        }
+        if let Some(&(texture, size)) = self.info.thumbnails.get(&snarl[node]) {
+            ui.add(egui::Image::new((texture, size)));
         }
     }
 

@@ -21,6 +21,8 @@ pub mod files;
 pub mod grouping;
 pub mod inspector;
 pub mod preview;
+pub mod render_job;
+pub mod scene_doc;
 pub mod scope;
 pub mod undo;
 pub mod viewer;
@@ -28,7 +30,9 @@ pub mod viewer;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-pub use app::{DEFAULT_PREVIEW_MAX, Editor, EditorApp, EditorConfig, EditorScene, Pick};
+pub use app::{
+    DEFAULT_PREVIEW_MAX, Editor, EditorApp, EditorConfig, EditorScene, Pick, RenderForm, SideTab,
+};
 use lumagraph_render::GpuContext;
 
 /// What can go wrong in the editor.

@@ -106,6 +106,61 @@ pub struct Preview {
     pub error: Option<String>,
     /// Counters.
     pub stats: PreviewStats,
+    /// Read back a small picture of every node's output (see [`Thumbnail`]).
+    pub thumbnails_on: bool,
+    /// The pictures, by node id.
+    pub thumbnails: BTreeMap<String, Thumbnail>,
+    thumbnails_at: Option<Instant>,
+    thumbnails_due: bool,
+}
+
+/// The longest side of a node thumbnail, in pixels.
+pub const THUMBNAIL_SIZE: u32 = 96;
+
+/// A small picture of a node's first output, encoded as the preview encodes its image,
+/// read back after a change and then at most once a second while a render accumulates.
+#[derive(Clone)]
+pub struct Thumbnail {
+    /// The port shown.
+    pub port: String,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Row-major RGBA8.
+    pub rgba: Vec<u8>,
+    texture: Option<egui::TextureHandle>,
+}
+
+impl std::fmt::Debug for Thumbnail {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Thumbnail({} {}×{})", self.port, self.width, self.height)
+    }
+}
+
+/// `image` shrunk by an integer factor (the mean of each block of pixels) so its longer
+/// side is at most `max`.
+pub fn shrink(image: &lumagraph_render::cpu::Image, max: u32) -> lumagraph_render::cpu::Image {
+    let f = image.width.max(image.height).div_ceil(max.max(1)).max(1);
+    let (w, h) = (image.width.div_ceil(f), image.height.div_ceil(f));
+    let mut out = lumagraph_render::cpu::Image::filled(w, h, [0.0; 4]);
+    for y in 0..h {
+        for x in 0..w {
+            let mut sum = [0.0f32; 4];
+            let mut n = 0.0f32;
+            for yy in y * f..((y + 1) * f).min(image.height) {
+                for xx in x * f..((x + 1) * f).min(image.width) {
+                    let p = image.pixels[(yy * image.width + xx) as usize];
+                    for c in 0..4 {
+                        sum[c] += p[c];
+                    }
+                    n += 1.0;
+                }
+            }
+            out.pixels[(y * w + x) as usize] = sum.map(|v| v / n.max(1.0));
+        }
+    }
+    out
 }
 
 impl std::fmt::Debug for Preview {
@@ -229,6 +284,10 @@ impl Preview {
             measurements: Vec::new(),
             error: None,
             stats: PreviewStats::default(),
+            thumbnails_on: false,
+            thumbnails: BTreeMap::new(),
+            thumbnails_at: None,
+            thumbnails_due: false,
         }
     }
 
@@ -311,6 +370,7 @@ impl Preview {
         self.samples = None;
         self.progressive = false;
         self.error = error;
+        self.thumbnails.clear();
     }
 
     fn render(
@@ -328,6 +388,7 @@ impl Preview {
             port,
             self.scene.as_deref(),
         )?;
+        self.thumbnails_due = true;
         let changed: Vec<String> = match &self.exec {
             Some(exec) => exec
                 .plan()
@@ -486,7 +547,95 @@ impl Preview {
         if let Some(exec) = &mut self.exec {
             self.measurements = exec.measurements().map_err(|e| e.to_string())?;
         }
+        self.read_thumbnails()
+    }
+
+    /// Turns the node thumbnails on or off; on, they are read back now.
+    pub fn set_thumbnails(&mut self, on: bool) {
+        self.thumbnails_on = on;
+        self.thumbnails_due = true;
+        if let Err(e) = self.read_thumbnails() {
+            self.error = Some(e);
+        }
+    }
+
+    /// Reads the node thumbnails back when they are on and due: after a change, or a
+    /// second after the last ones while frames keep coming.
+    fn read_thumbnails(&mut self) -> Result<(), String> {
+        if !self.thumbnails_on {
+            self.thumbnails.clear();
+            return Ok(());
+        }
+        let due = self.thumbnails_due
+            || self
+                .thumbnails_at
+                .is_none_or(|t| t.elapsed() >= std::time::Duration::from_secs(1));
+        let Some(exec) = self.exec.as_ref().filter(|_| due) else {
+            return Ok(());
+        };
+        let plan = exec.plan();
+        let n = plan.passes.len();
+        let mut thumbnails = BTreeMap::new();
+        for (i, pass) in plan.passes.iter().enumerate() {
+            // The first output kept alive to the end of the frame (the preview keeps every
+            // output that feeds a sink or the previewed port).
+            let Some(t) = plan.textures.iter().find(|t| t.first == i && t.last >= n) else {
+                continue;
+            };
+            let image = shrink(&exec.read(t.id).map_err(|e| e.to_string())?, THUMBNAIL_SIZE);
+            let mut thumbnail = Thumbnail {
+                port: t.name.clone(),
+                width: image.width,
+                height: image.height,
+                rgba: encode_rgba8(&image, t.ty),
+                texture: None,
+            };
+            // Keep the texture handle: it is updated in place.
+            if let Some(old) = self.thumbnails.get_mut(&pass.node) {
+                thumbnail.texture = old.texture.take();
+            }
+            thumbnails.insert(pass.node.clone(), thumbnail);
+        }
+        // Textures of the old pictures are re-uploaded from the new ones.
+        for t in thumbnails.values_mut() {
+            if let Some(tex) = &mut t.texture {
+                let color = egui::ColorImage::from_rgba_unmultiplied(
+                    [t.width as usize, t.height as usize],
+                    &t.rgba,
+                );
+                tex.set(color, egui::TextureOptions::LINEAR);
+            }
+        }
+        self.thumbnails = thumbnails;
+        self.thumbnails_at = Some(Instant::now());
+        self.thumbnails_due = false;
         Ok(())
+    }
+
+    /// The node thumbnails as egui textures (uploaded on first use), by node id: texture
+    /// and size in points.
+    pub fn thumbnail_textures(
+        &mut self,
+        ctx: &egui::Context,
+    ) -> BTreeMap<String, (egui::TextureId, egui::Vec2)> {
+        self.thumbnails
+            .iter_mut()
+            .map(|(node, t)| {
+                let tex = t.texture.get_or_insert_with(|| {
+                    let color = egui::ColorImage::from_rgba_unmultiplied(
+                        [t.width as usize, t.height as usize],
+                        &t.rgba,
+                    );
+                    ctx.load_texture(
+                        format!("thumbnail {node}"),
+                        color,
+                        egui::TextureOptions::LINEAR,
+                    )
+                });
+                let size = egui::vec2(t.width as f32, t.height as f32);
+                (node.clone(), (tex.id(), size))
+            })
+            .collect()
     }
 
     /// The egui texture of the last image, uploaded when it changed.

@@ -9,7 +9,7 @@ use egui_kittest::kittest::Queryable as _;
 use lumagraph_graph::{Graph, ParamValue};
 use lumagraph_render::{Executor, Resources, compile};
 
-use common::{editor, harness, repo, snapshot_options, with_config};
+use common::{click_at, editor, harness, repo, snapshot_options, with_config};
 use lumagraph_editor::{EditorConfig, Pick};
 
 fn post_tonemap() -> std::path::PathBuf {
@@ -360,21 +360,6 @@ fn clicking_a_node_selects_it() {
     click_at(&mut h, egui::pos2(500.0, 316.0));
     assert_eq!(h.state().selected, vec!["tonemap".to_owned()]);
     h.get_by_role_and_label(Role::ComboBox, "operator");
-}
-
-fn click_at(h: &mut egui_kittest::Harness<'_, lumagraph_editor::Editor>, pos: egui::Pos2) {
-    h.hover_at(pos);
-    h.run_ok();
-    for pressed in [true, false] {
-        h.event(egui::Event::PointerButton {
-            pos,
-            button: egui::PointerButton::Primary,
-            pressed,
-            modifiers: egui::Modifiers::NONE,
-        });
-        h.step();
-    }
-    h.run_ok();
 }
 
 /// Closing with unsaved changes asks first; a clean document closes at once.
@@ -1229,4 +1214,41 @@ fn pixel_readout_and_a_b_wipe() {
         "{:?} vs snapshot {r_snap:?} / live {r_live:?}",
         shown(pr)
     );
+}
+
+/// Node thumbnails (View → Node thumbnails): off by default on a CPU adapter; on, every
+/// node with an output shows a picture of it at most `THUMBNAIL_SIZE` wide, the output
+/// shrunk and encoded as the preview encodes its image; a param edit refreshes them.
+#[test]
+fn node_thumbnails_show_each_output() {
+    use lumagraph_editor::preview::{THUMBNAIL_SIZE, encode_rgba8, shrink};
+    let Some(ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    let mut h = harness(ed);
+    let cpu = h.state().preview.gpu().adapter.get_info().device_type == wgpu::DeviceType::Cpu;
+    assert_eq!(h.state().preview.thumbnails_on, !cpu);
+    h.state_mut().preview.set_thumbnails(true);
+    h.state_mut().select(vec!["tonemap".into()]);
+    h.run_ok();
+    let ed = h.state();
+    let nodes: Vec<&str> = ed.preview.thumbnails.keys().map(String::as_str).collect();
+    assert_eq!(
+        nodes,
+        ["exposure", "input", "tonemap"],
+        "the Output node has no output"
+    );
+    let t = &ed.preview.thumbnails["tonemap"];
+    assert_eq!(t.port, "tonemap.color");
+    assert!(t.width.max(t.height) <= THUMBNAIL_SIZE && t.width.max(t.height) > THUMBNAIL_SIZE / 2);
+    let (image, ty) = ed.preview.linear.clone().unwrap();
+    assert_eq!(t.rgba, encode_rgba8(&shrink(&image, THUMBNAIL_SIZE), ty));
+    let before = ed.preview.thumbnails["exposure"].rgba.clone();
+    h.state_mut()
+        .doc
+        .set_param("exposure", "ev", ParamValue::Float(-2.0));
+    h.run_ok();
+    assert_ne!(h.state().preview.thumbnails["exposure"].rgba, before);
+    h.state_mut().preview.set_thumbnails(false);
+    assert!(h.state().preview.thumbnails.is_empty());
 }

@@ -294,6 +294,57 @@ impl Executor {
         self.run(1, Mode::Only)
     }
 
+    /// Frames that make `spp` samples per pixel: `spp / samples_per_frame` of the pass
+    /// samples come from (rounded up, at least 1); 1 when the plan has no such pass.
+    pub fn frames_for(&self, spp: u32) -> u32 {
+        let spf = self
+            .plan
+            .passes
+            .iter()
+            .find(|p| p.params.has(lumagraph_graph::registry::SAMPLES_PER_FRAME))
+            .map_or(1, |p| {
+                u32::try_from(p.params.int(lumagraph_graph::registry::SAMPLES_PER_FRAME))
+                    .unwrap_or(1)
+                    .max(1)
+            });
+        spp.div_ceil(spf).max(1)
+    }
+
+    /// Runs `frames` frames, the last one finishing (the whole graph runs, sinks write):
+    /// a long render. Frames go in batches that grow while a batch takes under 200 ms, so
+    /// `progress(done, frames)` is called a few times a second; when it returns `false`
+    /// the render stops there and `Ok(None)` is returned (nothing written).
+    ///
+    /// # Errors
+    /// When a node fails; the error names the node.
+    pub fn render(
+        &mut self,
+        frames: u32,
+        mut progress: impl FnMut(u32, u32) -> bool,
+    ) -> Result<Option<FrameReport>> {
+        let frames = frames.max(1);
+        let mut done = 0;
+        let mut batch = 1;
+        while done + 1 < frames {
+            if !progress(done, frames) {
+                return Ok(None);
+            }
+            let n = batch.min(frames - 1 - done);
+            let t = Instant::now();
+            self.run_frames(n, false)?;
+            done += n;
+            if t.elapsed() < std::time::Duration::from_millis(200) {
+                batch = (batch * 2).min(256);
+            }
+        }
+        if !progress(done, frames) {
+            return Ok(None);
+        }
+        let report = self.run_frames(1, true)?;
+        progress(frames, frames);
+        Ok(Some(report))
+    }
+
     /// Records every pass once without writing files or keeping history, so drivers that
     /// compile pipelines at their first dispatch do it here rather than in a timed frame.
     ///

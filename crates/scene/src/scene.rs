@@ -300,6 +300,27 @@ pub struct Scene {
     pub report: LoadReport,
 }
 
+impl Scene {
+    /// Turns the scene into a white furnace: every material's albedo (base colour, its
+    /// texture and a conductor's reflectance) is 1 and nothing emits; the lights are
+    /// removed and a constant environment of radiance 1 lights everything. An
+    /// energy-conserving, energy-preserving material then looks like the background
+    /// (radiance 1) wherever the path depth suffices; what is darker loses energy, what is
+    /// brighter creates it. Roughness, metalness, transmission and normal maps are kept.
+    pub fn make_furnace(&mut self) {
+        for m in &mut self.materials {
+            m.base_color = Vec3::ONE;
+            m.emission = Vec3::ZERO;
+            m.textures.base_color = NO_TEXTURE;
+            m.textures.emissive = NO_TEXTURE;
+            m.textures.specular_color = NO_TEXTURE;
+            m.conductor = None;
+        }
+        self.lights.clear();
+        self.environment = Environment::Constant([1.0; 3]);
+    }
+}
+
 /// Checks a triangle and appends it, or counts it as dropped in `report`.
 ///
 /// Dropped: any corner NaN or infinite; zero area (the corners are collinear to within

@@ -10,6 +10,8 @@ use super::{Dialog, Editor, EditorScene, Pick, Then};
 use crate::EditorError;
 use crate::files;
 use crate::preview::PreviewScene;
+use crate::scene_doc::SceneDoc;
+use lumagraph_scene::GpuScene;
 
 impl Editor {
     /// Opens the file dialog for `pick`, starting in the folder that fits it.
@@ -37,6 +39,11 @@ impl Editor {
                 "Open scene",
                 start(self.scene.as_ref().map(|s| s.path.as_path())),
                 vec!["ron"],
+            ),
+            Pick::EnvironmentMap => (
+                "Pick the environment map",
+                start(self.scene.as_ref().map(|s| s.path.as_path())),
+                vec!["hdr", "exr"],
             ),
             Pick::Param(node, param) => {
                 let extensions = self
@@ -121,6 +128,19 @@ impl Editor {
             },
             Pick::Scene => {
                 self.load_scene(path);
+            }
+            Pick::EnvironmentMap => {
+                if let Some(s) = &mut self.scene {
+                    let base = std::path::absolute(s.doc.base_dir()).unwrap_or_default();
+                    let lumagraph_scene::Environment::Map { path: map, .. } =
+                        &mut s.doc.file.environment
+                    else {
+                        return;
+                    };
+                    *map = path
+                        .strip_prefix(&base)
+                        .map_or_else(|_| path.display().to_string(), |p| p.display().to_string());
+                }
             }
             Pick::GroupFile => self.group_selection(path),
             Pick::Param(node, param) => {
@@ -256,7 +276,10 @@ impl Editor {
         if !self.outer.is_empty() {
             return;
         }
-        if self.doc.is_dirty() && then != Then::Open(PathBuf::new()) {
+        let scene_dirty = self.scene.as_ref().is_some_and(|s| s.doc.is_dirty());
+        if (self.doc.is_dirty() || (then == Then::Quit && scene_dirty))
+            && then != Then::Open(PathBuf::new())
+        {
             self.dialog = Some(Dialog::Unsaved(then));
         } else {
             self.proceed(then);
@@ -282,34 +305,14 @@ impl Editor {
     /// preview. A scene that cannot be loaded leaves the current one (if any) and the
     /// error in the status line and the side panel. Returns whether it loaded.
     pub fn load_scene(&mut self, path: &Path) -> bool {
-        let loaded = lumagraph_scene::Scene::load(path)
-            .and_then(|scene| lumagraph_scene::GpuScene::build(&scene));
+        let loaded = SceneDoc::load(path).and_then(|doc| {
+            let gpu = doc.build()?;
+            Ok((doc, gpu))
+        });
         match loaded {
-            Ok(mut gpu) => {
-                let full = (gpu.settings.width, gpu.settings.height);
-                let longest = full.0.max(full.1).max(1);
-                if longest > self.preview_max {
-                    let scale = |x: u32| {
-                        u32::try_from(
-                            u64::from(x) * u64::from(self.preview_max) / u64::from(longest),
-                        )
-                        .unwrap_or(1)
-                        .max(1)
-                    };
-                    gpu.settings.width = scale(full.0);
-                    gpu.settings.height = scale(full.1);
-                }
-                self.scene_generation += 1;
-                self.scene = Some(EditorScene {
-                    path: path.to_owned(),
-                    full,
-                    preview: PreviewScene {
-                        gpu: Arc::new(gpu),
-                        generation: self.scene_generation,
-                    },
-                });
+            Ok((doc, gpu)) => {
+                self.scene = Some(self.editor_scene(doc, gpu));
                 self.scene_error = None;
-                self.errors_for = None;
                 self.say(format!("scene {}", path.display()), false);
                 true
             }
@@ -317,6 +320,65 @@ impl Editor {
                 let text = format!("cannot load the scene: {e}");
                 self.scene_error = Some(text.clone());
                 self.say(text, true);
+                false
+            }
+        }
+    }
+
+    /// The scene `doc` built as `gpu` (full resolution), as the preview renders it: a new
+    /// generation, so the preview restarts.
+    fn editor_scene(&mut self, doc: SceneDoc, mut gpu: GpuScene) -> EditorScene {
+        let full = (gpu.settings.width, gpu.settings.height);
+        crate::scene_doc::cap_resolution(&mut gpu, self.preview_max);
+        self.scene_generation += 1;
+        self.errors_for = None;
+        EditorScene {
+            path: doc.path.clone(),
+            full,
+            preview: PreviewScene {
+                gpu: Arc::new(gpu),
+                generation: self.scene_generation,
+            },
+            built: (doc.file.clone(), doc.furnace),
+            doc,
+        }
+    }
+
+    /// Rebuilds the preview's scene when the scene panel changed it (not while a drag is
+    /// going on: the preview then restarts once, where the drag ends). A scene that
+    /// cannot be built keeps the last good one in the preview and says why.
+    pub fn apply_scene_edits(&mut self, dragging: bool) {
+        let Some(s) = &mut self.scene else { return };
+        let now = (s.doc.file.clone(), s.doc.furnace);
+        if dragging || s.built == now {
+            return;
+        }
+        s.built = now;
+        match s.doc.build() {
+            Ok(gpu) => {
+                let doc = s.doc.clone();
+                self.scene = Some(self.editor_scene(doc, gpu));
+                self.scene_error = None;
+            }
+            Err(e) => {
+                self.scene_error = Some(format!("cannot use the edited scene: {e}"));
+            }
+        }
+    }
+
+    /// Saves the edited scene into its file, keeping the file's comments and layout.
+    pub fn save_scene(&mut self) -> bool {
+        let Some(s) = &mut self.scene else {
+            return false;
+        };
+        match s.doc.save() {
+            Ok(()) => {
+                let text = format!("saved {}", s.doc.path.display());
+                self.say(text, false);
+                true
+            }
+            Err(e) => {
+                self.say(format!("cannot save the scene: {e}"), true);
                 false
             }
         }

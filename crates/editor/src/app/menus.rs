@@ -56,25 +56,7 @@ impl Editor {
                 }
             });
             ui.menu_button("Edit", |ui| self.edit_menu(ui));
-            ui.menu_button("Scene", |ui| {
-                if ui.button("Open scene…").clicked() {
-                    self.open_file_dialog(Pick::Scene);
-                }
-                let path = self.scene.as_ref().map(|s| s.path.clone());
-                if ui
-                    .add_enabled(path.is_some(), egui::Button::new("Reload scene"))
-                    .clicked()
-                    && let Some(p) = path
-                {
-                    self.load_scene(&p);
-                }
-                if ui
-                    .add_enabled(self.scene.is_some(), egui::Button::new("Close scene"))
-                    .clicked()
-                {
-                    self.close_scene();
-                }
-            });
+            ui.menu_button("Scene", |ui| self.scene_menu(ui));
             ui.menu_button("View", |ui| {
                 if ui
                     .add(egui::Button::new("Frame all").shortcut_text("Home"))
@@ -90,6 +72,18 @@ impl Editor {
                     self.canvas
                         .request_frame(Frame::Nodes(self.selected.clone()));
                 }
+                ui.separator();
+                let mut on = self.preview.thumbnails_on;
+                if ui
+                    .checkbox(&mut on, "Node thumbnails")
+                    .on_hover_text(
+                        "a picture of each node's output on the node (off by default on a CPU \
+                         adapter, where reading every output back costs)",
+                    )
+                    .changed()
+                {
+                    self.preview.set_thumbnails(on);
+                }
             });
             ui.menu_button("Add node", |ui| {
                 if let Some(kind) = add_node_menu(ui, self.doc.registry(), &mut self.canvas.search)
@@ -98,6 +92,56 @@ impl Editor {
                 }
             });
         });
+    }
+
+    /// The Scene menu: open, edit, save, reload, close, furnace view, render to file.
+    fn scene_menu(&mut self, ui: &mut Ui) {
+        if ui.button("Open scene…").clicked() {
+            self.open_file_dialog(Pick::Scene);
+        }
+        let loaded = self.scene.is_some();
+        if ui
+            .add_enabled(loaded, egui::Button::new("Edit scene"))
+            .on_hover_text("materials, environment, camera and render settings")
+            .clicked()
+        {
+            self.side_tab = super::SideTab::Scene;
+        }
+        let dirty = self.scene.as_ref().is_some_and(|s| s.doc.is_dirty());
+        if ui
+            .add_enabled(
+                dirty,
+                egui::Button::new("Save scene").shortcut_text("Ctrl+Shift+S"),
+            )
+            .clicked()
+        {
+            self.save_scene();
+        }
+        let path = self.scene.as_ref().map(|s| s.path.clone());
+        if ui
+            .add_enabled(path.is_some(), egui::Button::new("Reload scene"))
+            .on_hover_text("reads the file again; unsaved scene edits are lost")
+            .clicked()
+            && let Some(p) = path
+        {
+            self.load_scene(&p);
+        }
+        if ui
+            .add_enabled(loaded, egui::Button::new("Close scene"))
+            .clicked()
+        {
+            self.close_scene();
+        }
+        ui.separator();
+        if let Some(s) = &mut self.scene {
+            ui.checkbox(&mut s.doc.furnace, "Furnace test");
+        }
+        if ui
+            .add(egui::Button::new("Render to file…").shortcut_text("Ctrl+R"))
+            .clicked()
+        {
+            self.side_tab = super::SideTab::Scene;
+        }
     }
 
     /// The Edit menu: undo, clipboard, duplicate, delete, groups.
@@ -192,17 +236,31 @@ impl Editor {
 
     fn unsaved_dialog(&mut self, ui: &mut Ui, then: &Then) -> bool {
         ui.heading("Unsaved changes");
-        ui.label(format!(
-            "Save the changes to {} first?",
-            self.doc.path.as_ref().map_or_else(
+        let graph_dirty = self.doc.is_dirty();
+        let scene = self
+            .scene
+            .as_ref()
+            .filter(|s| *then == Then::Quit && s.doc.is_dirty())
+            .map(|s| s.doc.path.display().to_string());
+        let mut what = Vec::new();
+        if graph_dirty {
+            what.push(self.doc.path.as_ref().map_or_else(
                 || "the untitled graph".to_owned(),
-                |p| p.display().to_string()
-            )
-        ));
+                |p| p.display().to_string(),
+            ));
+        }
+        what.extend(scene.clone().map(|s| format!("the scene {s}")));
+        ui.label(format!("Save the changes to {} first?", what.join(" and ")));
         let mut close = false;
         ui.horizontal(|ui| {
             if ui.button("Save").clicked() {
-                if self.doc.path.is_some() {
+                if scene.is_some() && !self.save_scene() {
+                    return;
+                }
+                if !graph_dirty {
+                    close = true;
+                    self.proceed(then.clone());
+                } else if self.doc.path.is_some() {
                     match self.save() {
                         Ok(()) => {
                             close = true;

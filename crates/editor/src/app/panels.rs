@@ -111,23 +111,24 @@ impl Editor {
                 .show(ui, self.preview.image.as_ref(), frame, width);
         }
         ui.separator();
-        ui.heading("Inspector");
-        egui::ScrollArea::vertical().show(ui, |ui| match self.selected.as_slice() {
-            [] => {
-                ui.weak("select a node");
-            }
-            [one] => {
-                let id = one.clone();
-                let errs = self.errors.get(&id).cloned();
-                if let Some(inspector::Request::PickFile(param)) =
-                    inspector::show(ui, &mut self.doc, &id, errs.as_ref())
-                {
-                    self.open_file_dialog(Pick::Param(id, param));
+        self.side_tabs(ui, |ed, ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| match ed.selected.as_slice() {
+                [] => {
+                    ui.weak("select a node");
                 }
-            }
-            many => {
-                ui.label(format!("{} nodes selected", many.len()));
-            }
+                [one] => {
+                    let id = one.clone();
+                    let errs = ed.errors.get(&id).cloned();
+                    if let Some(inspector::Request::PickFile(param)) =
+                        inspector::show(ui, &mut ed.doc, &id, errs.as_ref())
+                    {
+                        ed.open_file_dialog(Pick::Param(id, param));
+                    }
+                }
+                many => {
+                    ui.label(format!("{} nodes selected", many.len()));
+                }
+            });
         });
     }
 

@@ -88,6 +88,11 @@ pub fn with_config(graph: Option<&Path>, config: &EditorConfig) -> Option<Editor
 
 /// A headless harness drawing `editor` with egui's wgpu renderer on the shared device.
 pub fn harness(editor: Editor) -> Harness<'static, Editor> {
+    harness_sized(editor, SIZE)
+}
+
+/// [`harness`] with a window of `size` points.
+pub fn harness_sized(editor: Editor, size: egui::Vec2) -> Harness<'static, Editor> {
     let s = shared().expect("a harness needs the GPU");
     let setup = egui_wgpu::WgpuSetup::Existing(egui_wgpu::WgpuSetupExisting {
         instance: s.instance.clone(),
@@ -96,10 +101,26 @@ pub fn harness(editor: Editor) -> Harness<'static, Editor> {
         queue: s.ctx.queue.clone(),
     });
     let mut h = Harness::builder()
-        .with_size(SIZE)
+        .with_size(size)
         .with_pixels_per_point(1.0)
         .wgpu_setup(setup)
         .build_ui_state(|ui, editor: &mut Editor| editor.ui(ui), editor);
     h.run_ok();
     h
+}
+
+/// A click (press, release) at `pos`, with the pointer moved there first.
+pub fn click_at(h: &mut Harness<'_, Editor>, pos: egui::Pos2) {
+    h.hover_at(pos);
+    h.run_ok();
+    for pressed in [true, false] {
+        h.event(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+        h.step();
+    }
+    h.run_ok();
 }
