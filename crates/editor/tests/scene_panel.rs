@@ -90,7 +90,7 @@ fn a_material_edit_restarts_the_accumulation() {
     );
     assert_ne!(ed.preview.linear.as_ref().unwrap().0.pixels, image.pixels);
     assert!(
-        h.query_by_label_contains("Scene ●").is_some(),
+        h.query_by_label_contains("Scene *").is_some(),
         "the tab shows the change"
     );
     // It goes on accumulating.

@@ -89,9 +89,12 @@ fn colour(ui: &mut Ui, v: &mut V3, max: f32) -> bool {
     .inner
 }
 
-fn row(ui: &mut Ui, label: &str, hint: &str, widget: impl FnOnce(&mut Ui)) {
-    ui.label(label).on_hover_text(hint);
-    widget(ui);
+/// One grid row: a label with its hint, then the widgets in one cell.
+/// One grid row: a label with its hint, then the widgets in one cell; the closure gets the
+/// label's id, for widgets it names (`Response::labelled_by`).
+fn row(ui: &mut Ui, label: &str, hint: &str, widget: impl FnOnce(&mut Ui, egui::Id)) {
+    let id = ui.label(label).on_hover_text(hint).id;
+    ui.horizontal(|ui| widget(ui, id));
     ui.end_row();
 }
 
@@ -101,7 +104,7 @@ impl Editor {
         ui.horizontal(|ui| {
             ui.selectable_value(&mut self.side_tab, SideTab::Inspector, "Inspector");
             let dirty = self.scene.as_ref().is_some_and(|s| s.doc.is_dirty());
-            let label = if dirty { "Scene ●" } else { "Scene" };
+            let label = if dirty { "Scene *" } else { "Scene" };
             ui.selectable_value(&mut self.side_tab, SideTab::Scene, label);
         });
         ui.separator();
@@ -188,7 +191,7 @@ impl Editor {
         let scene_spp = self.scene.as_ref().map(|s| s.doc.file.render.spp);
         let running = self.render_job.as_ref().is_some_and(|j| !j.is_finished());
         let form = &mut self.render_form;
-        egui::Grid::new("render form")
+        egui::Grid::new("render form grid")
             .num_columns(2)
             .spacing([8.0, 4.0])
             .show(ui, |ui| {
@@ -196,7 +199,7 @@ impl Editor {
                     ui,
                     "samples",
                     "samples per pixel; 0: the scene's spp",
-                    |ui| {
+                    |ui, _| {
                         ui.add(egui::DragValue::new(&mut form.spp).range(0..=1_000_000));
                         if form.spp == 0
                             && let Some(n) = scene_spp
@@ -205,20 +208,18 @@ impl Editor {
                         }
                     },
                 );
-                row(ui, "write", "what the render writes", |ui| {
-                    ui.vertical(|ui| {
-                        ui.radio_value(&mut form.port_only, false, "the Output nodes")
-                            .on_hover_text("every Output node's file, relative to the folder");
-                        ui.radio_value(&mut form.port_only, true, "the previewed port")
-                            .on_hover_text("one file: .png (8-bit sRGB) or .exr (linear float)");
-                    });
+                row(ui, "write", "what the render writes", |ui, _| {
+                    ui.radio_value(&mut form.port_only, false, "Output nodes")
+                        .on_hover_text("every Output node's file, relative to the folder");
+                    ui.radio_value(&mut form.port_only, true, "previewed port")
+                        .on_hover_text("one file: .png (8-bit sRGB) or .exr (linear float)");
                 });
                 let (label, text) = if form.port_only {
                     ("file", &mut form.file)
                 } else {
                     ("folder", &mut form.dir)
                 };
-                row(ui, label, "relative to the graph's folder", |ui| {
+                row(ui, label, "relative to the graph's folder", |ui, _| {
                     ui.add(egui::TextEdit::singleline(text).desired_width(200.0));
                 });
             });
@@ -336,7 +337,7 @@ impl Editor {
 }
 
 fn render_settings(ui: &mut Ui, r: &mut RenderSettings) {
-    egui::Grid::new("render settings")
+    egui::Grid::new("render settings grid")
         .num_columns(2)
         .spacing([8.0, 4.0])
         .show(ui, |ui| {
@@ -344,19 +345,20 @@ fn render_settings(ui: &mut Ui, r: &mut RenderSettings) {
                 ui,
                 "size",
                 "image width and height, pixels (the preview is capped)",
-                |ui| {
+                |ui, _| {
                     ui.add(egui::DragValue::new(&mut r.width).range(1..=16384));
                     ui.add(egui::DragValue::new(&mut r.height).range(1..=16384));
                 },
             );
-            row(ui, "bounces", "most scattering events per path", |ui| {
-                ui.add(egui::Slider::new(&mut r.max_bounces, 0..=64).text("max_bounces"));
+            row(ui, "bounces", "most scattering events per path", |ui, l| {
+                ui.add(egui::Slider::new(&mut r.max_bounces, 0..=64))
+                    .labelled_by(l);
             });
             row(
                 ui,
                 "spp",
                 "the preview stops, and Render to file renders, at this many samples per pixel",
-                |ui| {
+                |ui, _| {
                     ui.add(
                         egui::Slider::new(&mut r.spp, 1..=65536)
                             .logarithmic(true)
@@ -364,14 +366,14 @@ fn render_settings(ui: &mut Ui, r: &mut RenderSettings) {
                     );
                 },
             );
-            row(ui, "seed", "random seed", |ui| {
+            row(ui, "seed", "random seed", |ui, _| {
                 ui.add(egui::DragValue::new(&mut r.seed));
             });
         });
 }
 
 fn camera(ui: &mut Ui, c: &mut CameraDesc) {
-    egui::Grid::new("camera")
+    egui::Grid::new("camera grid")
         .num_columns(2)
         .spacing([8.0, 4.0])
         .show(ui, |ui| {
@@ -385,17 +387,17 @@ fn camera(ui: &mut Ui, c: &mut CameraDesc) {
                     focus_distance,
                     autofocus,
                 } => {
-                    row(ui, "position", "eye position", |ui| {
+                    row(ui, "position", "eye position", |ui, _| {
                         vec3(ui, position, 0.01);
                     });
-                    row(ui, "target", "the point looked at", |ui| {
+                    row(ui, "target", "the point looked at", |ui, _| {
                         vec3(ui, target, 0.01);
                     });
-                    row(ui, "up", "up direction", |ui| {
+                    row(ui, "up", "up direction", |ui, _| {
                         vec3(ui, up, 0.01);
                     });
-                    row(ui, "field of view", "vertical, degrees", |ui| {
-                        ui.add(egui::Slider::new(fov_y, 1.0..=170.0).text("fov_y °"));
+                    row(ui, "field of view", "vertical, degrees", |ui, l| {
+                        ui.add(egui::Slider::new(fov_y, 1.0..=170.0)).labelled_by(l);
                     });
                     (aperture_radius, focus_distance, autofocus)
                 }
@@ -406,7 +408,7 @@ fn camera(ui: &mut Ui, c: &mut CameraDesc) {
                     focus_distance,
                     autofocus,
                 } => {
-                    row(ui, "glTF camera", "placed by the file", |ui| {
+                    row(ui, "glTF camera", "placed by the file", |ui, _| {
                         ui.weak(format!("camera {index} of shape \"{shape}\""));
                     });
                     (aperture_radius, focus_distance, autofocus)
@@ -416,7 +418,7 @@ fn camera(ui: &mut Ui, c: &mut CameraDesc) {
                     return;
                 }
             };
-            row(ui, "aperture", "lens radius; 0 is a pinhole", |ui| {
+            row(ui, "aperture", "lens radius; 0 is a pinhole", |ui, _| {
                 ui.add(
                     egui::DragValue::new(aperture_radius)
                         .speed(0.001)
@@ -424,7 +426,7 @@ fn camera(ui: &mut Ui, c: &mut CameraDesc) {
                         .max_decimals(4),
                 );
             });
-            row(ui, "focus", "distance to the plane in focus", |ui| {
+            row(ui, "focus", "distance to the plane in focus", |ui, _| {
                 let mut set = focus_distance.is_some();
                 if ui.checkbox(&mut set, "").changed() {
                     *focus_distance = set.then_some(1.0);
@@ -442,7 +444,7 @@ fn camera(ui: &mut Ui, c: &mut CameraDesc) {
                 ui,
                 "autofocus",
                 "focus on what the image centre sees",
-                |ui| {
+                |ui, _| {
                     ui.checkbox(autofocus, "");
                 },
             );
@@ -485,12 +487,12 @@ fn environment(ui: &mut Ui, env: &mut Environment) -> bool {
                 pick = true;
             }
         });
-    egui::Grid::new("environment")
+    egui::Grid::new("environment grid")
         .num_columns(2)
         .spacing([8.0, 4.0])
         .show(ui, |ui| match env {
             Environment::Constant(c) => {
-                row(ui, "radiance", "linear RGB", |ui| {
+                row(ui, "radiance", "linear RGB", |ui, _| {
                     colour(ui, c, 1e6);
                 });
             }
@@ -505,29 +507,28 @@ fn environment(ui: &mut Ui, env: &mut Environment) -> bool {
                     ui,
                     "file",
                     "equirectangular .hdr or .exr, relative to the scene file",
-                    |ui| {
+                    |ui, _| {
                         ui.add(egui::TextEdit::singleline(path).desired_width(180.0));
                         pick |= ui.button("…").on_hover_text("pick the file").clicked();
                     },
                 );
-                row(ui, "intensity", "radiance scale", |ui| {
-                    ui.add(
-                        egui::Slider::new(intensity, 0.0..=100.0)
-                            .logarithmic(true)
-                            .text("intensity"),
-                    );
+                row(ui, "intensity", "radiance scale", |ui, l| {
+                    ui.add(egui::Slider::new(intensity, 0.0..=100.0).logarithmic(true))
+                        .labelled_by(l);
                 });
-                row(ui, "rotation", "about the up axis, degrees", |ui| {
-                    ui.add(egui::Slider::new(azimuth, -180.0..=180.0).text("azimuth °"));
+                row(ui, "rotation", "about the up axis, degrees", |ui, l| {
+                    ui.add(egui::Slider::new(azimuth, -180.0..=180.0))
+                        .labelled_by(l);
                 });
-                row(ui, "tilt", "of the horizon, degrees", |ui| {
-                    ui.add(egui::Slider::new(elevation, -90.0..=90.0).text("elevation °"));
+                row(ui, "tilt", "of the horizon, degrees", |ui, l| {
+                    ui.add(egui::Slider::new(elevation, -90.0..=90.0))
+                        .labelled_by(l);
                 });
                 row(
                     ui,
                     "background",
                     "camera rays that miss see the map (else black)",
-                    |ui| {
+                    |ui, _| {
                         ui.checkbox(show_background, "visible");
                     },
                 );
@@ -546,21 +547,23 @@ fn material(ui: &mut Ui, name: &str, m: &mut MaterialDesc) {
                 ui,
                 "base colour",
                 "diffuse albedo or metal reflectance, linear RGB",
-                |ui| {
+                |ui, _| {
                     colour(ui, &mut m.base_color, 1.0);
                 },
             );
-            row(ui, "emission", "emitted radiance, linear RGB", |ui| {
+            row(ui, "emission", "emitted radiance, linear RGB", |ui, _| {
                 colour(ui, &mut m.emission, 1e6);
             });
-            row(ui, "roughness", "perceptual; α = roughness²", |ui| {
-                ui.add(egui::Slider::new(&mut m.roughness, 0.0..=1.0).text("roughness"));
+            row(ui, "roughness", "perceptual; α = roughness²", |ui, l| {
+                ui.add(egui::Slider::new(&mut m.roughness, 0.0..=1.0))
+                    .labelled_by(l);
             });
-            row(ui, "metallic", "0 dielectric, 1 metal", |ui| {
+            row(ui, "metallic", "0 dielectric, 1 metal", |ui, l| {
                 let auto = m.conductor.is_some() || m.eta.is_some() || m.k.is_some();
                 let mut v = m.metallic.unwrap_or(if auto { 1.0 } else { 0.0 });
                 if ui
-                    .add(egui::Slider::new(&mut v, 0.0..=1.0).text("metallic"))
+                    .add(egui::Slider::new(&mut v, 0.0..=1.0))
+                    .labelled_by(l)
                     .changed()
                 {
                     m.metallic = Some(v);
@@ -570,7 +573,7 @@ fn material(ui: &mut Ui, name: &str, m: &mut MaterialDesc) {
                 ui,
                 "conductor",
                 "a measured metal: exact conductor Fresnel",
-                |ui| {
+                |ui, _| {
                     let shown = m.conductor.clone().unwrap_or_else(|| "none".into());
                     egui::ComboBox::from_id_salt(("conductor", name))
                         .selected_text(shown)
@@ -596,32 +599,36 @@ fn material(ui: &mut Ui, name: &str, m: &mut MaterialDesc) {
                 ui,
                 "specular",
                 "dielectric specular strength; 0.5: F0 = 0.04",
-                |ui| {
-                    ui.add(egui::Slider::new(&mut m.specular, 0.0..=1.0).text("specular"));
+                |ui, l| {
+                    ui.add(egui::Slider::new(&mut m.specular, 0.0..=1.0))
+                        .labelled_by(l);
                 },
             );
-            row(ui, "specular tint", "towards the base colour", |ui| {
-                ui.add(egui::Slider::new(&mut m.specular_tint, 0.0..=1.0).text("specular_tint"));
+            row(ui, "specular tint", "towards the base colour", |ui, l| {
+                ui.add(egui::Slider::new(&mut m.specular_tint, 0.0..=1.0))
+                    .labelled_by(l);
             });
             row(
                 ui,
                 "transmission",
                 "transmitted fraction of the dielectric lobe",
-                |ui| {
-                    ui.add(egui::Slider::new(&mut m.transmission, 0.0..=1.0).text("transmission"));
+                |ui, l| {
+                    ui.add(egui::Slider::new(&mut m.transmission, 0.0..=1.0))
+                        .labelled_by(l);
                 },
             );
-            row(ui, "ior", "index of refraction", |ui| {
-                ui.add(egui::Slider::new(&mut m.ior, 1.0..=3.0).text("ior"));
+            row(ui, "ior", "index of refraction", |ui, l| {
+                ui.add(egui::Slider::new(&mut m.ior, 1.0..=3.0))
+                    .labelled_by(l);
             });
-            row(ui, "two-sided", "emission leaves both sides", |ui| {
+            row(ui, "two-sided", "emission leaves both sides", |ui, _| {
                 ui.checkbox(&mut m.two_sided, "");
             });
             row(
                 ui,
                 "multiscatter",
                 "compensate the energy microfacet lobes lose",
-                |ui| {
+                |ui, _| {
                     ui.checkbox(&mut m.multiscatter, "");
                 },
             );
