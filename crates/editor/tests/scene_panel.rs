@@ -178,6 +178,30 @@ fn scene_save_round_trip() {
     assert!(saved.contains("\"white\": (base_color: (0.885809, 0.698859, 0.666422)"));
     // The target spp is what the preview stops at.
     assert_eq!(ed.preview.target_spp, 64);
+
+    // The keyboard: Ctrl+Shift+S saves the scene (not the graph), Ctrl+R opens the tab.
+    h.state_mut().side_tab = SideTab::Inspector;
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::R);
+    h.run_ok();
+    assert_eq!(h.state().side_tab, SideTab::Scene, "Ctrl+R");
+    let doc = &mut h.state_mut().scene.as_mut().unwrap().doc;
+    doc.file.materials.get_mut("green").unwrap().specular = 0.5;
+    h.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::S,
+    );
+    h.run_ok();
+    let ed = h.state();
+    assert!(!ed.scene.as_ref().unwrap().doc.is_dirty(), "Ctrl+Shift+S");
+    let again = SceneFile::from_ron(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    assert!((again.materials["green"].specular - 0.5).abs() < 1e-6);
+    assert!(
+        !ed.doc.is_dirty()
+            && ed
+                .message
+                .as_ref()
+                .is_some_and(|(m, _)| m.contains("cornell.ron"))
+    );
 }
 
 /// Render to file: the graph's Output nodes at the scene's full resolution (256², where the
