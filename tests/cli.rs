@@ -783,3 +783,34 @@ fn render_to_file_in_the_editor_equals_the_cli_render() {
         "the editor's render differs from the CLI's"
     );
 }
+
+/// An image larger than the device holds is one clear error naming the port, the size, the
+/// adapter and its limit, before anything is allocated; never wgpu's panic.
+#[test]
+fn an_image_larger_than_the_device_holds_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("huge.ron");
+    let text = std::fs::read_to_string(common::repo("assets/cornell.ron"))
+        .unwrap()
+        .replace("width: 256, height: 256", "width: 100000, height: 100000");
+    std::fs::write(&scene, text).unwrap();
+    let (ok, out, err) = common::cli(&[
+        "render",
+        "graphs/pathtrace.ron",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(!ok, "{out}");
+    assert!(!err.contains("panicked"), "{err}");
+    let line = err
+        .lines()
+        .find(|l| l.starts_with("error:"))
+        .expect("an error line");
+    assert!(
+        line.contains("pathtrace.color: 100000×100000 image")
+            && line.contains("the largest image this device holds is"),
+        "{line}"
+    );
+}

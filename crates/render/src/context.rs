@@ -25,6 +25,8 @@ pub struct GpuContext {
     pub info: wgpu::AdapterInfo,
     /// Whether compute passes can be timed with timestamp queries.
     pub timestamps: bool,
+    /// The first GPU error no error scope caught (see [`GpuContext::take_error`]).
+    errors: std::sync::Arc<std::sync::Mutex<Option<String>>>,
 }
 
 impl GpuContext {
@@ -146,13 +148,51 @@ impl GpuContext {
     pub fn from_parts(adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
         let info = adapter.get_info();
         let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        // wgpu's default handler panics on an error no scope caught; keep it instead, to
+        // be returned as an error by the next wait.
+        let errors = std::sync::Arc::new(std::sync::Mutex::new(None::<String>));
+        let slot = std::sync::Arc::clone(&errors);
+        device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {
+            let mut first = slot
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            first.get_or_insert_with(|| e.to_string());
+        }));
         Self {
             adapter,
             device,
             queue,
             info,
             timestamps,
+            errors,
         }
+    }
+
+    /// Takes the first GPU error that no error scope caught since the last call, if any.
+    pub fn take_error(&self) -> Option<String> {
+        self.errors
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .take()
+    }
+
+    /// Checks that `extent` fits the device's largest 2D texture.
+    ///
+    /// # Errors
+    /// [`RenderError::TooLarge`] naming `what`, the size and the limit.
+    pub fn check_extent(&self, what: &str, width: u32, height: u32) -> Result<()> {
+        let max = self.device.limits().max_texture_dimension_2d;
+        if width > max || height > max {
+            return Err(RenderError::TooLarge {
+                what: format!("{what}: {width}×{height} image"),
+                adapter: self.info.name.clone(),
+                message: format!(
+                    "the largest image this device holds is {max}×{max} pixels (render at most \
+                     {max} pixels wide and high)"
+                ),
+            });
+        }
+        Ok(())
     }
 
     /// One line naming the adapter, backend and driver.
@@ -185,7 +225,11 @@ impl GpuContext {
                 timeout: Some(GPU_TIMEOUT),
             })
             .map(|_| ())
-            .map_err(|e| RenderError::Gpu(e.to_string()))
+            .map_err(|e| RenderError::Gpu(e.to_string()))?;
+        match self.take_error() {
+            Some(e) => Err(RenderError::Gpu(e)),
+            None => Ok(()),
+        }
     }
 }
 
@@ -221,5 +265,17 @@ pub fn for_tests<T, E: std::fmt::Display>(
         Err(e) => {
             panic!("{e}\nGPU tests need an adapter; set LUMAGRAPH_ALLOW_NO_GPU=1 to skip them")
         }
+    }
+}
+
+/// `bytes` in KiB, MiB or GiB, one decimal.
+pub fn human_bytes(bytes: u64) -> String {
+    #[expect(clippy::cast_precision_loss, reason = "a figure for people")]
+    let b = bytes as f64;
+    match bytes {
+        0..1024 => format!("{bytes} B"),
+        1024..1_048_576 => format!("{:.1} KiB", b / 1024.0),
+        1_048_576..1_073_741_824 => format!("{:.1} MiB", b / 1_048_576.0),
+        _ => format!("{:.1} GiB", b / 1_073_741_824.0),
     }
 }

@@ -47,6 +47,16 @@ pub enum RenderError {
         #[source]
         source: Box<RenderError>,
     },
+    /// The render needs more than the device allows or holds.
+    #[error("{what} on {adapter}: {message}")]
+    TooLarge {
+        /// What is too large (`node "pathtrace": 100000×100000 image`).
+        what: String,
+        /// The adapter.
+        adapter: String,
+        /// The limit and the numbers.
+        message: String,
+    },
     /// A node kind has no GPU implementation in this build.
     #[error("node kind {0} has no implementation")]
     Unimplemented(String),

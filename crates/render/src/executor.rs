@@ -117,13 +117,36 @@ impl Executor {
         paths: &Resources,
         library: &NodeLibrary,
     ) -> Result<Self> {
+        check_limits(ctx, &plan)?;
+        // Allocation failures (out of memory) and what the limits above do not foresee
+        // come back as errors, not as wgpu's panic.
+        let memory = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let nodes = plan
             .passes
             .iter()
             .map(|pass| library.create(ctx, pass, paths))
-            .collect::<Result<Vec<_>>>()?;
+            .collect::<Result<Vec<_>>>();
         let mut pool = TexturePool::new();
         let slots = pool.acquire(ctx, &plan);
+        let invalid = pollster::block_on(validation.pop());
+        let oom = pollster::block_on(memory.pop());
+        if let Some(e) = oom {
+            let textures: u64 = plan.slots.iter().map(lumagraph_graph::Slot::bytes).sum();
+            return Err(RenderError::TooLarge {
+                what: format!(
+                    "{} images ({}) and the nodes' buffers",
+                    plan.slots.len(),
+                    crate::context::human_bytes(textures)
+                ),
+                adapter: ctx.info.name.clone(),
+                message: format!("the device is out of memory ({e})"),
+            });
+        }
+        let nodes = nodes?;
+        if let Some(e) = invalid {
+            return Err(RenderError::Gpu(e.to_string()));
+        }
         // Two timestamps per pass; nodes with several passes get room too.
         let capacity = u32::try_from(plan.passes.len() * 8)
             .unwrap_or(u32::MAX)
@@ -577,6 +600,15 @@ fn new_encoder(ctx: &GpuContext) -> wgpu::CommandEncoder {
         .create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("frame"),
         })
+}
+
+/// Checks the plan's images (and so the nodes' own images of the same sizes) against the
+/// device's limits, before anything is allocated.
+fn check_limits(ctx: &GpuContext, plan: &Plan) -> Result<()> {
+    for t in &plan.textures {
+        ctx.check_extent(&t.name, t.extent.width, t.extent.height)?;
+    }
+    Ok(())
 }
 
 /// Submits `encoder`, turning validation errors into [`RenderError::Gpu`], and waits for
