@@ -15,6 +15,7 @@ mod bench;
 mod converge;
 mod gallery;
 mod plot;
+mod progressive;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -65,6 +66,17 @@ enum Command {
         /// Override a param: `node.param=value` (RON value, or a bare word for names).
         #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
         overrides: Vec<String>,
+        /// Where the checkpoint goes (on Ctrl-C or SIGTERM, and with `--checkpoint-every`);
+        /// default `OUT/render.checkpoint`.
+        #[arg(long, value_name = "FILE")]
+        checkpoint: Option<PathBuf>,
+        /// Write the checkpoint every this many seconds of rendering (atomically).
+        #[arg(long, value_name = "SECONDS")]
+        checkpoint_every: Option<f64>,
+        /// Go on from a checkpoint of the same graph, scene and overrides, to `--spp`: the
+        /// result is identical to an uninterrupted render.
+        #[arg(long, value_name = "CHECKPOINT")]
+        resume: Option<PathBuf>,
     },
     /// Print the compiled plan: passes in order, textures and shared memory, what is left out.
     #[command(after_help = "Example:\n  lumagraph plan graphs/post_tonemap.ron")]
@@ -248,63 +260,6 @@ fn progressive_source(plan: &crate::graph::Plan) -> Option<&crate::graph::Pass> 
         .find(|p| p.params.has(crate::graph::registry::SAMPLES_PER_FRAME))
 }
 
-/// Runs the progressive part of the graph for `spp` samples per pixel, then the rest once,
-/// with a progress bar once the render has taken more than a second.
-fn render_progressive(exec: &mut Executor, spp: u32) -> Result<crate::render::FrameReport> {
-    let frames = exec.frames_for(spp);
-    // Warm-up: drivers compile pipelines at their first dispatch; keep that out of the timing.
-    let warm = Instant::now();
-    exec.warm_up()?;
-    println!(
-        "warm-up (shader compilation): {:.0} ms",
-        warm.elapsed().as_secs_f64() * 1e3
-    );
-
-    let bar = indicatif::ProgressBar::with_draw_target(
-        Some(u64::from(frames)),
-        indicatif::ProgressDrawTarget::hidden(),
-    );
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} frames, {elapsed} (eta {eta})",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    let start = Instant::now();
-    let report = exec
-        .render(frames, |done, _| {
-            if bar.is_hidden() && start.elapsed() > Duration::from_secs(1) {
-                bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
-            }
-            bar.set_position(u64::from(done));
-            true
-        })?
-        .ok_or_else(|| anyhow::anyhow!("the render stopped"))?;
-    bar.finish_and_clear();
-    let wall = start.elapsed();
-    let counters = exec.counters()?;
-    let get = |name: &str| {
-        counters
-            .iter()
-            .find(|(_, c)| c.name == name)
-            .map_or(0, |(_, c)| c.value)
-    };
-    let samples = get("samples_per_pixel");
-    let extent = progressive_source(exec.plan()).map(|p| p.extent);
-    let pixels = extent.map_or(0, crate::graph::Extent::pixels);
-    let secs = wall.as_secs_f64();
-    #[expect(clippy::cast_precision_loss, reason = "report figures")]
-    let (paths, rays) = ((pixels * samples) as f64, get("rays") as f64);
-    println!(
-        "rendered {samples} spp at {} in {secs:.2} s: {:.3} M paths/s, {:.3} M rays/s, {} NaN/Inf samples dropped",
-        extent.map_or_else(String::new, |e| e.to_string()),
-        paths / secs / 1e6,
-        rays / secs / 1e6,
-        get("dropped_samples")
-    );
-    Ok(report)
-}
-
 fn render(args: &RenderArgs<'_>) -> Result<()> {
     let graph = load(args.graph, args.overrides)?;
     let scene = load_scene(args.scene)?;
@@ -333,7 +288,9 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
             .spp
             .or(scene.as_ref().map(|s| s.scene.settings.spp))
             .unwrap_or(1);
-        render_progressive(&mut exec, spp)?
+        let mut checkpoints = args.checkpoints.clone();
+        checkpoints.key = progressive::key(&graph, scene.as_ref().map(|s| &*s.gpu));
+        progressive::render(&mut exec, spp, &checkpoints)?
     } else {
         // The first frame includes pipeline compilation inside the driver; time a second one.
         let first = exec.run_frame()?;
@@ -417,6 +374,7 @@ struct RenderArgs<'a> {
     out: &'a Path,
     spp: Option<u32>,
     overrides: &'a [String],
+    checkpoints: progressive::Checkpoints,
 }
 
 /// `lumagraph plan`: the plan, node-owned memory, and the shader features per pass.
@@ -507,13 +465,22 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             out,
             spp,
             overrides,
+            checkpoint,
+            checkpoint_every,
+            resume,
         } => render(&RenderArgs {
             library,
             graph: &graph,
             scene: scene.as_deref(),
-            out: &out,
             spp,
             overrides: &overrides,
+            checkpoints: progressive::Checkpoints {
+                path: checkpoint.unwrap_or_else(|| out.join("render.checkpoint")),
+                every: checkpoint_every.map(Duration::from_secs_f64),
+                resume,
+                key: 0,
+            },
+            out: &out,
         }),
         Command::Plan {
             graph,

@@ -814,3 +814,166 @@ fn an_image_larger_than_the_device_holds_is_a_clear_error() {
         "{line}"
     );
 }
+
+/// The Cornell box at 64×64 and 1024 spp (256 frames of 4 samples): a few seconds on
+/// lavapipe.
+fn small_cornell(dir: &Path) -> std::path::PathBuf {
+    let scene = dir.join("small.ron");
+    let text = std::fs::read_to_string(common::repo("assets/cornell.ron"))
+        .unwrap()
+        .replace(
+            "width: 256, height: 256, max_bounces: 20, spp: 256",
+            "width: 64, height: 64, max_bounces: 20, spp: 1024",
+        );
+    std::fs::write(&scene, text).unwrap();
+    scene
+}
+
+/// Ctrl-C (SIGINT) during a render writes the outputs of the samples so far and a
+/// checkpoint, and exits non-zero saying so; `--resume` goes on to the full sample count
+/// and writes exactly (bit for bit) what an uninterrupted render writes. A checkpoint of
+/// another scene is refused.
+#[test]
+fn an_interrupted_render_resumes_bit_identically() {
+    use std::io::BufRead as _;
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_cornell(dir.path());
+    let out = |name: &str| dir.path().join(name);
+    let args = |o: &Path| {
+        vec![
+            "render".to_owned(),
+            "graphs/pathtrace.ron".into(),
+            "--scene".into(),
+            scene.display().to_string(),
+            "--out".into(),
+            o.display().to_string(),
+        ]
+    };
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lumagraph"))
+        .args(args(&out("stopped")))
+        .current_dir(common::root())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Once the shaders are compiled, frames are running: interrupt.
+    let mut stdout = std::io::BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    while stdout.read_line(&mut line).unwrap() > 0 && !line.contains("warm-up") {
+        line.clear();
+    }
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut stdout, &mut rest).unwrap();
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    if o.status.success() {
+        eprintln!("the render finished before the signal (a fast device): nothing to resume");
+        return;
+    }
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(err.contains("error: interrupted at frame"), "{err}");
+    assert!(
+        rest.contains("wrote") && rest.contains("render.exr"),
+        "{rest}"
+    );
+    let checkpoint = out("stopped").join("render.checkpoint");
+    let saved = lumagraph::render::Checkpoint::load(&checkpoint).unwrap();
+    assert!((1..256).contains(&saved.frames), "{} frames", saved.frames);
+    let partial = lumagraph::render::image_io::load(&out("stopped").join("render.exr")).unwrap();
+    assert!(
+        partial.pixels.iter().any(|p| p[0] > 0.0),
+        "the samples so far"
+    );
+
+    let mut resume = args(&out("resumed"));
+    resume.extend(["--resume".to_owned(), checkpoint.display().to_string()]);
+    let resume: Vec<&str> = resume.iter().map(String::as_str).collect();
+    let (ok, stdout, stderr) = common::cli(&resume);
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains(&format!("at frame {} of 256", saved.frames)),
+        "{stdout}"
+    );
+    let whole = args(&out("whole"));
+    let whole: Vec<&str> = whole.iter().map(String::as_str).collect();
+    let (ok, stdout, stderr) = common::cli(&whole);
+    assert!(ok, "{stdout}\n{stderr}");
+    let read = |d: &str| std::fs::read(out(d).join("render.exr")).unwrap();
+    assert!(
+        read("resumed") == read("whole"),
+        "the resumed render differs"
+    );
+
+    // Another scene (the full-size box) is refused, naming why.
+    let (ok, _, stderr) = common::cli(&[
+        "render",
+        "graphs/pathtrace.ron",
+        "--scene",
+        "assets/cornell.ron",
+        "--out",
+        out("other").to_str().unwrap(),
+        "--resume",
+        checkpoint.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("cannot resume from") && stderr.contains("another graph or scene"),
+        "{stderr}"
+    );
+}
+
+/// `--checkpoint-every` writes the checkpoint while rendering and at the end; a finished
+/// render goes on from its last checkpoint to more samples, exactly as a render of that many
+/// samples from the start; asking for no more samples than it has is refused.
+#[test]
+fn checkpoints_every_few_seconds_and_at_the_end() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_cornell(dir.path());
+    let out = |name: &str| dir.path().join(name);
+    let checkpoint = dir.path().join("ck.bin");
+    let run = |o: &str, spp: &str, extra: &[&str]| {
+        let o = out(o);
+        let mut args = vec![
+            "render",
+            "graphs/pathtrace.ron",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--spp",
+            spp,
+            "--out",
+            o.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        common::cli(&args)
+    };
+    let ck = checkpoint.to_str().unwrap();
+    let (ok, stdout, stderr) = run(
+        "a",
+        "64",
+        &["--checkpoint", ck, "--checkpoint-every", "0.01"],
+    );
+    assert!(ok, "{stdout}\n{stderr}");
+    let saved = lumagraph::render::Checkpoint::load(&checkpoint).unwrap();
+    assert_eq!(saved.frames, 16, "64 spp in frames of 4");
+    let (ok, stdout, stderr) = run("b", "128", &["--resume", ck]);
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(stdout.contains("at frame 16 of 32"), "{stdout}");
+    let (ok, stdout, stderr) = run("c", "128", &[]);
+    assert!(ok, "{stdout}\n{stderr}");
+    let read = |d: &str| std::fs::read(out(d).join("render.exr")).unwrap();
+    assert!(read("b") == read("c"), "64 + 64 spp differ from 128 spp");
+    let (ok, _, stderr) = run("d", "64", &["--resume", ck]);
+    assert!(!ok && stderr.contains("nothing to resume"), "{stderr}");
+}

@@ -227,7 +227,7 @@ fn run(
     exec.warm_up().map_err(|e| e.to_string())?;
     set(&|s| s.stage = "rendering");
     let report = exec
-        .render(frames, |done, _| {
+        .render(frames, |_, done, _| {
             set(&|s| s.done = done);
             !cancel.load(Ordering::Relaxed)
         })

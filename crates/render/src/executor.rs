@@ -333,23 +333,27 @@ impl Executor {
         spp.div_ceil(spf).max(1)
     }
 
-    /// Runs `frames` frames, the last one finishing (the whole graph runs, sinks write):
-    /// a long render. Frames go in batches that grow while a batch takes under 200 ms, so
-    /// `progress(done, frames)` is called a few times a second; when it returns `false`
-    /// the render stops there and `Ok(None)` is returned (nothing written).
+    /// Runs frames until `frames` ran since the last reset (counting those a
+    /// [`Executor::restore`] put back), the last one finishing (the whole graph runs,
+    /// sinks write): a long render. Frames go in batches that grow while a batch takes
+    /// under 200 ms, so `progress(self, done, frames)` is called a few times a second
+    /// (it may take a checkpoint); when it returns `false` the render stops there and
+    /// `Ok(None)` is returned (nothing written).
     ///
     /// # Errors
     /// When a node fails; the error names the node.
     pub fn render(
         &mut self,
         frames: u32,
-        mut progress: impl FnMut(u32, u32) -> bool,
+        mut progress: impl FnMut(&mut Self, u32, u32) -> bool,
     ) -> Result<Option<FrameReport>> {
         let frames = frames.max(1);
-        let mut done = 0;
+        let mut done = u32::try_from(self.frames)
+            .unwrap_or(u32::MAX)
+            .min(frames - 1);
         let mut batch = 1;
         while done + 1 < frames {
-            if !progress(done, frames) {
+            if !progress(self, done, frames) {
                 return Ok(None);
             }
             let n = batch.min(frames - 1 - done);
@@ -360,12 +364,78 @@ impl Executor {
                 batch = (batch * 2).min(256);
             }
         }
-        if !progress(done, frames) {
+        if !progress(self, done, frames) {
             return Ok(None);
         }
         let report = self.run_frames(1, true)?;
-        progress(frames, frames);
+        progress(self, frames, frames);
         Ok(Some(report))
+    }
+
+    /// Where the render stands: the frames run and every node's history (read back).
+    ///
+    /// # Errors
+    /// When a readback fails; the error names the node.
+    pub fn checkpoint(&mut self, key: u64) -> Result<crate::Checkpoint> {
+        let mut nodes = Vec::new();
+        for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
+            if let Some(state) = node
+                .save_state(&self.ctx)
+                .map_err(|e| e.in_node(&pass.node))?
+            {
+                nodes.push((pass.node.clone(), state));
+            }
+        }
+        Ok(crate::Checkpoint {
+            key,
+            version: env!("CARGO_PKG_VERSION").to_owned(),
+            adapter: self.ctx.info.name.clone(),
+            frames: self.frames,
+            nodes,
+        })
+    }
+
+    /// Goes on from `checkpoint`: every node's history and the frame count as they were,
+    /// so the next frames are those an uninterrupted render would run next. Check the
+    /// checkpoint's key first ([`crate::Checkpoint::check`]).
+    ///
+    /// # Errors
+    /// When a node that keeps history has no state in it, or the states do not fit (other
+    /// image sizes); the error names the node.
+    pub fn restore(&mut self, checkpoint: &crate::Checkpoint) -> Result<()> {
+        let mut used = 0;
+        for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
+            let saved = checkpoint.nodes.iter().find(|(id, _)| *id == pass.node);
+            let keeps = node.save_state(&self.ctx)?.is_some();
+            match (saved, keeps) {
+                (Some((_, state)), true) => {
+                    node.load_state(&self.ctx, pass, state)
+                        .map_err(|e| e.in_node(&pass.node))?;
+                    used += 1;
+                }
+                (None, true) => {
+                    return Err(RenderError::Gpu(
+                        "the checkpoint has no state for this node".into(),
+                    )
+                    .in_node(&pass.node));
+                }
+                (Some(_), false) => {
+                    return Err(RenderError::Gpu(
+                        "the checkpoint has a state for this node, which keeps none".into(),
+                    )
+                    .in_node(&pass.node));
+                }
+                (None, false) => {}
+            }
+        }
+        if used != checkpoint.nodes.len() {
+            return Err(RenderError::Gpu(format!(
+                "the checkpoint has states for {} nodes this graph does not run",
+                checkpoint.nodes.len() - used
+            )));
+        }
+        self.frames = checkpoint.frames;
+        Ok(())
     }
 
     /// Records every pass once without writing files or keeping history, so drivers that

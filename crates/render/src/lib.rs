@@ -14,6 +14,7 @@
 
 pub mod bsdf_check;
 pub mod bsdf_tables;
+pub mod checkpoint;
 mod context;
 pub mod cpu;
 pub mod custom;
@@ -35,7 +36,8 @@ pub mod shader;
 pub mod specialize;
 mod timing;
 
-pub use context::{GPU_TIMEOUT, GpuContext, for_tests};
+pub use checkpoint::Checkpoint;
+pub use context::{GPU_TIMEOUT, GpuContext, for_tests, human_bytes};
 pub use error::{RenderError, Result};
 pub use executor::{Executor, FrameReport, PassClock};
 pub use kernel::{Binding, Kernel, PassBuilder, uniform_buffer};

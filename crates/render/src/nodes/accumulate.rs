@@ -86,7 +86,131 @@ impl Accumulate {
     }
 }
 
+impl Accumulate {
+    /// New (uncleared) history buffers for `extent`.
+    fn make_history(&mut self, ctx: &GpuContext, extent: Extent) {
+        let make = |label, size| {
+            ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        };
+        let bytes = extent.pixels() * 16;
+        self.history = Some((
+            extent,
+            make("accumulate sum", bytes),
+            make("accumulate compensation", bytes),
+            make(
+                "accumulate second moment",
+                if self.variance { bytes } else { 16 },
+            ),
+        ));
+    }
+
+    /// Writes the params block for `extent` (done with every clear).
+    fn write_params(&self, ctx: &GpuContext, extent: Extent) {
+        // The image size rides with the params (outputs may be 1×1 stand-ins).
+        let block = AccumulateParams {
+            one: 1.0,
+            variance: u32::from(self.variance),
+            size: [extent.width, extent.height],
+        };
+        ctx.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&block));
+    }
+}
+
 impl NodeExec for Accumulate {
+    fn save_state(&mut self, ctx: &GpuContext) -> Result<Option<Vec<u8>>> {
+        // Header: width, height, and the size of each buffer; then the buffers. No history
+        // yet (or one to be cleared) is an empty state.
+        let Some((extent, sum, comp, m2)) = self.history.as_ref().filter(|_| !self.clear) else {
+            return Ok(Some(Vec::new()));
+        };
+        let mut out = Vec::new();
+        out.extend_from_slice(&extent.width.to_le_bytes());
+        out.extend_from_slice(&extent.height.to_le_bytes());
+        for b in [sum, comp, m2] {
+            out.extend_from_slice(&b.size().to_le_bytes());
+        }
+        for b in [sum, comp, m2] {
+            let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("accumulate state readback"),
+                size: b.size(),
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut encoder = ctx
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("accumulate state"),
+                });
+            encoder.copy_buffer_to_buffer(b, 0, &staging, 0, b.size());
+            ctx.queue.submit([encoder.finish()]);
+            crate::readback::map_read(ctx, &staging, b.size(), |bytes| {
+                out.extend_from_slice(bytes);
+            })?;
+        }
+        Ok(Some(out))
+    }
+
+    fn load_state(&mut self, ctx: &GpuContext, pass: &Pass, state: &[u8]) -> Result<()> {
+        if state.is_empty() {
+            self.clear = true;
+            return Ok(());
+        }
+        let bad =
+            |why: String| crate::error::RenderError::Gpu(format!("accumulation state: {why}"));
+        let u32_at = |i: usize| {
+            state
+                .get(i..i + 4)
+                .and_then(|b| b.try_into().ok())
+                .map(u32::from_le_bytes)
+        };
+        let u64_at = |i: usize| {
+            state
+                .get(i..i + 8)
+                .and_then(|b| b.try_into().ok())
+                .map(u64::from_le_bytes)
+        };
+        let (Some(w), Some(h)) = (u32_at(0), u32_at(4)) else {
+            return Err(bad("truncated".into()));
+        };
+        if Extent::new(w, h) != pass.extent {
+            return Err(bad(format!("{w}×{h}, but the image is {}", pass.extent)));
+        }
+        self.make_history(ctx, pass.extent);
+        let Some((_, sum, comp, m2)) = &self.history else {
+            return Err(bad("no buffers".into()));
+        };
+        let mut at = 8 + 3 * 8;
+        for (i, b) in [sum, comp, m2].into_iter().enumerate() {
+            let size = u64_at(8 + 8 * i).ok_or_else(|| bad("truncated".into()))?;
+            if size != b.size() {
+                return Err(bad(format!(
+                    "a buffer of {size} bytes where {} are expected (variance on or off?)",
+                    b.size()
+                )));
+            }
+            let len = usize::try_from(size).map_err(|_| bad("too large".into()))?;
+            let bytes = state
+                .get(at..at + len)
+                .ok_or_else(|| bad("truncated".into()))?;
+            ctx.queue.write_buffer(b, 0, bytes);
+            at += len;
+        }
+        if at != state.len() {
+            return Err(bad(format!("{} bytes too many", state.len() - at)));
+        }
+        self.write_params(ctx, pass.extent);
+        self.clear = false;
+        Ok(())
+    }
+
     fn update(&mut self, _ctx: &GpuContext, _pass: &Pass) -> Result<()> {
         Ok(())
     }
@@ -105,24 +229,7 @@ impl NodeExec for Accumulate {
         let mut clear = std::mem::take(&mut self.clear);
         let extent = pass.extent;
         if self.history.as_ref().is_none_or(|(e, ..)| *e != extent) {
-            let make = |label, size| {
-                ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(label),
-                    size,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                })
-            };
-            let bytes = extent.pixels() * 16;
-            self.history = Some((
-                extent,
-                make("accumulate sum", bytes),
-                make("accumulate compensation", bytes),
-                make(
-                    "accumulate second moment",
-                    if self.variance { bytes } else { 16 },
-                ),
-            ));
+            self.make_history(ctx, extent);
             clear = true;
         }
         let Some((_, sum, comp, m2)) = &self.history else {
@@ -134,14 +241,7 @@ impl NodeExec for Accumulate {
             encoder.clear_buffer(m2, 0, None);
         }
         if clear {
-            // The image size rides with the params (outputs may be 1×1 stand-ins).
-            let block = AccumulateParams {
-                one: 1.0,
-                variance: u32::from(self.variance),
-                size: [extent.width, extent.height],
-            };
-            ctx.queue
-                .write_buffer(&self.params, 0, bytemuck::bytes_of(&block));
+            self.write_params(ctx, extent);
         }
         let view = |t: Option<lumagraph_graph::TextureId>, i: usize| {
             t.map_or(&self.unused[i].view, |t| &io.texture(t).view)

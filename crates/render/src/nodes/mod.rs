@@ -184,6 +184,26 @@ pub trait NodeExec {
         Ok(Vec::new())
     }
 
+    /// The history this node keeps across frames, as bytes for a checkpoint
+    /// ([`crate::Checkpoint`]); `None` when it keeps none. Reads back from the GPU.
+    ///
+    /// # Errors
+    /// When the readback fails.
+    fn save_state(&mut self, _ctx: &GpuContext) -> Result<Option<Vec<u8>>> {
+        Ok(None)
+    }
+
+    /// Puts back what [`NodeExec::save_state`] returned, so the next frame continues
+    /// exactly where the saved one stopped.
+    ///
+    /// # Errors
+    /// When the bytes do not fit this node (another size, a truncated file).
+    fn load_state(&mut self, _ctx: &GpuContext, _pass: &Pass, _state: &[u8]) -> Result<()> {
+        Err(RenderError::Gpu(
+            "this node keeps no state to restore".into(),
+        ))
+    }
+
     /// Runs after the frame's GPU work finished; returns files written.
     ///
     /// # Errors

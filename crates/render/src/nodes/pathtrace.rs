@@ -251,6 +251,38 @@ impl NodeExec for PathTrace {
         notes
     }
 
+    fn save_state(&mut self, ctx: &GpuContext) -> Result<Option<Vec<u8>>> {
+        // Folds the GPU's counters into the totals first.
+        self.counters(ctx)?;
+        let mut bytes = Vec::with_capacity(24);
+        for v in [u64::from(self.samples), self.dropped, self.rays] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        Ok(Some(bytes))
+    }
+
+    fn load_state(&mut self, _ctx: &GpuContext, _pass: &Pass, state: &[u8]) -> Result<()> {
+        let word = |i: usize| {
+            state
+                .get(8 * i..8 * i + 8)
+                .and_then(|b| b.try_into().ok())
+                .map(u64::from_le_bytes)
+        };
+        let (Some(samples), Some(dropped), Some(rays), 24) =
+            (word(0), word(1), word(2), state.len())
+        else {
+            return Err(RenderError::Gpu(format!(
+                "a path tracer's state is 24 bytes, this one {}",
+                state.len()
+            )));
+        };
+        self.samples = u32::try_from(samples)
+            .map_err(|_| RenderError::Gpu(format!("{samples} samples per pixel is too many")))?;
+        self.dropped = dropped;
+        self.rays = rays;
+        Ok(())
+    }
+
     fn counters(&mut self, ctx: &GpuContext) -> Result<Vec<Counter>> {
         let mut encoder = ctx
             .device

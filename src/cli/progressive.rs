@@ -1,0 +1,213 @@
+//! `render`'s progressive part: frames up to the asked samples per pixel with a progress
+//! bar, checkpoints every few seconds when asked, and on Ctrl-C (SIGINT) or SIGTERM the
+//! outputs of the samples so far plus a checkpoint to go on from (`--resume`).
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use anyhow::{Result, anyhow, bail};
+
+use crate::graph::Graph;
+use crate::render::{Checkpoint, Executor, FrameReport};
+use crate::scene::GpuScene;
+
+/// Set by the signal handler: stop after the batch of frames running now.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+/// Where checkpoints go and when.
+#[derive(Clone, Debug)]
+pub(super) struct Checkpoints {
+    /// The checkpoint file.
+    pub path: PathBuf,
+    /// Write it this often while rendering.
+    pub every: Option<Duration>,
+    /// Go on from this checkpoint.
+    pub resume: Option<PathBuf>,
+    /// What is rendered ([`key`]).
+    pub key: u64,
+}
+
+/// The render's key: lumagraph's version, the graph as run (overrides applied, without
+/// layout and comments) and every number of the flattened scene.
+pub(super) fn key(graph: &Graph, scene: Option<&GpuScene>) -> u64 {
+    let mut g = graph.clone();
+    g.origin = None;
+    for n in &mut g.nodes {
+        n.pos = None;
+    }
+    let scene = scene.map_or_else(String::new, |s| format!("{s:?}"));
+    crate::render::checkpoint::render_key(&g.to_ron(), &scene)
+}
+
+/// The first Ctrl-C or SIGTERM asks the render to stop after its current batch of frames;
+/// a second one ends the process at once.
+fn on_signal() {
+    let installed = ctrlc::set_handler(|| {
+        if STOP.swap(true, Ordering::SeqCst) {
+            eprintln!("stopped");
+            std::process::exit(130);
+        }
+        eprintln!(
+            "stopping after this batch of frames: writing the samples so far and a checkpoint \
+             (press Ctrl-C again to quit without them)"
+        );
+    });
+    if let Err(e) = installed {
+        eprintln!("warning: Ctrl-C will not write a checkpoint: {e}");
+    }
+}
+
+/// Runs the progressive part of the graph to `spp` samples per pixel (going on from a
+/// checkpoint when asked), then the rest once.
+pub(super) fn render(exec: &mut Executor, spp: u32, ck: &Checkpoints) -> Result<FrameReport> {
+    let frames = exec.frames_for(spp);
+    // Warm-up: drivers compile pipelines at their first dispatch; keep that out of the timing.
+    let warm = Instant::now();
+    exec.warm_up()?;
+    println!(
+        "warm-up (shader compilation): {:.0} ms",
+        warm.elapsed().as_secs_f64() * 1e3
+    );
+    if let Some(path) = &ck.resume {
+        let from = Checkpoint::load(path)?;
+        from.check(ck.key)
+            .map_err(|e| anyhow!("cannot resume from {}: {e}", path.display()))?;
+        if from.adapter != exec.context().info.name {
+            println!(
+                "warning: the checkpoint was made on {}, this is {}: the result may differ \
+                 from an uninterrupted render in the last bits",
+                from.adapter,
+                exec.context().info.name
+            );
+        }
+        if from.frames >= u64::from(frames) {
+            bail!(
+                "nothing to resume from {}: it has {} frames, and {frames} make the {spp} spp \
+                 asked for; ask for more with --spp",
+                path.display(),
+                from.frames
+            );
+        }
+        exec.restore(&from)?;
+        println!(
+            "resuming from {} at frame {} of {frames}",
+            path.display(),
+            from.frames
+        );
+    }
+    let before = samples_per_pixel(exec)?;
+    on_signal();
+
+    let bar = indicatif::ProgressBar::with_draw_target(
+        Some(u64::from(frames)),
+        indicatif::ProgressDrawTarget::hidden(),
+    );
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} frames, {elapsed} (eta {eta})",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let start = Instant::now();
+    let mut last = Instant::now();
+    let mut failed = None;
+    let report = exec.render(frames, |exec, done, _| {
+        if bar.is_hidden() && start.elapsed() > Duration::from_secs(1) {
+            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+        bar.set_position(u64::from(done));
+        if ck.every.is_some_and(|every| last.elapsed() >= every) && done < frames {
+            last = Instant::now();
+            if let Err(e) = exec.checkpoint(ck.key).and_then(|c| c.save(&ck.path)) {
+                failed = Some(e);
+                return false;
+            }
+        }
+        !STOP.load(Ordering::SeqCst)
+    })?;
+    bar.finish_and_clear();
+    if let Some(e) = failed {
+        return Err(e.into());
+    }
+    match report {
+        Some(report) => {
+            report_speed(exec, start.elapsed(), before)?;
+            if ck.every.is_some() {
+                exec.checkpoint(ck.key)?.save(&ck.path)?;
+            }
+            Ok(report)
+        }
+        None => Err(stopped(exec, spp, frames, ck)),
+    }
+}
+
+/// After a stop: the checkpoint, the outputs of the samples so far, and the error saying so.
+fn stopped(exec: &mut Executor, spp: u32, frames: u32, ck: &Checkpoints) -> anyhow::Error {
+    let done = exec.frames();
+    if done == 0 {
+        return anyhow!("interrupted before the first frame: nothing written");
+    }
+    if let Err(e) = exec.checkpoint(ck.key).and_then(|c| c.save(&ck.path)) {
+        return anyhow!("interrupted at frame {done} of {frames}, and the checkpoint failed: {e}");
+    }
+    let written = match exec.run_tail() {
+        Ok(r) => r.written,
+        Err(e) => {
+            return anyhow!(
+                "interrupted at frame {done} of {frames}; checkpoint {}; the outputs failed: {e}",
+                ck.path.display()
+            );
+        }
+    };
+    for path in &written {
+        println!("wrote {} (frame {done} of {frames})", path.display());
+    }
+    anyhow!(
+        "interrupted at frame {done} of {frames} ({spp} spp asked): wrote the outputs of the \
+         samples so far and the checkpoint {}; go on with the same command and `--resume {}`",
+        ck.path.display(),
+        ck.path.display()
+    )
+}
+
+/// The path tracer's samples per pixel and rays so far (0 without one).
+fn samples_per_pixel(exec: &mut Executor) -> Result<(u64, u64)> {
+    let counters = exec.counters()?;
+    let get = |name: &str| {
+        counters
+            .iter()
+            .find(|(_, c)| c.name == name)
+            .map_or(0, |(_, c)| c.value)
+    };
+    Ok((get("samples_per_pixel"), get("rays")))
+}
+
+/// Prints samples, paths and rays per second of this run (`before`: the samples per pixel
+/// and rays a checkpoint brought).
+fn report_speed(exec: &mut Executor, wall: Duration, before: (u64, u64)) -> Result<()> {
+    let counters = exec.counters()?;
+    let get = |name: &str| {
+        counters
+            .iter()
+            .find(|(_, c)| c.name == name)
+            .map_or(0, |(_, c)| c.value)
+    };
+    let samples = get("samples_per_pixel");
+    let extent = super::progressive_source(exec.plan()).map(|p| p.extent);
+    let pixels = extent.map_or(0, crate::graph::Extent::pixels);
+    let secs = wall.as_secs_f64();
+    #[expect(clippy::cast_precision_loss, reason = "report figures")]
+    let (paths, rays) = (
+        (pixels * samples.saturating_sub(before.0)) as f64,
+        get("rays").saturating_sub(before.1) as f64,
+    );
+    println!(
+        "rendered {samples} spp at {} in {secs:.2} s: {:.3} M paths/s, {:.3} M rays/s, {} NaN/Inf samples dropped",
+        extent.map_or_else(String::new, |e| e.to_string()),
+        paths / secs / 1e6,
+        rays / secs / 1e6,
+        get("dropped_samples")
+    );
+    Ok(())
+}
