@@ -349,11 +349,11 @@ impl Editor {
     /// cannot be built keeps the last good one in the preview and says why.
     pub fn apply_scene_edits(&mut self, dragging: bool) {
         let Some(s) = &mut self.scene else { return };
-        let now = (s.doc.file.clone(), s.doc.furnace);
-        if dragging || s.built == now {
+        // Compared in place: this runs every UI frame.
+        if dragging || (s.built.0 == s.doc.file && s.built.1 == s.doc.furnace) {
             return;
         }
-        s.built = now;
+        s.built = (s.doc.file.clone(), s.doc.furnace);
         match s.doc.build() {
             Ok(gpu) => {
                 let doc = s.doc.clone();
