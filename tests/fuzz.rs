@@ -172,8 +172,8 @@ const JSON_TOKENS: &[&str] = &[
     "\"MAT4\"", "\"matrix\"", "\"rotation\"", "\"scale\"", "\"translation\"", "\"mode\"",
     "\"camera\"", "\"extensions\"", "\"KHR_lights_punctual\"", "\"light\"", "\"spot\"",
     "\"range\"", "\"data:application/octet-stream;base64,AAAA\"",
-    "\"data:image/png;base64,iVBORw0KGgo=\"", "\"missing.bin\"", "\"../\"", "5120", "5121",
-    "5122", "5123", "5125", "5126",
+    "\"data:image/png;base64,iVBORw0KGgo=\"", "\"missing.bin\"", "\"%FF%FE.bin\"", "%", "%2e",
+    "\"../\"", "5120", "5121", "5122", "5123", "5125", "5126",
 ];
 
 /// OBJ and MTL keywords and face corners.

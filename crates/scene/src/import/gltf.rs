@@ -35,10 +35,11 @@ use crate::texture::{Texture, Wrap};
 /// When the file or its buffers cannot be read or are not valid glTF.
 pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneError> {
     let file = open(path)?;
+    check_images(&file.document)?;
+    check_uris(&file.document, path.parent())?;
     let buffers = ::gltf::import_buffers(&file.document, path.parent(), file.blob.clone())?;
     let doc = &file.document;
     check_views(doc, &buffers)?;
-    check_images(doc)?;
     check_tree(doc)?;
     let mut out = ImportedMesh::default();
     let mut decoder = Decoder {
@@ -209,6 +210,69 @@ fn check_images(doc: &::gltf::Document) -> Result<(), SceneError> {
         }
     }
     Ok(())
+}
+
+/// Every buffer and image URI that names a file names a regular one in UTF-8: gltf unwraps
+/// the decoding of `%` escapes, and would read a device such as `/dev/zero` until memory
+/// runs out, or wait on a pipe. Run after [`check_images`] (`Image::source` unwraps).
+fn check_uris(doc: &::gltf::Document, base: Option<&Path>) -> Result<(), SceneError> {
+    let buffers = doc.buffers().filter_map(|b| match b.source() {
+        ::gltf::buffer::Source::Uri(uri) => Some((format!("buffer {}", b.index()), uri)),
+        ::gltf::buffer::Source::Bin => None,
+    });
+    let images = doc.images().filter_map(|i| match i.source() {
+        ::gltf::image::Source::Uri { uri, .. } => Some((format!("image {}", i.index()), uri)),
+        ::gltf::image::Source::View { .. } => None,
+    });
+    for (what, uri) in buffers.chain(images) {
+        let fail = |why: &str| {
+            Err(SceneError::new(ErrorKind::GltfData(format!(
+                "{what}: URI \"{}\" {why}",
+                uri.chars().take(80).collect::<String>()
+            ))))
+        };
+        let path = if uri.contains(':') {
+            match uri
+                .strip_prefix("file://")
+                .or_else(|| uri.strip_prefix("file:"))
+            {
+                Some(rest) => std::path::PathBuf::from(rest),
+                None => continue,
+            }
+        } else {
+            match String::from_utf8(percent_decode(uri)) {
+                Ok(decoded) => base.unwrap_or(Path::new("")).join(decoded),
+                Err(_) => return fail("is not UTF-8 once its % escapes are decoded"),
+            }
+        };
+        if std::fs::metadata(&path).is_ok_and(|m| !m.is_file()) {
+            return fail(&format!("names {}, which is not a file", path.display()));
+        }
+    }
+    Ok(())
+}
+
+/// `%XX` escapes decoded (others kept as written), as gltf decodes relative URIs.
+fn percent_decode(uri: &str) -> Vec<u8> {
+    let bytes = uri.as_bytes();
+    let hex = |b: u8| char::from(b).to_digit(16);
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%'
+            && let (Some(h), Some(l)) = (
+                bytes.get(i + 1).copied().and_then(hex),
+                bytes.get(i + 2).copied().and_then(hex),
+            )
+        {
+            out.push((h * 16 + l) as u8);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    out
 }
 
 /// The node hierarchy is a forest, as glTF requires: no node has two parents and no node
