@@ -100,7 +100,29 @@ pub fn load(path: &Path) -> Result<Image> {
     }
 }
 
+/// The most pixels an EXR layer may have (16384 × 16384, the largest image devices hold):
+/// the reader allocates the whole image from the header's size before reading any pixel,
+/// so a corrupt size would otherwise ask for terabytes and abort the process.
+pub const MAX_EXR_PIXELS: u64 = 1 << 28;
+
 fn load_exr(path: &Path) -> Result<Image> {
+    let meta = exrp::MetaData::read_from_file(path, false)
+        .map_err(|e| RenderError::image(path, format!("not a readable RGB(A) EXR file: {e}")))?;
+    for header in &meta.headers {
+        let size = header.layer_size;
+        let pixels = (size.width() as u64).saturating_mul(size.height() as u64);
+        if pixels > MAX_EXR_PIXELS {
+            return Err(RenderError::image(
+                path,
+                format!(
+                    "EXR layer of {}×{} pixels is larger than the {MAX_EXR_PIXELS} pixels \
+                     (16384×16384) this reader takes",
+                    size.width(),
+                    size.height()
+                ),
+            ));
+        }
+    }
     let read = exrp::read()
         .no_deep_data()
         .largest_resolution_level()

@@ -59,9 +59,17 @@ pub enum ErrorKind {
     /// A glTF file could not be loaded.
     #[error("glTF: {0}")]
     Gltf(#[source] Box<gltf::Error>),
+    /// A glTF file that parses but whose parts do not fit together: a buffer view or
+    /// accessor past the end of its data, an attribute of the wrong type, a node hierarchy
+    /// that is not a tree.
+    #[error("glTF: {0}")]
+    GltfData(String),
     /// An OBJ or MTL file could not be loaded.
     #[error("OBJ: {0}")]
     Obj(#[from] tobj::LoadError),
+    /// An OBJ face refers to an element the file does not have: the line and what.
+    #[error("OBJ: {0}")]
+    ObjData(String),
     /// A texture's image could not be read or decoded: the texture
     /// (`texture 0 (image 1, "wood.png")`) and what went wrong.
     #[error("{0}")]

@@ -34,9 +34,13 @@ use crate::texture::{Texture, Wrap};
 /// # Errors
 /// When the file or its buffers cannot be read or are not valid glTF.
 pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneError> {
-    let file = ::gltf::Gltf::open(path)?;
+    let file = open(path)?;
+    check_images(&file.document)?;
+    check_uris(&file.document, path.parent())?;
     let buffers = ::gltf::import_buffers(&file.document, path.parent(), file.blob.clone())?;
     let doc = &file.document;
+    check_views(doc, &buffers)?;
+    check_tree(doc)?;
     let mut out = ImportedMesh::default();
     let mut decoder = Decoder {
         base: path.parent(),
@@ -112,6 +116,13 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
                         out.materials.len() - 1
                     })
                 };
+                check_attributes(&prim, &buffers).map_err(|e| {
+                    SceneError::new(ErrorKind::GltfData(format!(
+                        "mesh {} primitive {}: {e}",
+                        mesh.index(),
+                        prim.index()
+                    )))
+                })?;
                 read_primitive(&prim, &buffers, &world, material as u32, &mut out);
             }
         }
@@ -119,6 +130,290 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
         stack.extend(children.into_iter().rev().map(|c| (c, world)));
     }
     Ok(out)
+}
+
+/// Reads and validates a `.gltf` or `.glb` file, as `gltf::Gltf::open` does, checking first
+/// what the gltf crate's validation indexes unchecked: each primitive's `POSITION`
+/// accessor.
+fn open(path: &Path) -> Result<::gltf::Gltf, SceneError> {
+    let bytes = std::fs::read(path).map_err(::gltf::Error::Io)?;
+    if bytes.starts_with(b"glTF") {
+        // gltf subtracts the header's 12 bytes from this length unchecked.
+        let length = bytes
+            .get(8..12)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        if length.is_none_or(|n| n < 12) {
+            return Err(SceneError::new(ErrorKind::GltfData(format!(
+                "the GLB header's length ({}) is less than the header's own 12 bytes",
+                length.map_or_else(|| "missing".to_owned(), |n| n.to_string())
+            ))));
+        }
+    }
+    let unchecked = ::gltf::Gltf::from_slice_without_validation(&bytes)?;
+    let json = unchecked.document.as_json();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let position = ::gltf::json::validation::Checked::Valid(::gltf::Semantic::Positions);
+            if let Some(i) = prim.attributes.get(&position)
+                && i.value() >= json.accessors.len()
+            {
+                return Err(SceneError::new(ErrorKind::GltfData(format!(
+                    "mesh {m} primitive {p}: POSITION is accessor {}, but the file has {} accessors",
+                    i.value(),
+                    json.accessors.len()
+                ))));
+            }
+        }
+    }
+    let document = ::gltf::Document::from_json(unchecked.document.into_json())?;
+    Ok(::gltf::Gltf {
+        document,
+        blob: unchecked.blob,
+    })
+}
+
+/// Every buffer view within its buffer's data (the gltf crate slices them unchecked, for
+/// images in buffer views, and adds their offsets and lengths unchecked).
+fn check_views(doc: &::gltf::Document, buffers: &[::gltf::buffer::Data]) -> Result<(), SceneError> {
+    for view in doc.views() {
+        let buffer = view.buffer().index();
+        let len = buffers.get(buffer).map_or(0, |d| d.len());
+        if view
+            .offset()
+            .checked_add(view.length())
+            .is_none_or(|end| end > len)
+        {
+            return Err(SceneError::new(ErrorKind::GltfData(format!(
+                "buffer view {}: bytes {} to {} + {} are past the end of buffer {buffer} ({len} bytes)",
+                view.index(),
+                view.offset(),
+                view.offset(),
+                view.length()
+            ))));
+        }
+    }
+    Ok(())
+}
+
+/// Every image has a source the gltf crate can give without panicking: a URI, or a buffer
+/// view with its MIME type.
+fn check_images(doc: &::gltf::Document) -> Result<(), SceneError> {
+    for (i, image) in doc.as_json().images.iter().enumerate() {
+        let ok = match image.buffer_view {
+            Some(_) => image.mime_type.is_some(),
+            None => image.uri.is_some(),
+        };
+        if !ok {
+            return Err(SceneError::new(ErrorKind::GltfData(format!(
+                "image {i} has neither a \"uri\" nor a \"bufferView\" with a \"mimeType\""
+            ))));
+        }
+    }
+    Ok(())
+}
+
+/// Every buffer and image URI that names a file names a regular one in UTF-8: gltf unwraps
+/// the decoding of `%` escapes, and would read a device such as `/dev/zero` until memory
+/// runs out, or wait on a pipe. Run after [`check_images`] (`Image::source` unwraps).
+fn check_uris(doc: &::gltf::Document, base: Option<&Path>) -> Result<(), SceneError> {
+    let buffers = doc.buffers().filter_map(|b| match b.source() {
+        ::gltf::buffer::Source::Uri(uri) => Some((format!("buffer {}", b.index()), uri)),
+        ::gltf::buffer::Source::Bin => None,
+    });
+    let images = doc.images().filter_map(|i| match i.source() {
+        ::gltf::image::Source::Uri { uri, .. } => Some((format!("image {}", i.index()), uri)),
+        ::gltf::image::Source::View { .. } => None,
+    });
+    for (what, uri) in buffers.chain(images) {
+        let fail = |why: &str| {
+            Err(SceneError::new(ErrorKind::GltfData(format!(
+                "{what}: URI \"{}\" {why}",
+                uri.chars().take(80).collect::<String>()
+            ))))
+        };
+        let path = if uri.contains(':') {
+            match uri
+                .strip_prefix("file://")
+                .or_else(|| uri.strip_prefix("file:"))
+            {
+                Some(rest) => std::path::PathBuf::from(rest),
+                None => continue,
+            }
+        } else {
+            match String::from_utf8(percent_decode(uri)) {
+                Ok(decoded) => base.unwrap_or(Path::new("")).join(decoded),
+                Err(_) => return fail("is not UTF-8 once its % escapes are decoded"),
+            }
+        };
+        if std::fs::metadata(&path).is_ok_and(|m| !m.is_file()) {
+            return fail(&format!("names {}, which is not a file", path.display()));
+        }
+    }
+    Ok(())
+}
+
+/// `%XX` escapes decoded (others kept as written), as gltf decodes relative URIs.
+fn percent_decode(uri: &str) -> Vec<u8> {
+    let bytes = uri.as_bytes();
+    let hex = |b: u8| char::from(b).to_digit(16);
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%'
+            && let (Some(h), Some(l)) = (
+                bytes.get(i + 1).copied().and_then(hex),
+                bytes.get(i + 2).copied().and_then(hex),
+            )
+        {
+            out.push((h * 16 + l) as u8);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    out
+}
+
+/// The node hierarchy is a forest, as glTF requires: no node has two parents and no node
+/// is its own ancestor (which would make the walk through it endless).
+fn check_tree(doc: &::gltf::Document) -> Result<(), SceneError> {
+    let count = doc.nodes().len();
+    let mut parent = vec![None; count];
+    for node in doc.nodes() {
+        for child in node.children() {
+            if let Some(p) = parent[child.index()].replace(node.index()) {
+                return Err(SceneError::new(ErrorKind::GltfData(format!(
+                    "node {} is a child of both node {p} and node {} (nodes form trees)",
+                    child.index(),
+                    node.index()
+                ))));
+            }
+        }
+    }
+    for start in 0..count {
+        let mut at = start;
+        for _ in 0..count {
+            match parent[at] {
+                Some(p) if p == start => {
+                    return Err(SceneError::new(ErrorKind::GltfData(format!(
+                        "node {start} is its own ancestor (nodes form trees)"
+                    ))));
+                }
+                Some(p) => at = p,
+                None => break,
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The accessors the importer reads (positions, normals, tangents, `TEXCOORD_0`,
+/// indices) are of the types glTF allows for them and lie within their buffer views: the
+/// gltf crate's reader asserts the first and computes the second unchecked.
+fn check_attributes(
+    prim: &::gltf::Primitive<'_>,
+    buffers: &[::gltf::buffer::Data],
+) -> Result<(), String> {
+    use ::gltf::Semantic;
+    use ::gltf::accessor::{DataType, Dimensions};
+    for (semantic, accessor) in prim.attributes() {
+        let (types, dims): (&[DataType], _) = match semantic {
+            Semantic::Positions | Semantic::Normals => (&[DataType::F32], Dimensions::Vec3),
+            Semantic::Tangents => (&[DataType::F32], Dimensions::Vec4),
+            Semantic::TexCoords(0) => (
+                &[DataType::F32, DataType::U8, DataType::U16],
+                Dimensions::Vec2,
+            ),
+            _ => continue,
+        };
+        check_accessor(&accessor, buffers, types, dims)
+            .map_err(|e| format!("{semantic:?} (accessor {}): {e}", accessor.index()))?;
+    }
+    if let Some(accessor) = prim.indices() {
+        let types = [DataType::U8, DataType::U16, DataType::U32];
+        check_accessor(&accessor, buffers, &types, Dimensions::Scalar)
+            .map_err(|e| format!("indices (accessor {}): {e}", accessor.index()))?;
+    }
+    Ok(())
+}
+
+fn check_accessor(
+    accessor: &::gltf::Accessor<'_>,
+    buffers: &[::gltf::buffer::Data],
+    types: &[::gltf::accessor::DataType],
+    dims: ::gltf::accessor::Dimensions,
+) -> Result<(), String> {
+    if !types.contains(&accessor.data_type()) || accessor.dimensions() != dims {
+        return Err(format!(
+            "{:?} of {:?}, where glTF allows {dims:?} of {types:?}",
+            accessor.dimensions(),
+            accessor.data_type()
+        ));
+    }
+    let size = accessor.size();
+    if let Some(view) = accessor.view() {
+        check_range(&view, buffers, accessor.offset(), accessor.count(), size)?;
+    }
+    if let Some(sparse) = accessor.sparse() {
+        let indices = sparse.indices();
+        let values = sparse.values();
+        check_range(
+            &indices.view(),
+            buffers,
+            indices.offset(),
+            sparse.count(),
+            indices.index_type().size(),
+        )
+        .map_err(|e| format!("sparse indices: {e}"))?;
+        check_range(
+            &values.view(),
+            buffers,
+            values.offset(),
+            sparse.count(),
+            size,
+        )
+        .map_err(|e| format!("sparse values: {e}"))?;
+    }
+    Ok(())
+}
+
+/// `count` elements of `size` bytes from `offset` in `view`, within the view and with a
+/// stride no smaller than an element.
+fn check_range(
+    view: &::gltf::buffer::View<'_>,
+    buffers: &[::gltf::buffer::Data],
+    offset: usize,
+    count: usize,
+    size: usize,
+) -> Result<(), String> {
+    if count == 0 {
+        return Err("count is 0".to_owned());
+    }
+    let stride = view.stride().unwrap_or(size);
+    if stride < size {
+        return Err(format!(
+            "buffer view {} has a byte stride of {stride}, less than an element's {size} bytes",
+            view.index()
+        ));
+    }
+    let len = buffers.get(view.buffer().index()).map_or(0, |d| d.len());
+    let end = stride
+        .checked_mul(count - 1)
+        .and_then(|n| n.checked_add(size))
+        .and_then(|n| n.checked_add(offset));
+    let view_fits = view
+        .offset()
+        .checked_add(view.length())
+        .is_some_and(|e| e <= len);
+    if !view_fits || end.is_none_or(|e| e > view.length()) {
+        return Err(format!(
+            "{count} elements of {size} bytes from byte {offset} do not fit in buffer view {} ({} bytes)",
+            view.index(),
+            view.length()
+        ));
+    }
+    Ok(())
 }
 
 /// Luminous efficacy of 555 nm light, lm/W: photometric glTF units to radiometric ones.

@@ -2,12 +2,13 @@
 //! emission, `Ks` black or absent → specular 0 (else 0.5), `Ni` → IOR, roughness 1.
 //! Vertex normals are kept when every corner has one.
 
+use std::cell::RefCell;
 use std::path::Path;
 
 use glam::{Mat4, Vec3};
 
 use super::ImportedMesh;
-use crate::error::SceneError;
+use crate::error::{ErrorKind, SceneError};
 use crate::scene::{Material, Triangle, push_triangle, transform_triangle};
 
 /// Imports an `.obj` file and the `.mtl` files it names.
@@ -21,14 +22,30 @@ pub fn import_obj(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneErr
         single_index: true,
         ..tobj::LoadOptions::default()
     };
-    let (models, materials) = tobj::load_obj(path, &options)?;
+    let text = std::fs::read(path).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+    if let Some(problem) = check_obj(&String::from_utf8_lossy(&text)) {
+        return Err(SceneError::new(ErrorKind::ObjData(problem)));
+    }
+    let base = path.parent().unwrap_or(Path::new(""));
+    // What tobj's own MTL loader would say, and which line it could not read (it says
+    // only that something failed).
+    let mtl_problem = RefCell::new(None);
+    let (models, materials) = tobj::load_obj_buf(&mut text.as_slice(), &options, |mtl: &Path| {
+        let mtl_path = base.join(mtl);
+        let text = std::fs::read(&mtl_path).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+        if let Some(problem) = check_mtl(&text) {
+            *mtl_problem.borrow_mut() = Some(format!("{}: {problem}", mtl_path.display()));
+            return Err(tobj::LoadError::MaterialParseError);
+        }
+        tobj::load_mtl_buf(&mut text.as_slice())
+    })?;
     let mut out = ImportedMesh::default();
     match materials {
         Ok(mats) => out.materials = mats.iter().map(material).collect(),
-        Err(e) => out
-            .report
-            .warnings
-            .push(format!("materials not loaded: {e}")),
+        Err(e) => out.report.warnings.push(match mtl_problem.into_inner() {
+            Some(problem) => format!("materials not loaded: {problem}"),
+            None => format!("materials not loaded: {e}"),
+        }),
     }
     let mut default_material = None;
     for model in &models {
@@ -78,6 +95,73 @@ pub fn import_obj(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneErr
         }
     }
     Ok(out)
+}
+
+/// The first face corner of an OBJ file that refers to an element the file does not have:
+/// index 0, a relative (negative) index before the first element, or an index past the
+/// last. tobj computes with such indices unchecked (an overflow) or reads past its arrays.
+fn check_obj(text: &str) -> Option<String> {
+    const KEYS: [&str; 3] = ["v", "vt", "vn"];
+    const WHAT: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+    let count = |key: &str| {
+        text.lines()
+            .filter(|l| l.split_whitespace().next() == Some(key))
+            .count()
+    };
+    let totals = KEYS.map(count);
+    let mut seen = [0usize; 3];
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("f" | "l") => {}
+            Some(key) => {
+                if let Some(k) = KEYS.iter().position(|&x| x == key) {
+                    seen[k] += 1;
+                }
+                continue;
+            }
+            None => continue,
+        }
+        for corner in words {
+            for (k, part) in corner.split('/').take(3).enumerate() {
+                let Ok(x) = part.parse::<i64>() else { continue };
+                let in_range = match usize::try_from(x.unsigned_abs()) {
+                    Ok(n) if x < 0 => n <= seen[k],
+                    Ok(n) => n >= 1 && n <= totals[k],
+                    Err(_) => false,
+                };
+                if !in_range {
+                    return Some(format!(
+                        "line {}: {} index {x} refers to no {} (the file has {} before this \
+                         line, {} in all; indices start at 1, negative ones count back)",
+                        i + 1,
+                        WHAT[k],
+                        WHAT[k],
+                        seen[k],
+                        totals[k]
+                    ));
+                }
+            }
+        }
+    }
+    None
+}
+
+/// The first line of an MTL file that tobj cannot be given: a colour (`Ka`, `Kd`, `Ks`,
+/// `Ke`) with fewer than three numbers, on which tobj 4.0 panics.
+fn check_mtl(text: &[u8]) -> Option<String> {
+    let text = String::from_utf8_lossy(text);
+    text.lines().enumerate().find_map(|(i, line)| {
+        let mut words = line.split_whitespace();
+        let key = words.next()?;
+        let numbers = words.count();
+        (matches!(key, "Ka" | "Kd" | "Ks" | "Ke") && numbers < 3).then(|| {
+            format!(
+                "line {}: `{key}` needs three numbers (red, green, blue), found {numbers}",
+                i + 1
+            )
+        })
+    })
 }
 
 fn material(m: &tobj::Material) -> Material {
