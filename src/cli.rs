@@ -16,6 +16,7 @@ mod converge;
 mod gallery;
 mod plot;
 mod progressive;
+mod tiled;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -77,6 +78,10 @@ enum Command {
         /// result is identical to an uninterrupted render.
         #[arg(long, value_name = "CHECKPOINT")]
         resume: Option<PathBuf>,
+        /// Render in tiles of this many pixels a side (0: never tile). By default an image
+        /// larger than the device holds, or than 4 GiB of images and buffers, is tiled.
+        #[arg(long, value_name = "PIXELS")]
+        tile: Option<u32>,
     },
     /// Print the compiled plan: passes in order, textures and shared memory, what is left out.
     #[command(after_help = "Example:\n  lumagraph plan graphs/post_tonemap.ron")]
@@ -278,6 +283,11 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
         scene: scene.as_ref().map(|s| Arc::clone(&s.gpu)),
         ..Resources::default()
     };
+    if let Some(done) =
+        tiled::render_if_needed(args, &graph, scene.as_ref(), &plan, &ctx, &resources)?
+    {
+        return Ok(done);
+    }
     let left_out = plan.left_out.clone();
     let mut exec = Executor::with_library(&ctx, plan, &resources, args.library)?;
     for (node, note) in exec.notes() {
@@ -375,6 +385,8 @@ struct RenderArgs<'a> {
     spp: Option<u32>,
     overrides: &'a [String],
     checkpoints: progressive::Checkpoints,
+    /// `--tile`.
+    tile: Option<u32>,
 }
 
 /// `lumagraph plan`: the plan, node-owned memory, and the shader features per pass.
@@ -468,6 +480,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             checkpoint,
             checkpoint_every,
             resume,
+            tile,
         } => render(&RenderArgs {
             library,
             graph: &graph,
@@ -481,6 +494,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
                 key: 0,
             },
             out: &out,
+            tile,
         }),
         Command::Plan {
             graph,

@@ -784,8 +784,10 @@ fn render_to_file_in_the_editor_equals_the_cli_render() {
     );
 }
 
-/// An image larger than the device holds is one clear error naming the port, the size, the
-/// adapter and its limit, before anything is allocated; never wgpu's panic.
+/// An image larger than the device holds is rendered in tiles, unless `--tile 0`: then it is
+/// one clear error naming the port, the size, the adapter and its limit, before anything is
+/// allocated; never wgpu's panic. At 100000×100000 the tiled render's images do not fit this
+/// machine's memory: one clear error before the first tile.
 #[test]
 fn an_image_larger_than_the_device_holds_is_a_clear_error() {
     let dir = tempfile::tempdir().unwrap();
@@ -794,23 +796,40 @@ fn an_image_larger_than_the_device_holds_is_a_clear_error() {
         .unwrap()
         .replace("width: 256, height: 256", "width: 100000, height: 100000");
     std::fs::write(&scene, text).unwrap();
-    let (ok, out, err) = common::cli(&[
-        "render",
-        "graphs/pathtrace.ron",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
-    assert!(!ok, "{out}");
-    assert!(!err.contains("panicked"), "{err}");
-    let line = err
-        .lines()
-        .find(|l| l.starts_with("error:"))
-        .expect("an error line");
+    let render = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "graphs/pathtrace.ron",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--out",
+            dir.path().to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let (ok, out, err) = common::cli(&args);
+        assert!(!ok, "{out}");
+        assert!(!err.contains("panicked"), "{err}");
+        let line = err
+            .lines()
+            .find(|l| l.starts_with("error:"))
+            .expect("an error line")
+            .to_owned();
+        (out, line)
+    };
+    let (_, line) = render(&["--tile", "0"]);
     assert!(
         line.contains("pathtrace.color: 100000×100000 image")
             && line.contains("the largest image this device holds is"),
+        "{line}"
+    );
+    // Tiled, but no tile is rendered: the images it writes (a PNG of 4 and an EXR of 16
+    // bytes a pixel) do not fit this machine.
+    let (out, line) = render(&[]);
+    assert!(out.contains("tiled: "), "{out}");
+    assert!(
+        line.contains(
+            "the 2 images this render writes (100000×100000: 186.3 GiB) on this machine:"
+        ) && line.contains("of memory is available; render smaller"),
         "{line}"
     );
 }

@@ -29,6 +29,9 @@ struct RasterCamera {
     width: f32,
     forward: vec3f,
     height: f32,
+    // The pixels this pass renders: left, top, width and height in the whole image (all of
+    // it unless the render is tiled).
+    window: vec4f,
 }
 
 const NEAR: f32 = 1e-4;
@@ -66,12 +69,19 @@ fn vs_main(v: VertexIn) -> VertexOut {
     let d = v.position - cam.position;
     let z = dot(d, cam.forward);
     var out: VertexOut;
-    out.clip = vec4f(
+    // NDC of the whole image, then of the window: x' = x W / w + (W - 2 left) / w - 1 and
+    // y' = y H / h + 1 - (H - 2 top) / h (y up), exactly x and y for the whole image.
+    let size = vec2f(cam.width, cam.height);
+    let scale = size / cam.window.zw;
+    let shift = vec2f(
+        (cam.width - 2.0 * cam.window.x) / cam.window.z - 1.0,
+        1.0 - (cam.height - 2.0 * cam.window.y) / cam.window.w,
+    );
+    let xy = vec2f(
         dot(d, cam.right) / (cam.tan_half_fov * cam.aspect),
         dot(d, cam.up) / cam.tan_half_fov,
-        NEAR,
-        z,
     );
+    out.clip = vec4f(xy * scale + z * shift, NEAR, z);
     out.world = v.position;
     out.normal = v.normal;
     out.albedo = v.albedo;
@@ -89,9 +99,10 @@ struct FragmentOut {
     @builtin(frag_depth) frag_depth: f32,
 }
 
-// The unit ray through framebuffer position `xy` (pixel centers at .5), as `pinhole_ray`.
+// The unit ray through framebuffer position `xy` (pixel centers at .5) of the window, as
+// `pinhole_ray`.
 fn pixel_ray(xy: vec2f) -> vec3f {
-    let u = xy / vec2f(cam.width, cam.height);
+    let u = (xy + cam.window.xy) / vec2f(cam.width, cam.height);
     return normalize(cam.forward + (2.0 * u.x - 1.0) * cam.tan_half_fov * cam.aspect * cam.right
         - (2.0 * u.y - 1.0) * cam.tan_half_fov * cam.up);
 }

@@ -30,6 +30,9 @@ struct Frame {
     // STRATEGY_MIS, STRATEGY_LIGHT or STRATEGY_BSDF: how direct light is estimated.
     strategy: u32,
     pad2: u32,
+    // The pixels this pass renders: left, top, width and height in the whole image (all of
+    // it unless the render is tiled); the output holds them from (0, 0).
+    window: vec4<u32>,
 }
 
 const STRATEGY_MIS: u32 = 0u;
@@ -453,17 +456,19 @@ fn trace_path(pixel: vec2u) -> vec3f {
 fn main(@builtin(global_invocation_id) id: vec3u) {
     let w = frame.settings.width;
     let h = frame.settings.height;
-    if id.x >= w || id.y >= h {
+    // The pixel of the whole image: tiles sample and trace exactly as the whole image does.
+    let pixel = id.xy + frame.window.xy;
+    if any(id.xy >= frame.window.zw) || pixel.x >= w || pixel.y >= h {
         return;
     }
-    let pixel_index = id.y * w + id.x;
+    let pixel_index = pixel.y * w + pixel.x;
     var sum = vec3f(0.0);
     var dropped = 0u;
     ray_count = 0u;
     let n = frame.samples_per_frame;
     for (var i = 0u; i < n; i++) {
         sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler);
-        var l = trace_path(id.xy);
+        var l = trace_path(pixel);
         if frame.firefly_clamp > 0.0 {
             let peak = max(l.x, max(l.y, l.z));
             l *= select(1.0, frame.firefly_clamp / peak, peak > frame.firefly_clamp);
@@ -486,7 +491,7 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
 
     if WRITE_AOVS {
         // First hit through the pixel center: what a raster G-buffer sees.
-        let ray = pinhole_ray(id.xy, vec2f(0.5));
+        let ray = pinhole_ray(pixel, vec2f(0.5));
         skip_prim = NO_HIT;
         origin_n = vec3f(0.0);
         origin_err = vec3f(0.0);

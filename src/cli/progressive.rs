@@ -13,7 +13,7 @@ use crate::render::{Checkpoint, Executor, FrameReport};
 use crate::scene::GpuScene;
 
 /// Set by the signal handler: stop after the batch of frames running now.
-static STOP: AtomicBool = AtomicBool::new(false);
+pub(super) static STOP: AtomicBool = AtomicBool::new(false);
 
 /// Where checkpoints go and when.
 #[derive(Clone, Debug)]
@@ -40,18 +40,15 @@ pub(super) fn key(graph: &Graph, scene: Option<&GpuScene>) -> u64 {
     crate::render::checkpoint::render_key(&g.to_ron(), &scene)
 }
 
-/// The first Ctrl-C or SIGTERM asks the render to stop after its current batch of frames;
-/// a second one ends the process at once.
-fn on_signal() {
-    let installed = ctrlc::set_handler(|| {
+/// The first Ctrl-C or SIGTERM asks the render to stop after its current batch of frames
+/// (saying `then`, what happens next); a second one ends the process at once.
+pub(super) fn on_signal(then: &'static str) {
+    let installed = ctrlc::set_handler(move || {
         if STOP.swap(true, Ordering::SeqCst) {
             eprintln!("stopped");
             std::process::exit(130);
         }
-        eprintln!(
-            "stopping after this batch of frames: writing the samples so far and a checkpoint \
-             (press Ctrl-C again to quit without them)"
-        );
+        eprintln!("stopping after this batch of frames: {then}");
     });
     if let Err(e) = installed {
         eprintln!("warning: Ctrl-C will not write a checkpoint: {e}");
@@ -97,7 +94,9 @@ pub(super) fn render(exec: &mut Executor, spp: u32, ck: &Checkpoints) -> Result<
         );
     }
     let before = samples_per_pixel(exec)?;
-    on_signal();
+    on_signal(
+        "writing the samples so far and a checkpoint (press Ctrl-C again to quit without them)",
+    );
 
     let bar = indicatif::ProgressBar::with_draw_target(
         Some(u64::from(frames)),

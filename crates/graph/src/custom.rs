@@ -11,7 +11,7 @@ use std::sync::{Arc, Mutex};
 
 use serde::{Deserialize, Serialize};
 
-use crate::registry::{Category, InputDef, NodeKind, OutputDef, ParamDef};
+use crate::registry::{Category, InputDef, NodeKind, OutputDef, ParamDef, Reach};
 use crate::types::{ParamType, PortType};
 
 /// The `'static` copy of `s`, made once per distinct string.
@@ -325,6 +325,9 @@ impl KindDecl {
             renders_scene: false,
             shader: Some(shader),
             example: Vec::new(),
+            reach: Reach::Image(
+                "a kind declared in a graph file: lumagraph cannot tell how far its shader reads",
+            ),
         })
     }
 }

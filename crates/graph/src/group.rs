@@ -20,6 +20,7 @@ use serde::{Deserialize, Serialize};
 use crate::custom::intern;
 use crate::error::{ErrorKind, GraphError, GraphErrors};
 use crate::graph::{Edge, Graph, Node, split_port_ref};
+use crate::registry::Reach;
 use crate::registry::{Category, InputDef, NodeKind, OutputDef, ParamDef, Registry, Shader};
 use crate::types::{ParamType, ParamValue, PortType};
 
@@ -258,6 +259,7 @@ impl Group {
             renders_scene: inner.iter().any(|k| k.renders_scene),
             shader: None,
             example: Vec::new(),
+            reach: Reach::Pixel,
         })
     }
 }

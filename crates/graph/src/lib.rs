@@ -17,6 +17,7 @@ pub mod group;
 pub mod layout;
 mod plan;
 pub mod registry;
+pub mod tile;
 mod types;
 
 pub use compile::{CompileOptions, Params, compile, resolve_params};

@@ -557,6 +557,7 @@ fn sized_registry() -> Registry {
         renders_scene: false,
         shader: None,
         example: Vec::new(),
+        reach: lumagraph_graph::registry::Reach::Pixel,
     })
     .unwrap();
     r

@@ -83,6 +83,8 @@ pub struct Executor {
     every_frame: Vec<bool>,
     /// Per pass: whether a [`Mode::Only`] run records it.
     only: Vec<bool>,
+    /// Sinks do not write their files (a tiled render assembles them).
+    hold_sinks: bool,
 }
 
 impl std::fmt::Debug for Executor {
@@ -169,6 +171,7 @@ impl Executor {
             frames: 0,
             every_frame,
             only: Vec::new(),
+            hold_sinks: false,
         })
     }
 
@@ -190,6 +193,26 @@ impl Executor {
     /// The texture pool (for reporting allocations).
     pub fn pool(&self) -> &TexturePool {
         &self.pool
+    }
+
+    /// Moves the window the nodes that render the scene render: its left and top pixel in
+    /// the whole image (its size is the plan's). For tiled renders.
+    pub fn set_origin(&mut self, origin: [u32; 2]) {
+        for node in &mut self.nodes {
+            node.set_origin(origin);
+        }
+    }
+
+    /// Starts over: history reset and no frames run (the next tile of a tiled render).
+    pub fn restart(&mut self) {
+        self.reset_history();
+        self.frames = 0;
+    }
+
+    /// With `hold`, sinks record as usual but write no files: the caller reads their inputs
+    /// ([`Executor::read_raw`]) and writes them (tiled renders).
+    pub fn hold_sinks(&mut self, hold: bool) {
+        self.hold_sinks = hold;
     }
 
     /// Restarts progressive accumulation in every node that keeps history.
@@ -520,7 +543,7 @@ impl Executor {
         let mut written = Vec::new();
         if matches!(mode, Mode::Finish | Mode::Tail | Mode::Only) {
             for (p, (pass, node)) in self.plan.passes.iter().zip(&mut self.nodes).enumerate() {
-                if mode == Mode::Only && !self.only[p] {
+                if (mode == Mode::Only && !self.only[p]) || (self.hold_sinks && pass.kind.sink) {
                     continue;
                 }
                 written.extend(
@@ -604,6 +627,35 @@ impl Executor {
         let bytes =
             crate::readback::read_texture(&self.ctx, &texture.texture, desc.format, desc.extent)?;
         Ok(crate::readback::to_image(&bytes, desc.format, desc.extent))
+    }
+
+    /// The images the sinks would have written in the last finishing frame, as `(pass
+    /// index, image)` ([`Executor::hold_sinks`]).
+    ///
+    /// # Errors
+    /// When a readback fails; the error names the node.
+    pub fn held_images(&mut self) -> Result<Vec<(usize, crate::nodes::HeldImage)>> {
+        let mut out = Vec::new();
+        for (p, (pass, node)) in self.plan.passes.iter().zip(&mut self.nodes).enumerate() {
+            if let Some(image) = node
+                .held_image(&self.ctx)
+                .map_err(|e| e.in_node(&pass.node))?
+            {
+                out.push((p, image));
+            }
+        }
+        Ok(out)
+    }
+
+    /// Reads back the current contents of a planned texture as stored: rows of
+    /// `extent.width × format.bytes_per_pixel()` bytes, no padding.
+    ///
+    /// # Errors
+    /// When the GPU does not finish.
+    pub fn read_raw(&self, id: TextureId) -> Result<Vec<u8>> {
+        let desc = &self.plan.textures[id.0];
+        let texture = &self.slots[desc.slot];
+        crate::readback::read_texture(&self.ctx, &texture.texture, desc.format, desc.extent)
     }
 
     /// Reads back the texture on output `"node.port"`, which must be kept alive by the plan

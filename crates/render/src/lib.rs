@@ -34,6 +34,7 @@ pub mod sampler;
 mod scene_gpu;
 pub mod shader;
 pub mod specialize;
+pub mod tiled;
 mod timing;
 
 pub use checkpoint::Checkpoint;

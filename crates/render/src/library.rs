@@ -207,8 +207,44 @@ impl NodeLibrary {
         keep: &[String],
         scene: Option<&GpuScene>,
     ) -> std::result::Result<Plan, GraphErrors> {
-        let extent =
-            |kind: &NodeKind, params: &Params| self.source_extent(base_dir, scene, kind, params);
+        self.compile_sized(graph, registry, base_dir, keep, scene, None)
+    }
+
+    /// Compiles `graph` as [`NodeLibrary::compile`] does, with the nodes that render the
+    /// scene making `window`-sized images (one tile's window of a tiled render).
+    ///
+    /// # Errors
+    /// Every problem found in the graph (first in its declared kinds).
+    pub fn compile_window(
+        &self,
+        graph: &Graph,
+        keep: &[String],
+        scene: Option<&GpuScene>,
+        window: Extent,
+    ) -> std::result::Result<Plan, GraphErrors> {
+        self.compile_sized(
+            graph,
+            &self.registry_for(graph)?,
+            &graph.base_dir(),
+            keep,
+            scene,
+            Some(window),
+        )
+    }
+
+    fn compile_sized(
+        &self,
+        graph: &Graph,
+        registry: &Registry,
+        base_dir: &Path,
+        keep: &[String],
+        scene: Option<&GpuScene>,
+        window: Option<Extent>,
+    ) -> std::result::Result<Plan, GraphErrors> {
+        let extent = |kind: &NodeKind, params: &Params| match window {
+            Some(w) if kind.renders_scene => Ok(w),
+            _ => self.source_extent(base_dir, scene, kind, params),
+        };
         lumagraph_graph::compile(
             graph,
             registry,

@@ -13,7 +13,7 @@
 
 use std::path::Path;
 
-use lumagraph::graph::registry::{OutputDef, ParamDef};
+use lumagraph::graph::registry::{OutputDef, ParamDef, Reach};
 use lumagraph::graph::{Category, Extent, NodeKind, Params, Pass, PortType};
 use lumagraph::render::cpu::Image;
 use lumagraph::render::nodes::{NodeExec, NodeImpl, Recording, boxed};
@@ -67,6 +67,7 @@ pub fn kind() -> NodeKind {
         renders_scene: false,
         shader: None,
         example: Vec::new(),
+        reach: Reach::Image("it draws its rings around the whole image's centre"),
     }
 }
 

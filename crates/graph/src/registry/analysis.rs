@@ -1,6 +1,6 @@
 //! Analysis nodes: images measured against a reference.
 
-use super::{COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, post_node};
+use super::{COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, Reach, post_node};
 use crate::types::{ParamValue, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
@@ -61,4 +61,5 @@ fn difference() -> NodeKind {
         )
     }
     .with_example(&[("max_error", ParamValue::Float(10.0))])
+    .with_reach(Reach::Image("it measures the whole image"))
 }

@@ -1,8 +1,8 @@
 //! Colour nodes: exposure, vignette and tone mapping.
 
 use super::{
-    COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, TONEMAP_OPERATORS, post_filter,
-    post_node,
+    COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, Reach, TONEMAP_OPERATORS,
+    post_filter, post_node,
 };
 use crate::types::{ParamType, ParamValue, PortType};
 
@@ -240,6 +240,7 @@ fn auto_exposure() -> NodeKind {
         ],
     )
     .with_example(&[("key", ParamValue::Float(0.5))])
+    .with_reach(Reach::Image("it meters the whole image"))
 }
 
 fn vignette() -> NodeKind {
@@ -280,6 +281,9 @@ fn vignette() -> NodeKind {
         ],
         "post/vignette.wgsl",
     )
+    .with_reach(Reach::Image(
+        "it darkens by the distance from the image center",
+    ))
 }
 
 fn tonemap() -> NodeKind {
@@ -318,5 +322,6 @@ fn tonemap() -> NodeKind {
         renders_scene: false,
         shader: None,
         example: Vec::new(),
+        reach: Reach::Pixel,
     }
 }

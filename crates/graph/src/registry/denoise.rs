@@ -1,6 +1,6 @@
 //! Denoising nodes.
 
-use super::{COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef};
+use super::{COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, Reach};
 use crate::types::{ParamType, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
@@ -104,5 +104,10 @@ fn denoise() -> NodeKind {
         renders_scene: false,
         shader: None,
         example: Vec::new(),
+        // Pass i reads 2 × 2^i pixels away (its 5×5 kernel's taps `step` apart).
+        reach: Reach::Within(|p| {
+            let n = u32::try_from(p.int("iterations")).unwrap_or(0).min(16);
+            2 * ((1 << n) - 1)
+        }),
     }
 }

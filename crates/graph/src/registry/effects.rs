@@ -1,6 +1,6 @@
 //! Filter nodes: sharpening, lens and film effects.
 
-use super::{Category, NodeKind, ParamDef, post_filter, post_node};
+use super::{Category, NodeKind, ParamDef, Reach, post_filter, post_node};
 use crate::types::ParamValue;
 
 pub(super) fn kinds() -> Vec<NodeKind> {
@@ -29,6 +29,7 @@ fn blur() -> NodeKind {
         )],
     )
     .with_example(&[("sigma", ParamValue::Float(3.0))])
+    .with_reach(Reach::Within(three_sigma))
 }
 
 fn bloom() -> NodeKind {
@@ -57,6 +58,7 @@ fn bloom() -> NodeKind {
         ],
     )
     .with_example(&[("intensity", ParamValue::Float(0.3))])
+    .with_reach(Reach::Image("its pyramid halves the whole image"))
 }
 
 fn sharpen() -> NodeKind {
@@ -84,6 +86,7 @@ fn sharpen() -> NodeKind {
         "post/sharpen.wgsl",
     )
     .with_example(&[("amount", ParamValue::Float(2.0))])
+    .with_reach(Reach::Within(three_sigma))
 }
 
 fn chromatic_aberration() -> NodeKind {
@@ -103,6 +106,9 @@ fn chromatic_aberration() -> NodeKind {
         "post/chromatic_aberration.wgsl",
     )
     .with_example(&[("strength", ParamValue::Float(0.02))])
+    .with_reach(Reach::Image(
+        "it moves pixels by their distance from the image center",
+    ))
 }
 
 fn film_grain() -> NodeKind {
@@ -129,4 +135,18 @@ fn film_grain() -> NodeKind {
         "post/film_grain.wgsl",
     )
     .with_example(&[("intensity", ParamValue::Float(0.2))])
+    .with_reach(Reach::Image(
+        "its grain is keyed to the pixel's place in the image",
+    ))
+}
+
+/// Pixels within ceil(3 `sigma`): a Gaussian's taps.
+fn three_sigma(params: &crate::Params) -> u32 {
+    #[expect(
+        clippy::cast_possible_truncation,
+        clippy::cast_sign_loss,
+        reason = "sigma is at most 64"
+    )]
+    let r = (3.0 * params.float("sigma")).ceil().max(0.0) as u32;
+    r
 }

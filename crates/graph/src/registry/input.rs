@@ -1,6 +1,6 @@
 //! Input nodes: images from files.
 
-use super::{Category, NodeKind, OutputDef, ParamDef};
+use super::{Category, NodeKind, OutputDef, ParamDef, Reach};
 use crate::types::{ParamType, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
@@ -32,5 +32,6 @@ fn image_input() -> NodeKind {
         renders_scene: false,
         shader: None,
         example: Vec::new(),
+        reach: Reach::Image("it reads its file whole"),
     }
 }

@@ -253,6 +253,20 @@ impl ParamDef {
     }
 }
 
+/// How far from an output pixel a node reads its inputs: what a tiled render must render
+/// around each tile (its apron) for the tile to come out as in the whole image.
+#[derive(Clone, Copy, Debug)]
+pub enum Reach {
+    /// Each output pixel reads the inputs at the same pixel only; a node that renders the
+    /// scene renders its pixels of the whole image.
+    Pixel,
+    /// Each output pixel reads the inputs within this many pixels (from the params).
+    Within(fn(&crate::Params) -> u32),
+    /// It reads the whole image, or the pixel's place in it: it cannot run tile by tile
+    /// (the reason).
+    Image(&'static str),
+}
+
 /// A kind of node: what it reads, writes and is configured with.
 #[derive(Clone, Debug)]
 pub struct NodeKind {
@@ -287,9 +301,18 @@ pub struct NodeKind {
     /// Params that show what the node does, for the gallery (`lumagraph gallery`); empty:
     /// its defaults (which for a grading node change nothing).
     pub example: Vec<(&'static str, ParamValue)>,
+    /// How far it reads around a pixel, for tiled renders.
+    pub reach: Reach,
 }
 
 impl NodeKind {
+    /// The same kind with how far it reads around a pixel.
+    #[must_use]
+    pub fn with_reach(mut self, reach: Reach) -> Self {
+        self.reach = reach;
+        self
+    }
+
     /// The same kind with `example` params for the gallery.
     #[must_use]
     pub fn with_example(mut self, example: &[(&'static str, ParamValue)]) -> Self {
@@ -475,6 +498,7 @@ pub(crate) fn post_node(
         renders_scene: false,
         shader: None,
         example: Vec::new(),
+        reach: Reach::Pixel,
     }
 }
 

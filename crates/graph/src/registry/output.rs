@@ -1,6 +1,6 @@
 //! Output nodes: files written out of the graph.
 
-use super::{ANY_IMAGE, Category, InputDef, NodeKind, ParamDef};
+use super::{ANY_IMAGE, Category, InputDef, NodeKind, ParamDef, Reach};
 use crate::types::ParamType;
 
 pub(super) fn kinds() -> Vec<NodeKind> {
@@ -29,5 +29,6 @@ fn output() -> NodeKind {
         renders_scene: false,
         shader: None,
         example: Vec::new(),
+        reach: Reach::Pixel,
     }
 }

@@ -1,6 +1,6 @@
 //! Render nodes: the path tracer, progressive accumulation and the G-buffer.
 
-use super::{COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef};
+use super::{COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, Reach};
 use crate::types::{ParamType, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
@@ -125,6 +125,7 @@ fn path_trace() -> NodeKind {
         renders_scene: true,
         shader: None,
         example: Vec::new(),
+        reach: Reach::Pixel,
     }
 }
 
@@ -154,6 +155,8 @@ fn accumulate() -> NodeKind {
         renders_scene: false,
         shader: None,
         example: Vec::new(),
+        // Its variance after one frame is taken over the 3×3 neighborhood.
+        reach: Reach::Within(|_| 1),
     }
 }
 
@@ -201,5 +204,6 @@ fn gbuffer() -> NodeKind {
         renders_scene: true,
         shader: None,
         example: Vec::new(),
+        reach: Reach::Pixel,
     }
 }

@@ -1,11 +1,14 @@
 //! Transform nodes: images resampled to another size.
 
-use super::{Category, NodeKind, OutputSize, ParamDef, post_filter};
+use super::{Category, NodeKind, OutputSize, ParamDef, Reach, post_filter};
 use crate::compile::Params;
 use crate::types::{Extent, ParamValue};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
-    vec![resize(), crop()]
+    vec![
+        resize().with_reach(Reach::Image("it resamples the whole image")),
+        crop().with_reach(Reach::Image("it cuts a rectangle out of the whole image")),
+    ]
 }
 
 fn crop() -> NodeKind {

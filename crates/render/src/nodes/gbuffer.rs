@@ -50,6 +50,11 @@ pub(crate) struct GBuffer {
     segments: u32,
     /// Depth attachment and stand-ins for unread outputs, at the pass's size.
     targets: Option<(Extent, wgpu::TextureView, [Option<PooledTexture>; 3])>,
+    /// The camera uniform, rewritten when the window moves.
+    camera: wgpu::Buffer,
+    /// Where the pass's image lies in the whole image, and the camera block written for it.
+    origin: [u32; 2],
+    written: Option<RasterCamera>,
 }
 
 impl GBuffer {
@@ -70,7 +75,7 @@ impl GBuffer {
         let camera = uniform_buffer(
             ctx,
             "gbuffer camera",
-            bytemuck::bytes_of(&raster_camera(&scene)),
+            bytemuck::bytes_of(&raster_camera(&scene, [0, 0], pass.extent)),
         );
         // The materials are always read (their emission marks emitters); the textures only
         // with textures: without, a zeroed stand-in.
@@ -121,6 +126,9 @@ impl GBuffer {
             vertices: None,
             segments: 0,
             targets: None,
+            camera,
+            origin: [0, 0],
+            written: None,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -237,11 +245,20 @@ crate::param_block! {
         width: f32,
         forward: [f32; 3],
         height: f32,
+        /// The pixels this pass renders: left, top, width and height in the whole image.
+        window: [f32; 4],
     }
 }
 
-fn raster_camera(scene: &GpuScene) -> RasterCamera {
+fn raster_camera(scene: &GpuScene, origin: [u32; 2], extent: Extent) -> RasterCamera {
     let c = &scene.camera;
+    #[expect(clippy::cast_precision_loss, reason = "image sizes are small")]
+    let window = [
+        origin[0] as f32,
+        origin[1] as f32,
+        extent.width as f32,
+        extent.height as f32,
+    ];
     #[expect(clippy::cast_precision_loss, reason = "image sizes are small")]
     let (width, height) = (scene.settings.width as f32, scene.settings.height as f32);
     RasterCamera {
@@ -253,6 +270,7 @@ fn raster_camera(scene: &GpuScene) -> RasterCamera {
         width,
         forward: c.forward,
         height,
+        window,
     }
 }
 
@@ -398,9 +416,19 @@ impl NodeExec for GBuffer {
         Ok(())
     }
 
+    fn set_origin(&mut self, origin: [u32; 2]) {
+        self.origin = origin;
+    }
+
     fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
         let (ctx, encoder, io, timer) = rec.parts();
         let extent = pass.extent;
+        let camera = raster_camera(&self.scene, self.origin, extent);
+        if self.written != Some(camera) {
+            ctx.queue
+                .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
+            self.written = Some(camera);
+        }
         if self.targets.as_ref().is_none_or(|(e, _, _)| *e != extent) {
             let depth = ctx.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some("gbuffer depth"),

@@ -9,7 +9,7 @@ pub mod difference;
 pub(crate) mod gbuffer;
 mod image_input;
 pub mod lut;
-mod output;
+pub(crate) mod output;
 pub(crate) mod pathtrace;
 pub mod post_filter;
 pub(crate) mod tonemap;
@@ -42,6 +42,19 @@ pub struct Resources {
     /// Traverse the BVH even where a CPU adapter would intersect a small scene inline: what
     /// GPU adapters run (tests compare the two on lavapipe).
     pub traverse_bvh: bool,
+}
+
+/// An image a sink would write: its pixels and what they are.
+#[derive(Clone, Debug)]
+pub struct HeldImage {
+    /// Rows of `extent.width` pixels of `format`, no padding.
+    pub bytes: Vec<u8>,
+    /// Storage format.
+    pub format: lumagraph_graph::TexFormat,
+    /// What it holds.
+    pub ty: lumagraph_graph::PortType,
+    /// Size.
+    pub extent: lumagraph_graph::Extent,
 }
 
 /// A named count a node keeps (samples, rays, dropped samples), since its last reset.
@@ -155,6 +168,20 @@ pub trait NodeExec {
 
     /// Forgets history kept across frames (progressive accumulation restarts).
     fn reset(&mut self) {}
+
+    /// The image a sink writes, as recorded in the last finishing frame (rows of
+    /// `extent.width` pixels of `format`, no padding); `None` for other nodes. A tiled
+    /// render reads it instead of letting the sink write ([`crate::Executor::hold_sinks`]).
+    ///
+    /// # Errors
+    /// When the readback fails.
+    fn held_image(&mut self, _ctx: &GpuContext) -> Result<Option<HeldImage>> {
+        Ok(None)
+    }
+
+    /// Where the pass's images lie in the whole image, for a node that renders the scene
+    /// (a tiled render's window: left and top; the size is the pass's extent).
+    fn set_origin(&mut self, _origin: [u32; 2]) {}
 
     /// Records this frame's GPU work.
     ///

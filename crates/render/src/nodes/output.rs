@@ -1,12 +1,12 @@
 //! Output: copies its input to a readback buffer in the frame, then writes the file.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use lumagraph_graph::{Extent, Pass, PortType, TexFormat};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed, check_writable};
+use crate::nodes::{HeldImage, NodeExec, NodeImpl, Recording, Resources, boxed, check_writable};
 
 /// The `Output` kind.
 pub(crate) const IMPL: NodeImpl = NodeImpl::new("Output", |ctx, pass, resources| {
@@ -37,7 +37,7 @@ impl Output {
     }
 
     fn path(&self, pass: &Pass) -> PathBuf {
-        self.paths.output(pass.params.str("path"))
+        output_path(pass, &self.paths)
     }
 }
 
@@ -88,9 +88,9 @@ impl NodeExec for Output {
         Ok(())
     }
 
-    fn finish(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<Vec<PathBuf>> {
+    fn held_image(&mut self, ctx: &GpuContext) -> Result<Option<HeldImage>> {
         let Some(s) = &self.staged else {
-            return Ok(Vec::new());
+            return Ok(None);
         };
         let row = s.extent.width as usize * s.format.bytes_per_pixel() as usize;
         let size = s.buffer.size();
@@ -99,16 +99,45 @@ impl NodeExec for Output {
                 .flat_map(|r| r[..row].to_vec())
                 .collect::<Vec<u8>>()
         })?;
+        Ok(Some(HeldImage {
+            bytes,
+            format: s.format,
+            ty: s.ty,
+            extent: s.extent,
+        }))
+    }
+
+    fn finish(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<Vec<PathBuf>> {
+        let Some(image) = self.held_image(ctx)? else {
+            return Ok(Vec::new());
+        };
         let path = self.path(pass);
-        let is_png = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-        if is_png && s.format == TexFormat::Rgba8Unorm {
-            crate::image_io::write_png(&path, s.extent.width, s.extent.height, &bytes)?;
-        } else {
-            let image = crate::readback::to_image(&bytes, s.format, s.extent);
-            crate::image_io::save(&path, &image, s.ty != PortType::LdrColor)?;
-        }
+        write_image(&path, &image.bytes, image.format, image.ty, image.extent)?;
         Ok(vec![path])
+    }
+}
+
+/// The file an `Output` node writes of `pass` (its `path` param, relative to `out_dir`).
+pub(crate) fn output_path(pass: &Pass, resources: &Resources) -> PathBuf {
+    resources.output(pass.params.str("path"))
+}
+
+/// Writes an image as an `Output` node does: `bytes` rows of `format` pixels holding a
+/// `ty` image; PNG or EXR by the extension.
+pub(crate) fn write_image(
+    path: &Path,
+    bytes: &[u8],
+    format: TexFormat,
+    ty: PortType,
+    extent: Extent,
+) -> Result<()> {
+    let is_png = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if is_png && format == TexFormat::Rgba8Unorm {
+        crate::image_io::write_png(path, extent.width, extent.height, bytes)
+    } else {
+        let image = crate::readback::to_image(bytes, format, extent);
+        crate::image_io::save(path, &image, ty != PortType::LdrColor)
     }
 }

@@ -61,6 +61,9 @@ crate::param_block! {
         /// The `strategy` param's option index.
         strategy: u32,
         pad2: u32,
+        /// The pixels this pass renders: left, top, width and height in the whole image
+        /// (all of it unless the render is tiled).
+        window: [u32; 4],
     }
 }
 
@@ -92,6 +95,8 @@ pub(crate) struct PathTrace {
     /// `STRATEGY_MIS` (0), `STRATEGY_LIGHT` (1) or `STRATEGY_BSDF` (2) in
     /// `pathtrace/pathtrace.wgsl`.
     strategy: u32,
+    /// Where the pass's image lies in the whole image (tiled renders).
+    origin: [u32; 2],
 }
 
 impl PathTrace {
@@ -159,12 +164,13 @@ impl PathTrace {
             firefly_clamp: 0.0,
             sampler: 0,
             strategy: 0,
+            origin: [0, 0],
         };
         node.update(ctx, pass)?;
         Ok(node)
     }
 
-    fn frame(&self) -> Frame {
+    fn frame(&self, extent: lumagraph_graph::Extent) -> Frame {
         let s = &self.scene;
         Frame {
             settings: s.settings,
@@ -178,6 +184,7 @@ impl PathTrace {
             sampler: self.sampler,
             strategy: self.strategy,
             pad2: 0,
+            window: [self.origin[0], self.origin[1], extent.width, extent.height],
         }
     }
 }
@@ -191,6 +198,10 @@ impl NodeExec for PathTrace {
         self.sampler = crate::params::enum_index(pass, "sampler")?;
         self.strategy = crate::params::enum_index(pass, "strategy")?;
         Ok(())
+    }
+
+    fn set_origin(&mut self, origin: [u32; 2]) {
+        self.origin = origin;
     }
 
     fn reset(&mut self) {
@@ -207,7 +218,7 @@ impl NodeExec for PathTrace {
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("pathtrace frame staging"),
-                contents: bytemuck::bytes_of(&self.frame()),
+                contents: bytemuck::bytes_of(&self.frame(pass.extent)),
                 usage: wgpu::BufferUsages::COPY_SRC,
             });
         encoder.copy_buffer_to_buffer(&staging, 0, &self.frame, 0, self.frame.size());

@@ -1,0 +1,297 @@
+//! Tiled renders: an image larger than the device holds, rendered window by window through
+//! one executor and assembled on the host.
+//!
+//! The plan is compiled at the window's size ([`crate::NodeLibrary::compile_window`]); each
+//! tile moves the window ([`Executor::set_origin`]), renders every frame, and its sinks' images
+//! (held, not written: [`Executor::hold_sinks`]) have their cores copied into whole-image
+//! canvases, written once at the end as the `Output` nodes would have. The tile geometry and
+//! the apron are [`lumagraph_graph::tile`]'s: a plan whose nodes all read within a bounded
+//! distance gives cores equal to the whole image's pixels.
+
+use std::path::PathBuf;
+
+use lumagraph_graph::tile::{Tile, Untileable};
+use lumagraph_graph::{Extent, Plan};
+
+use crate::context::{GpuContext, human_bytes};
+use crate::error::{RenderError, Result};
+use crate::executor::Executor;
+use crate::nodes::Resources;
+
+/// Images, buffers and node memory above this are rendered in tiles unless asked otherwise.
+pub const MEMORY_BUDGET: u64 = 4 << 30;
+
+/// The largest tile side chosen automatically.
+const LARGEST_TILE: u32 = 4096;
+
+/// Why and how a render is tiled.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Tiling {
+    /// The tile side (cores), in pixels.
+    pub tile: u32,
+    /// Pixels rendered around each core ([`lumagraph_graph::tile::apron`]).
+    pub apron: u32,
+    /// The window every tile renders.
+    pub window: Extent,
+    /// The tiles, row by row.
+    pub tiles: Vec<Tile>,
+    /// Why it is tiled (for the log).
+    pub why: String,
+}
+
+/// Whether the whole-image `plan` (its images and the nodes' own memory, `bytes`) is
+/// rendered in tiles on `ctx`, and how: `forced` is `--tile` (0: never; a side: that one);
+/// otherwise when an image is larger than the device holds or `bytes` passes
+/// [`MEMORY_BUDGET`], with the largest power-of-two tile side that fits both.
+///
+/// # Errors
+/// A plan that must be tiled but cannot (the node that needs the whole image), or that
+/// cannot be tiled small enough.
+pub fn plan_tiling(
+    ctx: &GpuContext,
+    plan: &Plan,
+    image: Extent,
+    bytes: u64,
+    forced: Option<u32>,
+) -> Result<Option<Tiling>> {
+    let limits = ctx.device.limits();
+    let max_side = limits.max_texture_dimension_2d;
+    // Node-owned history buffers hold 16 bytes a pixel.
+    let max_buffer = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size);
+    let buffer_pixels = max_buffer / 16;
+    let fits = |w: u32, h: u32, bytes: u64| {
+        w <= max_side
+            && h <= max_side
+            && u64::from(w) * u64::from(h) <= buffer_pixels
+            && bytes <= MEMORY_BUDGET
+    };
+    let why = match forced {
+        Some(0) => return Ok(None),
+        Some(side) => format!("--tile {side}"),
+        None if fits(image.width, image.height, bytes) => return Ok(None),
+        None => format!(
+            "{}×{} needs {} of images and buffers on {} (budget {}, largest image {max_side}², \
+             largest buffer {})",
+            image.width,
+            image.height,
+            human_bytes(bytes),
+            ctx.info.name,
+            human_bytes(MEMORY_BUDGET),
+            human_bytes(max_buffer)
+        ),
+    };
+    let apron = lumagraph_graph::tile::apron(plan).map_err(|e| untileable(&e, &why))?;
+    let per_pixel = bytes.div_ceil(image.pixels().max(1));
+    let window = |tile: u32| {
+        Extent::new(
+            lumagraph_graph::tile::window(image.width, tile, apron),
+            lumagraph_graph::tile::window(image.height, tile, apron),
+        )
+    };
+    let tile = match forced {
+        Some(side) => side,
+        None => {
+            let mut tile = LARGEST_TILE;
+            loop {
+                let w = window(tile);
+                if fits(w.width, w.height, per_pixel * w.pixels()) {
+                    break tile;
+                }
+                if tile <= 64 {
+                    return Err(RenderError::TooLarge {
+                        what: format!("{}×{} render", image.width, image.height),
+                        adapter: ctx.info.name.clone(),
+                        message: format!(
+                            "even 64-pixel tiles with their {apron}-pixel apron do not fit \
+                             ({why})"
+                        ),
+                    });
+                }
+                tile /= 2;
+            }
+        }
+    };
+    let tiles = lumagraph_graph::tile::tiles(image.width, image.height, tile, apron);
+    Ok(Some(Tiling {
+        tile,
+        apron,
+        window: window(tile),
+        tiles,
+        why,
+    }))
+}
+
+fn untileable(e: &Untileable, why: &str) -> RenderError {
+    RenderError::Gpu(format!(
+        "this render must be tiled ({why}), but {e}; render it smaller, or without that node"
+    ))
+}
+
+/// One sink's whole-image canvas.
+struct Canvas {
+    node: String,
+    path: PathBuf,
+    bytes: Vec<u8>,
+    image: Option<crate::nodes::HeldImage>,
+}
+
+/// Renders `tiling`'s tiles through `exec` (compiled at `tiling.window`), each to
+/// `frames` frames, and writes every sink's assembled image; `progress(tile index, frames
+/// done, frames)` is called as [`Executor::render`] calls its own, and `false` stops the
+/// render (`Ok(None)`, nothing written).
+///
+/// # Errors
+/// A sink that is not an `Output` node, memory for the canvases, a failing node or file.
+pub fn render(
+    exec: &mut Executor,
+    tiling: &Tiling,
+    image: Extent,
+    resources: &Resources,
+    frames: u32,
+    mut progress: impl FnMut(usize, u32, u32) -> bool,
+) -> Result<Option<Vec<PathBuf>>> {
+    exec.hold_sinks(true);
+    let mut canvases: Vec<(usize, Canvas, lumagraph_graph::TexFormat)> = Vec::new();
+    for (p, pass) in exec.plan().passes.iter().enumerate() {
+        if !pass.kind.sink {
+            continue;
+        }
+        if pass.kind.name != "Output" {
+            return Err(RenderError::Gpu(format!(
+                "node \"{}\" ({}) writes no image: it cannot run tile by tile",
+                pass.node, pass.kind.name
+            )));
+        }
+        let format = pass
+            .input("color")
+            .map_or(lumagraph_graph::TexFormat::Rgba32Float, |t| {
+                exec.plan().textures[t.0].format
+            });
+        canvases.push((
+            p,
+            Canvas {
+                node: pass.node.clone(),
+                path: crate::nodes::output::output_path(pass, resources),
+                bytes: Vec::new(),
+                image: None,
+            },
+            format,
+        ));
+    }
+    allocate(&mut canvases, image)?;
+    for (i, tile) in tiling.tiles.iter().enumerate() {
+        exec.set_origin([tile.window.x, tile.window.y]);
+        exec.restart();
+        if exec
+            .render(frames, |_, done, total| progress(i, done, total))?
+            .is_none()
+        {
+            return Ok(None);
+        }
+        for (p, held) in exec.held_images()? {
+            let Some((_, canvas, _)) = canvases.iter_mut().find(|(q, ..)| *q == p) else {
+                continue;
+            };
+            paste(canvas, &held, tile, image)?;
+        }
+    }
+    let mut written = Vec::new();
+    for (_, canvas, _) in canvases {
+        let Some(held) = canvas.image else { continue };
+        crate::nodes::output::write_image(&canvas.path, &canvas.bytes, held.format, held.ty, image)
+            .map_err(|e| e.in_node(&canvas.node))?;
+        written.push(canvas.path);
+    }
+    Ok(Some(written))
+}
+
+/// The whole-image canvases, allocated before the first tile so a render the host cannot
+/// hold stops at once: checked against the memory the system says is available (Linux),
+/// then reserved.
+fn allocate(
+    canvases: &mut [(usize, Canvas, lumagraph_graph::TexFormat)],
+    image: Extent,
+) -> Result<()> {
+    let need: u64 = canvases
+        .iter()
+        .map(|(_, _, f)| image.pixels() * f.bytes_per_pixel())
+        .sum();
+    let count = canvases.len();
+    let too_large = |message: String| RenderError::TooLarge {
+        what: format!(
+            "the {count} images this render writes ({}×{}: {})",
+            image.width,
+            image.height,
+            human_bytes(need)
+        ),
+        adapter: "this machine".into(),
+        message,
+    };
+    if let Some(available) = available_memory()
+        && need > available
+    {
+        return Err(too_large(format!(
+            "{} of memory is available; render smaller, or write fewer outputs",
+            human_bytes(available)
+        )));
+    }
+    for (_, canvas, format) in canvases.iter_mut() {
+        let len = usize::try_from(image.pixels() * format.bytes_per_pixel())
+            .map_err(|_| too_large("more than this machine addresses".into()))?;
+        canvas.bytes.try_reserve_exact(len).map_err(|_| {
+            too_large(format!(
+                "{} of memory could not be had",
+                human_bytes(len as u64)
+            ))
+        })?;
+        canvas.bytes.resize(len, 0);
+    }
+    Ok(())
+}
+
+/// Memory the system says is available (`MemAvailable` in `/proc/meminfo`), where it says.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Copies the core of `tile` from its window's image `held` into the whole image.
+fn paste(
+    canvas: &mut Canvas,
+    held: &crate::nodes::HeldImage,
+    tile: &Tile,
+    image: Extent,
+) -> Result<()> {
+    let bpp = held.format.bytes_per_pixel() as usize;
+    if canvas.image.is_none() {
+        canvas.image = Some(crate::nodes::HeldImage {
+            bytes: Vec::new(),
+            format: held.format,
+            ty: held.ty,
+            extent: image,
+        });
+    }
+    if canvas.bytes.len() != image.pixels() as usize * bpp {
+        return Err(RenderError::Gpu(format!(
+            "node \"{}\": a {} image of {} where {} were planned",
+            canvas.node,
+            held.format.name(),
+            held.extent,
+            human_bytes(canvas.bytes.len() as u64)
+        )));
+    }
+    let (cx, cy) = tile.core_in_window();
+    let window_row = held.extent.width as usize * bpp;
+    let image_row = image.width as usize * bpp;
+    let core_row = tile.core.width as usize * bpp;
+    for y in 0..tile.core.height as usize {
+        let src = (cy as usize + y) * window_row + cx as usize * bpp;
+        let dst = (tile.core.y as usize + y) * image_row + tile.core.x as usize * bpp;
+        canvas.bytes[dst..dst + core_row].copy_from_slice(&held.bytes[src..src + core_row]);
+    }
+    Ok(())
+}
