@@ -405,6 +405,10 @@ impl Editor {
         {
             let _ = self.preview.step(p);
         }
+        if let Some(message) = self.preview.reopen_if_lost() {
+            self.message = Some((message, true));
+            ui.ctx().request_repaint();
+        }
         if self.preview.wants_frames() {
             ui.ctx().request_repaint();
         }

@@ -72,6 +72,8 @@ pub struct PreviewStats {
     pub restarts: u64,
     /// Nodes the last param update re-ran, in order.
     pub last_update: Vec<String>,
+    /// Times the GPU device was lost and a new one opened.
+    pub devices_reopened: u64,
 }
 
 /// The preview state.
@@ -294,6 +296,34 @@ impl Preview {
     /// The GPU context.
     pub fn gpu(&self) -> &GpuContext {
         &self.gpu
+    }
+
+    /// When the device was lost (a driver reset, the GPU removed): opens a new one on the
+    /// same adapter and drops everything made on the old one, so the next update builds the
+    /// preview again and accumulation starts over; returns what happened, for the status
+    /// line. `None` while the device is fine.
+    pub fn reopen_if_lost(&mut self) -> Option<String> {
+        let reason = self.gpu.lost()?;
+        let adapter = self.gpu.info.name.clone();
+        match self.gpu.reopen() {
+            Ok(gpu) => {
+                self.gpu = gpu;
+                self.exec = None;
+                self.clear(None);
+                self.stats.devices_reopened += 1;
+                Some(format!(
+                    "the GPU device ({adapter}) was lost ({reason}); the preview goes on on a \
+                     new one, from the first sample"
+                ))
+            }
+            Err(e) => {
+                self.clear(Some(format!(
+                    "the GPU device ({adapter}) was lost ({reason}), and a new one could not \
+                     be opened: {e}"
+                )));
+                None
+            }
+        }
     }
 
     /// Brings the preview up to date with `graph` showing `port`, rendering `scene` when

@@ -296,3 +296,42 @@ fn a_render_without_outputs_says_why() {
     let err = job.progress().finished.unwrap().unwrap_err();
     assert!(err.contains("no output node"), "{err}");
 }
+
+/// A lost GPU device (here destroyed, as a driver reset would lose it) does not end the
+/// editor: the preview opens a new device on the same adapter, says so in the status line,
+/// and accumulates again from the first sample. The preview gets a device of its own, so
+/// the harness's painter (on the shared one) is not lost with it.
+#[test]
+fn the_preview_goes_on_after_the_device_is_lost() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("cornell.ron");
+    std::fs::copy(repo("assets/cornell.ron"), &scene).unwrap();
+    let own = lumagraph_render::GpuContext::headless_prefer_cpu().unwrap();
+    let ed = Editor::new(
+        own.clone(),
+        Some(&repo("graphs/pathtrace.ron")),
+        &EditorConfig {
+            scene: Some(scene),
+            preview_max: 24,
+            ..EditorConfig::default()
+        },
+    );
+    let mut h = accumulating(ed);
+    assert!(h.state().preview.samples.expect("a sample count") >= 4);
+    own.device.destroy();
+    for _ in 0..8 {
+        h.step();
+    }
+    let ed = h.state();
+    assert_eq!(ed.preview.stats.devices_reopened, 1);
+    let (message, _) = ed.message.clone().expect("a status message");
+    assert!(message.contains("was lost (destroyed"), "{message}");
+    assert!(ed.preview.error.is_none(), "{:?}", ed.preview.error);
+    assert!(ed.preview.gpu().lost().is_none());
+    let samples = ed.preview.samples.expect("a sample count");
+    assert!(samples >= 1, "{samples} spp after the new device");
+    assert!(ed.preview.linear.is_some());
+}

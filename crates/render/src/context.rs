@@ -27,6 +27,8 @@ pub struct GpuContext {
     pub timestamps: bool,
     /// The first GPU error no error scope caught (see [`GpuContext::take_error`]).
     errors: std::sync::Arc<std::sync::Mutex<Option<String>>>,
+    /// Why the device was lost, once it is (see [`GpuContext::lost`]).
+    lost: std::sync::Arc<std::sync::Mutex<Option<String>>>,
 }
 
 impl GpuContext {
@@ -158,6 +160,24 @@ impl GpuContext {
                 .unwrap_or_else(std::sync::PoisonError::into_inner);
             first.get_or_insert_with(|| e.to_string());
         }));
+        // A lost device (driver reset, GPU removed, `destroy`) is remembered, to be
+        // returned by the next wait as `RenderError::DeviceLost`.
+        let lost = std::sync::Arc::new(std::sync::Mutex::new(None::<String>));
+        let slot = std::sync::Arc::clone(&lost);
+        device.set_device_lost_callback(move |reason, message| {
+            let why = match reason {
+                wgpu::DeviceLostReason::Destroyed => "destroyed".to_owned(),
+                wgpu::DeviceLostReason::Unknown => "lost by the driver".to_owned(),
+            };
+            let why = if message.is_empty() {
+                why
+            } else {
+                format!("{why}: {message}")
+            };
+            slot.lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .get_or_insert(why);
+        });
         Self {
             adapter,
             device,
@@ -165,7 +185,38 @@ impl GpuContext {
             info,
             timestamps,
             errors,
+            lost,
         }
+    }
+
+    /// Why the device was lost, once it is: nothing more runs on it, and a new context on
+    /// the same adapter ([`GpuContext::from_adapter`]) is the way on.
+    pub fn lost(&self) -> Option<String> {
+        self.lost
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .clone()
+    }
+
+    /// `message` (a GPU error) as a [`RenderError`]: [`RenderError::DeviceLost`] when the
+    /// device was lost (the error most likely came from that), else [`RenderError::Gpu`].
+    pub fn error(&self, message: impl std::fmt::Display) -> RenderError {
+        match self.lost() {
+            Some(reason) => RenderError::DeviceLost {
+                adapter: self.info.name.clone(),
+                reason,
+            },
+            None => RenderError::Gpu(message.to_string()),
+        }
+    }
+
+    /// A new device on the same adapter, with the same features and limits (after the
+    /// device was lost).
+    ///
+    /// # Errors
+    /// When the device cannot be opened.
+    pub fn reopen(&self) -> Result<Self> {
+        pollster::block_on(Self::from_adapter(self.adapter.clone()))
     }
 
     /// Takes the first GPU error that no error scope caught since the last call, if any.
@@ -219,13 +270,17 @@ impl GpuContext {
     /// # Errors
     /// When the GPU does not finish within [`GPU_TIMEOUT`] or the device is lost.
     pub fn wait(&self) -> Result<()> {
-        self.device
-            .poll(wgpu::PollType::Wait {
-                submission_index: None,
-                timeout: Some(GPU_TIMEOUT),
-            })
-            .map(|_| ())
-            .map_err(|e| RenderError::Gpu(e.to_string()))?;
+        let polled = self.device.poll(wgpu::PollType::Wait {
+            submission_index: None,
+            timeout: Some(GPU_TIMEOUT),
+        });
+        if let Some(reason) = self.lost() {
+            return Err(RenderError::DeviceLost {
+                adapter: self.info.name.clone(),
+                reason,
+            });
+        }
+        polled.map_err(|e| RenderError::Gpu(e.to_string()))?;
         match self.take_error() {
             Some(e) => Err(RenderError::Gpu(e)),
             None => Ok(()),

@@ -57,6 +57,17 @@ pub enum RenderError {
         /// The limit and the numbers.
         message: String,
     },
+    /// The device was lost (driver reset, GPU removed): nothing more runs on it.
+    #[error(
+        "the GPU device ({adapter}) was lost ({reason}): the render cannot go on on it; run it \
+         again (with --checkpoint-every, a render goes on from its last checkpoint with --resume)"
+    )]
+    DeviceLost {
+        /// The adapter.
+        adapter: String,
+        /// Why, as the driver says.
+        reason: String,
+    },
     /// A node kind has no GPU implementation in this build.
     #[error("node kind {0} has no implementation")]
     Unimplemented(String),

@@ -147,7 +147,7 @@ impl Executor {
         }
         let nodes = nodes?;
         if let Some(e) = invalid {
-            return Err(RenderError::Gpu(e.to_string()));
+            return Err(ctx.error(e));
         }
         // Two timestamps per pass; nodes with several passes get room too.
         let capacity = u32::try_from(plan.passes.len() * 8)
@@ -739,7 +739,7 @@ fn submit_and_wait(ctx: &GpuContext, encoder: wgpu::CommandEncoder) -> Result<()
     let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
     ctx.queue.submit([encoder.finish()]);
     if let Some(e) = pollster::block_on(scope.pop()) {
-        return Err(RenderError::Gpu(e.to_string()));
+        return Err(ctx.error(e));
     }
     ctx.wait()
 }
