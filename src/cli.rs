@@ -16,6 +16,7 @@ mod converge;
 mod gallery;
 mod plot;
 mod progressive;
+mod split;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -77,6 +78,35 @@ enum Command {
         /// result is identical to an uninterrupted render.
         #[arg(long, value_name = "CHECKPOINT")]
         resume: Option<PathBuf>,
+        /// Take only samples START..END of each pixel's sequence, exactly those a whole
+        /// render takes there, and write the partial render OUT/samples-START-END.partial
+        /// for `lumagraph merge` (docs/distributed.md).
+        #[arg(long, value_name = "START..END", value_parser = split::parse_range,
+              conflicts_with_all = ["spp", "resume", "checkpoint_every"])]
+        samples: Option<split::SampleRange>,
+    },
+    /// Merge partial renders (`render --samples`) of one graph and scene into what a single
+    /// render of all their samples writes: checks that they belong together, sums them
+    /// exactly and runs the rest of the graph (docs/distributed.md).
+    #[command(
+        after_help = "Example:\n  lumagraph render graphs/pathtrace.ron --scene assets/cornell.ron --samples 0..128 --out parts\n  lumagraph render graphs/pathtrace.ron --scene assets/cornell.ron --samples 128..256 --out parts\n  lumagraph merge parts/*.partial --out out"
+    )]
+    Merge {
+        /// The partial renders.
+        #[arg(required = true)]
+        partials: Vec<PathBuf>,
+        /// Folder Output paths are relative to (created if missing).
+        #[arg(long, default_value = ".")]
+        out: PathBuf,
+        /// The graph file, when it is no longer where the partial renders say.
+        #[arg(long)]
+        graph: Option<PathBuf>,
+        /// The scene file, when it is no longer where the partial renders say.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Merge ranges that leave samples out (by default a gap is an error).
+        #[arg(long)]
+        allow_gaps: bool,
     },
     /// Print the compiled plan: passes in order, textures and shared memory, what is left out.
     #[command(after_help = "Example:\n  lumagraph plan graphs/post_tonemap.ron")]
@@ -283,6 +313,17 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
     for (node, note) in exec.notes() {
         println!("{node}: {note}");
     }
+    if let Some(range) = args.samples {
+        anyhow::ensure!(progressive, "--samples needs a graph that renders a scene");
+        let origin = split::Origin {
+            graph: args.graph,
+            scene: args.scene,
+            overrides: args.overrides,
+            key: progressive::key(&graph, scene.as_ref().map(|s| &*s.gpu)),
+            out: args.out,
+        };
+        return split::render_partial(&mut exec, range, &origin);
+    }
     let report = if progressive {
         let spp = args
             .spp
@@ -375,6 +416,7 @@ struct RenderArgs<'a> {
     spp: Option<u32>,
     overrides: &'a [String],
     checkpoints: progressive::Checkpoints,
+    samples: Option<split::SampleRange>,
 }
 
 /// `lumagraph plan`: the plan, node-owned memory, and the shader features per pass.
@@ -468,6 +510,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             checkpoint,
             checkpoint_every,
             resume,
+            samples,
         } => render(&RenderArgs {
             library,
             graph: &graph,
@@ -481,6 +524,21 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
                 key: 0,
             },
             out: &out,
+            samples,
+        }),
+        Command::Merge {
+            partials,
+            out,
+            graph,
+            scene,
+            allow_gaps,
+        } => split::merge(&split::MergeArgs {
+            library,
+            partials: &partials,
+            out: &out,
+            graph: graph.as_deref(),
+            scene: scene.as_deref(),
+            allow_gaps,
         }),
         Command::Plan {
             graph,
