@@ -82,7 +82,7 @@ enum Command {
         /// render takes there, and write the partial render OUT/samples-START-END.partial
         /// for `lumagraph merge` (docs/distributed.md).
         #[arg(long, value_name = "START..END", value_parser = split::parse_range,
-              conflicts_with_all = ["spp", "resume", "checkpoint_every"])]
+              conflicts_with_all = ["spp", "resume", "checkpoint", "checkpoint_every"])]
         samples: Option<split::SampleRange>,
     },
     /// Merge partial renders (`render --samples`) of one graph and scene into what a single

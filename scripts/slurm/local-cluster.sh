@@ -76,6 +76,11 @@ install)
     ;;
 start)
     need
+    running() { [ -f "$1" ] && kill -0 "$(cat "$1")" 2>/dev/null; }
+    if running "$dir/slurmctld.pid" || running "$dir/munge/munged.pid"; then
+        echo "local-cluster: already running (stop it first: $0 stop)" >&2
+        exit 1
+    fi
     write_conf
     [ -f /etc/munge/munge.key ] || {
         echo "local-cluster: /etc/munge/munge.key is missing (reinstall munge)" >&2

@@ -62,6 +62,8 @@ if [ -z "${LUMAGRAPH:-}" ]; then
     LUMAGRAPH="$(command -v lumagraph || true)"
     [ -n "$LUMAGRAPH" ] || LUMAGRAPH="$(cd "$(dirname "$0")/../.." && pwd)/target/release/lumagraph"
 fi
+# Jobs may start in another folder: name the binary absolutely.
+case "$LUMAGRAPH" in */*) LUMAGRAPH="$(cd "$(dirname "$LUMAGRAPH")" && pwd)/$(basename "$LUMAGRAPH")" ;; esac
 [ -x "$LUMAGRAPH" ] || {
     echo "render-array: $LUMAGRAPH is not an executable (set LUMAGRAPH)" >&2
     exit 1
