@@ -16,6 +16,7 @@ mod converge;
 mod gallery;
 mod plot;
 mod progressive;
+mod split;
 mod tiled;
 
 use std::path::{Path, PathBuf};
@@ -82,6 +83,35 @@ enum Command {
         /// larger than the device holds, or than 4 GiB of images and buffers, is tiled.
         #[arg(long, value_name = "PIXELS")]
         tile: Option<u32>,
+        /// Take only samples START..END of each pixel's sequence, exactly those a whole
+        /// render takes there, and write the partial render OUT/samples-START-END.partial
+        /// for `lumagraph merge` (docs/distributed.md).
+        #[arg(long, value_name = "START..END", value_parser = split::parse_range,
+              conflicts_with_all = ["spp", "resume", "checkpoint", "checkpoint_every", "tile"])]
+        samples: Option<split::SampleRange>,
+    },
+    /// Merge partial renders (`render --samples`) of one graph and scene into what a single
+    /// render of all their samples writes: checks that they belong together, sums them
+    /// exactly and runs the rest of the graph (docs/distributed.md).
+    #[command(
+        after_help = "Example:\n  lumagraph render graphs/pathtrace.ron --scene assets/cornell.ron --samples 0..128 --out parts\n  lumagraph render graphs/pathtrace.ron --scene assets/cornell.ron --samples 128..256 --out parts\n  lumagraph merge parts/*.partial --out out"
+    )]
+    Merge {
+        /// The partial renders.
+        #[arg(required = true)]
+        partials: Vec<PathBuf>,
+        /// Folder Output paths are relative to (created if missing).
+        #[arg(long, default_value = ".")]
+        out: PathBuf,
+        /// The graph file, when it is no longer where the partial renders say.
+        #[arg(long)]
+        graph: Option<PathBuf>,
+        /// The scene file, when it is no longer where the partial renders say.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Merge ranges that leave samples out (by default a gap is an error).
+        #[arg(long)]
+        allow_gaps: bool,
     },
     /// Print the compiled plan: passes in order, textures and shared memory, what is left out.
     #[command(after_help = "Example:\n  lumagraph plan graphs/post_tonemap.ron")]
@@ -293,6 +323,17 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
     for (node, note) in exec.notes() {
         println!("{node}: {note}");
     }
+    if let Some(range) = args.samples {
+        anyhow::ensure!(progressive, "--samples needs a graph that renders a scene");
+        let origin = split::Origin {
+            graph: args.graph,
+            scene: args.scene,
+            overrides: args.overrides,
+            key: progressive::key(&graph, scene.as_ref().map(|s| &*s.gpu)),
+            out: args.out,
+        };
+        return split::render_partial(&mut exec, range, &origin);
+    }
     let report = if progressive {
         let spp = args
             .spp
@@ -387,6 +428,8 @@ struct RenderArgs<'a> {
     checkpoints: progressive::Checkpoints,
     /// `--tile`.
     tile: Option<u32>,
+    /// `--samples`.
+    samples: Option<split::SampleRange>,
 }
 
 /// `lumagraph plan`: the plan, node-owned memory, and the shader features per pass.
@@ -481,6 +524,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             checkpoint_every,
             resume,
             tile,
+            samples,
         } => render(&RenderArgs {
             library,
             graph: &graph,
@@ -495,6 +539,21 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             },
             out: &out,
             tile,
+            samples,
+        }),
+        Command::Merge {
+            partials,
+            out,
+            graph,
+            scene,
+            allow_gaps,
+        } => split::merge(&split::MergeArgs {
+            library,
+            partials: &partials,
+            out: &out,
+            graph: graph.as_deref(),
+            scene: scene.as_deref(),
+            allow_gaps,
         }),
         Command::Plan {
             graph,

@@ -14,6 +14,10 @@
 // luminance (what Denoise reads) a robust one from the median absolute deviation, so a wall
 // pixel beside the light does not look noisy.
 //
+// When `params.present` is 1 (a merge of partial renders, `lumagraph merge`), the pass adds
+// nothing: it writes the mean and variance of the history as it stands, with the same
+// arithmetic as the frame that added the last sample.
+//
 // Shader compilers may simplify `((s + y) - s) - y` to 0 (Mesa's NIR does, since naga marks no
 // operation exact), which silently turns Kahan summation into a plain sum. Multiplying by
 // `params.one` (1.0, but unknown to the compiler) keeps the compensation term alive.
@@ -22,6 +26,8 @@ struct Params {
     one: f32,
     variance: u32,
     size: vec2u,
+    present: u32,
+    pad: u32,
 }
 
 @group(0) @binding(0) var input: texture_2d<f32>;
@@ -101,6 +107,10 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     let i = id.y * size.x + id.x;
+    if params.present == 1u {
+        present(id.xy, i);
+        return;
+    }
     let x = textureLoad(input, id.xy, 0).rgb;
     var s = sum[i];
     let c = comp[i].rgb;
@@ -127,5 +137,21 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
             v = spatial_variance(vec2i(id.xy), vec2i(size));
         }
         textureStore(variance_out, id.xy, v);
+    }
+}
+
+// The mean (and variance) of the history as it stands, adding nothing.
+fn present(p: vec2u, i: u32) {
+    let s = sum[i];
+    textureStore(output, p, vec4f(s.rgb / s.a, 1.0));
+    if params.variance == 1u {
+        let n = s.a;
+        var v: vec4f;
+        if n >= 2.0 {
+            v = max(m2[i], vec4f(0.0)) / (n * (n - 1.0));
+        } else {
+            v = spatial_variance(vec2i(p), vec2i(params.size));
+        }
+        textureStore(variance_out, p, v);
     }
 }

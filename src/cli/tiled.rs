@@ -38,6 +38,13 @@ pub(super) fn render_if_needed(
     else {
         return Ok(None);
     };
+    if args.samples.is_some() {
+        bail!(
+            "this render is tiled ({}), and partial renders (--samples) are not tiled yet: \
+             render it smaller",
+            tiling.why
+        );
+    }
     if args.checkpoints.resume.is_some() || args.checkpoints.every.is_some() {
         bail!(
             "this render is tiled ({}), and tiled renders keep no checkpoints yet: leave out \

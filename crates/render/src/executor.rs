@@ -28,6 +28,9 @@ enum Mode {
     /// Only the passes marked in `Executor::only`, timed; their sinks write. No frame is
     /// added.
     Only,
+    /// Everything once, timed, nodes with history presenting it ([`NodeExec::set_present`]);
+    /// sinks write. No frame is added.
+    Present,
 }
 
 /// How [`FrameReport::pass_ms`] was measured.
@@ -461,6 +464,82 @@ impl Executor {
         Ok(())
     }
 
+    /// Starts a partial render of the samples from `first` on: history cleared, each pixel's
+    /// sample sequence starting at index `first`, and `frames` counted as run (those that
+    /// take the samples before `first`), so [`Executor::render`] and the checkpoints go on
+    /// as in a render that took them. See [`crate::partial`].
+    pub fn start_at_sample(&mut self, first: u32, frames: u64) {
+        self.reset_history();
+        for node in &mut self.nodes {
+            node.start_at_sample(first);
+        }
+        self.frames = frames;
+    }
+
+    /// The history of one render of every sample range the checkpoints `parts` (of
+    /// partial renders of this plan, in sample order) hold: each node's states merged
+    /// ([`NodeExec::merge_states`]). Its frames are the last part's; restore it
+    /// ([`Executor::restore`]) and [`Executor::present`] it.
+    ///
+    /// # Errors
+    /// When a part lacks a node's state or the states do not fit together; the error names
+    /// the node.
+    pub fn merge(&mut self, parts: &[crate::Checkpoint]) -> Result<crate::Checkpoint> {
+        let first = parts
+            .first()
+            .ok_or_else(|| RenderError::Gpu("nothing to merge".into()))?;
+        let mut nodes = Vec::new();
+        for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
+            let states: Vec<&[u8]> = parts
+                .iter()
+                .filter_map(|c| c.nodes.iter().find(|(id, _)| *id == pass.node))
+                .map(|(_, state)| state.as_slice())
+                .collect();
+            if states.is_empty() {
+                continue;
+            }
+            if states.len() != parts.len() {
+                return Err(RenderError::Gpu(format!(
+                    "{} of the {} partial renders have no state for this node",
+                    parts.len() - states.len(),
+                    parts.len()
+                ))
+                .in_node(&pass.node));
+            }
+            let merged = node
+                .merge_states(&states)
+                .map_err(|e| e.in_node(&pass.node))?;
+            nodes.push((pass.node.clone(), merged));
+        }
+        Ok(crate::Checkpoint {
+            key: first.key,
+            version: first.version.clone(),
+            adapter: first.adapter.clone(),
+            frames: parts.iter().map(|c| c.frames).max().unwrap_or(0),
+            nodes,
+        })
+    }
+
+    /// Runs the whole graph once over the history as it stands (after a
+    /// [`Executor::restore`]), adding nothing to it: nodes with history write what the frame
+    /// that added their last sample wrote ([`NodeExec::set_present`]), the rest of the
+    /// graph runs on that, and sinks write their files. A merge of partial renders ends
+    /// with it.
+    ///
+    /// # Errors
+    /// When a node fails (one with no history to present among them); the error names the
+    /// node.
+    pub fn present(&mut self) -> Result<FrameReport> {
+        for node in &mut self.nodes {
+            node.set_present(&self.ctx, true);
+        }
+        let report = self.run(1, Mode::Present);
+        for node in &mut self.nodes {
+            node.set_present(&self.ctx, false);
+        }
+        report
+    }
+
     /// Records every pass once without writing files or keeping history, so drivers that
     /// compile pipelines at their first dispatch do it here rather than in a timed frame.
     ///
@@ -486,7 +565,7 @@ impl Executor {
             slots: &self.slots,
         };
         let mut executed = Vec::with_capacity(self.plan.passes.len());
-        let timed = matches!(mode, Mode::Finish | Mode::Tail | Mode::Only);
+        let timed = matches!(mode, Mode::Finish | Mode::Tail | Mode::Only | Mode::Present);
         let mut wall_ms: Vec<(String, f64)> = Vec::new();
         let n = n.max(1);
         for frame in 0..n {
@@ -541,7 +620,7 @@ impl Executor {
         }
         submit_and_wait(&self.ctx, encoder)?;
         let mut written = Vec::new();
-        if matches!(mode, Mode::Finish | Mode::Tail | Mode::Only) {
+        if timed {
             for (p, (pass, node)) in self.plan.passes.iter().zip(&mut self.nodes).enumerate() {
                 if (mode == Mode::Only && !self.only[p]) || (self.hold_sinks && pass.kind.sink) {
                     continue;
@@ -557,7 +636,7 @@ impl Executor {
             Some(t) if timed => Some(t.read(&self.ctx)?),
             _ => None,
         };
-        if !matches!(mode, Mode::Tail | Mode::Only) {
+        if !matches!(mode, Mode::Tail | Mode::Only | Mode::Present) {
             self.frames += u64::from(n);
         }
         Ok(FrameReport {

@@ -37,11 +37,14 @@ pub(crate) const IMPL: NodeImpl = NodeImpl::new("Accumulate", |ctx, pass, _| {
 
 crate::param_block! {
     /// Accumulate's params: a 1.0 the compiler cannot fold away (it keeps the Kahan
-    /// compensation), whether to estimate the variance, and the image size.
+    /// compensation), whether to estimate the variance, the image size, and whether to
+    /// present the history without adding to it.
     pub(crate) struct AccumulateParams in "post/accumulate.wgsl" as "Params" {
         one: f32,
         variance: u32,
         size: [u32; 2],
+        present: u32,
+        pad: u32,
     }
 }
 
@@ -52,6 +55,8 @@ pub(crate) struct Accumulate {
     history: Option<(Extent, wgpu::Buffer, wgpu::Buffer, wgpu::Buffer)>,
     clear: bool,
     variance: bool,
+    /// Write the mean of the history without adding a frame ([`NodeExec::set_present`]).
+    present: bool,
     /// Stand-ins for an output nothing reads (color, variance).
     unused: [PooledTexture; 2],
 }
@@ -63,7 +68,7 @@ impl Accumulate {
         let block = AccumulateParams {
             one: 1.0,
             variance: u32::from(variance),
-            size: [0; 2],
+            ..AccumulateParams::default()
         };
         let params = uniform_buffer(ctx, "accumulate params", bytemuck::bytes_of(&block));
         let one = Extent::new(1, 1);
@@ -73,6 +78,7 @@ impl Accumulate {
             history: None,
             clear: true,
             variance,
+            present: false,
             unused: [
                 create(ctx, "unused accumulate color", TexFormat::Rgba32Float, one),
                 create(
@@ -118,6 +124,8 @@ impl Accumulate {
             one: 1.0,
             variance: u32::from(self.variance),
             size: [extent.width, extent.height],
+            present: u32::from(self.present),
+            pad: 0,
         };
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&block));
@@ -219,6 +227,18 @@ impl NodeExec for Accumulate {
         self.clear = true;
     }
 
+    fn set_present(&mut self, ctx: &GpuContext, present: bool) {
+        self.present = present;
+        if let Some((extent, ..)) = &self.history {
+            self.write_params(ctx, *extent);
+        }
+    }
+
+    fn merge_states(&mut self, states: &[&[u8]]) -> Result<Vec<u8>> {
+        crate::partial::merge_accumulations(states)
+            .map_err(|e| crate::error::RenderError::Gpu(format!("accumulation state: {e}")))
+    }
+
     fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
         let (ctx, encoder, io, timer) = rec.parts();
         let input = io.input(pass, "color")?;
@@ -226,8 +246,14 @@ impl NodeExec for Accumulate {
         if out.is_none() && var.is_none() {
             return Ok(());
         }
-        let mut clear = std::mem::take(&mut self.clear);
         let extent = pass.extent;
+        if self.present && (self.clear || self.history.as_ref().is_none_or(|(e, ..)| *e != extent))
+        {
+            return Err(crate::error::RenderError::Gpu(
+                "no accumulated samples to present".into(),
+            ));
+        }
+        let mut clear = std::mem::take(&mut self.clear);
         if self.history.as_ref().is_none_or(|(e, ..)| *e != extent) {
             self.make_history(ctx, extent);
             clear = true;

@@ -231,6 +231,28 @@ pub trait NodeExec {
         ))
     }
 
+    /// Starts the history at sample `first` of each pixel's sequence instead of 0, as if
+    /// the samples before it had been taken elsewhere: a partial render of a sample range
+    /// (`lumagraph render --samples`). Nodes whose history is not indexed by sample ignore
+    /// it.
+    fn start_at_sample(&mut self, _first: u32) {}
+
+    /// While `present` is set, [`NodeExec::record`] writes the node's outputs from its
+    /// history as it stands, adding nothing to it: the outputs of the frame that added the
+    /// last sample. A merge of partial renders restores the merged history and presents it.
+    fn set_present(&mut self, _ctx: &GpuContext, _present: bool) {}
+
+    /// Combines the states ([`NodeExec::save_state`]) of several partial renders of
+    /// disjoint sample ranges, in sample order, into the state of one render of them all.
+    ///
+    /// # Errors
+    /// When the states do not fit together, or the node cannot merge its history.
+    fn merge_states(&mut self, _states: &[&[u8]]) -> Result<Vec<u8>> {
+        Err(RenderError::Gpu(
+            "this node's history cannot be merged from partial renders".into(),
+        ))
+    }
+
     /// Runs after the frame's GPU work finished; returns files written.
     ///
     /// # Errors

@@ -294,6 +294,22 @@ impl NodeExec for PathTrace {
         Ok(())
     }
 
+    fn start_at_sample(&mut self, first: u32) {
+        self.samples = first;
+    }
+
+    fn set_present(&mut self, _ctx: &GpuContext, present: bool) {
+        // Presenting re-runs the frame that took the last samples (for outputs read
+        // downstream, such as the first-hit AOVs); recording it counts them again.
+        if present {
+            self.samples = self.samples.saturating_sub(self.samples_per_frame);
+        }
+    }
+
+    fn merge_states(&mut self, states: &[&[u8]]) -> Result<Vec<u8>> {
+        crate::partial::merge_path_tracers(states).map_err(RenderError::Gpu)
+    }
+
     fn counters(&mut self, ctx: &GpuContext) -> Result<Vec<Counter>> {
         let mut encoder = ctx
             .device
