@@ -83,6 +83,11 @@ enum Command {
         /// larger than the device holds, or than 4 GiB of images and buffers, is tiled.
         #[arg(long, value_name = "PIXELS")]
         tile: Option<u32>,
+        /// Render only tiles FIRST..END (row by row from 0) of the tiled render, and write
+        /// them as OUT/tiles-FIRST-END.tiles for `lumagraph merge` (docs/distributed.md).
+        #[arg(long, value_name = "FIRST..END", value_parser = split::parse_range,
+              conflicts_with_all = ["resume", "checkpoint", "checkpoint_every", "samples"])]
+        tiles: Option<split::SampleRange>,
         /// Take only samples START..END of each pixel's sequence, exactly those a whole
         /// render takes there, and write the partial render OUT/samples-START-END.partial
         /// for `lumagraph merge` (docs/distributed.md).
@@ -430,6 +435,8 @@ struct RenderArgs<'a> {
     tile: Option<u32>,
     /// `--samples`.
     samples: Option<split::SampleRange>,
+    /// `--tiles`.
+    tiles: Option<split::SampleRange>,
 }
 
 /// `lumagraph plan`: the plan, node-owned memory, and the shader features per pass.
@@ -524,6 +531,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             checkpoint_every,
             resume,
             tile,
+            tiles,
             samples,
         } => render(&RenderArgs {
             library,
@@ -539,6 +547,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             },
             out: &out,
             tile,
+            tiles,
             samples,
         }),
         Command::Merge {

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 /// `scene` (a file under `assets/`) at `width` × `height` and `spp`, written into `dir`.
 fn scene_at(dir: &Path, scene: &str, width: u32, height: u32, spp: u32) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
     let path = dir.join(scene.rsplit('/').next().unwrap());
     let text = std::fs::read_to_string(common::repo(scene))
         .unwrap()
@@ -201,5 +202,79 @@ fn the_default_graph_needs_a_63_pixel_apron() {
     assert_eq!(
         (tiles[0].window.width, tiles[0].window.height),
         (250 + 126, 200 + 126)
+    );
+}
+
+/// Tiles as a split across machines: `render --tiles` of two ranges, merged, writes what the
+/// whole render writes, byte for byte (the blur graph, whose tiled render is the whole
+/// render's). Sets that overlap, leave tiles out or come from another scene are refused,
+/// naming the files and tiles.
+#[test]
+fn tile_sets_rendered_apart_merge_into_the_whole_image() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_at(dir.path(), "assets/cornell_spheres.ron", 70, 50, 8);
+    let graph = dir.path().join("blur.ron");
+    std::fs::write(&graph, BLUR_GRAPH).unwrap();
+    let whole = dir.path().join("whole");
+    render(&graph, &scene, &whole, &[]);
+    let parts = dir.path().join("parts");
+    for range in ["0..4", "4..9", "3..5"] {
+        let log = render(&graph, &scene, &parts, &["--tile", "24", "--tiles", range]);
+        assert!(
+            log.contains(&format!(
+                "wrote {}",
+                parts
+                    .join(format!("tiles-{}.tiles", range.replace("..", "-")))
+                    .display()
+            )),
+            "{log}"
+        );
+    }
+    let set = |r: &str| parts.join(format!("tiles-{r}.tiles")).display().to_string();
+    let merged = dir.path().join("merged");
+    let merge = |files: &[String]| {
+        let mut args = vec!["merge".to_owned()];
+        args.extend(files.iter().cloned());
+        args.extend(["--out".to_owned(), merged.display().to_string()]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        common::cli(&args)
+    };
+    let (ok, stdout, stderr) = merge(&[set("4-9"), set("0-4")]);
+    assert!(ok, "{stdout}\n{stderr}");
+    for file in ["render.png", "raw.exr", "blurred.exr"] {
+        assert!(
+            std::fs::read(whole.join(file)).unwrap() == std::fs::read(merged.join(file)).unwrap(),
+            "{file}: the merged tiles differ from the whole render"
+        );
+    }
+    let (ok, _, stderr) = merge(&[set("0-4"), set("3-5")]);
+    assert!(!ok, "{stderr}");
+    assert!(stderr.contains("tile 3 is in both"), "{stderr}");
+    assert!(stderr.contains("tiles 5..9 are in no tile set"), "{stderr}");
+    // Another scene (other samples per pixel): another render.
+    let other = scene_at(
+        &dir.path().join("other"),
+        "assets/cornell_spheres.ron",
+        70,
+        50,
+        4,
+    );
+    let elsewhere = dir.path().join("elsewhere");
+    render(
+        &graph,
+        &other,
+        &elsewhere,
+        &["--tile", "24", "--tiles", "4..9"],
+    );
+    let (ok, _, stderr) = merge(&[
+        set("0-4"),
+        elsewhere.join("tiles-4-9.tiles").display().to_string(),
+    ]);
+    assert!(
+        !ok && stderr.contains("is of another render than"),
+        "{stderr}"
     );
 }

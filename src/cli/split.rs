@@ -14,8 +14,8 @@ use crate::render::{Executor, GpuContext, NodeLibrary, Partial, Resources};
 /// A range of sample indices, `first..end`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) struct SampleRange {
-    first: u32,
-    end: u32,
+    pub first: u32,
+    pub end: u32,
 }
 
 /// Parses `START..END` (clap's value parser for `--samples`).
@@ -132,6 +132,21 @@ pub(super) struct MergeArgs<'a> {
 
 /// `merge`: the partial renders checked, merged and run through the rest of the graph.
 pub(super) fn merge(args: &MergeArgs<'_>) -> Result<()> {
+    let sets = args
+        .partials
+        .iter()
+        .filter(|p| crate::render::tile_set::TileSet::is_tile_set(p))
+        .count();
+    if sets == args.partials.len() {
+        return super::tiled::merge_tiles(args.partials, args.out);
+    }
+    if sets > 0 {
+        bail!(
+            "{sets} of the {} files are tile sets (render --tiles) and the others are not: \
+             merge each kind on its own",
+            args.partials.len()
+        );
+    }
     let mut parts = Vec::new();
     for path in args.partials {
         parts.push((path.clone(), Partial::load(path)?));

@@ -1,6 +1,7 @@
 //! `render` of an image larger than the device holds: tile by tile
 //! ([`crate::render::tiled`]), with a progress bar over all tiles.
 
+use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
@@ -9,6 +10,8 @@ use anyhow::{Result, bail};
 use super::progressive::{STOP, on_signal};
 use super::{LoadedScene, RenderArgs, progressive_source, uses_scene};
 use crate::graph::{Extent, Graph, Plan};
+use crate::render::tile_set::TileSet;
+use crate::render::tiled::Tiling;
 use crate::render::{Executor, GpuContext, Resources};
 
 /// Renders tile by tile when `--tile` asks or the whole image does not fit the device
@@ -36,6 +39,12 @@ pub(super) fn render_if_needed(
             .sum::<u64>();
     let Some(tiling) = crate::render::tiled::plan_tiling(ctx, plan, image, bytes, args.tile)?
     else {
+        if args.tiles.is_some() {
+            bail!(
+                "--tiles: this render is not tiled; give the tile side with --tile (or render \
+                 an image that must be tiled)"
+            );
+        }
         return Ok(None);
     };
     if args.samples.is_some() {
@@ -77,44 +86,111 @@ pub(super) fn render_if_needed(
         warm.elapsed().as_secs_f64() * 1e3
     );
     on_signal("tiled renders keep no checkpoint, so nothing is written");
-    let total = u64::from(frames) * n as u64;
-    let bar = indicatif::ProgressBar::with_draw_target(
-        Some(total),
-        indicatif::ProgressDrawTarget::hidden(),
-    );
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:40} tile {msg}, {pos}/{len} frames in all, {elapsed} (eta {eta})",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    let start = Instant::now();
-    let mut at = 0;
-    let written = crate::render::tiled::render(
-        &mut exec,
-        &tiling,
-        image,
-        resources,
-        frames,
-        |tile, done, _| {
-            if bar.is_hidden() && start.elapsed() > Duration::from_secs(1) {
-                bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+    let mut bar = TileBar::new(n, frames);
+    match args.tiles {
+        Some(range) => {
+            let key = super::progressive::key(graph, Some(&scene.gpu));
+            let set = crate::render::tiled::render_set(
+                &mut exec,
+                &tiling,
+                image,
+                (range.first, range.end),
+                frames,
+                key,
+                |tile, done, _| bar.tick(tile, done),
+            )?;
+            bar.bar.finish_and_clear();
+            let Some(set) = set else {
+                bail!("interrupted in tile {}: nothing was written", bar.at + 1);
+            };
+            std::fs::create_dir_all(args.out)?;
+            let path = args
+                .out
+                .join(format!("tiles-{}-{}.tiles", range.first, range.end));
+            set.save(&path)?;
+            println!(
+                "rendered tiles {}..{} of {n} in {:.2} s",
+                range.first,
+                range.end,
+                bar.start.elapsed().as_secs_f64()
+            );
+            println!("wrote {}", path.display());
+        }
+        None => {
+            let written = crate::render::tiled::render(
+                &mut exec,
+                &tiling,
+                image,
+                resources,
+                frames,
+                |tile, done, _| bar.tick(tile, done),
+            )?;
+            bar.bar.finish_and_clear();
+            let Some(written) = written else {
+                bail!(
+                    "interrupted in tile {} of {n}: tiled renders keep no checkpoint yet, so \
+                     nothing was written",
+                    bar.at + 1
+                );
+            };
+            report(&exec, &tiling, image, frames, bar.start.elapsed());
+            for path in &written {
+                println!("wrote {}", path.display());
             }
-            at = tile;
-            bar.set_message(format!("{} of {n}", tile + 1));
-            bar.set_position(tile as u64 * u64::from(frames) + u64::from(done));
-            !STOP.load(Ordering::SeqCst)
-        },
-    )?;
-    bar.finish_and_clear();
-    let Some(written) = written else {
-        bail!(
-            "interrupted in tile {} of {n}: tiled renders keep no checkpoint yet, so nothing \
-             was written",
-            at + 1
+        }
+    }
+    Ok(Some(()))
+}
+
+/// The progress bar over all tiles' frames (drawn once the render takes over a second).
+struct TileBar {
+    bar: indicatif::ProgressBar,
+    tiles: usize,
+    frames: u32,
+    start: Instant,
+    /// The tile rendering now.
+    at: usize,
+}
+
+impl TileBar {
+    fn new(tiles: usize, frames: u32) -> Self {
+        let bar = indicatif::ProgressBar::with_draw_target(
+            Some(u64::from(frames) * tiles as u64),
+            indicatif::ProgressDrawTarget::hidden(),
         );
-    };
-    let secs = start.elapsed().as_secs_f64();
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} tile {msg}, {pos}/{len} frames in all, {elapsed} (eta {eta})",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        Self {
+            bar,
+            tiles,
+            frames,
+            start: Instant::now(),
+            at: 0,
+        }
+    }
+
+    /// Frame `done` of tile `tile`; whether to go on (no Ctrl-C).
+    fn tick(&mut self, tile: usize, done: u32) -> bool {
+        if self.bar.is_hidden() && self.start.elapsed() > Duration::from_secs(1) {
+            self.bar
+                .set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+        self.at = tile;
+        self.bar
+            .set_message(format!("{} of {}", tile + 1, self.tiles));
+        self.bar
+            .set_position(tile as u64 * u64::from(self.frames) + u64::from(done));
+        !STOP.load(Ordering::SeqCst)
+    }
+}
+
+/// Prints the tiled render's speed and the aprons' cost.
+fn report(exec: &Executor, tiling: &Tiling, image: Extent, frames: u32, wall: Duration) {
+    let secs = wall.as_secs_f64();
     let spf = progressive_source(exec.plan()).map_or(1, |p| {
         u64::try_from(p.params.int(crate::graph::registry::SAMPLES_PER_FRAME)).unwrap_or(1)
     });
@@ -130,13 +206,51 @@ pub(super) fn render_if_needed(
         rendered as f64 / image.pixels() as f64 - 1.0,
     );
     println!(
-        "rendered {samples} spp at {image} in {n} tiles in {secs:.2} s: {:.3} M paths/s of the \
+        "rendered {samples} spp at {image} in {} tiles in {secs:.2} s: {:.3} M paths/s of the \
          image ({:.1} % more pixels rendered for the aprons)",
+        tiling.tiles.len(),
         paths / secs / 1e6,
         overhead * 100.0
+    );
+}
+
+/// `merge` of tile sets (`render --tiles`): checked, assembled, each output written as the
+/// whole tiled render writes it.
+pub(super) fn merge_tiles(paths: &[PathBuf], out: &Path) -> Result<()> {
+    let start = Instant::now();
+    let mut sets = Vec::new();
+    for path in paths {
+        sets.push((path.clone(), TileSet::load(path)?));
+    }
+    sets.sort_by_key(|(_, s)| s.first);
+    let images = crate::render::tile_set::assemble(&sets).map_err(|e| {
+        anyhow::anyhow!(
+            "the tile sets do not belong together:\n  {}",
+            e.replace('\n', "\n  ")
+        )
+    })?;
+    let whole = sets[0].1.image;
+    std::fs::create_dir_all(out)
+        .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", out.display()))?;
+    let resources = Resources {
+        out_dir: out.to_owned(),
+        ..Resources::default()
+    };
+    let mut written = Vec::new();
+    for image in images {
+        let file = resources.output(&image.path);
+        crate::render::write_output(&file, &image.bytes, image.format, image.ty, whole)
+            .map_err(|e| anyhow::anyhow!("node \"{}\": {e}", image.node))?;
+        written.push(file);
+    }
+    println!(
+        "merged {} tile sets ({} tiles of {whole}) in {:.2} s",
+        sets.len(),
+        sets[0].1.count,
+        start.elapsed().as_secs_f64()
     );
     for path in &written {
         println!("wrote {}", path.display());
     }
-    Ok(Some(()))
+    Ok(())
 }

@@ -35,6 +35,7 @@ pub mod sampler;
 mod scene_gpu;
 pub mod shader;
 pub mod specialize;
+pub mod tile_set;
 pub mod tiled;
 mod timing;
 
@@ -44,6 +45,7 @@ pub use error::{RenderError, Result};
 pub use executor::{Executor, FrameReport, PassClock};
 pub use kernel::{Binding, Kernel, PassBuilder, uniform_buffer};
 pub use library::{NodeLibrary, compile, compile_with};
+pub use nodes::output::write_image as write_output;
 pub use nodes::{Counter, Measurement, Resources};
 pub use partial::Partial;
 pub use pool::{PooledTexture, TexturePool, create as create_texture, wgpu_format};

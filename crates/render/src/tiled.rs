@@ -147,7 +147,7 @@ struct Canvas {
 pub fn render(
     exec: &mut Executor,
     tiling: &Tiling,
-    image: Extent,
+    whole: Extent,
     resources: &Resources,
     frames: u32,
     mut progress: impl FnMut(usize, u32, u32) -> bool,
@@ -180,31 +180,144 @@ pub fn render(
             format,
         ));
     }
-    allocate(&mut canvases, image)?;
-    for (i, tile) in tiling.tiles.iter().enumerate() {
+    allocate(&mut canvases, whole)?;
+    let all = 0..tiling.tiles.len();
+    let done = render_tiles(exec, tiling, all, frames, &mut progress, |_, tile, held| {
+        for (p, image) in held {
+            if let Some((_, canvas, _)) = canvases.iter_mut().find(|(q, ..)| *q == p) {
+                paste(canvas, &image, tile, whole)?;
+            }
+        }
+        Ok(())
+    })?;
+    if !done {
+        return Ok(None);
+    }
+    let mut written = Vec::new();
+    for (_, canvas, _) in canvases {
+        let Some(held) = canvas.image else { continue };
+        crate::nodes::output::write_image(&canvas.path, &canvas.bytes, held.format, held.ty, whole)
+            .map_err(|e| e.in_node(&canvas.node))?;
+        written.push(canvas.path);
+    }
+    Ok(Some(written))
+}
+
+/// Renders tiles `range` of `tiling` through `exec` (compiled at `tiling.window`), each to
+/// `frames` frames, handing each tile's held sink images, as `(pass index, image)`, to
+/// `take`; returns `false` when `progress` stopped it.
+///
+/// # Errors
+/// A failing node, or what `take` returns.
+pub fn render_tiles(
+    exec: &mut Executor,
+    tiling: &Tiling,
+    range: std::ops::Range<usize>,
+    frames: u32,
+    mut progress: impl FnMut(usize, u32, u32) -> bool,
+    mut take: impl FnMut(usize, &Tile, Vec<(usize, crate::nodes::HeldImage)>) -> Result<()>,
+) -> Result<bool> {
+    exec.hold_sinks(true);
+    for i in range {
+        let tile = &tiling.tiles[i];
         exec.set_origin([tile.window.x, tile.window.y]);
         exec.restart();
         if exec
             .render(frames, |_, done, total| progress(i, done, total))?
             .is_none()
         {
-            return Ok(None);
+            return Ok(false);
         }
-        for (p, held) in exec.held_images()? {
-            let Some((_, canvas, _)) = canvases.iter_mut().find(|(q, ..)| *q == p) else {
-                continue;
-            };
-            paste(canvas, &held, tile, image)?;
+        take(i, tile, exec.held_images()?)?;
+    }
+    Ok(true)
+}
+
+/// Renders tiles `first..end` of `tiling` (see [`render_tiles`]) into a
+/// [`crate::tile_set::TileSet`] of every `Output` node's cores, for `key` (the render's;
+/// [`crate::checkpoint::render_key`]) and a whole image of `whole`; `None` when `progress`
+/// stopped it.
+///
+/// # Errors
+/// A sink that is not an `Output` node, a range outside the tiles, a failing node.
+pub fn render_set(
+    exec: &mut Executor,
+    tiling: &Tiling,
+    whole: Extent,
+    (first, end): (u32, u32),
+    frames: u32,
+    key: u64,
+    progress: impl FnMut(usize, u32, u32) -> bool,
+) -> Result<Option<crate::tile_set::TileSet>> {
+    let count = u32::try_from(tiling.tiles.len()).unwrap_or(u32::MAX);
+    if first >= end || end > count {
+        return Err(RenderError::Gpu(format!(
+            "tiles {first}..{end}: this render has tiles 0..{count}"
+        )));
+    }
+    let mut outputs = Vec::new();
+    let mut passes = Vec::new();
+    for (p, pass) in exec.plan().passes.iter().enumerate() {
+        if !pass.kind.sink {
+            continue;
         }
+        let Some(input) = pass.input("color").filter(|_| pass.kind.name == "Output") else {
+            return Err(RenderError::Gpu(format!(
+                "node \"{}\" ({}) writes no image: it cannot run tile by tile",
+                pass.node, pass.kind.name
+            )));
+        };
+        let desc = &exec.plan().textures[input.0];
+        passes.push(p);
+        outputs.push(crate::tile_set::TileOutput {
+            node: pass.node.clone(),
+            path: pass.params.str("path").to_owned(),
+            format: desc.format,
+            ty: desc.ty,
+            cores: Vec::new(),
+        });
     }
-    let mut written = Vec::new();
-    for (_, canvas, _) in canvases {
-        let Some(held) = canvas.image else { continue };
-        crate::nodes::output::write_image(&canvas.path, &canvas.bytes, held.format, held.ty, image)
-            .map_err(|e| e.in_node(&canvas.node))?;
-        written.push(canvas.path);
+    let done = render_tiles(
+        exec,
+        tiling,
+        first as usize..end as usize,
+        frames,
+        progress,
+        |_, tile, held| {
+            for (p, image) in held {
+                if let Some(o) = passes.iter().position(|&q| q == p) {
+                    outputs[o].cores.push(core_of(&image, tile));
+                }
+            }
+            Ok(())
+        },
+    )?;
+    // By node id, so sets of one render list their outputs alike.
+    outputs.sort_by(|a, b| a.node.cmp(&b.node));
+    Ok(done.then_some(crate::tile_set::TileSet {
+        key,
+        image: whole,
+        tile: tiling.tile,
+        apron: tiling.apron,
+        count,
+        first,
+        end,
+        outputs,
+    }))
+}
+
+/// The core of `tile` out of its window's image.
+fn core_of(held: &crate::nodes::HeldImage, tile: &Tile) -> Vec<u8> {
+    let bpp = held.format.bytes_per_pixel() as usize;
+    let (cx, cy) = tile.core_in_window();
+    let window_row = held.extent.width as usize * bpp;
+    let core_row = tile.core.width as usize * bpp;
+    let mut out = Vec::with_capacity(core_row * tile.core.height as usize);
+    for y in 0..tile.core.height as usize {
+        let src = (cy as usize + y) * window_row + cx as usize * bpp;
+        out.extend_from_slice(&held.bytes[src..src + core_row]);
     }
-    Ok(Some(written))
+    out
 }
 
 /// The whole-image canvases, allocated before the first tile so a render the host cannot

@@ -9,7 +9,7 @@ pub mod difference;
 pub(crate) mod gbuffer;
 mod image_input;
 pub mod lut;
-pub(crate) mod output;
+pub mod output;
 pub(crate) mod pathtrace;
 pub mod post_filter;
 pub(crate) mod tonemap;

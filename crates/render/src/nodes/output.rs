@@ -1,4 +1,5 @@
-//! Output: copies its input to a readback buffer in the frame, then writes the file.
+//! Output: copies its input to a readback buffer in the frame, then writes the file
+//! ([`write_image`], also what tiled renders and tile merges write with).
 
 use std::path::{Path, PathBuf};
 
@@ -124,7 +125,7 @@ pub(crate) fn output_path(pass: &Pass, resources: &Resources) -> PathBuf {
 
 /// Writes an image as an `Output` node does: `bytes` rows of `format` pixels holding a
 /// `ty` image; PNG or EXR by the extension.
-pub(crate) fn write_image(
+pub fn write_image(
     path: &Path,
     bytes: &[u8],
     format: TexFormat,
