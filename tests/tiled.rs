@@ -278,3 +278,80 @@ fn tile_sets_rendered_apart_merge_into_the_whole_image() {
         "{stderr}"
     );
 }
+
+/// Ctrl-C (SIGINT) during a tiled render writes the tiles done as a tile set and says how
+/// to go on; the rest rendered with `--tiles` and merged gives the whole render's files.
+#[test]
+fn an_interrupted_tiled_render_keeps_its_finished_tiles() {
+    use std::io::BufRead as _;
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_at(dir.path(), "assets/cornell_spheres.ron", 70, 50, 64);
+    let graph = dir.path().join("blur.ron");
+    std::fs::write(&graph, BLUR_GRAPH).unwrap();
+    let whole = dir.path().join("whole");
+    render(&graph, &scene, &whole, &[]);
+    let out = dir.path().join("out");
+    let args = [
+        "render",
+        graph.to_str().unwrap(),
+        "--scene",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--tile",
+        "24",
+    ];
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_lumagraph"))
+        .args(args)
+        .current_dir(common::root())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdout = std::io::BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    while stdout.read_line(&mut line).unwrap() > 0 && !line.starts_with("tile 2 of 9 done") {
+        line.clear();
+    }
+    assert!(line.starts_with("tile 2 of 9 done"), "{line}");
+    let kill = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    let done: usize = err
+        .split("wrote the ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{err}"));
+    assert!((2..9).contains(&done), "{err}");
+    let set = out.join(format!("tiles-0-{done}.tiles"));
+    assert!(err.contains(&format!("`--tiles {done}..9`")), "{err}");
+    let rest = format!("{done}..9");
+    let mut again = args.to_vec();
+    again.extend(["--tiles", &rest]);
+    let (ok, stdout, stderr) = common::cli(&again);
+    assert!(ok, "{stdout}\n{stderr}");
+    let merged = dir.path().join("merged");
+    let (ok, stdout, stderr) = common::cli(&[
+        "merge",
+        set.to_str().unwrap(),
+        out.join(format!("tiles-{done}-9.tiles")).to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    for file in ["render.png", "raw.exr", "blurred.exr"] {
+        assert!(
+            std::fs::read(whole.join(file)).unwrap() == std::fs::read(merged.join(file)).unwrap(),
+            "{file}"
+        );
+    }
+}

@@ -11,7 +11,7 @@ use super::progressive::{STOP, on_signal};
 use super::{LoadedScene, RenderArgs, progressive_source, uses_scene};
 use crate::graph::{Extent, Graph, Plan};
 use crate::render::tile_set::TileSet;
-use crate::render::tiled::Tiling;
+use crate::render::tiled::{Ended, Tiling};
 use crate::render::{Executor, GpuContext, Resources};
 
 /// Renders tile by tile when `--tile` asks or the whole image does not fit the device
@@ -85,10 +85,11 @@ pub(super) fn render_if_needed(
         "warm-up (shader compilation): {:.0} ms",
         warm.elapsed().as_secs_f64() * 1e3
     );
-    on_signal("tiled renders keep no checkpoint, so nothing is written");
+    on_signal("writing the tiles done so far");
     let mut bar = TileBar::new(n, frames);
     match args.tiles {
         Some(range) => {
+            bar.at = range.first as usize;
             let key = super::progressive::key(graph, Some(&scene.gpu));
             let set = crate::render::tiled::render_set(
                 &mut exec,
@@ -117,21 +118,19 @@ pub(super) fn render_if_needed(
             println!("wrote {}", path.display());
         }
         None => {
-            let written = crate::render::tiled::render(
+            let key = super::progressive::key(graph, Some(&scene.gpu));
+            let ended = crate::render::tiled::render(
                 &mut exec,
                 &tiling,
                 image,
                 resources,
-                frames,
+                (frames, key),
                 |tile, done, _| bar.tick(tile, done),
             )?;
             bar.bar.finish_and_clear();
-            let Some(written) = written else {
-                bail!(
-                    "interrupted in tile {} of {n}: tiled renders keep no checkpoint yet, so \
-                     nothing was written",
-                    bar.at + 1
-                );
+            let written = match ended {
+                Ended::Written(written) => written,
+                Ended::Stopped(set) => return Err(stopped(set, bar.at, n, args.out)),
             };
             report(&exec, &tiling, image, frames, bar.start.elapsed());
             for path in &written {
@@ -140,6 +139,33 @@ pub(super) fn render_if_needed(
         }
     }
     Ok(Some(()))
+}
+
+/// After a stop in tile `at` of `n`: the tiles done written as a tile set, and the error
+/// saying how to go on.
+fn stopped(set: Option<TileSet>, at: usize, n: usize, out: &Path) -> anyhow::Error {
+    let Some(set) = set else {
+        return anyhow::anyhow!("interrupted in the first tile of {n}: nothing was written");
+    };
+    let path = out.join(format!("tiles-0-{}.tiles", set.end));
+    if let Err(e) = std::fs::create_dir_all(out)
+        .map_err(anyhow::Error::from)
+        .and_then(|()| set.save(&path).map_err(anyhow::Error::from))
+    {
+        return anyhow::anyhow!(
+            "interrupted in tile {} of {n}, and the {} tiles done could not be written: {e}",
+            at + 1,
+            set.end
+        );
+    }
+    anyhow::anyhow!(
+        "interrupted in tile {} of {n}: wrote the {} tiles done as {}; render the rest with \
+         the same command and `--tiles {}..{n}`, then `lumagraph merge` both tile sets",
+        at + 1,
+        set.end,
+        path.display(),
+        set.end
+    )
 }
 
 /// The progress bar over all tiles' frames (drawn once the render takes over a second).
@@ -173,11 +199,25 @@ impl TileBar {
         }
     }
 
-    /// Frame `done` of tile `tile`; whether to go on (no Ctrl-C).
+    /// Frame `done` of tile `tile`; whether to go on (no Ctrl-C). A line for each tile
+    /// finished, for logs.
     fn tick(&mut self, tile: usize, done: u32) -> bool {
         if self.bar.is_hidden() && self.start.elapsed() > Duration::from_secs(1) {
             self.bar
                 .set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+        if tile > self.at {
+            let line = format!(
+                "tile {} of {} done ({:.1} s)",
+                self.at + 1,
+                self.tiles,
+                self.start.elapsed().as_secs_f64()
+            );
+            if self.bar.is_hidden() {
+                println!("{line}");
+            } else {
+                self.bar.println(line);
+            }
         }
         self.at = tile;
         self.bar

@@ -132,9 +132,21 @@ fn untileable(e: &Untileable, why: &str) -> RenderError {
 /// One sink's whole-image canvas.
 struct Canvas {
     node: String,
+    /// The node's `path` param, and the file it names.
+    param: String,
     path: PathBuf,
     bytes: Vec<u8>,
     image: Option<crate::nodes::HeldImage>,
+}
+
+/// How a tiled render ended.
+#[derive(Debug)]
+pub enum Ended {
+    /// Every tile rendered and the files written.
+    Written(Vec<PathBuf>),
+    /// Stopped by `progress` after the tiles of the set (none before the first finished):
+    /// they can be saved, the rest rendered with `--tiles`, and both merged.
+    Stopped(Option<crate::tile_set::TileSet>),
 }
 
 /// Renders `tiling`'s tiles through `exec` (compiled at `tiling.window`), each to
@@ -149,9 +161,9 @@ pub fn render(
     tiling: &Tiling,
     whole: Extent,
     resources: &Resources,
-    frames: u32,
+    (frames, key): (u32, u64),
     mut progress: impl FnMut(usize, u32, u32) -> bool,
-) -> Result<Option<Vec<PathBuf>>> {
+) -> Result<Ended> {
     exec.hold_sinks(true);
     let mut canvases: Vec<(usize, Canvas, lumagraph_graph::TexFormat)> = Vec::new();
     for (p, pass) in exec.plan().passes.iter().enumerate() {
@@ -173,6 +185,7 @@ pub fn render(
             p,
             Canvas {
                 node: pass.node.clone(),
+                param: pass.params.str("path").to_owned(),
                 path: crate::nodes::output::output_path(pass, resources),
                 bytes: Vec::new(),
                 image: None,
@@ -182,16 +195,20 @@ pub fn render(
     }
     allocate(&mut canvases, whole)?;
     let all = 0..tiling.tiles.len();
-    let done = render_tiles(exec, tiling, all, frames, &mut progress, |_, tile, held| {
+    let mut finished = 0;
+    let done = render_tiles(exec, tiling, all, frames, &mut progress, |i, tile, held| {
         for (p, image) in held {
             if let Some((_, canvas, _)) = canvases.iter_mut().find(|(q, ..)| *q == p) {
                 paste(canvas, &image, tile, whole)?;
             }
         }
+        finished = i + 1;
         Ok(())
     })?;
     if !done {
-        return Ok(None);
+        return Ok(Ended::Stopped(finished_set(
+            &canvases, tiling, whole, finished, key,
+        )));
     }
     let mut written = Vec::new();
     for (_, canvas, _) in canvases {
@@ -200,7 +217,58 @@ pub fn render(
             .map_err(|e| e.in_node(&canvas.node))?;
         written.push(canvas.path);
     }
-    Ok(Some(written))
+    Ok(Ended::Written(written))
+}
+
+/// The first `finished` tiles of a stopped render, out of its canvases, as a tile set.
+fn finished_set(
+    canvases: &[(usize, Canvas, lumagraph_graph::TexFormat)],
+    tiling: &Tiling,
+    whole: Extent,
+    finished: usize,
+    key: u64,
+) -> Option<crate::tile_set::TileSet> {
+    if finished == 0 {
+        return None;
+    }
+    let mut outputs: Vec<crate::tile_set::TileOutput> = canvases
+        .iter()
+        .filter_map(|(_, canvas, format)| {
+            let image = canvas.image.as_ref()?;
+            let bpp = format.bytes_per_pixel() as usize;
+            let row = whole.width as usize * bpp;
+            let cores = tiling.tiles[..finished]
+                .iter()
+                .map(|t| {
+                    let w = t.core.width as usize * bpp;
+                    let mut core = Vec::with_capacity(w * t.core.height as usize);
+                    for y in t.core.y as usize..(t.core.y + t.core.height) as usize {
+                        let at = y * row + t.core.x as usize * bpp;
+                        core.extend_from_slice(&canvas.bytes[at..at + w]);
+                    }
+                    core
+                })
+                .collect();
+            Some(crate::tile_set::TileOutput {
+                node: canvas.node.clone(),
+                path: canvas.param.clone(),
+                format: *format,
+                ty: image.ty,
+                cores,
+            })
+        })
+        .collect();
+    outputs.sort_by(|a, b| a.node.cmp(&b.node));
+    Some(crate::tile_set::TileSet {
+        key,
+        image: whole,
+        tile: tiling.tile,
+        apron: tiling.apron,
+        count: u32::try_from(tiling.tiles.len()).unwrap_or(u32::MAX),
+        first: 0,
+        end: u32::try_from(finished).unwrap_or(u32::MAX),
+        outputs,
+    })
 }
 
 /// Renders tiles `range` of `tiling` through `exec` (compiled at `tiling.window`), each to
