@@ -174,7 +174,15 @@ pub fn compile(
     // Cycles.
     let mut dag = DiGraph::<usize, ()>::with_capacity(n, checked.inputs.len());
     let idx: Vec<NodeIndex> = (0..n).map(|i| dag.add_node(i)).collect();
-    for (&(to, _), &(from, _)) in &checked.inputs {
+    // In a fixed order (the map's is random), so the same graph always gives the same
+    // pass order.
+    let mut edges: Vec<(usize, &str, usize)> = checked
+        .inputs
+        .iter()
+        .map(|(&(to, port), &(from, _))| (to, port, from))
+        .collect();
+    edges.sort_unstable();
+    for (to, _, from) in edges {
         dag.update_edge(idx[from], idx[to], ());
     }
     let order = if let Ok(order) = toposort(&dag, None) {

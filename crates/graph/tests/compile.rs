@@ -832,3 +832,26 @@ fn comments_survive_an_edit_and_a_save() {
     );
     assert_eq!(Graph::from_ron(&saved).unwrap(), g);
 }
+
+/// The same graph compiles to the same pass order every time (edges are not taken in a
+/// hash map's order): Output nodes at the same depth used to swap between runs.
+#[test]
+fn the_pass_order_does_not_change_between_compiles() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../graphs/pathtrace_denoise.ron"
+    ))
+    .unwrap();
+    let order = || {
+        let g = Graph::from_ron(&text).unwrap();
+        let plan = compile_graph(&g).unwrap();
+        plan.passes
+            .iter()
+            .map(|p| p.node.clone())
+            .collect::<Vec<_>>()
+    };
+    let first = order();
+    for _ in 0..20 {
+        assert_eq!(order(), first);
+    }
+}
