@@ -828,7 +828,8 @@ fn an_image_larger_than_the_device_holds_is_a_clear_error() {
     assert!(out.contains("tiled: "), "{out}");
     assert!(
         line.contains(
-            "the 2 images this render writes (100000×100000: 186.3 GiB) on this machine:"
+            "the 2 images this render writes (100000×100000: 186.3 GiB, and 298.0 GiB more \
+             while one is written) on this machine:"
         ) && line.contains("of memory is available; render smaller"),
         "{line}"
     );

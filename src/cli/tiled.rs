@@ -279,7 +279,7 @@ pub(super) fn merge_tiles(paths: &[PathBuf], out: &Path) -> Result<()> {
     let mut written = Vec::new();
     for image in images {
         let file = resources.output(&image.path);
-        crate::render::write_output(&file, &image.bytes, image.format, image.ty, whole)
+        crate::render::write_output(&file, image.bytes, image.format, image.ty, whole)
             .map_err(|e| anyhow::anyhow!("node \"{}\": {e}", image.node))?;
         written.push(file);
     }

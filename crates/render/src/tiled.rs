@@ -11,7 +11,7 @@
 use std::path::PathBuf;
 
 use lumagraph_graph::tile::{Tile, Untileable};
-use lumagraph_graph::{Extent, Plan};
+use lumagraph_graph::{Extent, Plan, TexFormat};
 
 use crate::context::{GpuContext, human_bytes};
 use crate::error::{RenderError, Result};
@@ -213,7 +213,7 @@ pub fn render(
     let mut written = Vec::new();
     for (_, canvas, _) in canvases {
         let Some(held) = canvas.image else { continue };
-        crate::nodes::output::write_image(&canvas.path, &canvas.bytes, held.format, held.ty, whole)
+        crate::nodes::output::write_image(&canvas.path, canvas.bytes, held.format, held.ty, whole)
             .map_err(|e| e.in_node(&canvas.node))?;
         written.push(canvas.path);
     }
@@ -391,21 +391,26 @@ fn core_of(held: &crate::nodes::HeldImage, tile: &Tile) -> Vec<u8> {
 /// The whole-image canvases, allocated before the first tile so a render the host cannot
 /// hold stops at once: checked against the memory the system says is available (Linux),
 /// then reserved.
-fn allocate(
-    canvases: &mut [(usize, Canvas, lumagraph_graph::TexFormat)],
-    image: Extent,
-) -> Result<()> {
-    let need: u64 = canvases
+fn allocate(canvases: &mut [(usize, Canvas, TexFormat)], image: Extent) -> Result<()> {
+    let held: u64 = canvases
         .iter()
         .map(|(_, _, f)| image.pixels() * f.bytes_per_pixel())
         .sum();
+    // Writing an EXR converts one image to RGBA floats and encodes it (at most as large).
+    let writing = if canvases.iter().any(|(_, _, f)| *f != TexFormat::Rgba8Unorm) {
+        2 * 16 * image.pixels()
+    } else {
+        0
+    };
+    let need = held + writing;
     let count = canvases.len();
     let too_large = |message: String| RenderError::TooLarge {
         what: format!(
-            "the {count} images this render writes ({}×{}: {})",
+            "the {count} images this render writes ({}×{}: {}, and {} more while one is written)",
             image.width,
             image.height,
-            human_bytes(need)
+            human_bytes(held),
+            human_bytes(writing)
         ),
         adapter: "this machine".into(),
         message,

@@ -113,7 +113,7 @@ impl NodeExec for Output {
             return Ok(Vec::new());
         };
         let path = self.path(pass);
-        write_image(&path, &image.bytes, image.format, image.ty, image.extent)?;
+        write_image(&path, image.bytes, image.format, image.ty, image.extent)?;
         Ok(vec![path])
     }
 }
@@ -124,10 +124,11 @@ pub(crate) fn output_path(pass: &Pass, resources: &Resources) -> PathBuf {
 }
 
 /// Writes an image as an `Output` node does: `bytes` rows of `format` pixels holding a
-/// `ty` image; PNG or EXR by the extension.
+/// `ty` image; PNG or EXR by the extension. `bytes` is dropped once converted, so a large
+/// image is not held twice while it is encoded.
 pub fn write_image(
     path: &Path,
-    bytes: &[u8],
+    bytes: Vec<u8>,
     format: TexFormat,
     ty: PortType,
     extent: Extent,
@@ -136,9 +137,10 @@ pub fn write_image(
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("png"));
     if is_png && format == TexFormat::Rgba8Unorm {
-        crate::image_io::write_png(path, extent.width, extent.height, bytes)
+        crate::image_io::write_png(path, extent.width, extent.height, &bytes)
     } else {
-        let image = crate::readback::to_image(bytes, format, extent);
+        let image = crate::readback::to_image(&bytes, format, extent);
+        drop(bytes);
         crate::image_io::save(path, &image, ty != PortType::LdrColor)
     }
 }
