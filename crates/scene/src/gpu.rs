@@ -84,6 +84,17 @@ pub struct GpuBvhNode {
     pub bits: u32,
 }
 
+/// A BVH node as the GPU reads it, 64 bytes: the node, then its skip links for the 8 ray
+/// octants (see [`crate::bvh`]), so the link a ray needs is in the node's cache line.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuBvhRecord {
+    /// The node (offset 0).
+    pub node: GpuBvhNode,
+    /// Where a ray of each octant goes after the node's subtree (offset 32).
+    pub skips: [u32; 8],
+}
+
 /// A triangle's intersection data, 48 bytes: corner 0 and the two edges from it, as
 /// Möller–Trumbore uses them.
 #[repr(C)]
