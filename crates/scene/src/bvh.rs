@@ -104,7 +104,7 @@ pub fn skip_links(nodes: &[GpuBvhNode]) -> Vec<[u32; BVH_OCTANTS]> {
     // (node, the node after its subtree); the explicit stack keeps deep trees off the
     // call stack.
     let mut todo = Vec::new();
-    for (octant, _) in [(); BVH_OCTANTS].iter().enumerate() {
+    for octant in 0..BVH_OCTANTS {
         todo.push((0u32, BVH_END));
         while let Some((i, next)) = todo.pop() {
             skips[i as usize][octant] = next;

@@ -5,9 +5,9 @@
 //! A test checks each offset and size against naga's layouter.
 //!
 //! Intersection data is kept apart from shading data so the traversal loop loads little:
-//! [`GpuBvhNode`] (32 B) and [`GpuTriangle`] (48 B: a corner and two edges) or the first
-//! 16 bytes of [`GpuSphere`]; normals and material ids live in [`GpuTriShading`], read once
-//! per hit.
+//! [`GpuBvhNode`] (32 B, then one 4-byte skip link of its [`GpuBvhRecord`]) and
+//! [`GpuTriangle`] (48 B: a corner and two edges) or the first 16 bytes of [`GpuSphere`];
+//! normals and material ids live in [`GpuTriShading`], read once per hit.
 //!
 //! Primitive ids: triangles and spheres are stored in BVH leaf order (see [`crate::bvh`]).
 //! A hit's `prim` is the triangle index, or the sphere index with [`PRIM_SPHERE`] set.
