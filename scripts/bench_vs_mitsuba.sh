@@ -30,14 +30,21 @@ trap 'rm -rf "$tmp"' EXIT
 echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 
 specialized() { awk '$1 == "specialized" && $3 == "M" {print $2}'; }
+paths() { python3 -c 'import json, sys; print(json.loads(sys.stdin.read().splitlines()[-1])["paths_per_s"] / 1e6)'; }
 
 $lg_bin export assets/cornell.ron --out "$tmp/cornell" > /dev/null
-lg_c=$($lg_bin bench --scene assets/cornell.ron --spp "$spp" --runs 3 | tee -a /dev/stderr | specialized)
-mi_c=$("$py" scripts/bench/mitsuba_time.py "$tmp/cornell" --spp "$spp" --runs 3 \
-    | tee -a /dev/stderr | python3 -c 'import json, sys; print(json.load(sys.stdin)["paths_per_s"] / 1e6)')
-lg_m=$($lg_bin bench --scene assets/bench/mesh_env.ron --spp "$spp" --runs 3 | tee -a /dev/stderr | specialized)
-mi_m=$("$py" scripts/bench/mesh_env.py mitsuba assets/bench/blob.obj --spp "$spp" --runs 3 \
-    | tee -a /dev/stderr | python3 -c 'import json, sys; print(json.load(sys.stdin)["paths_per_s"] / 1e6)')
+out=$($lg_bin bench --scene assets/cornell.ron --spp "$spp" --runs 3)
+echo "$out"
+lg_c=$(specialized <<< "$out")
+out=$("$py" scripts/bench/mitsuba_time.py "$tmp/cornell" --spp "$spp" --runs 3)
+echo "$out"
+mi_c=$(paths <<< "$out")
+out=$($lg_bin bench --scene assets/bench/mesh_env.ron --spp "$spp" --runs 3)
+echo "$out"
+lg_m=$(specialized <<< "$out")
+out=$("$py" scripts/bench/mesh_env.py mitsuba assets/bench/blob.obj --spp "$spp" --runs 3)
+echo "$out"
+mi_m=$(paths <<< "$out")
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
 for row in "Cornell box:$lg_c:$mi_c" "mesh scene:$lg_m:$mi_m"; do
     IFS=: read -r name lg mi <<< "$row"
