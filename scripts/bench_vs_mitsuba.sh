@@ -1,23 +1,52 @@
 #!/usr/bin/env bash
-# lumagraph and Mitsuba 3 side by side on the mesh benchmark scene (assets/bench/mesh_env.ron:
-# an 81 920-triangle mesh under an environment map), in one run on this machine; prints
-# both paths/s and their ratio. Only a ratio taken in one run means something on a shared
-# machine.
+# lumagraph and Mitsuba 3 side by side, in one run on this machine: the Cornell box
+# (assets/cornell.ron) and the mesh benchmark scene (assets/bench/mesh_env.ron: an
+# 81 920-triangle mesh under an environment map). Prints both renderers' paths/s and their
+# ratio for each. Only a ratio taken in one run means something on a shared machine; the
+# load average is printed before and after.
 #
 #   scripts/bench_vs_mitsuba.sh [SPP]
 #
-# Mitsuba 3.9.1 (variant llvm_ad_rgb) is taken from MITSUBA_PYTHON, by default
+# It builds and runs target/release/lumagraph, or runs the binary LUMAGRAPH names (the GPU
+# work is Mesa's, so a dev build gives the same figures).
+# lumagraph's figure is `bench`'s "specialized" line (the shader the renderer uses). Mitsuba
+# 3.9.1 (variant llvm_ad_rgb) is taken from MITSUBA_PYTHON, by default
 # .venv-mitsuba/bin/python (python3 -m venv .venv-mitsuba && .venv-mitsuba/bin/pip install
-# mitsuba==3.9.1; Debian also needs `apt-get install libllvm19`).
+# mitsuba==3.9.1 numpy; Debian also needs `apt-get install libllvm19`). The Cornell box goes
+# to Mitsuba through `lumagraph export` and scripts/references/make.py, as in the reference
+# suite (scripts/bench/mitsuba_time.py).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 spp=${1:-64}
 py=${MITSUBA_PYTHON:-.venv-mitsuba/bin/python}
 [ -f assets/bench/blob.obj ] || python3 scripts/bench/mesh_env.py make assets/bench/blob.obj
 . scripts/env.sh
-cargo build --release -q
-lg=$(target/release/lumagraph bench --scene assets/bench/mesh_env.ron --spp "$spp" --runs 3 \
-    | tee /dev/stderr | awk '$1 == "specialized" && $3 == "M" {print $2}')
-mi=$("$py" scripts/bench/mesh_env.py mitsuba assets/bench/blob.obj --spp "$spp" --runs 3 \
-    | tee /dev/stderr | python3 -c 'import json, sys; print(json.load(sys.stdin)["paths_per_s"] / 1e6)')
-python3 -c "lg, mi = $lg, $mi; print(f'mesh scene, {$spp} spp: lumagraph {lg:.3f} M paths/s, Mitsuba {mi:.3f} M paths/s: {lg / mi:.3f}x')"
+if [ -z "${LUMAGRAPH:-}" ]; then
+    cargo build --release -q
+fi
+lg_bin=${LUMAGRAPH:-target/release/lumagraph}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
+
+specialized() { awk '$1 == "specialized" && $3 == "M" {print $2}'; }
+paths() { python3 -c 'import json, sys; print(json.loads(sys.stdin.read().splitlines()[-1])["paths_per_s"] / 1e6)'; }
+
+$lg_bin export assets/cornell.ron --out "$tmp/cornell" > /dev/null
+out=$($lg_bin bench --scene assets/cornell.ron --spp "$spp" --runs 3)
+echo "$out"
+lg_c=$(specialized <<< "$out")
+out=$("$py" scripts/bench/mitsuba_time.py "$tmp/cornell" --spp "$spp" --runs 3)
+echo "$out"
+mi_c=$(paths <<< "$out")
+out=$($lg_bin bench --scene assets/bench/mesh_env.ron --spp "$spp" --runs 3)
+echo "$out"
+lg_m=$(specialized <<< "$out")
+out=$("$py" scripts/bench/mesh_env.py mitsuba assets/bench/blob.obj --spp "$spp" --runs 3)
+echo "$out"
+mi_m=$(paths <<< "$out")
+echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
+for row in "Cornell box:$lg_c:$mi_c" "mesh scene:$lg_m:$mi_m"; do
+    IFS=: read -r name lg mi <<< "$row"
+    python3 -c "lg, mi = $lg, $mi; print(f'$name, $spp spp: lumagraph {lg:.3f} M paths/s, Mitsuba {mi:.3f} M paths/s: {lg / mi:.3f}x')"
+done

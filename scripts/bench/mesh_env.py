@@ -2,6 +2,7 @@
 """A mesh benchmark scene and its Mitsuba 3 timing, for side-by-side paths/s on one machine.
 
     python mesh_env.py make blob.obj             # 81 920-triangle displaced sphere, vertex normals
+    python mesh_env.py make blob.obj --level 8   # 20 * 4^level triangles (3: 1 280 ... 8: 1 310 720)
     python mesh_env.py mitsuba blob.obj [--spp 64] [--runs 3]
 
 The scene (assets/bench/mesh_env.ron; docs/benchmarks.md): the blob, diffuse 0.8 grey, centred at (0, 1, 0) with radius
@@ -114,8 +115,9 @@ def main():
     ap.add_argument("--variant", default="llvm_ad_rgb")
     ap.add_argument("--width", type=int, default=256)
     ap.add_argument("--height", type=int, default=256)
+    ap.add_argument("--level", type=int, default=6, help="subdivisions of the icosahedron (make)")
     a = ap.parse_args()
-    make(a.obj) if a.cmd == "make" else mitsuba(a.obj, a.spp, a.runs, a.variant, a.width, a.height)
+    make(a.obj, a.level) if a.cmd == "make" else mitsuba(a.obj, a.spp, a.runs, a.variant, a.width, a.height)
 
 
 if __name__ == "__main__":

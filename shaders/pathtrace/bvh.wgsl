@@ -2,39 +2,44 @@
 
 // BVH traversal, a line-for-line mirror of crates/scene/src/traverse.rs. The including
 // shader declares the storage buffers:
-//   var<storage, read> bvh_nodes: array<BvhNode>;
+//   var<storage, read> bvh_nodes: array<vec4<u32>>;
 //   var<storage, read> tri_positions: array<TriPositions>;
 //   var<storage, read> spheres: array<Sphere>;
 // Hits count for 0 < t < t_max; callers offset ray origins off surfaces.
+//
+// `bvh_nodes` holds one 64-byte record per node (4 vec4s): the BvhNode (aabb_min, index;
+// aabb_max, bits), then its skip links for ray octants 0-3 and 4-7: the node after its
+// subtree in the order rays of that octant visit the tree (see crates/scene/src/bvh.rs).
+// With them the traversal keeps no stack, which llvmpipe would keep in scratch memory.
 
-const BVH_STACK_SIZE: u32 = 64u;
+// Skip link past the last node: the traversal ends.
+const BVH_END: u32 = 0xffffffffu;
 
 // Closest hit (any_hit false) or first hit found (any_hit true) with 0 < t < t_max.
 fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
     var hit = Hit(NO_HIT, t_max, 0.0, 0.0);
     let inv_dir = safe_inverse(ray.dir);
-    var stack: array<u32, BVH_STACK_SIZE>;
-    var sp = 0u;
+    // Bit a set where the direction's component on axis a is negative: such rays visit the
+    // second child of a node split on a first.
+    let octant = select(0u, 1u, ray.dir.x < 0.0) | select(0u, 2u, ray.dir.y < 0.0) | select(0u, 4u, ray.dir.z < 0.0);
     var node_index = 0u;
     loop {
-        let node = bvh_nodes[node_index];
-        if (ray_aabb(ray.origin, inv_dir, node.aabb_min, node.aabb_max, hit.t)) {
-            let count = node.bits >> NODE_COUNT_SHIFT;
+        if (node_index == BVH_END) {
+            break;
+        }
+        let lo = bvh_nodes[node_index * 4u];
+        let hi = bvh_nodes[node_index * 4u + 1u];
+        if (ray_aabb(ray.origin, inv_dir, bitcast<vec3<f32>>(lo.xyz), bitcast<vec3<f32>>(hi.xyz), hit.t)) {
+            let count = hi.w >> NODE_COUNT_SHIFT;
             if (count == 0u) {
-                // Inner node: the first child is adjacent, the second at `index`.
-                let axis = node.bits & 3u;
-                if (ray.dir[axis] < 0.0) {
-                    stack[sp] = node_index + 1u;
-                    node_index = node.index;
-                } else {
-                    stack[sp] = node.index;
-                    node_index = node_index + 1u;
-                }
-                sp = sp + 1u;
+                // Inner node: on to the near child (the first one is adjacent, the second at
+                // `index`).
+                let axis = hi.w & 3u;
+                node_index = select(node_index + 1u, lo.w, ((octant >> axis) & 1u) == 1u);
                 continue;
             }
-            let first = node.index;
-            if ((node.bits & NODE_SPHERES) == 0u) {
+            let first = lo.w;
+            if ((hi.w & NODE_SPHERES) == 0u) {
                 for (var i = first; i < first + count; i = i + 1u) {
                     let tri = tri_positions[i];
                     let r = intersect_triangle(ray.origin, ray.dir, tri.v0, tri.e1, tri.e2, hit.t);
@@ -58,11 +63,8 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                 }
             }
         }
-        if (sp == 0u) {
-            break;
-        }
-        sp = sp - 1u;
-        node_index = stack[sp];
+        // A leaf, or a box missed: past this subtree.
+        node_index = bvh_nodes[node_index * 4u + 2u + (octant >> 2u)][octant & 3u];
     }
     return hit;
 }

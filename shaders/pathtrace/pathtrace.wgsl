@@ -55,7 +55,7 @@ fn light_weight(light_pdf: f32, bsdf_pdf: f32) -> f32 {
 
 @group(0) @binding(0) var output: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(1) var<uniform> frame: Frame;
-@group(0) @binding(2) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(2) var<storage, read> bvh_nodes: array<vec4<u32>>;
 @group(0) @binding(3) var<storage, read> tri_positions: array<TriPositions>;
 @group(0) @binding(4) var<storage, read> tri_shading: array<TriShading>;
 @group(0) @binding(5) var<storage, read> spheres: array<Sphere>;

@@ -16,7 +16,7 @@ struct Params {
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> queries: array<Query>;
 @group(0) @binding(2) var<storage, read_write> hits: array<Hit>;
-@group(0) @binding(3) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(3) var<storage, read> bvh_nodes: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read> tri_positions: array<TriPositions>;
 @group(0) @binding(5) var<storage, read> spheres: array<Sphere>;
 

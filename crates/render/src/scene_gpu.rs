@@ -9,7 +9,7 @@ use crate::context::GpuContext;
 /// The scene's storage buffers.
 #[derive(Debug)]
 pub struct SceneBuffers {
-    /// BVH nodes.
+    /// BVH nodes, each with its skip links ([`GpuScene::bvh_records`]).
     pub bvh_nodes: wgpu::Buffer,
     /// Triangle intersection data.
     pub tri_positions: wgpu::Buffer,
@@ -59,8 +59,9 @@ impl SceneBuffers {
         } else {
             &scene.tri_texcoords[..]
         };
+        let records = scene.bvh_records();
         let parts: [(&str, &[u8]); 9] = [
-            ("bvh_nodes", bytemuck::cast_slice(&scene.bvh_nodes)),
+            ("bvh_nodes", bytemuck::cast_slice(&records)),
             ("tri_positions", bytemuck::cast_slice(&scene.tri_positions)),
             ("tri_shading", bytemuck::cast_slice(&scene.tri_shading)),
             ("spheres", bytemuck::cast_slice(&scene.spheres)),

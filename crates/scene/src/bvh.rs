@@ -20,8 +20,22 @@
 //! that every leaf's primitives are contiguous in their array: no index indirection, one
 //! load fewer per primitive. [`crate::GpuScene::tri_source`] maps back to the scene order.
 //!
-//! The traversal keeps a stack of second children; its depth never exceeds the tree depth,
-//! which is checked against [`BVH_STACK_SIZE`] here.
+//! # Skip links (stackless traversal)
+//! The traversal keeps no stack. A ray visits an inner node's children in the order its
+//! direction's sign on the node's `axis` gives (the second child first when negative), so
+//! the depth-first order in which a ray visits the nodes depends only on its direction's
+//! octant (the signs of its three components). For each node and each of the 8 octants,
+//! [`FlatBvh::skips`] holds the node that comes after the node's subtree in that order,
+//! or [`BVH_END`]: where a ray goes after a leaf, or after an inner node whose box it
+//! misses. After an inner node whose box it meets, it goes to the near child. This visits
+//! the nodes in the order a stack traversal would (push the far child, pop after a leaf or
+//! a miss), so hits are the same, without a per-ray stack array (which llvmpipe keeps in
+//! scratch memory, one access per SIMD lane).
+//!
+//! Octant `o` has bit `a` set when the direction's component on axis `a` is `< 0`. On the
+//! GPU each node is a 64-byte record: the 32-byte [`GpuBvhNode`], then its 8 skip links
+//! (octants 0 to 7), so the link a ray needs is in the cache line of the node it has just
+//! read. The recursive flattening refuses trees deeper than [`BVH_MAX_DEPTH`].
 
 use std::time::Duration;
 
@@ -33,9 +47,14 @@ use obvhs::bvh2::Bvh2;
 use crate::error::{ErrorKind, SceneError};
 use crate::gpu::GpuBvhNode;
 
-/// Entries in the traversal stack of the CPU and WGSL traversal (`BVH_STACK_SIZE` in
-/// `bvh.wgsl`); trees deeper than this are refused.
-pub const BVH_STACK_SIZE: usize = 64;
+/// Most inner nodes above a leaf; deeper trees are refused (the flattening recurses).
+pub const BVH_MAX_DEPTH: usize = 64;
+
+/// A skip link's value after the last node of an octant's order: the traversal ends.
+pub const BVH_END: u32 = u32::MAX;
+
+/// Ray octants, each with its own visit order.
+pub const BVH_OCTANTS: usize = 8;
 
 /// `bits` bit: the leaf holds spheres.
 pub const NODE_SPHERES: u32 = 4;
@@ -69,8 +88,40 @@ pub(crate) struct FlatBvh {
     pub tri_order: Vec<u32>,
     /// New sphere order, likewise.
     pub sphere_order: Vec<u32>,
+    /// For each node and ray octant, the node after its subtree in that octant's visit
+    /// order, or [`BVH_END`] (see the module docs).
+    pub skips: Vec<[u32; BVH_OCTANTS]>,
     /// Most inner nodes above a leaf.
     pub depth: usize,
+}
+
+/// The skip links of `nodes` (depth-first, first child adjacent, see the module docs).
+pub fn skip_links(nodes: &[GpuBvhNode]) -> Vec<[u32; BVH_OCTANTS]> {
+    let mut skips = vec![[BVH_END; BVH_OCTANTS]; nodes.len()];
+    if nodes.is_empty() {
+        return skips;
+    }
+    // (node, the node after its subtree); the explicit stack keeps deep trees off the
+    // call stack.
+    let mut todo = Vec::new();
+    for octant in 0..BVH_OCTANTS {
+        todo.push((0u32, BVH_END));
+        while let Some((i, next)) = todo.pop() {
+            skips[i as usize][octant] = next;
+            let node = &nodes[i as usize];
+            if node.bits >> NODE_COUNT_SHIFT == 0 {
+                let (first, second) = (i + 1, node.index);
+                let (near, far) = if (octant >> (node.bits & 3)) & 1 == 1 {
+                    (second, first)
+                } else {
+                    (first, second)
+                };
+                todo.push((far, next));
+                todo.push((near, far));
+            }
+        }
+    }
+    skips
 }
 
 /// Builds and flattens the BVH over `tri_boxes` (primitives `0..n`) and `sphere_boxes`
@@ -99,6 +150,7 @@ pub(crate) fn build(
         out: &mut flat,
     };
     f.node(0, 0)?;
+    flat.skips = skip_links(&flat.nodes);
     Ok(flat)
 }
 
@@ -115,10 +167,10 @@ fn to3(v: Vec3A) -> [f32; 3] {
 
 impl Flattener<'_> {
     fn too_deep(depth: usize) -> Result<(), SceneError> {
-        if depth > BVH_STACK_SIZE {
+        if depth > BVH_MAX_DEPTH {
             return Err(SceneError::new(ErrorKind::BvhTooDeep {
                 depth,
-                max: BVH_STACK_SIZE,
+                max: BVH_MAX_DEPTH,
             }));
         }
         Ok(())

@@ -77,12 +77,12 @@ pub enum ErrorKind {
     /// A mesh file has an extension this build does not import.
     #[error("unsupported mesh file type \"{0}\" (use .gltf, .glb or .obj)")]
     MeshType(String),
-    /// The BVH is deeper than the traversal stack.
-    #[error("BVH depth {depth} exceeds the traversal stack size {max}")]
+    /// The BVH is deeper than the flattening accepts.
+    #[error("BVH depth {depth} exceeds the most accepted, {max}")]
     BvhTooDeep {
         /// Depth of the built tree.
         depth: usize,
-        /// The stack size the traversal code uses.
+        /// The most accepted ([`crate::bvh::BVH_MAX_DEPTH`]).
         max: usize,
     },
     /// More primitives than the GPU layout can index.

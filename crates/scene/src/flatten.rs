@@ -12,10 +12,10 @@ use crate::file::Environment;
 use crate::gpu::{
     ENV_CONSTANT, ENV_MAP, ENV_NONE, ENV_SHOW_BACKGROUND, FEATURE_ENVIRONMENT, FEATURE_LIGHTS,
     FEATURE_METAL, FEATURE_SPHERES, FEATURE_TEXTURES, FEATURE_TRANSMISSION, GpuAliasEntry,
-    GpuBvhNode, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere, GpuTriShading,
-    GpuTriTexcoords, GpuTriangle, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPHERE, LIGHT_SPOT,
-    LIGHT_TWO_SIDED, MATERIAL_CONDUCTOR, MATERIAL_SINGLE_SCATTER, MATERIAL_TWO_SIDED, NO_LIGHT,
-    TRI_VERTEX_NORMALS,
+    GpuBvhNode, GpuBvhRecord, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere,
+    GpuTriShading, GpuTriTexcoords, GpuTriangle, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPHERE,
+    LIGHT_SPOT, LIGHT_TWO_SIDED, MATERIAL_CONDUCTOR, MATERIAL_SINGLE_SCATTER, MATERIAL_TWO_SIDED,
+    NO_LIGHT, TRI_VERTEX_NORMALS,
 };
 use crate::scene::{Material, NO_TEXTURE, PunctualLight, Scene};
 
@@ -29,8 +29,11 @@ pub struct GpuScene {
     pub camera: GpuCamera,
     /// Image size, sampling, environment.
     pub settings: GpuSettings,
-    /// BVH nodes, root first (buffer `bvh_nodes`).
+    /// BVH nodes, root first (buffer `bvh_nodes`, each node followed by its skip links).
     pub bvh_nodes: Vec<GpuBvhNode>,
+    /// For each node and ray octant, where traversal goes after the node's subtree (see
+    /// [`crate::bvh`]); same length as `bvh_nodes`.
+    pub bvh_skips: Vec<[u32; crate::bvh::BVH_OCTANTS]>,
     /// Triangle intersection data in BVH order (buffer `tri_positions`).
     pub tri_positions: Vec<GpuTriangle>,
     /// Triangle shading data, same order (buffer `tri_shading`).
@@ -253,6 +256,26 @@ pub fn alias_table(w: &[f32]) -> Vec<GpuAliasEntry> {
 }
 
 impl GpuScene {
+    /// The `bvh_nodes` buffer: each node with its skip links. An empty scene gets one leaf
+    /// over triangle 0, which the zeroed stand-in triangle buffer makes a degenerate
+    /// triangle no ray hits, so the traversal needs no special case.
+    pub fn bvh_records(&self) -> Vec<GpuBvhRecord> {
+        if self.bvh_nodes.is_empty() {
+            return vec![GpuBvhRecord {
+                node: GpuBvhNode {
+                    bits: 1 << crate::bvh::NODE_COUNT_SHIFT,
+                    ..GpuBvhNode::default()
+                },
+                skips: [crate::bvh::BVH_END; crate::bvh::BVH_OCTANTS],
+            }];
+        }
+        self.bvh_nodes
+            .iter()
+            .zip(&self.bvh_skips)
+            .map(|(&node, &skips)| GpuBvhRecord { node, skips })
+            .collect()
+    }
+
     /// Flattens `scene` with the default BVH options.
     ///
     /// # Errors
@@ -294,6 +317,7 @@ impl GpuScene {
         let mut out = Self {
             materials: scene.materials.iter().map(GpuMaterial::from).collect(),
             bvh_nodes: flat.nodes,
+            bvh_skips: flat.skips,
             tri_source: flat.tri_order,
             sphere_source: flat.sphere_order,
             environment_map: match &scene.environment {

@@ -5,9 +5,9 @@
 //! A test checks each offset and size against naga's layouter.
 //!
 //! Intersection data is kept apart from shading data so the traversal loop loads little:
-//! [`GpuBvhNode`] (32 B) and [`GpuTriangle`] (48 B: a corner and two edges) or the first
-//! 16 bytes of [`GpuSphere`]; normals and material ids live in [`GpuTriShading`], read once
-//! per hit.
+//! [`GpuBvhNode`] (32 B, then one 4-byte skip link of its [`GpuBvhRecord`]) and
+//! [`GpuTriangle`] (48 B: a corner and two edges) or the first 16 bytes of [`GpuSphere`];
+//! normals and material ids live in [`GpuTriShading`], read once per hit.
 //!
 //! Primitive ids: triangles and spheres are stored in BVH leaf order (see [`crate::bvh`]).
 //! A hit's `prim` is the triangle index, or the sphere index with [`PRIM_SPHERE`] set.
@@ -82,6 +82,17 @@ pub struct GpuBvhNode {
     /// Bits 0–1 split axis (inner), bit 2 leaf kind (1 = spheres), bits 3–31 primitive
     /// count (0 = inner node) (offset 28).
     pub bits: u32,
+}
+
+/// A BVH node as the GPU reads it, 64 bytes: the node, then its skip links for the 8 ray
+/// octants (see [`crate::bvh`]), so the link a ray needs is in the node's cache line.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuBvhRecord {
+    /// The node (offset 0).
+    pub node: GpuBvhNode,
+    /// Where a ray of each octant goes after the node's subtree (offset 32).
+    pub skips: [u32; 8],
 }
 
 /// A triangle's intersection data, 48 bytes: corner 0 and the two edges from it, as

@@ -34,7 +34,7 @@ mod scene;
 pub mod texture;
 pub mod traverse;
 
-pub use bvh::{BVH_STACK_SIZE, BvhOptions};
+pub use bvh::{BVH_END, BVH_MAX_DEPTH, BvhOptions};
 pub use error::{ErrorKind, Pos, SceneError};
 pub use file::{Environment, LightDesc, RenderSettings, VERSION};
 pub use flatten::{GpuScene, LIGHT_UNIFORM_SHARE, alias_table, light_selection, luminance};

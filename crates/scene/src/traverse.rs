@@ -7,7 +7,7 @@
 
 use glam::Vec3;
 
-use crate::bvh::{BVH_STACK_SIZE, NODE_COUNT_SHIFT, NODE_SPHERES};
+use crate::bvh::{BVH_END, NODE_COUNT_SHIFT, NODE_SPHERES};
 use crate::flatten::GpuScene;
 use crate::gpu::{NO_HIT, PRIM_SPHERE};
 
@@ -168,10 +168,13 @@ fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
         return None;
     }
     let inv_dir = safe_inverse(ray.dir);
-    let mut stack = [0u32; BVH_STACK_SIZE];
-    let mut sp = 0usize;
+    // Bit `a` set where the direction's component on axis `a` is negative: such rays visit
+    // the second child of a node split on `a` first.
+    let octant = u32::from(ray.dir.x < 0.0)
+        | (u32::from(ray.dir.y < 0.0) << 1)
+        | (u32::from(ray.dir.z < 0.0) << 2);
     let mut node_index = 0u32;
-    loop {
+    while node_index != BVH_END {
         let node = scene.bvh_nodes[node_index as usize];
         if ray_aabb(
             ray.origin,
@@ -182,16 +185,14 @@ fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
         ) {
             let count = node.bits >> NODE_COUNT_SHIFT;
             if count == 0 {
-                // Inner node: the first child is adjacent, the second at `index`.
-                let axis = (node.bits & 3) as usize;
-                if ray.dir[axis] < 0.0 {
-                    stack[sp] = node_index + 1;
-                    node_index = node.index;
+                // Inner node: on to the near child (the first one is adjacent, the second at
+                // `index`).
+                let axis = node.bits & 3;
+                node_index = if (octant >> axis) & 1 == 1 {
+                    node.index
                 } else {
-                    stack[sp] = node.index;
-                    node_index += 1;
-                }
-                sp += 1;
+                    node_index + 1
+                };
                 continue;
             }
             let first = node.index;
@@ -231,11 +232,8 @@ fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
                 }
             }
         }
-        if sp == 0 {
-            break;
-        }
-        sp -= 1;
-        node_index = stack[sp];
+        // A leaf, or a box missed: past this subtree.
+        node_index = scene.bvh_skips[node_index as usize][octant as usize];
     }
     (hit.prim != NO_HIT).then_some(hit)
 }

@@ -265,7 +265,7 @@ fn bvh_agrees_with_brute_force_on_100k_rays() {
     assert_eq!(g.tri_positions.len(), scene.triangles.len());
     assert_eq!(g.spheres.len(), 9);
     assert_eq!(g.lights.len(), 3);
-    assert!(g.header.bvh_depth as usize <= lumagraph_scene::BVH_STACK_SIZE);
+    assert!(g.header.bvh_depth as usize <= lumagraph_scene::BVH_MAX_DEPTH);
 
     let mut rng = common::Pcg::new(7);
     let rays: Vec<Ray> = (0..100_000).map(|_| random_ray(&mut rng)).collect();
@@ -343,6 +343,78 @@ fn bvh_structure_is_consistent() {
         g.bvh_nodes.len()
     );
     assert!(mean <= 4.0);
+}
+
+#[test]
+fn skip_links_follow_each_octants_stack_order() {
+    let scene = sphere_grid_scene();
+    let g = GpuScene::build(&scene).unwrap();
+    assert_eq!(g.bvh_skips.len(), g.bvh_nodes.len());
+    for octant in 0..8u32 {
+        // The order a stack traversal that enters every box visits the nodes in: near child
+        // first, where near is the second child when the octant's bit for the axis is set.
+        let mut order = Vec::new();
+        let mut stack = vec![0u32];
+        while let Some(i) = stack.pop() {
+            order.push(i);
+            let n = g.bvh_nodes[i as usize];
+            if n.bits >> 3 == 0 {
+                let (near, far) = if (octant >> (n.bits & 3)) & 1 == 1 {
+                    (n.index, i + 1)
+                } else {
+                    (i + 1, n.index)
+                };
+                stack.push(far);
+                stack.push(near);
+            }
+        }
+        assert_eq!(order.len(), g.bvh_nodes.len());
+        // Skip links entering every box: a leaf goes to its skip link, an inner node to its
+        // near child. The same walk.
+        let mut walk = Vec::new();
+        let mut i = 0u32;
+        while i != lumagraph_scene::BVH_END {
+            walk.push(i);
+            let n = g.bvh_nodes[i as usize];
+            i = if n.bits >> 3 == 0 {
+                if (octant >> (n.bits & 3)) & 1 == 1 {
+                    n.index
+                } else {
+                    i + 1
+                }
+            } else {
+                g.bvh_skips[i as usize][octant as usize]
+            };
+        }
+        assert_eq!(walk, order, "octant {octant}");
+        // An inner node's skip link is where the walk goes after its subtree.
+        let position: Vec<usize> = {
+            let mut p = vec![0; order.len()];
+            for (k, &i) in order.iter().enumerate() {
+                p[i as usize] = k;
+            }
+            p
+        };
+        for (i, n) in g.bvh_nodes.iter().enumerate() {
+            let size = subtree_size(&g, i as u32);
+            let after = order.get(position[i] + size).copied();
+            assert_eq!(
+                g.bvh_skips[i][octant as usize],
+                after.unwrap_or(lumagraph_scene::BVH_END),
+                "node {i} ({}), octant {octant}",
+                n.bits
+            );
+        }
+    }
+}
+
+fn subtree_size(g: &GpuScene, i: u32) -> usize {
+    let n = g.bvh_nodes[i as usize];
+    if n.bits >> 3 == 0 {
+        1 + subtree_size(g, i + 1) + subtree_size(g, n.index)
+    } else {
+        1
+    }
 }
 
 #[test]

@@ -30,7 +30,7 @@ fn validate(source: &str, what: &str) -> naga::Module {
 }
 
 const STUB: &str = r#"
-@group(0) @binding(0) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(0) var<storage, read> bvh_nodes: array<vec4<u32>>;
 @group(0) @binding(1) var<storage, read> tri_positions: array<TriPositions>;
 @group(0) @binding(2) var<storage, read> spheres: array<Sphere>;
 @group(0) @binding(3) var<storage, read_write> out_hits: array<Hit>;
@@ -204,11 +204,8 @@ fn wgsl_layouts_match_rust() {
 #[test]
 fn wgsl_constants_match_rust() {
     let src = std::fs::read_to_string(common::shaders().join("pathtrace/bvh.wgsl")).unwrap();
-    let stack = format!(
-        "const BVH_STACK_SIZE: u32 = {}u;",
-        lumagraph_scene::BVH_STACK_SIZE
-    );
-    assert!(src.contains(&stack), "bvh.wgsl must declare `{stack}`");
+    let end = format!("const BVH_END: u32 = {:#x}u;", lumagraph_scene::BVH_END);
+    assert!(src.contains(&end), "bvh.wgsl must declare `{end}`");
     let types =
         std::fs::read_to_string(common::shaders().join("pathtrace/scene_types.wgsl")).unwrap();
     for (name, value) in [
