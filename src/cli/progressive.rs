@@ -55,17 +55,23 @@ pub(super) fn on_signal(then: &'static str) {
     }
 }
 
-/// Runs the progressive part of the graph to `spp` samples per pixel (going on from a
-/// checkpoint when asked), then the rest once.
-pub(super) fn render(exec: &mut Executor, spp: u32, ck: &Checkpoints) -> Result<FrameReport> {
-    let frames = exec.frames_for(spp);
-    // Warm-up: drivers compile pipelines at their first dispatch; keep that out of the timing.
+/// Warms `exec` up and prints how long it took: drivers compile pipelines at their first
+/// dispatch, and that is kept out of the timed frames.
+pub(super) fn warm_up(exec: &mut Executor) -> Result<()> {
     let warm = Instant::now();
     exec.warm_up()?;
     println!(
         "warm-up (shader compilation): {:.0} ms",
         warm.elapsed().as_secs_f64() * 1e3
     );
+    Ok(())
+}
+
+/// Runs the progressive part of the graph to `spp` samples per pixel (going on from a
+/// checkpoint when asked), then the rest once.
+pub(super) fn render(exec: &mut Executor, spp: u32, ck: &Checkpoints) -> Result<FrameReport> {
+    let frames = exec.frames_for(spp);
+    warm_up(exec)?;
     if let Some(path) = &ck.resume {
         let from = Checkpoint::load(path)?;
         from.check(ck.key)

@@ -72,12 +72,7 @@ pub(super) fn render_partial(
             range.end.div_ceil(spf) * spf
         );
     }
-    let warm = Instant::now();
-    exec.warm_up()?;
-    println!(
-        "warm-up (shader compilation): {:.0} ms",
-        warm.elapsed().as_secs_f64() * 1e3
-    );
+    super::progressive::warm_up(exec)?;
     let start = Instant::now();
     exec.start_at_sample(range.first, u64::from(range.first / spf));
     let frames = (range.end - range.first) / spf;

@@ -79,12 +79,7 @@ pub(super) fn render_if_needed(
     }
     let spp = args.spp.unwrap_or(scene.scene.settings.spp);
     let frames = exec.frames_for(spp);
-    let warm = Instant::now();
-    exec.warm_up()?;
-    println!(
-        "warm-up (shader compilation): {:.0} ms",
-        warm.elapsed().as_secs_f64() * 1e3
-    );
+    super::progressive::warm_up(&mut exec)?;
     on_signal("writing the tiles done so far");
     let mut bar = TileBar::new(n, frames);
     match args.tiles {
