@@ -176,15 +176,18 @@ fn stopped(exec: &mut Executor, spp: u32, frames: u32, ck: &Checkpoints) -> anyh
     )
 }
 
+/// The value of the counter called `name` (0 when no node keeps one).
+fn counter(counters: &[(String, crate::render::Counter)], name: &str) -> u64 {
+    counters
+        .iter()
+        .find(|(_, c)| c.name == name)
+        .map_or(0, |(_, c)| c.value)
+}
+
 /// The path tracer's samples per pixel and rays so far (0 without one).
 fn samples_per_pixel(exec: &mut Executor) -> Result<(u64, u64)> {
     let counters = exec.counters()?;
-    let get = |name: &str| {
-        counters
-            .iter()
-            .find(|(_, c)| c.name == name)
-            .map_or(0, |(_, c)| c.value)
-    };
+    let get = |name: &str| counter(&counters, name);
     Ok((get("samples_per_pixel"), get("rays")))
 }
 
@@ -192,12 +195,7 @@ fn samples_per_pixel(exec: &mut Executor) -> Result<(u64, u64)> {
 /// and rays a checkpoint brought).
 fn report_speed(exec: &mut Executor, wall: Duration, before: (u64, u64)) -> Result<()> {
     let counters = exec.counters()?;
-    let get = |name: &str| {
-        counters
-            .iter()
-            .find(|(_, c)| c.name == name)
-            .map_or(0, |(_, c)| c.value)
-    };
+    let get = |name: &str| counter(&counters, name);
     let samples = get("samples_per_pixel");
     let extent = super::progressive_source(exec.plan()).map(|p| p.extent);
     let pixels = extent.map_or(0, crate::graph::Extent::pixels);
