@@ -67,7 +67,9 @@ SUITE = {
     "cornell": {"scene": "assets/cornell.ron", "reference": "tests/reference/cornell_ref.exr",
                 "made_by": "existing"},
     "mesh_env": {"scene": "assets/bench/mesh_env.ron", "made_by": "mitsuba"},
-    "boxtextured": {"scene": "tests/scenes/denoise/boxtextured.ron", "made_by": "lumagraph"},
+    # 0.29 M paths/s on lavapipe (the textured shader): 4096 spp take about 16 minutes
+    "boxtextured": {"scene": "tests/scenes/denoise/boxtextured.ron", "made_by": "lumagraph",
+                    "spp": 4096},
     "metals": {"scene": "tests/scenes/denoise/metals.ron", "made_by": "mitsuba"},
 }
 
@@ -152,20 +154,39 @@ def lumagraph_render(lumagraph, graph, scene, spp, out, sets=()):
     subprocess.run(cmd, check=True, cwd=ROOT, stdout=subprocess.DEVNULL)
 
 
+def seeded_scene(scene, seed):
+    """A copy of `scene` with render seed `seed`, beside it (its relative paths hold)."""
+    import re
+    src = os.path.join(ROOT, scene)
+    with open(src) as f:
+        text = f.read()
+    text, n = re.subn(r"seed:\s*\d+", f"seed: {seed}", text)
+    assert n == 1, f"{scene}: no single `seed:` to replace"
+    path = src[:-len(".ron")] + f".seed{seed}.ron"
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
 def reference_lumagraph(name, lumagraph, spp):
-    """Two independent halves (seeds 1001 and 1002) of the default graph's accumulation."""
+    """Two independent halves (scene seeds 1001 and 1002) of the default graph's accumulation."""
     halves = []
     start = time.time()
     with tempfile.TemporaryDirectory() as tmp:
         for seed in (1001, 1002):
-            lumagraph_render(lumagraph, INPUTS_GRAPH, SUITE[name]["scene"], spp // 2, tmp,
-                             [f"pathtrace.seed={seed}"])
+            scene = seeded_scene(SUITE[name]["scene"], seed)
+            try:
+                lumagraph_render(lumagraph, INPUTS_GRAPH, scene, spp // 2, tmp,
+                                 ["pathtrace.samples_per_frame=32"])
+            finally:
+                os.remove(scene)
             halves.append(read_exr(os.path.join(tmp, "color.exr")))
             print(f"  {name}: seed {seed}, {spp // 2} spp, {time.time() - start:.0f} s", flush=True)
     a, b = halves
     return (a + b) / 2, a, b, time.time() - start, {
-        "renderer": f"lumagraph, {INPUTS_GRAPH} (the default graph's PathTrace + Accumulate), "
-                    "two renders of spp/2 with seeds 1001 and 1002, averaged"}
+        "renderer": f"lumagraph, {INPUTS_GRAPH} (the default graph's PathTrace + Accumulate, "
+                    "32 samples a frame), two renders of spp/2 with scene seeds 1001 and 1002, "
+                    "averaged"}
 
 
 def step_refs(names, a):
@@ -179,14 +200,15 @@ def step_refs(names, a):
             entry["own_error"] = {"rmse": 1.2e-3, "relmse": 1.3e-5,
                                   "from": "tests/reference/README.md"}
         else:
+            spp = s.get("spp", a.spp)
             if s["made_by"] == "mitsuba":
-                ref, h1, h2, seconds, how = reference_mitsuba(name, a.lumagraph, a.spp, a.chunk)
+                ref, h1, h2, seconds, how = reference_mitsuba(name, a.lumagraph, spp, a.chunk)
             else:
-                ref, h1, h2, seconds, how = reference_lumagraph(name, a.lumagraph, a.spp)
+                ref, h1, h2, seconds, how = reference_lumagraph(name, a.lumagraph, spp)
             write_exr(ref_path(name), ref)
             stored = read_exr(ref_path(name))  # half float: score against what is stored
             entry.update(how)
-            entry["spp"] = a.spp
+            entry["spp"] = spp
             entry["seconds"] = round(seconds, 1)
             # two independent halves: E[(h1 - h2)^2] = 4 var(mean of both)
             d2 = (h1 - h2) ** 2
@@ -196,7 +218,7 @@ def step_refs(names, a):
                 "half_float_relmse": mk.relmse(stored, ref),
                 "from": "two independent halves: relMSE(half1, half2) / 4",
             }
-            print(f"{name}: {a.spp} spp in {seconds:.0f} s, own relMSE "
+            print(f"{name}: {spp} spp in {seconds:.0f} s, own relMSE "
                   f"{entry['own_error']['relmse']:.2e}, RMSE {entry['own_error']['rmse']:.2e}")
         meta["scenes"].setdefault(name, {}).update(entry)
         save_meta(meta)
@@ -364,6 +386,42 @@ def step_timing(names, a):
     save_meta(meta)
 
 
+def step_converge(names, a):
+    """`lumagraph converge` per scene: the plot (docs/images/denoise_NAME.png) and a check
+    that baseline.csv's raw and a-trous figures are what converge scores at those spp."""
+    import shutil
+    with open(os.path.join(OUT, "baseline.csv")) as f:
+        base = list(csv.DictReader(f))
+    for name in names:
+        out = os.path.join(a.converge_out, "converge_" + name)
+        cmd = [a.lumagraph, "converge", DEFAULT_GRAPH, "--scene", SUITE[name]["scene"],
+               "--reference", rel(ref_path(name)), "--seconds", str(a.seconds), "--out", out]
+        if os.path.exists(converge_csv(name)):
+            cmd += ["--compare", rel(converge_csv(name))]
+        print("  " + " ".join(cmd[1:]), flush=True)
+        subprocess.run(cmd, check=True, cwd=ROOT, stdout=subprocess.DEVNULL)
+        os.makedirs(os.path.join(ROOT, "docs", "images"), exist_ok=True)
+        shutil.copy(os.path.join(out, "converge.png"),
+                    os.path.join(ROOT, "docs", "images", f"denoise_{name}.png"))
+        with open(os.path.join(out, "converge.csv")) as f:
+            conv = {(r["output"], int(r["spp"])): float(r["relmse"]) for r in csv.DictReader(f)}
+        for r in base:
+            if r["scene"] != name:
+                continue
+            spp = int(r["spp"])
+            for col, port in (("raw_relmse", "accumulate.color"),
+                              ("atrous_relmse", "denoise.color")):
+                if (port, spp) not in conv:
+                    print(f"  {name}: converge stopped before {spp} spp")
+                    continue
+                ours, theirs = float(r[col]), conv[(port, spp)]
+                ok = abs(ours - theirs) <= 1e-3 * theirs
+                print(f"  {name} {spp} spp {col}: baseline {ours:.5e}, converge {theirs:.5e}"
+                      + ("" if ok else "  MISMATCH"))
+                if not ok:
+                    sys.exit(f"{name}: baseline.csv does not match lumagraph converge")
+
+
 def cpu_name():
     try:
         with open("/proc/cpuinfo") as f:
@@ -378,19 +436,22 @@ def cpu_name():
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("names", nargs="*", help="suite scenes (default: all): " + ", ".join(SUITE))
-    p.add_argument("--steps", nargs="+", default=["refs", "mitsuba", "inputs", "timing"],
-                   choices=["refs", "mitsuba", "inputs", "timing"])
+    p.add_argument("--steps", nargs="+", default=["refs", "mitsuba", "inputs", "converge", "timing"],
+                   choices=["refs", "mitsuba", "inputs", "converge", "timing"])
     p.add_argument("--lumagraph", default=os.path.join(ROOT, "target", "release", "lumagraph"))
     p.add_argument("--spp", type=int, default=8192, help="reference samples per pixel")
     p.add_argument("--chunk", type=int, default=512, help="samples per Mitsuba render call")
     p.add_argument("--runs", type=int, default=5, help="OIDN timing runs")
+    p.add_argument("--seconds", type=float, default=60, help="`lumagraph converge` budget")
+    p.add_argument("--converge-out", default=tempfile.gettempdir(),
+                   help="where the converge_NAME folders go")
     a = p.parse_args()
     a.lumagraph = os.path.abspath(a.lumagraph)
     import mitsuba as mi
     mi.set_variant("llvm_ad_rgb")
     names = a.names or list(SUITE)
     steps = {"refs": step_refs, "mitsuba": step_mitsuba, "inputs": step_inputs,
-             "timing": step_timing}
+             "converge": step_converge, "timing": step_timing}
     for step in a.steps:
         if step in steps:
             steps[step](names, a)
