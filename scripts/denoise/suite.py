@@ -11,8 +11,9 @@ goes into tests/reference/denoise/:
                       `lumagraph converge --compare` reads)
   baseline.csv        per scene and spp (4, 16, 64): relMSE of lumagraph's raw accumulation, of
                       its a-trous Denoise, of OIDN 2.5 (RT filter, hdr, albedo + normal) on the
-                      same accumulation with lumagraph's G-buffer albedo and normal, of OIDN on
-                      the colour alone, and OIDN's CPU seconds per frame
+                      same accumulation with lumagraph's G-buffer albedo and normal (cleanAux;
+                      and with cleanAux off, OIDN prefiltering them), of OIDN on the colour
+                      alone, and OIDN's CPU seconds per frame
   suite.json          per scene: scene file, reference file, reference spp, the reference's own
                       error and how it was made; OIDN timings at 256x256 and 1920x1080
 
@@ -224,12 +225,14 @@ def step_refs(names, a):
         save_meta(meta)
 
 
-def oidn(color, albedo=None, normal=None):
-    """OIDN 2.5 RT filter on the CPU, hdr, quality high; aux images are noise-free (cleanAux)."""
+def oidn(color, albedo=None, normal=None, clean_aux=True):
+    """OIDN 2.5 RT filter on the CPU, hdr, quality high; with `clean_aux` the auxiliary
+    images are taken as noise-free (cleanAux), else OIDN prefilters them."""
     import pyoidn
     f32 = lambda x: None if x is None else np.ascontiguousarray(x, dtype=np.float32)
     return pyoidn.denoise(f32(color), f32(albedo), f32(normal), hdr=True,
-                          clean_aux=albedo is not None, quality="high").astype(np.float64)
+                          clean_aux=clean_aux and albedo is not None,
+                          quality="high").astype(np.float64)
 
 
 def timed_oidn(color, albedo, normal, runs):
@@ -322,14 +325,17 @@ def step_inputs(names, a):
                     for f in ("color", "denoised", "albedo", "normal"))
             den, seconds = timed_oidn(color, albedo, normal, 3)
             noaov = oidn(color)
+            prefiltered = oidn(color, albedo, normal, clean_aux=False)
             r = {"scene": name, "spp": spp,
                  "raw_relmse": mk.relmse(color, ref),
                  "atrous_relmse": mk.relmse(denoised, ref),
                  "oidn_relmse": mk.relmse(den, ref),
+                 "oidn_prefilter_relmse": mk.relmse(prefiltered, ref),
                  "oidn_noaov_relmse": mk.relmse(noaov, ref),
                  "oidn_seconds": seconds}
             print(f"  {name} {spp} spp: raw {r['raw_relmse']:.3e}, a-trous "
-                  f"{r['atrous_relmse']:.3e}, OIDN {r['oidn_relmse']:.3e} (no AOVs "
+                  f"{r['atrous_relmse']:.3e}, OIDN {r['oidn_relmse']:.3e} (aux prefiltered "
+                  f"{r['oidn_prefilter_relmse']:.3e}, no AOVs "
                   f"{r['oidn_noaov_relmse']:.3e}), OIDN {seconds:.3f} s", flush=True)
             rows.append(r)
     order = list(SUITE)
@@ -337,7 +343,7 @@ def step_inputs(names, a):
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
         cols = ["scene", "spp", "raw_relmse", "atrous_relmse", "oidn_relmse",
-                "oidn_noaov_relmse", "oidn_seconds"]
+                "oidn_prefilter_relmse", "oidn_noaov_relmse", "oidn_seconds"]
         w.writerow(cols)
         for r in rows:
             w.writerow([r["scene"], r["spp"]] + [f"{float(r[c]):.6g}" for c in cols[2:]])
@@ -349,7 +355,9 @@ def step_inputs(names, a):
                      "Accumulate.color, atrous: Denoise.color",
         "oidn": "OIDN 2.5.1 (pyoidn), RT filter, hdr, quality high, CPU; with lumagraph's "
                 "GBuffer albedo and normal (first hit, noise-free: cleanAux) on the same "
-                "accumulation; oidn_noaov: colour alone; oidn_seconds: median of 3 calls",
+                "accumulation; oidn_prefilter: the same with cleanAux off (OIDN prefilters "
+                "the aux images); oidn_noaov: colour alone; oidn_seconds: median of 3 calls "
+                "of the first (filter built before)",
         "relmse": "mean over pixels and RGB of (x - ref)^2 / (ref^2 + 1e-2)",
     }
     save_meta(meta)
@@ -359,7 +367,7 @@ def step_timing(names, a):
     """OIDN per frame (RT, hdr, albedo + normal) at 256x256 and 1920x1080 on noise."""
     import pyoidn  # noqa: F401
     rng = np.random.default_rng(0)
-    out = {}
+    out = {"load_average_before": round(os.getloadavg()[0], 2)}
     for w, h in ((256, 256), (1920, 1080)):
         color = rng.exponential(0.5, (h, w, 3)).astype(np.float32)
         albedo = rng.uniform(0, 1, (h, w, 3)).astype(np.float32)
@@ -381,7 +389,7 @@ def step_timing(names, a):
                "high, albedo + normal, float32; the filter is built once, each run is one "
                "denoise call including the copies in and out",
         "cpu": cpu_name(), "cores": os.cpu_count(),
-        "load_average_before": round(os.getloadavg()[0], 2),
+        "load_average_after": round(os.getloadavg()[0], 2),
     }
     save_meta(meta)
 
@@ -398,8 +406,11 @@ def step_converge(names, a):
                "--reference", rel(ref_path(name)), "--seconds", str(a.seconds), "--out", out]
         if os.path.exists(converge_csv(name)):
             cmd += ["--compare", rel(converge_csv(name))]
-        print("  " + " ".join(cmd[1:]), flush=True)
-        subprocess.run(cmd, check=True, cwd=ROOT, stdout=subprocess.DEVNULL)
+        if a.reuse_converge and os.path.exists(os.path.join(out, "converge.csv")):
+            print(f"  {name}: reusing {out}")
+        else:
+            print("  " + " ".join(cmd[1:]), flush=True)
+            subprocess.run(cmd, check=True, cwd=ROOT, stdout=subprocess.DEVNULL)
         os.makedirs(os.path.join(ROOT, "docs", "images"), exist_ok=True)
         shutil.copy(os.path.join(out, "converge.png"),
                     os.path.join(ROOT, "docs", "images", f"denoise_{name}.png"))
@@ -409,8 +420,7 @@ def step_converge(names, a):
             if r["scene"] != name:
                 continue
             spp = int(r["spp"])
-            for col, port in (("raw_relmse", "accumulate.color"),
-                              ("atrous_relmse", "denoise.color")):
+            for col, port in (("raw_relmse", "accumulate"), ("atrous_relmse", "denoise")):
                 if (port, spp) not in conv:
                     print(f"  {name}: converge stopped before {spp} spp")
                     continue
@@ -445,6 +455,8 @@ def main():
     p.add_argument("--seconds", type=float, default=60, help="`lumagraph converge` budget")
     p.add_argument("--converge-out", default=tempfile.gettempdir(),
                    help="where the converge_NAME folders go")
+    p.add_argument("--reuse-converge", action="store_true",
+                   help="take converge_NAME/converge.csv from an earlier run if it is there")
     a = p.parse_args()
     a.lumagraph = os.path.abspath(a.lumagraph)
     import mitsuba as mi
