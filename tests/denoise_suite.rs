@@ -85,6 +85,13 @@ fn render(scene: &str, spp: u32) -> Option<(Image, Image)> {
     let ctx = common::gpu()?;
     let mut graph = Graph::load(&common::repo("graphs/pathtrace_denoise.ron")).unwrap();
     graph.remove_sinks(&NodeLibrary::builtins().registry_for(&graph).unwrap());
+    let mesh = common::repo("assets/bench/blob.obj");
+    assert!(
+        scene != "assets/bench/mesh_env.ron" || mesh.exists(),
+        "{} is missing: `python3 scripts/bench/mesh_env.py make assets/bench/blob.obj` \
+         (scripts/test.sh does it)",
+        mesh.display()
+    );
     let scene = common::gpu_scene(scene, None);
     let plan = compile(
         &graph,

@@ -2,7 +2,7 @@
 """The denoising test suite: references, noisy inputs, OIDN 2.5 baselines, recorded as data.
 
 Scenes (SUITE below; 256 x 256, 20 bounces): the Cornell box, an environment-lit mesh, a
-textured glTF under an environment map, rough and smooth metals under the map. Everything
+textured glTF under an environment map, rough metals under the map. Everything
 goes into tests/reference/denoise/:
 
   NAME_ref.exr        reference, linear RGB, half float (Cornell: tests/reference/cornell_ref.exr)
@@ -19,22 +19,26 @@ goes into tests/reference/denoise/:
 
 Steps (default: all, in this order; each can run alone):
   refs       references: Mitsuba at --spp (scenes that map, see scripts/references/make.py),
-             else a long lumagraph render of the default graph (another seed); own error from
-             two independent halves: relMSE(half1, half2) / 4
-  mitsuba    NAME_converge.csv (Mitsuba at 1, 2, 4 .. 256 spp, then OIDN on each)
+             else (textures) a long lumagraph render of the default graph (SUITE's spp, other
+             seeds); own error from two independent halves: relMSE(half1, half2) / 4
+  mitsuba    NAME_converge.csv (Mitsuba at 1, 2, 4 .. 256 spp, then OIDN on each; FLIP
+             columns need flip-evaluator)
   inputs     lumagraph's accumulation (graphs/denoise_inputs.ron: the default graph with the
              accumulation, G-buffer albedo and normal as outputs) at 4, 16, 64 spp, seed 0; OIDN
              on them; baseline.csv (the raw and a-trous figures are scored here and checked
-             against `lumagraph converge` at the same spp)
+             against `lumagraph converge` at the same spp by the next step)
+  converge   `lumagraph converge` per scene (--seconds, into --converge-out): the plots
+             docs/images/denoise_NAME.png, and the check that baseline.csv's raw and a-trous
+             figures are converge's
   timing     OIDN CPU time per frame at 256x256 and 1920x1080 (median of --runs)
 
 Usage (from the repository root; Mitsuba 3.9.1 and pyoidn 2.5 in a venv):
   python3 -m venv .venv-mitsuba
-  .venv-mitsuba/bin/pip install -r scripts/references/requirements.txt pyoidn==2.5.1
+  .venv-mitsuba/bin/pip install -r scripts/references/requirements.txt pyoidn==2.5.1 flip-evaluator
   python3 scripts/bench/mesh_env.py make assets/bench/blob.obj
   cargo build --release
   .venv-mitsuba/bin/python scripts/denoise/suite.py                      # everything
-  .venv-mitsuba/bin/python scripts/denoise/suite.py --steps inputs timing mesh_env
+  .venv-mitsuba/bin/python scripts/denoise/suite.py mesh_env metals --steps inputs converge
   .venv-mitsuba/bin/python scripts/denoise/suite.py --lumagraph path/to/lumagraph --spp 8192
 
 The converge plots in docs/denoise.md come from
@@ -200,6 +204,8 @@ def step_refs(names, a):
             entry["spp"] = 24576
             entry["own_error"] = {"rmse": 1.2e-3, "relmse": 1.3e-5,
                                   "from": "tests/reference/README.md"}
+            entry["mitsuba_converge"] = {"file": rel(converge_csv(name)),
+                                         "how": "see tests/reference/README.md"}
         else:
             spp = s.get("spp", a.spp)
             if s["made_by"] == "mitsuba":
