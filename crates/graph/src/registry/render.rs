@@ -73,25 +73,8 @@ fn path_trace() -> NodeKind {
                 },
                 doc: "how light sampling draws directions from an environment map",
             },
-            ParamDef {
-                name: "sampler",
-                ty: ParamType::Enum {
-                    default: "sobol",
-                    options: &[
-                        (
-                            "sobol",
-                            "Owen-scrambled Sobol points for the pixel, lens, and first-hit \
-                         light and BSDF samples; the other dimensions independent",
-                        ),
-                        (
-                            "independent",
-                            "every dimension from a PCG hash stream (a baseline for \
-                         comparisons)",
-                        ),
-                    ],
-                },
-                doc: "how the random numbers of a path are drawn (docs/pathtracer.md)",
-            },
+            sampler_param(),
+            replicates_param(),
             ParamDef {
                 name: "strategy",
                 ty: ParamType::Enum {
@@ -119,18 +102,6 @@ fn path_trace() -> NodeKind {
                 doc: "how direct light is estimated; every strategy converges to the same \
                   image (docs/pathtracer.md)",
             },
-            ParamDef {
-                name: "replicates",
-                ty: ParamType::Int {
-                    default: 1,
-                    min: 1,
-                    max: 2,
-                },
-                doc: "independent Sobol replicates: 1, one sequence per pixel (least noise); \
-                  2, frames alternate between two, so the mean of the even and that of the \
-                  odd frames are independent and Accumulate's `variance_estimate: halves` \
-                  is right (raw relMSE a few percent higher; docs/denoise.md)",
-            },
         ],
         sink: false,
         history: false,
@@ -138,6 +109,45 @@ fn path_trace() -> NodeKind {
         shader: None,
         example: Vec::new(),
         reach: Reach::Pixel,
+    }
+}
+
+/// `PathTrace`'s `sampler` param.
+fn sampler_param() -> ParamDef {
+    ParamDef {
+        name: "sampler",
+        ty: ParamType::Enum {
+            default: "sobol",
+            options: &[
+                (
+                    "sobol",
+                    "Owen-scrambled Sobol points for the pixel, lens, and first-hit \
+             light and BSDF samples; the other dimensions independent",
+                ),
+                (
+                    "independent",
+                    "every dimension from a PCG hash stream (a baseline for \
+             comparisons)",
+                ),
+            ],
+        },
+        doc: "how the random numbers of a path are drawn (docs/pathtracer.md)",
+    }
+}
+
+/// `PathTrace`'s `replicates` param.
+fn replicates_param() -> ParamDef {
+    ParamDef {
+        name: "replicates",
+        ty: ParamType::Int {
+            default: 1,
+            min: 1,
+            max: 2,
+        },
+        doc: "independent Sobol replicates: 1, one sequence per pixel (least noise); \
+      2, frames alternate between two, so the mean of the even and that of the \
+      odd frames are independent and Accumulate's `variance_estimate: halves` \
+      is right (raw relMSE a few percent higher; docs/denoise.md)",
     }
 }
 
