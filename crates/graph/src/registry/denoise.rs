@@ -122,7 +122,9 @@ fn regression() -> NodeKind {
               and the normal over a (2 `radius` + 1)² window, and the fit at the pixel, times \
               the albedo, is the output. Diffuse light changes smoothly with the normal, so \
               curved surfaces are averaged where Denoise's normal edge-stop refuses to. \
-              Slower than Denoise; two images are the memory it adds.",
+              Pixels within one pixel of a light's edge, whose color mixes the light and \
+              its surroundings, are passed through. Slower than Denoise; three images are \
+              the memory it adds.",
         inputs: vec![
             InputDef::new(
                 "color",
@@ -160,7 +162,7 @@ fn regression() -> NodeKind {
         params: vec![
             ParamDef::int(
                 "radius",
-                8,
+                10,
                 [1, 32],
                 "window radius in pixels; the spatial weight is a Gaussian of σ = radius / 2",
             ),
@@ -186,10 +188,11 @@ fn regression() -> NodeKind {
             ),
             ParamDef::float(
                 "sigma_color",
-                0.0,
+                3.0,
                 [0.0, 1000.0],
-                "luminance tolerance in standard deviations beyond the noise (needs \
-                 `variance`; 0 = off)",
+                "luminance tolerance: a tap whose 5×5 mean luminance differs from the \
+                 pixel's by more than the noise of the two means is weighted down, in units \
+                 of that noise's standard deviation (needs `variance`; 0 = off)",
             ),
             ParamDef::float(
                 "ridge",
@@ -203,7 +206,8 @@ fn regression() -> NodeKind {
         renders_scene: false,
         shader: None,
         example: Vec::new(),
-        // The window (the depth gradient at its center reads 1 pixel away, inside it).
-        reach: Reach::Within(|p| u32::try_from(p.int("radius")).unwrap_or(0)),
+        // The window's taps, their 5×5 guide (2 more) and the light-boundary test of the
+        // guide's pixels (1 more).
+        reach: Reach::Within(|p| u32::try_from(p.int("radius")).unwrap_or(0) + 3),
     }
 }
