@@ -1,7 +1,7 @@
 //! The `RegressionDenoise` node: its GPU passes against their plain-Rust mirror
 //! (`cpu::regression`), finite output on degenerate inputs, and its gain over the à-trous
 //! `Denoise` at 16 spp on the Cornell box and the environment-lit mesh, against Mitsuba's
-//! references (`docs/denoise.md`, "RegressionDenoise").
+//! references (`docs/denoise.md`, section `RegressionDenoise`).
 
 mod common;
 
@@ -139,6 +139,9 @@ fn filter_image(color: &Image, frames: u32, params: &[(&str, ParamValue)]) -> Op
     run(&graph, &scene, frames, &["dn.color"]).map(|mut v| v.remove(0))
 }
 
+/// What a degenerate-input case runs: its name, the color, the frames, the node's params.
+type Case<'a> = (&'a str, &'a Image, u32, &'a [(&'a str, ParamValue)]);
+
 #[test]
 fn degenerate_inputs_give_finite_output() {
     const SIZE: u32 = 64;
@@ -161,7 +164,7 @@ fn degenerate_inputs_give_finite_output() {
         ("sigma_color", ParamValue::Float(0.0)),
         ("ridge", ParamValue::Float(0.0)),
     ];
-    let cases: [(&str, &Image, u32, &[(&str, ParamValue)]); 7] = [
+    let cases: [Case<'_>; 7] = [
         ("NaN and Inf", &nan, 3, &[]),
         ("huge values", &huge, 3, &[]),
         ("zero variance", &noise(SIZE), 2, &[]),
