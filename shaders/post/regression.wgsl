@@ -4,11 +4,14 @@
 //
 // Around pixel p, the taps q of a (2 radius + 1)² window (every `stride`-th pixel) of p's
 // kind (surface or emitter; see regression_prepare.wgsl) fit
-//     y_q ≈ β0 + β · x_q,   x_q = (Δx / r, Δy / r, (z_q − z_p) / z_p, n_q − n_p)
+//     y_q ≈ β0 + β · x_q,   x_q = (Δx / r, Δy / r, (z_q − z_p) / z_p, n_q − n_p, a_q − a_p)
 // by weighted least squares, per color channel, and the output is the fit at p (x_p = 0),
-// multiplied back by the albedo. Diffuse lighting varies smoothly with the normal and the
-// position, so the fit averages over a curved surface where an edge-stop on the normal
-// would refuse to. Weight of tap q:
+// multiplied back by the albedo a_p. Diffuse lighting varies smoothly with the normal and
+// the position, so the fit averages over a curved surface where an edge-stop on the normal
+// would refuse to. The albedo term is for what demodulation leaves: where the reflectance
+// is not albedo × lighting (a metal's Fresnel term whitens it at grazing angles, so
+// color / albedo comes out larger on a texel of low albedo), the fit tells texels apart
+// instead of averaging them. Weight of tap q:
 //     w = exp(−2 |Δ|² / r²)                              spatial (σ = r / 2)
 //       · exp(−max(1 − n_p·n_q, 0) / sigma_normal)       normal
 //       · exp(−(e / (sigma_depth z_p))²)                 depth, e = z_q − z_p − ∇z·Δ
@@ -17,7 +20,8 @@
 //                                                        the guide (regression_guide.wgsl)
 // and 0 for a tap of another kind.
 //
-// The system is solved centered on the weighted means (m, ȳ): (C + R) β = b with
+// The system (9 features: position, normal and albedo, each a 3-vector whose sums are kept
+// as 3×3 blocks) is solved centered on the weighted means (m, ȳ): (C + R) β = b with
 // C = Σ w (x − m)(x − m)ᵀ, b = Σ w (x − m)(y − ȳ), and the fit at p is ȳ − β · m.
 // R = ridge · diag(C) + 1e-7 Σw I: relative to each feature's own spread, so it does not
 // depend on the features' units, and positive where a feature is constant over the window
@@ -45,7 +49,7 @@ struct Params {
 #import "post/regression_common.wgsl"
 
 // Features besides the constant.
-const K: i32 = 6;
+const K: i32 = 9;
 
 fn in_image(p: vec2i, size: vec2i) -> bool {
     return all(p >= vec2i(0)) && all(p < size);
@@ -114,14 +118,19 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     let c2 = params.sigma_color * params.sigma_color;
 
     // Sums over the taps: of w, w x (position part x1 = (Δx/r, Δy/r, Δz/z), normal part
-    // x2 = Δn), w y, w x xᵀ (blocks x1x1ᵀ, x1x2ᵀ, x2x2ᵀ) and w y xᵀ.
+    // x2 = Δn, albedo part x3 = Δa), w y, w x xᵀ (blocks x_i x_jᵀ, i <= j) and w y xᵀ.
     var s = 0.0;
     var s1 = vec3f(0.0);
     var s2 = vec3f(0.0);
+    var s3 = vec3f(0.0);
     var sy = vec3f(0.0);
     var s11 = mat3x3f();
     var s12 = mat3x3f();
     var s22 = mat3x3f();
+    var s13 = mat3x3f();
+    var s23 = mat3x3f();
+    var s33 = mat3x3f();
+    var sy3 = mat3x3f();
     var sy1 = mat3x3f();
     var sy2 = mat3x3f();
     for (var j = -steps; j <= steps; j++) {
@@ -136,6 +145,7 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
                 continue;
             }
             let y = textureLoad(illumination, q, 0).rgb;
+            let a_q = max(finite(textureLoad(albedo, q, 0)).rgb, vec3f(EPS));
             let z_q = abs(f_q.w);
             let df = vec2f(d);
             let e = (z_q - z_p - dot(grad, df)) / z_denom;
@@ -151,15 +161,22 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
             let w = exp(-arg);
             let x1 = vec3f(df * inv_r, (z_q - z_p) / z_p);
             let x2 = f_q.xyz - n_p;
+            let x3 = a_q - a;
             let w1 = w * x1;
             let w2 = w * x2;
+            let w3 = w * x3;
             s += w;
             s1 += w1;
             s2 += w2;
+            s3 += w3;
             sy += w * y;
             s11 += outer(w1, x1);
             s12 += outer(w1, x2);
             s22 += outer(w2, x2);
+            s13 += outer(w1, x3);
+            s23 += outer(w2, x3);
+            s33 += outer(w3, x3);
+            sy3 += outer(y, w3);
             sy1 += outer(y, w1);
             sy2 += outer(y, w2);
         }
@@ -172,22 +189,31 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     for (var u = 0; u < 3; u++) {
         m[u] = s1[u] / s;
         m[u + 3] = s2[u] / s;
+        m[u + 6] = s3[u] / s;
         b[u] = sy1[u];
         b[u + 3] = sy2[u];
+        b[u + 6] = sy3[u];
     }
-    // Centered, ridged normal equations (lower triangle of the row-major 6×6 `l`), factored
+    // Centered, ridged normal equations (lower triangle of the row-major 9×9 `l`), factored
     // in place (Cholesky) and solved for the three channels at once.
-    var l: array<f32, 36>;
+    var l: array<f32, 81>;
     for (var u = 0; u < K; u++) {
         b[u] -= s * m[u] * mean_y;
         for (var v = 0; v <= u; v++) {
+            // Σ w x_u x_v from the blocks: block (i, j), i <= j, holds Σ w x_i x_jᵀ with
+            // column k for x_j's k-th component.
+            let bu = u / 3;
+            let bv = v / 3;
+            let iu = u % 3;
+            let iv = v % 3;
             var c: f32;
-            if u < 3 {
-                c = s11[v][u];
-            } else if v < 3 {
-                c = s12[u - 3][v];
-            } else {
-                c = s22[v - 3][u - 3];
+            switch bv * 3 + bu {
+                case 0: { c = s11[iv][iu]; }
+                case 1: { c = s12[iu][iv]; }
+                case 2: { c = s13[iu][iv]; }
+                case 4: { c = s22[iv][iu]; }
+                case 5: { c = s23[iu][iv]; }
+                default: { c = s33[iv][iu]; }
             }
             c -= s * m[u] * m[v];
             if u == v {

@@ -118,8 +118,8 @@ fn regression() -> NodeKind {
         category: Category::Denoise,
         doc: "Per-pixel first-order feature regression (after NFOR, Bitterli et al. 2016): \
               around each pixel, the color divided by the albedo is fitted by weighted least \
-              squares as an affine function of the screen offset, the relative depth change \
-              and the normal over a (2 `radius` + 1)² window, and the fit at the pixel, times \
+              squares as an affine function of the screen offset, the relative depth change, \
+              the normal and the albedo over a (2 `radius` + 1)² window, and the fit at the pixel, times \
               the albedo, is the output. Diffuse light changes smoothly with the normal, so \
               curved surfaces are averaged where Denoise's normal edge-stop refuses to. \
               Pixels within one pixel of a light's edge, whose color mixes the light and \

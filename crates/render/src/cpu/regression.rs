@@ -1,7 +1,7 @@
 //! The `RegressionDenoise` filter of `shaders/post/regression*.wgsl`, mirrored: preparation
 //! (demodulation, classes), the guide (5×5 mean luminance of the same class and its
-//! variance), then the per-pixel weighted first-order regression, solved by the same
-//! Cholesky factorization in the same order.
+//! variance), then the per-pixel weighted first-order regression on position, normal and
+//! albedo, solved by the same Cholesky factorization in the same order.
 
 use super::{Image, V3, luminance, rgb};
 
@@ -37,7 +37,7 @@ impl Default for RegressionParams {
 }
 
 const EPS: f32 = 1e-3;
-const K: usize = 6;
+const K: usize = 9;
 
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Class {
@@ -236,6 +236,7 @@ pub fn regression(
                         continue;
                     }
                     let yq = rgb(illumination[q]);
+                    let a_q = alb(q);
                     let z_q = f_q[3].abs();
                     #[expect(clippy::cast_precision_loss, reason = "small offsets")]
                     let df = [dx as f32, dy as f32];
@@ -257,6 +258,9 @@ pub fn regression(
                         f_q[0] - n_p[0],
                         f_q[1] - n_p[1],
                         f_q[2] - n_p[2],
+                        a_q[0] - a[0],
+                        a_q[1] - a[1],
+                        a_q[2] - a[2],
                     ];
                     s += wt;
                     for c in 0..3 {
@@ -283,12 +287,9 @@ pub fn regression(
                     b[u][c] = sxy[u][c] - s * m[u] * mean_y[c];
                 }
                 for v in 0..=u {
-                    // The shader keeps the position × normal block as Σ (w x_v) x_u.
-                    let mut c = if v < 3 && u >= 3 {
-                        sxx[v][u]
-                    } else {
-                        sxx[u][v]
-                    };
+                    // The shader keeps the blocks of different feature groups (position,
+                    // normal, albedo) as Σ (w x_v) x_u, v's group before u's.
+                    let mut c = if v / 3 < u / 3 { sxx[v][u] } else { sxx[u][v] };
                     c -= s * m[u] * m[v];
                     if u == v {
                         c = c.max(0.0) * (1.0 + params.ridge) + 1e-7 * s;
