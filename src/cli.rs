@@ -218,6 +218,10 @@ enum Command {
         /// CSV with Mitsuba (and OIDN) figures per spp to plot beside ours.
         #[arg(long)]
         compare: Option<PathBuf>,
+        /// The relMSE to print each curve's time to (default with `--compare`: the
+        /// comparison's raw relMSE at its largest spp).
+        #[arg(long)]
+        target_relmse: Option<f64>,
         /// Folder for converge.csv and converge.png (created if missing).
         #[arg(long, default_value = "converge")]
         out: PathBuf,
@@ -599,6 +603,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             reference_spp,
             seconds,
             compare,
+            target_relmse,
             out,
             overrides,
         } => converge::run(&converge::Args {
@@ -608,6 +613,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             reference_spp,
             seconds,
             compare: compare.as_deref(),
+            target_relmse,
             out: &out,
             overrides: &overrides,
             library,

@@ -467,7 +467,13 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     ray_count = 0u;
     let n = frame.samples_per_frame;
     for (var i = 0u; i < n; i++) {
-        sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler);
+        sampler_init(
+            pixel_index,
+            frame.sample_offset + i,
+            frame.settings.seed,
+            frame.sampler,
+            n,
+        );
         var l = trace_path(pixel);
         if frame.firefly_clamp > 0.0 {
             let peak = max(l.x, max(l.y, l.z));

@@ -27,7 +27,8 @@ struct Params {
     variance: u32,
     size: vec2u,
     present: u32,
-    pad: u32,
+    // 1 when the history's first frame is an odd frame of the render.
+    parity: u32,
 }
 
 @group(0) @binding(0) var input: texture_2d<f32>;
@@ -39,6 +40,11 @@ struct Params {
 @group(0) @binding(6) var variance_out: texture_storage_2d<rgba32float, write>;
 
 const LUMA = vec3f(0.2126, 0.7152, 0.0722);
+
+// `params.variance`: no variance, from Welford's second moment over frames, or from halves.
+const VARIANCE_OFF: u32 = 0u;
+const VARIANCE_FRAMES: u32 = 1u;
+const VARIANCE_HALVES: u32 = 2u;
 
 // Sample variance (rgb, luminance) of the input over the 3×3 neighborhood of `p`.
 fn spatial_variance(p: vec2i, size: vec2i) -> vec4f {
@@ -123,35 +129,60 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     let mean = s.rgb / s.a;
     textureStore(output, id.xy, vec4f(mean, 1.0));
 
-    if params.variance == 1u {
+    if params.variance == VARIANCE_FRAMES {
         let mean_before = select(x, before.rgb / before.a, before.a > 0.0);
         let d = vec4f(x - mean_before, dot(x - mean_before, LUMA));
         let e = vec4f(x - mean, dot(x - mean, LUMA));
         let moment = m2[i] + d * e;
         m2[i] = moment;
-        let n = s.a;
-        var v: vec4f;
-        if n >= 2.0 {
-            v = max(moment, vec4f(0.0)) / (n * (n - 1.0));
-        } else {
-            v = spatial_variance(vec2i(id.xy), vec2i(size));
+        textureStore(variance_out, id.xy, frames_variance(moment, s.a, vec2i(id.xy)));
+    } else if params.variance == VARIANCE_HALVES {
+        // Odd frames of the render (the path tracer's second Sobol replicate) make the
+        // second half.
+        var odd = m2[i];
+        if ((u32(before.a) + params.parity) & 1u) == 1u {
+            odd += vec4f(x, 1.0);
+            m2[i] = odd;
         }
-        textureStore(variance_out, id.xy, v);
+        textureStore(variance_out, id.xy, halves_variance(s, odd, vec2i(id.xy)));
     }
+}
+
+// The variance of the mean of `n` frames from Welford's second moment `moment`; after one
+// frame, estimated over the pixel's neighborhood.
+fn frames_variance(moment: vec4f, n: f32, p: vec2i) -> vec4f {
+    if n >= 2.0 {
+        return max(moment, vec4f(0.0)) / (n * (n - 1.0));
+    }
+    return spatial_variance(p, vec2i(params.size));
+}
+
+// The variance of the mean from its two halves: with `a` and `b` the means of the n_a and
+// n_b frames of each, (a - b)^2 n_a n_b / n^2 estimates the variance of the mean of all
+// n = n_a + n_b frames without bias (for n_a = n_b; nearly, for n_a = n_b + 1) as long as
+// the halves are independent of each other, whatever the correlation of the frames within
+// a half (stratified Sobol frames are negatively correlated, which the spread over frames
+// does not see). One degree of freedom
+// per channel: Denoise blurs it before use. After one frame, estimated spatially.
+fn halves_variance(sum: vec4f, odd: vec4f, p: vec2i) -> vec4f {
+    let n = sum.a;
+    let nb = odd.a;
+    let na = n - nb;
+    if nb < 1.0 || na < 1.0 {
+        return spatial_variance(p, vec2i(params.size));
+    }
+    let d = (sum.rgb - odd.rgb) / na - odd.rgb / nb;
+    let dd = vec4f(d, dot(d, LUMA));
+    return dd * dd * (na * nb / (n * n));
 }
 
 // The mean (and variance) of the history as it stands, adding nothing.
 fn present(p: vec2u, i: u32) {
     let s = sum[i];
     textureStore(output, p, vec4f(s.rgb / s.a, 1.0));
-    if params.variance == 1u {
-        let n = s.a;
-        var v: vec4f;
-        if n >= 2.0 {
-            v = max(m2[i], vec4f(0.0)) / (n * (n - 1.0));
-        } else {
-            v = spatial_variance(vec2i(p), vec2i(params.size));
-        }
-        textureStore(variance_out, p, v);
+    if params.variance == VARIANCE_FRAMES {
+        textureStore(variance_out, p, frames_variance(m2[i], s.a, vec2i(p)));
+    } else if params.variance == VARIANCE_HALVES {
+        textureStore(variance_out, p, halves_variance(s, m2[i], vec2i(p)));
     }
 }

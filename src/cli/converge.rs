@@ -17,7 +17,9 @@
 //! independent of the runs it scores).
 //!
 //! Writes `converge.csv` and `converge.png` (log-log relMSE against seconds, one line per
-//! output, plus Mitsuba and OIDN points from `--compare`) into `--out`.
+//! output, plus Mitsuba and OIDN points from `--compare`) into `--out`, and prints the time
+//! each curve takes to reach a relMSE (`--target-relmse`, or the comparison's raw relMSE at
+//! its largest spp), interpolated log-log between the checkpoints around it.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -39,6 +41,7 @@ pub struct Args<'a> {
     pub reference_spp: Option<u32>,
     pub seconds: f64,
     pub compare: Option<&'a Path>,
+    pub target_relmse: Option<f64>,
     pub out: &'a Path,
     pub overrides: &'a [String],
     pub library: &'a NodeLibrary,
@@ -213,6 +216,7 @@ pub fn run(args: &Args<'_>) -> Result<()> {
         .with_context(|| format!("cannot write {}", csv.display()))?;
     println!("wrote {}", csv.display());
     let compare = args.compare.map(read_compare).transpose()?;
+    print_times_to(&rows_by_output(&rows), compare.as_ref(), args.target_relmse);
     let png = args.out.join("converge.png");
     match super::plot::write(&png, &rows_by_output(&rows), compare.as_ref()) {
         Ok(()) => println!("wrote {}", png.display()),
@@ -257,6 +261,53 @@ fn csv_text(rows: &[Row]) -> String {
         );
     }
     s
+}
+
+/// Prints the time each curve (ours, then the comparison's) takes to reach `target`, or
+/// by default the comparison's raw relMSE at its largest spp; nothing without either.
+fn print_times_to(
+    ours: &[(String, Vec<(f64, f64)>)],
+    compare: Option<&Compare>,
+    target: Option<f64>,
+) {
+    let last_raw = compare
+        .and_then(|c| c.first())
+        .and_then(|(label, pts)| Some((label, pts.last()?.1)));
+    let (target, what) = match (target, last_raw) {
+        (Some(t), _) => (t, "--target-relmse".to_owned()),
+        (None, Some((label, t))) => (t, format!("{label} at its largest spp")),
+        (None, None) => return,
+    };
+    println!("time to relMSE {target:.3e} ({what}):");
+    for (label, pts) in ours.iter().chain(compare.into_iter().flatten()) {
+        let line = match time_to(pts, target) {
+            Some(s) => format!("{s:.3} s"),
+            None => {
+                let best = pts.iter().min_by(|a, b| a.1.total_cmp(&b.1));
+                best.map_or_else(
+                    || "no points".to_owned(),
+                    |(s, r)| format!("not reached (best {r:.3e} at {s:.3} s)"),
+                )
+            }
+        };
+        println!("  {label:<22} {line}");
+    }
+}
+
+/// The first time the curve `pts` (`(seconds, relmse)`, by time) is at or below `target`:
+/// between the two points around the crossing, interpolated linearly in log-log (as the
+/// plot draws it); the first point's time if that one already is.
+fn time_to(pts: &[(f64, f64)], target: f64) -> Option<f64> {
+    let i = pts.iter().position(|p| p.1 <= target)?;
+    let Some(&(s0, r0)) = i.checked_sub(1).and_then(|j| pts.get(j)) else {
+        return Some(pts[i].0);
+    };
+    let (s1, r1) = pts[i];
+    if !(s0 > 0.0 && s1 > 0.0 && r0 > 0.0 && r1 > 0.0 && target > 0.0) || r0 == r1 {
+        return Some(s1);
+    }
+    let f = (target.ln() - r0.ln()) / (r1.ln() - r0.ln());
+    Some((s0.ln() + f * (s1.ln() - s0.ln())).exp())
 }
 
 /// `(output, [(seconds, relmse)])` in first-seen order.
@@ -306,4 +357,22 @@ fn read_compare(path: &Path) -> Result<Compare> {
         out.push(("Mitsuba 3 + OIDN 2.5".to_owned(), denoised));
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::time_to;
+
+    #[test]
+    fn time_to_interpolates_log_log_at_the_first_crossing() {
+        // relMSE 1e-1 at 1 s, 1e-3 at 100 s: a straight line in log-log; 1e-2 at 10 s.
+        let pts = [(1.0, 1e-1), (100.0, 1e-3), (200.0, 5e-4)];
+        let t = time_to(&pts, 1e-2).unwrap();
+        assert!((t - 10.0).abs() < 1e-9, "{t}");
+        assert_eq!(time_to(&pts, 0.5), Some(1.0), "reached at the first point");
+        assert_eq!(time_to(&pts, 1e-4), None, "never reached");
+        // A curve that goes down, up, and down again: the first crossing counts.
+        let bumpy = [(1.0, 1e-1), (2.0, 1e-2), (4.0, 1e-1), (8.0, 1e-3)];
+        assert_eq!(time_to(&bumpy, 1e-2), Some(2.0));
+    }
 }

@@ -471,7 +471,7 @@ impl Executor {
     pub fn start_at_sample(&mut self, first: u32, frames: u64) {
         self.reset_history();
         for node in &mut self.nodes {
-            node.start_at_sample(first);
+            node.start_at_sample(first, frames);
         }
         self.frames = frames;
     }

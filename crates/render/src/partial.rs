@@ -412,12 +412,14 @@ impl Exact {
 /// Merges accumulation states of disjoint sample ranges into one: per pixel and channel
 /// the exact sum of every part's compensated Kahan sum (sum − compensation), rounded once
 /// to `f32`, with the rounding error as the new compensation, so the mean is the correctly
-/// rounded mean of every frame added; the frame counts summed; the second moments combined
-/// with the pairwise formula of Chan, Golub and `LeVeque` (in `f64`, rounded once).
+/// rounded mean of every frame added; the frame counts summed; the variance's buffer
+/// combined: with `halves` (Accumulate's `variance_estimate: halves`) the second halves'
+/// sums and counts added (in `f64`, rounded once), otherwise the second moments with the
+/// pairwise formula of Chan, Golub and `LeVeque` (in `f64`, rounded once).
 ///
 /// # Errors
 /// When a state does not parse or the states are of other sizes.
-pub fn merge_accumulations(states: &[&[u8]]) -> std::result::Result<Vec<u8>, String> {
+pub fn merge_accumulations(states: &[&[u8]], halves: bool) -> std::result::Result<Vec<u8>, String> {
     let parts = states
         .iter()
         .map(|s| Accumulation::parse(s))
@@ -467,10 +469,22 @@ pub fn merge_accumulations(states: &[&[u8]]) -> std::result::Result<Vec<u8>, Str
         merged.sum.push(sum);
         merged.comp.push(comp);
         if variance {
-            merged.m2[i] = chan(&parts, i);
+            merged.m2[i] = if halves {
+                half_sums(&parts, i)
+            } else {
+                chan(&parts, i)
+            };
         }
     }
     Ok(merged.to_bytes())
+}
+
+/// The sum (rgb) and count (alpha) of every part's second half of frames together.
+fn half_sums(parts: &[Accumulation], i: usize) -> [f32; 4] {
+    let total: [f64; 4] =
+        std::array::from_fn(|c| parts.iter().map(|p| f64::from(p.m2[i][c])).sum());
+    #[expect(clippy::cast_possible_truncation, reason = "f32 state")]
+    total.map(|v| v as f32)
 }
 
 /// The second moment (per channel, and of the luminance) of every part's frames together:
@@ -618,7 +632,7 @@ mod tests {
                 })
                 .collect();
             let refs: Vec<&[u8]> = states.iter().map(Vec::as_slice).collect();
-            let merged = Accumulation::parse(&merge_accumulations(&refs).unwrap()).unwrap();
+            let merged = Accumulation::parse(&merge_accumulations(&refs, false).unwrap()).unwrap();
             let exact: f64 = xs.iter().map(|&x| f64::from(x)).sum();
             #[expect(clippy::cast_possible_truncation, reason = "rounding once")]
             let rounded = exact as f32;
@@ -677,7 +691,7 @@ mod tests {
             b
         };
         let (a, b) = (state(&xs[..2]), state(&xs[2..]));
-        let merged = Accumulation::parse(&merge_accumulations(&[&a, &b]).unwrap()).unwrap();
+        let merged = Accumulation::parse(&merge_accumulations(&[&a, &b], false).unwrap()).unwrap();
         let (_, m2) = welford(&xs);
         assert!(
             (f64::from(merged.m2[0][0]) - m2).abs() < 1e-5 * m2,

@@ -144,12 +144,31 @@ fn accumulate() -> NodeKind {
                 "variance",
                 PortType::Variance,
                 "variance of that mean per pixel (rgb per channel, alpha of the \
-                  luminance), from a Welford second moment over frames; after a single \
-                  frame, estimated over the pixel's 3×3 neighborhood (luminance: from the median \
-                  absolute deviation)",
+                  luminance), as `variance_estimate` says; after a single frame, estimated \
+                  over the pixel's 3×3 neighborhood (luminance: from the median absolute \
+                  deviation)",
             ),
         ],
-        params: vec![],
+        params: vec![ParamDef {
+            name: "variance_estimate",
+            ty: ParamType::Enum {
+                default: "halves",
+                options: &[
+                    (
+                        "halves",
+                        "from the difference of the means of two halves of the frames \
+                         (alternate frames): right for stratified (Sobol) frames too; one \
+                         degree of freedom per pixel",
+                    ),
+                    (
+                        "frames",
+                        "from the spread of the frames (Welford): assumes independent \
+                         frames, so it overstates the variance of Sobol-stratified ones",
+                    ),
+                ],
+            },
+            doc: "how the `variance` output is estimated",
+        }],
         sink: false,
         history: true,
         renders_scene: false,

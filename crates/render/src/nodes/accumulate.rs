@@ -3,10 +3,11 @@
 //! The sums are history that outlives a frame, so they live in buffers the node owns, not
 //! in the per-frame texture pool. [`NodeExec::reset`] clears them (scene or camera changed).
 //!
-//! When the `variance` output is read, a third buffer keeps Welford's second moment over
-//! frames (the Kahan sums, and so the mean, are computed exactly as without it), and the
-//! pass also writes the variance of the mean; otherwise that buffer and output are 16-byte
-//! and 1×1 stand-ins and the shader skips the work.
+//! When the `variance` output is read, a third buffer keeps what the variance of the mean
+//! is estimated from (the Kahan sums, and so the mean, are computed exactly as without it):
+//! the sum and count of the second half of the frames (`variance_estimate: halves`, every
+//! other frame), or Welford's second moment over frames (`frames`). Otherwise that buffer
+//! and output are 16-byte and 1×1 stand-ins and the shader skips the work.
 
 use lumagraph_graph::{Extent, Pass, TexFormat};
 
@@ -30,33 +31,57 @@ pub(crate) const IMPL: NodeImpl = NodeImpl::new("Accumulate", |ctx, pass, _| {
         buffers * 16 * pass.extent.pixels(),
         format!(
             "{buffers} history buffers of 16 B per pixel (sum, compensation{})",
-            if buffers == 3 { ", second moment" } else { "" }
+            if buffers == 3 {
+                ", half sum or second moment"
+            } else {
+                ""
+            }
         ),
     ))
 });
 
 crate::param_block! {
     /// Accumulate's params: a 1.0 the compiler cannot fold away (it keeps the Kahan
-    /// compensation), whether to estimate the variance, the image size, and whether to
-    /// present the history without adding to it.
+    /// compensation), how to estimate the variance (0: not at all, 1: from the frames'
+    /// spread, 2: from two halves), the image size, whether to present the history
+    /// without adding to it, and the parity of the render's frame before the first one
+    /// added (odd in a partial render that starts at an odd frame).
     pub(crate) struct AccumulateParams in "post/accumulate.wgsl" as "Params" {
         one: f32,
         variance: u32,
         size: [u32; 2],
         present: u32,
-        pad: u32,
+        parity: u32,
+    }
+}
+
+/// `params.variance` when the variance is estimated from two halves of the frames.
+const VARIANCE_HALVES: u32 = 2;
+
+/// The shader's `params.variance` for `pass`: 0 when nothing reads the variance.
+fn variance_mode(pass: &Pass) -> u32 {
+    if pass.output("variance").is_none() {
+        0
+    } else if pass.params.str("variance_estimate") == "frames" {
+        1
+    } else {
+        VARIANCE_HALVES
     }
 }
 
 pub(crate) struct Accumulate {
     kernel: Kernel,
     params: wgpu::Buffer,
-    /// Size, sum, compensation and second moment (a stand-in without `variance`).
+    /// Size, sum, compensation and the variance's buffer (a stand-in without `variance`).
     history: Option<(Extent, wgpu::Buffer, wgpu::Buffer, wgpu::Buffer)>,
     clear: bool,
-    variance: bool,
+    /// The shader's `params.variance`: 0 (no `variance` output), 1 (frames) or 2 (halves).
+    variance: u32,
     /// Write the mean of the history without adding a frame ([`NodeExec::set_present`]).
     present: bool,
+    /// 1 when the first frame added is an odd frame of the render (the path tracer's second
+    /// Sobol replicate): it then belongs to the second half.
+    parity: u32,
     /// Stand-ins for an output nothing reads (color, variance).
     unused: [PooledTexture; 2],
 }
@@ -64,10 +89,10 @@ pub(crate) struct Accumulate {
 impl Accumulate {
     pub(crate) fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
         let kernel = Kernel::new(ctx, "post/accumulate.wgsl")?;
-        let variance = pass.output("variance").is_some();
+        let variance = variance_mode(pass);
         let block = AccumulateParams {
             one: 1.0,
-            variance: u32::from(variance),
+            variance,
             ..AccumulateParams::default()
         };
         let params = uniform_buffer(ctx, "accumulate params", bytemuck::bytes_of(&block));
@@ -79,6 +104,7 @@ impl Accumulate {
             clear: true,
             variance,
             present: false,
+            parity: 0,
             unused: [
                 create(ctx, "unused accumulate color", TexFormat::Rgba32Float, one),
                 create(
@@ -112,7 +138,7 @@ impl Accumulate {
             make("accumulate compensation", bytes),
             make(
                 "accumulate second moment",
-                if self.variance { bytes } else { 16 },
+                if self.variance > 0 { bytes } else { 16 },
             ),
         ));
     }
@@ -122,10 +148,10 @@ impl Accumulate {
         // The image size rides with the params (outputs may be 1×1 stand-ins).
         let block = AccumulateParams {
             one: 1.0,
-            variance: u32::from(self.variance),
+            variance: self.variance,
             size: [extent.width, extent.height],
             present: u32::from(self.present),
-            pad: 0,
+            parity: self.parity,
         };
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&block));
@@ -219,12 +245,23 @@ impl NodeExec for Accumulate {
         Ok(())
     }
 
-    fn update(&mut self, _ctx: &GpuContext, _pass: &Pass) -> Result<()> {
+    fn update(&mut self, _ctx: &GpuContext, pass: &Pass) -> Result<()> {
+        // Another estimate keeps other numbers in the third buffer: start again.
+        let variance = variance_mode(pass);
+        if variance != self.variance {
+            self.variance = variance;
+            self.history = None;
+            self.clear = true;
+        }
         Ok(())
     }
 
     fn reset(&mut self) {
         self.clear = true;
+    }
+
+    fn start_at_sample(&mut self, _first: u32, frames: u64) {
+        self.parity = u32::from(frames % 2 == 1);
     }
 
     fn set_present(&mut self, ctx: &GpuContext, present: bool) {
@@ -235,7 +272,7 @@ impl NodeExec for Accumulate {
     }
 
     fn merge_states(&mut self, states: &[&[u8]]) -> Result<Vec<u8>> {
-        crate::partial::merge_accumulations(states)
+        crate::partial::merge_accumulations(states, self.variance == VARIANCE_HALVES)
             .map_err(|e| crate::error::RenderError::Gpu(format!("accumulation state: {e}")))
     }
 

@@ -234,9 +234,9 @@ pub trait NodeExec {
 
     /// Starts the history at sample `first` of each pixel's sequence instead of 0, as if
     /// the samples before it had been taken elsewhere: a partial render of a sample range
-    /// (`lumagraph render --samples`). Nodes whose history is not indexed by sample ignore
-    /// it.
-    fn start_at_sample(&mut self, _first: u32) {}
+    /// (`lumagraph render --samples`); `frames` took those samples. Nodes whose history is
+    /// not indexed by sample or frame ignore it.
+    fn start_at_sample(&mut self, _first: u32, _frames: u64) {}
 
     /// While `present` is set, [`NodeExec::record`] writes the node's outputs from its
     /// history as it stands, adding nothing to it: the outputs of the frame that added the

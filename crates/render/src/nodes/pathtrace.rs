@@ -294,7 +294,7 @@ impl NodeExec for PathTrace {
         Ok(())
     }
 
-    fn start_at_sample(&mut self, first: u32) {
+    fn start_at_sample(&mut self, first: u32, _frames: u64) {
         self.samples = first;
     }
 
