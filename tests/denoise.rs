@@ -118,7 +118,7 @@ fn gpu_filter_matches_cpu_mirror() {
             &read("gb.depth"),
             &DenoiseParams {
                 iterations: 5,
-                sigma_color: 8.0,
+                sigma_color: 4.0,
                 sigma_normal: 0.02,
                 sigma_depth: 0.5,
                 variance_guided: guided,

@@ -29,7 +29,8 @@ struct Frame {
     sampler: u32,
     // STRATEGY_MIS, STRATEGY_LIGHT or STRATEGY_BSDF: how direct light is estimated.
     strategy: u32,
-    pad2: u32,
+    // 1 or 2 Sobol replicates, alternating by frame (sampler.wgsl).
+    replicates: u32,
     // The pixels this pass renders: left, top, width and height in the whole image (all of
     // it unless the render is tiled); the output holds them from (0, 0).
     window: vec4<u32>,
@@ -473,6 +474,7 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
             frame.settings.seed,
             frame.sampler,
             n,
+            frame.replicates,
         );
         var l = trace_path(pixel);
         if frame.firefly_clamp > 0.0 {

@@ -10,13 +10,15 @@
 // does with the independent sampler. Sobol indices run in blocks of 2^16 samples; each
 // block has a seed of its own.
 //
-// Frames alternate between two independent replicates of these sequences (seeds of their
-// own): even frames take their samples from the first, odd frames from the second, each
-// replicate's samples in order. So the mean of the even frames and that of the odd ones
-// are independent, each from stratified points, and Accumulate's variance from the two
-// halves is right for Sobol points (the spread of the frames is not: stratified frames are
-// negatively correlated). Any even number of frames of the same total splits the samples
-// the same way: 2 frames of 8 samples or 16 of 1 take the same points and numbers.
+// With two replicates (`PathTrace.replicates` 2), frames alternate between two independent
+// replicates of these sequences (seeds of their own): even frames take their samples from
+// the first, odd frames from the second, each replicate's samples in order. So the mean of
+// the even frames and that of the odd ones are independent, each from stratified points,
+// and Accumulate's variance from the two halves is right for Sobol points (the spread of
+// the frames is not: stratified frames are negatively correlated). Any even number of
+// frames of the same total then splits the samples the same way: 2 frames of 8 samples or
+// 16 of 1 take the same points and numbers. With one (the default), every frame goes on
+// with the one sequence: a little less noise, and no independent halves.
 #import "common/rng.wgsl"
 #import "common/sobol.wgsl"
 
@@ -35,19 +37,25 @@ var<private> sampler_index: u32;
 var<private> sampler_seed: u32;
 
 // `sample` is the index of the pixel's sample over the whole render, `per_frame` the
-// samples each frame takes.
-fn sampler_init(pixel: u32, sample: u32, seed: u32, kind: u32, per_frame: u32) {
-    let n = max(per_frame, 1u);
-    let frame = sample / n;
-    // The replicate, and the index within it.
-    let replicate = frame & 1u;
-    let index = (frame >> 1u) * n + sample % n;
-    // The PCG stream too is the replicate's sample's (the same as `sample` at one sample a
-    // frame), so the frames' split does not change the numbers.
-    rng_init(pixel, index * 2u + replicate, seed);
+// samples each frame takes, `replicates` 1 or 2.
+fn sampler_init(pixel: u32, sample: u32, seed: u32, kind: u32, per_frame: u32, replicates: u32) {
+    var index = sample;
+    var stream = sample;
+    var block = sample >> 16u;
+    if replicates == 2u {
+        let n = max(per_frame, 1u);
+        let frame = sample / n;
+        // The replicate, and the index within it.
+        let replicate = frame & 1u;
+        index = (frame >> 1u) * n + sample % n;
+        // The PCG stream too is the replicate's sample's (the same as `sample` at one
+        // sample a frame), so the frames' split does not change the numbers.
+        stream = index * 2u + replicate;
+        block = ((index >> 16u) << 1u) | replicate;
+    }
+    rng_init(pixel, stream, seed);
     sampler_sobol = kind == SAMPLER_SOBOL;
     sampler_index = index & 0xffffu;
-    let block = ((index >> 16u) << 1u) | replicate;
     sampler_seed = pcg_hash(pixel ^ pcg_hash(block ^ pcg_hash(seed ^ 0x3c6ef372u)));
 }
 

@@ -1,7 +1,7 @@
 // The path tracer's sampler, evaluated for a buffer of queries, so tests can check it:
 // mode 0: x = sobol_owen(index = a, dimension = b, seed = c);
-// mode 1: the 2D point of pair d for pixel a, sample b, seed c (sample_2d, Sobol sampler),
-// one sample a frame (so even samples are the first replicate's, odd ones the second's).
+// mode 1: the 2D point of pair d for pixel a, sample b, seed c (sample_2d, Sobol sampler,
+// one replicate).
 #import "pathtrace/sampler.wgsl"
 
 struct Params {
@@ -23,7 +23,7 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     if params.mode == 0u {
         points[i] = vec2f(sobol_owen(q.x, q.y, q.z), 0.0);
     } else {
-        sampler_init(q.x, q.y, q.z, SAMPLER_SOBOL, 1u);
+        sampler_init(q.x, q.y, q.z, SAMPLER_SOBOL, 1u, 1u);
         points[i] = sample_2d(q.w);
     }
 }

@@ -21,8 +21,7 @@ pub enum SamplerQuery {
         seed: u32,
     },
     /// The 2D point of dimension pair `pair` of sample `sample` in pixel `pixel` under the
-    /// render seed `seed`, as the path tracer's Sobol sampler draws it with one sample a
-    /// frame (even samples from the first replicate, odd ones from the second).
+    /// render seed `seed`, as the path tracer's Sobol sampler draws it (one replicate).
     Pixel {
         /// Pixel index (`y * width + x`).
         pixel: u32,

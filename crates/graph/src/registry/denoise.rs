@@ -64,7 +64,7 @@ fn denoise() -> NodeKind {
             ParamDef {
                 name: "sigma_color",
                 ty: ParamType::Float {
-                    default: 8.0,
+                    default: 4.0,
                     min: 0.0,
                     max: 1000.0,
                 },

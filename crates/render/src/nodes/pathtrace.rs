@@ -60,7 +60,8 @@ crate::param_block! {
         sampler: u32,
         /// The `strategy` param's option index.
         strategy: u32,
-        pad2: u32,
+        /// The `replicates` param: 1 or 2 Sobol replicates, alternating by frame.
+        replicates: u32,
         /// The pixels this pass renders: left, top, width and height in the whole image
         /// (all of it unless the render is tiled).
         window: [u32; 4],
@@ -95,6 +96,8 @@ pub(crate) struct PathTrace {
     /// `STRATEGY_MIS` (0), `STRATEGY_LIGHT` (1) or `STRATEGY_BSDF` (2) in
     /// `pathtrace/pathtrace.wgsl`.
     strategy: u32,
+    /// Sobol replicates (1 or 2), alternating by frame.
+    replicates: u32,
     /// Where the pass's image lies in the whole image (tiled renders).
     origin: [u32; 2],
 }
@@ -164,6 +167,7 @@ impl PathTrace {
             firefly_clamp: 0.0,
             sampler: 0,
             strategy: 0,
+            replicates: 1,
             origin: [0, 0],
         };
         node.update(ctx, pass)?;
@@ -183,7 +187,7 @@ impl PathTrace {
             firefly_clamp: self.firefly_clamp,
             sampler: self.sampler,
             strategy: self.strategy,
-            pad2: 0,
+            replicates: self.replicates,
             window: [self.origin[0], self.origin[1], extent.width, extent.height],
         }
     }
@@ -197,6 +201,7 @@ impl NodeExec for PathTrace {
         self.firefly_clamp = clamp;
         self.sampler = crate::params::enum_index(pass, "sampler")?;
         self.strategy = crate::params::enum_index(pass, "strategy")?;
+        self.replicates = u32::try_from(pass.params.int("replicates")).unwrap_or(1);
         Ok(())
     }
 
