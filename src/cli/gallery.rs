@@ -2,7 +2,8 @@
 //! graph, and `gallery.md`, the page that shows them. Post nodes run on the Venice map
 //! (resized to 384×192, the test chart as a second input) with their registry `example`
 //! params and are tone-mapped (`agx`) for display; the nodes of a path-tracing graph show
-//! their first output on the Cornell box after 64 frames of `graphs/pathtrace_denoise.ron`;
+//! their first output on the Cornell box after 64 frames of `graphs/pathtrace_denoise.ron`
+//! (or of `graphs/pathtrace_regression.ron`, for the kinds only it has);
 //! a source that reads no file shows its first output with its `example` params.
 
 use std::fmt::Write as _;
@@ -18,7 +19,11 @@ use anyhow::{Context, Result, bail};
 const SOURCE: &str = "assets/hdri/venice_sunset_1k.hdr";
 const SECOND: &str = "assets/test_chart.exr";
 const SCENE: &str = "assets/cornell.ron";
-const RENDER_GRAPH: &str = "graphs/pathtrace_denoise.ron";
+/// The path-tracing graphs, searched in order for a node of the kind shown.
+const RENDER_GRAPHS: [&str; 2] = [
+    "graphs/pathtrace_denoise.ron",
+    "graphs/pathtrace_regression.ron",
+];
 const RENDER_FRAMES: u32 = 64;
 
 /// A node with `params`.
@@ -61,17 +66,20 @@ fn recipe(
         .iter()
         .all(|i| i.accepts.contains(&PortType::HdrColor));
     if kind.renders_scene || kind.history || !hdr_in {
-        // A node of the path-tracing graph: its first output there.
-        let mut g = Graph::load(&root.join(RENDER_GRAPH))?;
-        g.remove_sinks(registry);
-        let n = g
-            .nodes
-            .iter()
-            .find(|n| n.kind == kind.name)
-            .with_context(|| format!("{RENDER_GRAPH} has no {} node to show", kind.name))?;
-        let out = kind.outputs.first().context("no output")?;
-        let port = format!("{}.{}", n.id, out.name);
-        return Ok((g, port, out.ty, RENDER_FRAMES));
+        // A node of a path-tracing graph: its first output there.
+        for path in RENDER_GRAPHS {
+            let mut g = Graph::load(&root.join(path))?;
+            g.remove_sinks(registry);
+            if let Some(n) = g.nodes.iter().find(|n| n.kind == kind.name) {
+                let out = kind.outputs.first().context("no output")?;
+                let port = format!("{}.{}", n.id, out.name);
+                return Ok((g, port, out.ty, RENDER_FRAMES));
+            }
+        }
+        bail!(
+            "no graph of {RENDER_GRAPHS:?} has a {} node to show",
+            kind.name
+        );
     }
     let mut g = sources();
     let reads_file = kind
@@ -186,7 +194,8 @@ pub fn markdown(registry: &Registry) -> String {
          (do not edit: run it again). Post nodes run on the Venice map at 384×192 (the test \
          chart is a second input) with the params listed, tone-mapped with AgX for display; \
          the nodes of the path-tracing graph show their first output on the Cornell box \
-         after 64 frames of `graphs/pathtrace_denoise.ron`.\n",
+         after 64 frames of `graphs/pathtrace_denoise.ron` (`RegressionDenoise`: of \
+         `graphs/pathtrace_regression.ron`).\n",
     );
     let mut categories: Vec<_> = registry.kinds().iter().map(|k| k.category).collect();
     categories.sort();

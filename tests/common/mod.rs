@@ -351,3 +351,45 @@ pub fn cli(args: &[&str]) -> (bool, String, String) {
         String::from_utf8_lossy(&o.stderr).into_owned(),
     )
 }
+
+/// `source` → `Accumulate` (`acc`) → a denoiser of `kind` (`dn`, with `params`), guided by
+/// `GBuffer` (`gb`) and, when `variance`, by `acc`'s variance.
+pub fn filter_graph(
+    kind: &str,
+    source: lumagraph::graph::Node,
+    params: &[(&str, lumagraph::graph::ParamValue)],
+    variance: bool,
+) -> lumagraph::graph::Graph {
+    use lumagraph::graph::{Edge, Node};
+    let mut graph = denoise_graph(source, params);
+    if let Some(dn) = graph.nodes.iter_mut().find(|n| n.id == "dn") {
+        *dn = params
+            .iter()
+            .fold(Node::new("dn", kind), |n, (k, v)| n.with(k, v.clone()));
+    }
+    if !variance {
+        graph
+            .edges
+            .retain(|e| e != &Edge::new("acc.variance", "dn.variance"));
+    }
+    graph
+}
+
+/// The environment-lit mesh scene (`assets/bench/mesh_env.ron`) at `size`, after making its
+/// mesh (`assets/bench/blob.obj`, not in git) with `scripts/bench/mesh_env.py` when missing.
+pub fn mesh_env_scene(size: Option<u32>) -> std::sync::Arc<lumagraph::scene::GpuScene> {
+    let blob = repo("assets/bench/blob.obj");
+    if !blob.exists() {
+        // Written beside and renamed, so tests making it at once never read half a file.
+        let tmp = blob.with_extension(format!("obj.{}", std::process::id()));
+        let ok = std::process::Command::new("python3")
+            .arg(repo("scripts/bench/mesh_env.py"))
+            .arg("make")
+            .arg(&tmp)
+            .status()
+            .is_ok_and(|s| s.success());
+        assert!(ok, "python3 scripts/bench/mesh_env.py make failed");
+        std::fs::rename(&tmp, &blob).unwrap();
+    }
+    gpu_scene("assets/bench/mesh_env.ron", size)
+}

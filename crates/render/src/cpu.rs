@@ -33,6 +33,9 @@ impl Image {
     }
 }
 
+mod regression;
+pub use regression::{RegressionParams, regression};
+
 type V3 = [f32; 3];
 
 fn rgb(p: [f32; 4]) -> V3 {

@@ -73,6 +73,7 @@ pub const BLOCKS: &[BlockLayout] = &[
     <crate::nodes::tonemap::TonemapParams as ParamBlock>::LAYOUT,
     <crate::nodes::accumulate::AccumulateParams as ParamBlock>::LAYOUT,
     <crate::nodes::denoise::DenoiseParams as ParamBlock>::LAYOUT,
+    <crate::nodes::regression::RegressionParams as ParamBlock>::LAYOUT,
     <crate::nodes::pathtrace::Frame as ParamBlock>::LAYOUT,
     <crate::nodes::gbuffer::RasterCamera as ParamBlock>::LAYOUT,
     <crate::nodes::blur::BlurParams as ParamBlock>::LAYOUT,

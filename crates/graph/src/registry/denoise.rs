@@ -4,7 +4,7 @@ use super::{COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, Reac
 use crate::types::{ParamType, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
-    vec![denoise()]
+    vec![denoise(), regression()]
 }
 
 fn denoise() -> NodeKind {
@@ -109,5 +109,105 @@ fn denoise() -> NodeKind {
             let n = u32::try_from(p.int("iterations")).unwrap_or(0).min(16);
             2 * ((1 << n) - 1)
         }),
+    }
+}
+
+fn regression() -> NodeKind {
+    NodeKind {
+        name: "RegressionDenoise",
+        category: Category::Denoise,
+        doc: "Per-pixel first-order feature regression (after NFOR, Bitterli et al. 2016): \
+              around each pixel, the color divided by the albedo is fitted by weighted least \
+              squares as an affine function of the screen offset, the relative depth change, \
+              the normal and the albedo over a (2 `radius` + 1)² window, and the fit at the pixel, times \
+              the albedo, is the output. Diffuse light changes smoothly with the normal, so \
+              curved surfaces are averaged where Denoise's normal edge-stop refuses to. \
+              Pixels within one pixel of a light's edge, whose color mixes the light and \
+              its surroundings, are passed through. Slower than Denoise; three images are \
+              the memory it adds.",
+        inputs: vec![
+            InputDef::new(
+                "color",
+                COLOR_TYPES,
+                "noisy linear color (e.g. Accumulate.color)",
+            ),
+            InputDef::new(
+                "albedo",
+                &[PortType::Albedo],
+                "first-hit albedo (GBuffer or PathTrace); alpha 2 marks emitters",
+            ),
+            InputDef::new(
+                "normal",
+                &[PortType::Normal],
+                "first-hit world-space normal",
+            ),
+            InputDef::new(
+                "depth",
+                &[PortType::Depth],
+                "first-hit distance along the camera ray (0: nothing hit, passed through)",
+            ),
+            InputDef::new(
+                "variance",
+                &[PortType::Variance],
+                "variance of the color's mean (Accumulate.variance), for the luminance \
+                 weight; without it that weight is off",
+            )
+            .optional(),
+        ],
+        outputs: vec![OutputDef::new(
+            "color",
+            PortType::HdrColor,
+            "filtered linear color",
+        )],
+        params: vec![
+            ParamDef::int(
+                "radius",
+                10,
+                [1, 32],
+                "window radius in pixels; the spatial weight is a Gaussian of σ = radius / 2",
+            ),
+            ParamDef::int(
+                "stride",
+                1,
+                [1, 8],
+                "distance between the window's taps (2 reads a quarter of the pixels)",
+            ),
+            ParamDef::float(
+                "sigma_normal",
+                0.5,
+                [0.0, 10.0],
+                "normal tolerance: weight exp(-(1 - n_p·n_q) / sigma_normal); the fit \
+                 handles smooth normal changes, this only parts creases",
+            ),
+            ParamDef::float(
+                "sigma_depth",
+                0.05,
+                [0.0, 10.0],
+                "depth tolerance, relative to the pixel's depth, of a tap's distance from \
+                 the pixel's tangent plane (parts silhouettes)",
+            ),
+            ParamDef::float(
+                "sigma_color",
+                3.0,
+                [0.0, 1000.0],
+                "luminance tolerance: a tap whose 5×5 mean luminance differs from the \
+                 pixel's by more than the noise of the two means is weighted down, in units \
+                 of that noise's standard deviation (needs `variance`; 0 = off)",
+            ),
+            ParamDef::float(
+                "ridge",
+                1e-3,
+                [0.0, 1.0],
+                "ridge term, relative to each feature's spread in the window",
+            ),
+        ],
+        sink: false,
+        history: false,
+        renders_scene: false,
+        shader: None,
+        example: Vec::new(),
+        // The window's taps, their 5×5 guide (2 more) and the light-boundary test of the
+        // guide's pixels (1 more).
+        reach: Reach::Within(|p| u32::try_from(p.int("radius")).unwrap_or(0) + 3),
     }
 }

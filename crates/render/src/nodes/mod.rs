@@ -12,6 +12,7 @@ pub mod lut;
 pub mod output;
 pub(crate) mod pathtrace;
 pub mod post_filter;
+pub(crate) mod regression;
 pub(crate) mod tonemap;
 
 use std::path::{Path, PathBuf};
@@ -361,6 +362,7 @@ pub static IMPLEMENTATIONS: &[NodeImpl] = &[
     accumulate::IMPL,
     gbuffer::IMPL,
     denoise::IMPL,
+    regression::IMPL,
     blur::IMPL,
     bloom::IMPL,
     lut::IMPL,
