@@ -10,7 +10,7 @@ goes into tests/reference/denoise/:
                       image, the columns of tests/reference/cornell_converge.csv (what
                       `lumagraph converge --compare` reads)
   baseline.csv        per scene and spp (4, 16, 64): relMSE of lumagraph's raw accumulation, of
-                      its a-trous Denoise, of OIDN 2.5 (RT filter, hdr, albedo + normal) on the
+                      its a-trous Denoise and its RegressionDenoise, of OIDN 2.5 (RT filter, hdr, albedo + normal) on the
                       same accumulation with lumagraph's G-buffer albedo and normal (cleanAux;
                       and with cleanAux off, OIDN prefiltering them), of OIDN on the colour
                       alone, and OIDN's CPU seconds per frame
@@ -326,21 +326,22 @@ def step_inputs(names, a):
         for spp in SPPS:
             with tempfile.TemporaryDirectory() as tmp:
                 lumagraph_render(a.lumagraph, INPUTS_GRAPH, SUITE[name]["scene"], spp, tmp)
-                color, denoised, albedo, normal = (
+                color, denoised, regressed, albedo, normal = (
                     read_exr(os.path.join(tmp, f + ".exr"))
-                    for f in ("color", "denoised", "albedo", "normal"))
+                    for f in ("color", "denoised", "regressed", "albedo", "normal"))
             den, seconds = timed_oidn(color, albedo, normal, 3)
             noaov = oidn(color)
             prefiltered = oidn(color, albedo, normal, clean_aux=False)
             r = {"scene": name, "spp": spp,
                  "raw_relmse": mk.relmse(color, ref),
                  "atrous_relmse": mk.relmse(denoised, ref),
+                 "regression_relmse": mk.relmse(regressed, ref),
                  "oidn_relmse": mk.relmse(den, ref),
                  "oidn_prefilter_relmse": mk.relmse(prefiltered, ref),
                  "oidn_noaov_relmse": mk.relmse(noaov, ref),
                  "oidn_seconds": seconds}
             print(f"  {name} {spp} spp: raw {r['raw_relmse']:.3e}, a-trous "
-                  f"{r['atrous_relmse']:.3e}, OIDN {r['oidn_relmse']:.3e} (aux prefiltered "
+                  f"{r['atrous_relmse']:.3e}, regression {r['regression_relmse']:.3e}, OIDN {r['oidn_relmse']:.3e} (aux prefiltered "
                   f"{r['oidn_prefilter_relmse']:.3e}, no AOVs "
                   f"{r['oidn_noaov_relmse']:.3e}), OIDN {seconds:.3f} s", flush=True)
             rows.append(r)
@@ -348,7 +349,7 @@ def step_inputs(names, a):
     rows.sort(key=lambda r: (order.index(r["scene"]), int(r["spp"])))
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
-        cols = ["scene", "spp", "raw_relmse", "atrous_relmse", "oidn_relmse",
+        cols = ["scene", "spp", "raw_relmse", "atrous_relmse", "regression_relmse", "oidn_relmse",
                 "oidn_prefilter_relmse", "oidn_noaov_relmse", "oidn_seconds"]
         w.writerow(cols)
         for r in rows:
@@ -358,7 +359,8 @@ def step_inputs(names, a):
         "file": rel(path),
         "lumagraph": f"{INPUTS_GRAPH} (the default graph {DEFAULT_GRAPH} with its inputs as "
                      f"files), `lumagraph render --spp N`, the scene's seed ({SEED}); raw: "
-                     "Accumulate.color, atrous: Denoise.color",
+                     "Accumulate.color, atrous: Denoise.color, regression: "
+                     "RegressionDenoise.color",
         "oidn": "OIDN 2.5.1 (pyoidn), RT filter, hdr, quality high, CPU; with lumagraph's "
                 "GBuffer albedo and normal (first hit, noise-free: cleanAux) on the same "
                 "accumulation; oidn_prefilter: the same with cleanAux off (OIDN prefilters "
