@@ -42,7 +42,7 @@ Usage (from the repository root; Mitsuba 3.9.1 and pyoidn 2.5 in a venv):
   .venv-mitsuba/bin/python scripts/denoise/suite.py --lumagraph path/to/lumagraph --spp 8192
 
 The converge plots in docs/denoise.md come from
-  lumagraph converge graphs/pathtrace_denoise.ron --scene SCENE \
+  lumagraph converge graphs/denoise_inputs.ron --scene SCENE \
     --reference tests/reference/denoise/NAME_ref.exr --seconds 60 \
     --compare tests/reference/denoise/NAME_converge.csv --out converge_NAME
 """
@@ -403,14 +403,15 @@ def step_timing(names, a):
 
 
 def step_converge(names, a):
-    """`lumagraph converge` per scene: the plot (docs/images/denoise_NAME.png) and a check
-    that baseline.csv's raw and a-trous figures are what converge scores at those spp."""
+    """`lumagraph converge` per scene of the inputs graph (raw, a-trous and regression curves):
+    the plot (docs/images/denoise_NAME.png) and a check that baseline.csv's figures are what
+    converge scores at those spp."""
     import shutil
     with open(os.path.join(OUT, "baseline.csv")) as f:
         base = list(csv.DictReader(f))
     for name in names:
         out = os.path.join(a.converge_out, "converge_" + name)
-        cmd = [a.lumagraph, "converge", DEFAULT_GRAPH, "--scene", SUITE[name]["scene"],
+        cmd = [a.lumagraph, "converge", INPUTS_GRAPH, "--scene", SUITE[name]["scene"],
                "--reference", rel(ref_path(name)), "--seconds", str(a.seconds), "--out", out]
         if os.path.exists(converge_csv(name)):
             cmd += ["--compare", rel(converge_csv(name))]
@@ -428,7 +429,8 @@ def step_converge(names, a):
             if r["scene"] != name:
                 continue
             spp = int(r["spp"])
-            for col, port in (("raw_relmse", "accumulate"), ("atrous_relmse", "denoise")):
+            for col, port in (("raw_relmse", "accumulate"), ("atrous_relmse", "denoise"),
+                              ("regression_relmse", "regression")):
                 if (port, spp) not in conv:
                     print(f"  {name}: converge stopped before {spp} spp")
                     continue
