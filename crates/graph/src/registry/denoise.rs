@@ -7,6 +7,35 @@ pub(super) fn kinds() -> Vec<NodeKind> {
     vec![denoise(), regression()]
 }
 
+/// The inputs of a denoiser guided by the G-buffer: the noisy color, the first hit's
+/// albedo, normal and depth, and optionally the variance of the color's mean (`variance`
+/// says what the kind does with it).
+fn guided_inputs(variance: &'static str) -> Vec<InputDef> {
+    vec![
+        InputDef::new(
+            "color",
+            COLOR_TYPES,
+            "noisy linear color (e.g. Accumulate.color)",
+        ),
+        InputDef::new(
+            "albedo",
+            &[PortType::Albedo],
+            "first-hit albedo (GBuffer or PathTrace); alpha 2 marks emitters",
+        ),
+        InputDef::new(
+            "normal",
+            &[PortType::Normal],
+            "first-hit world-space normal",
+        ),
+        InputDef::new(
+            "depth",
+            &[PortType::Depth],
+            "first-hit distance along the camera ray (0: nothing hit)",
+        ),
+        InputDef::new("variance", &[PortType::Variance], variance).optional(),
+    ]
+}
+
 fn denoise() -> NodeKind {
     NodeKind {
         name: "Denoise",
@@ -17,35 +46,10 @@ fn denoise() -> NodeKind {
               multiplied back after; each tap is weighted by luminance (scaled by the \
               pixel's standard deviation when `variance_guided`), normal and depth \
               differences. Two ping-pong images are the only memory it adds.",
-        inputs: vec![
-            InputDef::new(
-                "color",
-                COLOR_TYPES,
-                "noisy linear color (e.g. Accumulate.color)",
-            ),
-            InputDef::new(
-                "albedo",
-                &[PortType::Albedo],
-                "first-hit albedo (GBuffer or PathTrace)",
-            ),
-            InputDef::new(
-                "normal",
-                &[PortType::Normal],
-                "first-hit world-space normal",
-            ),
-            InputDef::new(
-                "depth",
-                &[PortType::Depth],
-                "first-hit distance along the camera ray",
-            ),
-            InputDef::new(
-                "variance",
-                &[PortType::Variance],
-                "variance of the color's mean (Accumulate.variance); without it the \
-                 luminance tolerance is the fixed one, as with `variance_guided` off",
-            )
-            .optional(),
-        ],
+        inputs: guided_inputs(
+            "variance of the color's mean (Accumulate.variance); without it the luminance \
+             tolerance is the fixed one, as with `variance_guided` off",
+        ),
         outputs: vec![OutputDef::new(
             "color",
             PortType::HdrColor,
@@ -125,35 +129,10 @@ fn regression() -> NodeKind {
               Pixels within one pixel of a light's edge, whose color mixes the light and \
               its surroundings, are passed through. Slower than Denoise; three images are \
               the memory it adds.",
-        inputs: vec![
-            InputDef::new(
-                "color",
-                COLOR_TYPES,
-                "noisy linear color (e.g. Accumulate.color)",
-            ),
-            InputDef::new(
-                "albedo",
-                &[PortType::Albedo],
-                "first-hit albedo (GBuffer or PathTrace); alpha 2 marks emitters",
-            ),
-            InputDef::new(
-                "normal",
-                &[PortType::Normal],
-                "first-hit world-space normal",
-            ),
-            InputDef::new(
-                "depth",
-                &[PortType::Depth],
-                "first-hit distance along the camera ray (0: nothing hit, passed through)",
-            ),
-            InputDef::new(
-                "variance",
-                &[PortType::Variance],
-                "variance of the color's mean (Accumulate.variance), for the luminance \
-                 weight; without it that weight is off",
-            )
-            .optional(),
-        ],
+        inputs: guided_inputs(
+            "variance of the color's mean (Accumulate.variance), for the luminance weight; \
+             without it that weight is off",
+        ),
         outputs: vec![OutputDef::new(
             "color",
             PortType::HdrColor,
