@@ -197,7 +197,7 @@ enum Command {
     /// accumulation and every Denoise output against a reference (RMSE, relMSE, SSIM);
     /// writes a CSV and a log-log plot.
     #[command(
-        after_help = "Example:\n  lumagraph converge graphs/pathtrace_denoise.ron --scene assets/cornell.ron \\\n    --reference tests/reference/cornell_ref.exr --seconds 10 \\\n    --compare tests/reference/cornell_converge.csv --out converge"
+        after_help = "Example:\n  lumagraph converge graphs/pathtrace_denoise.ron --scene assets/cornell.ron \\\n    --reference tests/reference/cornell_ref.exr --seconds 10 \\\n    --compare tests/reference/cornell_converge.csv --out converge\n  lumagraph converge graphs/pathtrace.ron --scene assets/cornell.ron \\\n    --reference tests/reference/cornell_ref.exr --seconds 30 \\\n    --variant \"adaptive 0.03:pathtrace.adaptive_error=0.03\" --out converge"
     )]
     Converge {
         /// The graph file (RON); its Output nodes are ignored.
@@ -228,6 +228,10 @@ enum Command {
         /// Override a param: `node.param=value`.
         #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
         overrides: Vec<String>,
+        /// Also measure the graph with these overrides (`;` between them), as a curve named
+        /// LABEL; the runs take turns at each checkpoint, so a busy machine slows them alike.
+        #[arg(long = "variant", value_name = "LABEL:NODE.PARAM=VALUE[;...]")]
+        variants: Vec<String>,
     },
     /// Write the resolved scene for other renderers: scene.json (camera, materials, spheres,
     /// lights, environment, settings) and OBJ files of its triangles; scripts/references/
@@ -606,6 +610,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             target_relmse,
             out,
             overrides,
+            variants,
         } => converge::run(&converge::Args {
             graph: &graph,
             scene: &scene,
@@ -616,6 +621,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             target_relmse,
             out: &out,
             overrides: &overrides,
+            variants: &variants,
             library,
         }),
         Command::Export { scene, out } => {

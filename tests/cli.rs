@@ -542,6 +542,8 @@ fn plan_lists_shader_features_for_the_scene() {
         "environment",
         "metal lobe",
         "glass lobe",
+        "rough diffuse (EON)",
+        "participating media",
         "first-hit AOVs",
     ] {
         assert!(
@@ -549,6 +551,19 @@ fn plan_lists_shader_features_for_the_scene() {
             "{f} not listed as left out:\n{stdout}"
         );
     }
+    let o = lumagraph(&[
+        "plan",
+        "graphs/pathtrace.ron",
+        "--scene",
+        "assets/diffuse_roughness.ron",
+    ]);
+    let (rough, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    let compiled_in = rough.split("left out:\n").next().unwrap();
+    assert!(
+        compiled_in.contains("8 materials with diffuse_roughness > 0"),
+        "{rough}"
+    );
     assert!(
         stdout.contains("compiled in:\n    inline intersection"),
         "{stdout}"

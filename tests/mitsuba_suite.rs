@@ -178,6 +178,8 @@ suite!(
     env_map_mirror,
     gltf_lights,
     layer,
+    media_absorbing_glass,
+    media_scattering,
     punctual_lights,
     thin_lens,
 );

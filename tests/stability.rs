@@ -151,6 +151,49 @@ fn white_furnace_every_lobe_every_roughness() {
     );
 }
 
+/// The rough diffuse base (EON) at diffuse roughness 0, 0.25, 0.5 and 1, alone (`specular:
+/// 0`) and under the dielectric layer's specular at roughness 0 and 0.5: white within 1 %.
+#[test]
+fn white_furnace_rough_diffuse() {
+    let mut failures = Vec::new();
+    let mut report = String::new();
+    for rd in ["0.0", "0.25", "0.5", "1.0"] {
+        let cases = [
+            (
+                "diffuse",
+                format!("(base_color: (1, 1, 1), diffuse_roughness: {rd}, specular: 0.0)"),
+            ),
+            (
+                "layer roughness 0",
+                format!(
+                    "(base_color: (1, 1, 1), diffuse_roughness: {rd}, roughness: 0.0, specular: 0.5)"
+                ),
+            ),
+            (
+                "layer roughness 0.5",
+                format!(
+                    "(base_color: (1, 1, 1), diffuse_roughness: {rd}, roughness: 0.5, specular: 0.5)"
+                ),
+            ),
+        ];
+        for (name, material) in cases {
+            let Some(mean) = furnace_mean(&material) else {
+                return;
+            };
+            report += &format!("{name} diffuse_roughness {rd}: {mean:.4}\n");
+            if (mean - 1.0).abs() > 0.01 {
+                failures.push(format!("{name} diffuse_roughness {rd}: mean {mean:.4}"));
+            }
+        }
+    }
+    eprint!("{report}");
+    assert!(
+        failures.is_empty(),
+        "furnace not white:\n{}",
+        failures.join("\n")
+    );
+}
+
 #[test]
 fn glass_of_ior_one_vanishes() {
     // IOR 1 (and 1.0001): the sphere bends nothing, so each pixel is exactly the

@@ -217,7 +217,7 @@ impl Gltf {
             .collect();
         let list = |v: &[String]| v.join(",");
         let json = format!(
-            r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["KHR_materials_transmission","KHR_materials_ior","KHR_materials_specular","KHR_materials_emissive_strength"],
+            r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["KHR_materials_transmission","KHR_materials_ior","KHR_materials_specular","KHR_materials_emissive_strength","KHR_materials_volume"],
 "scene":0,"scenes":[{{"nodes":[{}]}}],"nodes":[{}],"meshes":[{}],"materials":[{}],
 "textures":[{}],"images":[{}],"samplers":[{}],"accessors":[{}],"bufferViews":[{}],
 "buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{}"}}]}}"#,
@@ -523,6 +523,40 @@ fn khr_transmission_ior_specular_and_emissive_strength_are_read() {
 }
 
 #[test]
+fn khr_materials_volume_is_an_absorbing_medium() {
+    let dir = temp();
+    let volume = |thickness: f32| {
+        format!(
+            r#"{{"name":"v{thickness}","extensions":{{"KHR_materials_transmission":{{"transmissionFactor":1}},
+            "KHR_materials_volume":{{"thicknessFactor":{thickness},"attenuationDistance":2,"attenuationColor":[0.5,0.25,1]}}}}}}"#
+        )
+    };
+    let gltf = Gltf {
+        images: Vec::new(),
+        materials: vec![volume(1.0), volume(0.0)],
+        quads: vec![Quad::at(0.0, 0.0, 0), Quad::at(1.0, 0.0, 1)],
+    }
+    .write(dir.path(), "volume");
+    let scene = Scene::load(&scene_file(
+        dir.path(),
+        &gltf,
+        Vec3::Z * 3.0,
+        Vec3::ZERO,
+        (8, 8),
+        "",
+    ))
+    .unwrap();
+    // sigma_a = -ln(color) / distance; a thickness of 0 is thin-walled: no volume.
+    let m = scene.materials[0]
+        .medium
+        .expect("a medium from KHR_materials_volume");
+    let want = Vec3::new(0.5f32.ln(), 0.25f32.ln(), 0.0) / -2.0;
+    assert!((m.sigma_a - want).abs().max_element() < 1e-6, "{m:?}");
+    assert_eq!(m.sigma_s, Vec3::ZERO);
+    assert_eq!(scene.materials[1].medium, None);
+}
+
+#[test]
 fn missing_or_broken_images_name_the_material_and_image() {
     let dir = temp();
     let mut g = Gltf {
@@ -577,6 +611,7 @@ fn plan_lists_textures_for_textured_scenes_only() {
         specialize: true,
         cpu_adapter: true,
         aovs: false,
+        adaptive: false,
         data_in_buffers: false,
     };
     let on = |path: &Path| {
@@ -1285,6 +1320,7 @@ fn small_scenes_are_inlined_on_cpu_adapters_only() {
             specialize: true,
             cpu_adapter,
             aovs: false,
+            adaptive: false,
             data_in_buffers: false,
         };
         let f = features(&scene, opts);

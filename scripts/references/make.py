@@ -29,6 +29,12 @@ Materials map one to one or the scene is refused (never an approximation in sile
                                                       plastic / roughplastic instead
 Rough lobes need `multiscatter: false` to be the same model as Mitsuba's (which has no
 multiple-scattering compensation); a rough lobe with it on is flagged too.
+
+Media: a material's `medium` (or `attenuation_*`, exported as a medium of sigma_s 0) becomes
+the shape's `interior`, a `homogeneous` medium (sigma_t = sigma_a + sigma_s, albedo =
+sigma_s / sigma_t, `hg` phase function); an `index_matched` material becomes the `null`
+BSDF. A scene with a medium renders with `volpath` instead of `path` (the same depth
+counting: medium scattering counts as a bounce, crossing a null boundary does not).
 """
 import argparse
 import json
@@ -61,6 +67,8 @@ def bsdf(m):
     notes = []
     if m["textured"]:
         raise Refused(f"material {m['name']}: textured materials have no mapping here")
+    if m.get("index_matched"):
+        return {"type": "null"}, notes
     alpha = m["roughness"] ** 2
     smooth = alpha < ALPHA_MIN
     metallic, transmission, specular = m["metallic"], m["transmission"], m["specular"]
@@ -107,6 +115,21 @@ def bsdf(m):
     return d, notes
 
 
+def medium(m):
+    """Mitsuba `homogeneous` medium for a material's interior, or None."""
+    med = m.get("medium")
+    if med is None:
+        return None
+    sigma_t = [a + b for a, b in zip(med["sigma_a"], med["sigma_s"])]
+    albedo = [s / t if t > 0 else 0.0 for s, t in zip(med["sigma_s"], sigma_t)]
+    # RGB values of a medium are read as reflectances (in [0, 1]): the extinction goes in
+    # as sigma_t / its largest channel, times that as `scale`.
+    scale = max(sigma_t)
+    return {"type": "homogeneous", "sigma_t": rgb([t / scale for t in sigma_t]),
+            "albedo": rgb(albedo), "scale": float(scale),
+            "phase": {"type": "hg", "g": float(med["g"])}}
+
+
 def rotation(axis, degrees):
     import mitsuba as mi
     return mi.ScalarTransform4f().rotate(axis, degrees)
@@ -129,8 +152,10 @@ def mitsuba_scene(export_dir, spp, seed):
     if c["aperture_radius"] > 0:
         sensor["aperture_radius"] = c["aperture_radius"]
         sensor["focus_distance"] = c["focus_distance"]
+    has_media = any(m.get("medium") is not None for m in s["materials"])
     d = {"type": "scene",
-         "integrator": {"type": "path", "max_depth": r["max_bounces"] + 1, "rr_depth": 5},
+         "integrator": {"type": "volpath" if has_media else "path",
+                        "max_depth": r["max_bounces"] + 1, "rr_depth": 5},
          "sensor": sensor}
     plugins, notes = {}, []
     mats = s["materials"]
@@ -155,6 +180,9 @@ def mitsuba_scene(export_dir, spp, seed):
         e = emitter(mesh["material"])
         if e:
             shape["emitter"] = e
+        inside = medium(mats[mesh["material"]])
+        if inside:
+            shape["interior"] = inside
         d[f"mesh_{k}"] = shape
     for k, sph in enumerate(s["spheres"]):
         shape = {"type": "sphere", "center": sph["center"], "radius": sph["radius"],
@@ -162,6 +190,9 @@ def mitsuba_scene(export_dir, spp, seed):
         e = emitter(sph["material"])
         if e:
             shape["emitter"] = e
+        inside = medium(mats[sph["material"]])
+        if inside:
+            shape["interior"] = inside
         d[f"sphere_{k}"] = shape
     for k, l in enumerate(s["lights"]):
         if l["type"] == "point":
@@ -232,8 +263,8 @@ def make(name, lumagraph, spp, chunk, seeds):
     bmp.write(os.path.join(OUT, name + ".exr"))
     meta = {
         "scene": f"tests/scenes/{name}.ron",
-        "renderer": f"Mitsuba {mi.__version__} ({mi.variant()}), integrator path, "
-                    "independent sampler, box filter",
+        "renderer": f"Mitsuba {mi.__version__} ({mi.variant()}), integrator "
+                    f"{d['integrator']['type']}, independent sampler, box filter",
         "spp": spp,
         "seconds": round(seconds, 1),
         "plugins": plugins,

@@ -10,6 +10,11 @@ docs/images/mitsuba_suite.png: per scene, lumagraph at 1024 spp | Mitsuba's refe
 (lumagraph - reference) / reference from -10 % (blue) to +10 % (red).
 
   .venv-mitsuba/bin/python scripts/references/report.py [--lumagraph target/release/lumagraph]
+
+Scene names restrict it to those scenes (then give `--image`), e.g. the media figure:
+
+  .venv-mitsuba/bin/python scripts/references/report.py media_absorbing_glass \
+      media_scattering --image docs/images/media.png
 """
 import argparse
 import json
@@ -63,14 +68,15 @@ def heat(x, ref):
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--lumagraph", default=os.path.join(ROOT, "target", "release", "lumagraph"))
+    p.add_argument("scenes", nargs="*", help="scene names in tests/scenes (default: all)")
     p.add_argument("--image", default=os.path.join(ROOT, "docs", "images", "mitsuba_suite.png"))
     a = p.parse_args()
     import mitsuba as mi
     mi.set_variant("scalar_rgb")
     with open(os.path.join(ROOT, "tests", "scenes", "suite.json")) as f:
         manifest = json.load(f)["scenes"]
-    names = sorted(f[:-4] for f in os.listdir(os.path.join(ROOT, "tests", "scenes"))
-                   if f.endswith(".ron"))
+    names = a.scenes or sorted(f[:-4] for f in os.listdir(os.path.join(ROOT, "tests", "scenes"))
+                               if f.endswith(".ron"))
     print("| scene | Mitsuba plugins | relMSE at 256 spp | × Mitsuba's | worst block at 1024 spp |")
     print("|---|---|---|---|---|")
     tiles = []

@@ -1,7 +1,9 @@
 // The material model: three lobes mixed by metallic and transmission.
 //   dielectric layer  (1 - metallic)(1 - transmission): GGX specular with Schlick Fresnel
 //                     (F0 = 0.08 specular, tinted by specular_tint) over a Lambertian base
-//                     that receives exactly the energy the specular does not reflect;
+//                     that receives exactly the energy the specular does not reflect, or
+//                     with diffuse_roughness > 0 an energy-preserving Oren-Nayar base (EON,
+//                     eon.wgsl, compiled in with HAS_ROUGH_DIFFUSE) weighted the same way;
 //   metal             metallic: GGX with Schlick Fresnel on base_color, or the exact
 //                     conductor Fresnel of a complex index eta + i k (MATERIAL_CONDUCTOR),
 //                     plus Kulla-Conty multiple-scattering compensation;
@@ -17,6 +19,7 @@
 #import "pathtrace/scene_types.wgsl"
 #import "common/color.wgsl"
 #import "common/sampling.wgsl"
+#import "pathtrace/eon.wgsl"
 
 // Below this alpha (= roughness^2) a lobe is a perfect mirror or interface.
 const ALPHA_MIN: f32 = 1e-3;
@@ -159,11 +162,28 @@ fn dielectric_f0(m: Material) -> vec3f {
     return clamp(0.08 * m.specular, 0.0, 1.0) * mix(vec3f(1.0), tint, clamp(m.specular_tint, 0.0, 1.0));
 }
 
+// Whether the dielectric layer's diffuse base is EON (else Lambertian).
+fn rough_diffuse(m: Material) -> bool {
+    return HAS_ROUGH_DIFFUSE && m.diffuse_roughness > 0.0;
+}
+
+fn diffuse_roughness(m: Material) -> f32 {
+    return clamp(m.diffuse_roughness, 0.0, 1.0);
+}
+
 // Probability of sampling the specular part of the dielectric layer.
 fn layer_spec_prob(m: Material, es_o: vec3f) -> f32 {
     let s = luminance(es_o);
     let d = luminance(m.base_color * (1.0 - es_o));
     return clamp(s / max(s + d, 1e-6), 0.1, 0.9);
+}
+
+// `layer_spec_prob`, or 0 for a rough diffuse base with no specular (F0 = 0) at all.
+fn layer_spec_sample_prob(m: Material, f0: vec3f, es_o: vec3f) -> f32 {
+    if rough_diffuse(m) && all(f0 == vec3f(0.0)) {
+        return 0.0;
+    }
+    return layer_spec_prob(m, es_o);
 }
 
 // Probability of sampling the single-scattering part of the metal lobe (the rest is
@@ -205,7 +225,13 @@ fn eval_bsdf(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
     let w = lobe_weights(m);
     let cos_pdf = wi.z * INV_PI;
     if !HAS_SPECULAR && !HAS_METAL {
-        // The scene has only Lambertian and glass lobes: no microfacet code compiled in.
+        // The scene has only diffuse and glass lobes: no microfacet code compiled in.
+        if rough_diffuse(m) {
+            let r = diffuse_roughness(m);
+            out.f_cos = w.x * eon_f(m.base_color, r, wo, wi) * wi.z;
+            out.pdf = w.x * eon_pdf(wo, wi, r);
+            return out;
+        }
         out.f_cos = w.x * m.base_color * cos_pdf;
         out.pdf = w.x * cos_pdf;
         return out;
@@ -228,11 +254,19 @@ fn eval_bsdf(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
         let es_o = lobe_albedo(f0, to);
         let es_i = lobe_albedo(f0, ti);
         let es_avg = lobe_albedo(f0, ta);
-        let diffuse = m.base_color * (1.0 - es_o) * (1.0 - es_i) / (PI * max(1.0 - es_avg, vec3f(1e-4))) * wi.z;
+        var diffuse = m.base_color * (1.0 - es_o) * (1.0 - es_i) / (PI * max(1.0 - es_avg, vec3f(1e-4))) * wi.z;
+        var diffuse_pdf = cos_pdf;
+        if rough_diffuse(m) {
+            // EON in place of rho / pi, with the same (reciprocal) weighting by what the
+            // specular leaves.
+            let r = diffuse_roughness(m);
+            diffuse = eon_f(m.base_color, r, wo, wi) * (1.0 - es_o) * (1.0 - es_i) / max(1.0 - es_avg, vec3f(1e-4)) * wi.z;
+            diffuse_pdf = eon_pdf(wo, wi, r);
+        }
         let spec = g2_over * schlick(f0, dot(wo, h));
-        let ps = layer_spec_prob(m, es_o);
+        let ps = layer_spec_sample_prob(m, f0, es_o);
         out.f_cos += w.x * (diffuse + spec);
-        out.pdf += w.x * (ps * vndf_pdf + (1.0 - ps) * cos_pdf);
+        out.pdf += w.x * (ps * vndf_pdf + (1.0 - ps) * diffuse_pdf);
     }
     if HAS_METAL && w.y > 0.0 {
         let e_o = to.x + to.y;
@@ -318,6 +352,16 @@ fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
         return out;
     }
     if !HAS_SPECULAR && !HAS_METAL {
+        if rough_diffuse(m) {
+            let r = diffuse_roughness(m);
+            let wi = eon_sample(wo, r, u.xy);
+            let pdf = eon_pdf(wo, wi, r);
+            out.wi = wi;
+            out.weight = eon_f(m.base_color, r, wo, wi) * (wi.z / pdf) * (w.x / max(1.0 - w.z, 1e-6));
+            out.pdf = w.x * pdf;
+            out.valid = wi.z > 0.0 && pdf > 0.0;
+            return out;
+        }
         // Lambertian: f cos / pdf = base_color for the dielectric share of the material.
         out.wi = sample_cosine(vec3f(0.0, 0.0, 1.0), u.xy);
         out.weight = m.base_color * (w.x / max(1.0 - w.z, 1e-6));
@@ -333,7 +377,7 @@ fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     let layer = v * (w.x + w.y) < w.x;
     if layer {
         fresnel_f0 = dielectric_f0(m);
-        p_mirror = w.x * layer_spec_prob(m, lobe_albedo(fresnel_f0, to));
+        p_mirror = w.x * layer_spec_sample_prob(m, fresnel_f0, lobe_albedo(fresnel_f0, to));
     } else {
         fresnel_f0 = m.base_color;
         p_mirror = w.y * metal_ss_sample_prob(m, lp, to.x + to.y);
@@ -352,6 +396,8 @@ fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     if mirror {
         let mh = sample_vndf(wo, sqrt(lp.a2), u.xy);
         wi = 2.0 * dot(wo, mh) * mh - wo;
+    } else if layer && rough_diffuse(m) {
+        wi = eon_sample(wo, diffuse_roughness(m), u.xy);
     } else {
         wi = sample_cosine(vec3f(0.0, 0.0, 1.0), u.xy);
     }

@@ -4,6 +4,9 @@
 
 // Write first-hit albedo, normal and depth (through the pixel center) to the AOV outputs.
 const WRITE_AOVS: bool = true;
+// Adaptive sampling: skip the pixels `pathtrace/adaptive.wgsl` has stopped, and keep the
+// statistics it stops them by.
+const ADAPTIVE: bool = true;
 
 // Lobes some material of the scene uses; the code of the others is left out.
 const HAS_SPECULAR: bool = true;
@@ -17,3 +20,10 @@ const HAS_ENVIRONMENT: bool = true;
 const HAS_ENV_MAP: bool = true;
 // Some material has a texture: UVs, tangents and texture sampling compiled in.
 const HAS_TEXTURES: bool = true;
+// Some material has diffuse_roughness > 0: the energy-preserving Oren-Nayar (EON) diffuse
+// base and its sampling compiled in (else the diffuse base is Lambertian only).
+const HAS_ROUGH_DIFFUSE: bool = true;
+// Some material has a medium inside (absorbing glass, scattering media) or is an
+// index-matched boundary: medium tracking, distance sampling and shadow-ray transmittance
+// compiled in.
+const HAS_MEDIA: bool = true;

@@ -3,8 +3,11 @@
 // multiple importance sampling (power heuristic) for emissive triangles and spheres and the
 // environment map, next-event estimation alone for point, spot and directional lights,
 // Russian roulette from the fifth bounce, one-sided Lambertian materials and emitters
-// (Mitsuba 3's conventions, so the references match). Samples that are not finite never
-// reach the output: they are dropped and counted in `stats[0]`.
+// (Mitsuba 3's conventions, so the references match). With HAS_MEDIA, homogeneous media
+// inside closed shapes (medium.wgsl): Beer-Lambert absorption, or free-flight distance
+// sampling with Henyey-Greenstein scattering, next-event estimation from medium points with
+// MIS against phase sampling, and shadow rays through index-matched boundaries. Samples
+// that are not finite never reach the output: they are dropped and counted in `stats[0]`.
 #import "pathtrace/scene_types.wgsl"
 #import "pathtrace/sampler.wgsl"
 #import "common/sampling.wgsl"
@@ -77,9 +80,17 @@ fn light_weight(light_pdf: f32, bsdf_pdf: f32) -> f32 {
 // zeroed entry each when no material has a texture (HAS_TEXTURES off).
 @group(0) @binding(16) var<storage, read> tri_texcoords: array<TriTexcoords>;
 @group(0) @binding(17) var<storage, read> textures: array<u32>;
+// Adaptive sampling (ADAPTIVE), per pixel of the window: the sums (rgb) and frame counts (a)
+// of the even and of the odd frames, in that order, and whether `pathtrace/adaptive.wgsl`
+// stopped the pixel (16-byte stand-ins otherwise).
+@group(0) @binding(18) var<storage, read_write> adaptive_halves: array<vec4f>;
+@group(0) @binding(19) var<storage, read> adaptive_stopped: array<u32>;
+// The pixels still sampling this frame: their count, then each one's x | y << 16.
+@group(0) @binding(20) var<storage, read> adaptive_active: array<u32>;
 
 #import "pathtrace/intersect.wgsl"
 #import "pathtrace/scene_data.wgsl"
+#import "pathtrace/medium.wgsl"
 
 const RR_START: u32 = 5u;
 
@@ -294,6 +305,16 @@ fn sample_light(x: vec3f, bounce: u32) -> LightSample {
     return out;
 }
 
+// A light sample for next-event estimation from `x`: the environment map with probability
+// `p_env`, else an emitter.
+fn sample_next_event(x: vec3f, bounce: u32, p_env: f32) -> LightSample {
+    if rand() < p_env {
+        let es = sample_env(rand(), rand2());
+        return LightSample(es.wi, F32_MAX, es.radiance, es.pdf * p_env, 0.0, false);
+    }
+    return sample_light(x, bounce);
+}
+
 // The pinhole ray through image position `u` within `pixel`.
 fn pinhole_ray(pixel: vec2u, u: vec2f) -> Ray {
     let cam = frame.camera;
@@ -336,6 +357,31 @@ fn leave(s: Surface, on_sphere: bool, n: vec3f, dir: vec3f) -> vec3f {
     return s.p;
 }
 
+// Light reaching medium point `p` (a ray travelling along `dir` scattered there, phase
+// asymmetry `g`) by next-event estimation, over the scattering coefficient: phase function
+// times radiance times transmittance over the light sample's pdf, MIS-weighted against
+// phase sampling.
+fn medium_next_event(p: vec3f, dir: vec3f, g: f32, bounce: u32, has_lights: bool) -> vec3f {
+    let p_env = env_select_prob();
+    if !(has_lights || p_env > 0.0) {
+        return vec3f(0.0);
+    }
+    let ls = sample_next_event(p, bounce, p_env);
+    if !(ls.pdf > 0.0) || !(ls.delta || frame.strategy != STRATEGY_BSDF) {
+        return vec3f(0.0);
+    }
+    let phase = hg_eval(dot(dir, ls.wi), g);
+    skip_prim = NO_HIT;
+    origin_n = vec3f(0.0);
+    origin_err = vec3f(0.0);
+    origin_off = 0.0;
+    origin_slab = 0.0;
+    ray_count += 1u;
+    let tr = shadow_transmittance(Ray(p, ls.wi), ls.dist - ls.margin, medium_id);
+    let w = select(light_weight(ls.pdf, phase), 1.0, ls.delta);
+    return phase * ls.radiance * tr * (w / ls.pdf);
+}
+
 fn trace_path(pixel: vec2u) -> vec3f {
     var ray = camera_ray(pixel, sample_2d(PAIR_PIXEL));
     var throughput = vec3f(1.0);
@@ -352,9 +398,63 @@ fn trace_path(pixel: vec2u) -> vec3f {
     origin_err = vec3f(0.0);
     origin_off = 0.0;
     origin_slab = 0.0;
+    // The medium the ray travels in (paths start in none) and the index-matched boundaries
+    // crossed so far.
+    var crossings = 0u;
+    if HAS_MEDIA {
+        medium_id = NO_MEDIUM;
+    }
     for (var bounce = 0u; ; bounce++) {
         let hit = intersect_scene(ray);
         ray_count += 1u;
+        if HAS_MEDIA && medium_id != NO_MEDIUM {
+            let m = scene_material(medium_id);
+            let t_hit = select(F32_MAX, hit.t, hit.prim != NO_HIT);
+            let sigma_t = m.sigma_a + m.sigma_s;
+            if all(m.sigma_s == vec3f(0.0)) {
+                // Absorption only: Beer-Lambert to the next surface.
+                throughput *= exp(-sigma_t * t_hit);
+            } else {
+                // Free-flight distance by the extinction of a channel picked uniformly; the
+                // pdf is the mean over the channels (one-sample MIS over the three).
+                let c = min(u32(rand() * 3.0), 2u);
+                let t = -log(1.0 - rand()) / sigma_t[c];
+                if t < t_hit {
+                    let tr = exp(-sigma_t * t);
+                    let pdf = dot(sigma_t * tr, vec3f(1.0 / 3.0));
+                    if !(pdf > 0.0) || bounce >= max_bounces {
+                        break;
+                    }
+                    throughput *= m.sigma_s * tr / pdf;
+                    let p = ray.origin + t * ray.dir;
+                    radiance += throughput * medium_next_event(p, ray.dir, m.phase_g, bounce, has_lights);
+                    let wi = hg_sample(ray.dir, m.phase_g, rand2());
+                    bsdf_pdf = hg_eval(dot(ray.dir, wi), m.phase_g);
+                    prev_p = p;
+                    skip_prim = NO_HIT;
+                    origin_n = vec3f(0.0);
+                    origin_err = vec3f(0.0);
+                    origin_off = 0.0;
+                    origin_slab = 0.0;
+                    ray = Ray(p, wi);
+                    if bounce + 1u >= RR_START {
+                        let q = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
+                        if rand() >= q {
+                            break;
+                        }
+                        throughput /= q;
+                    }
+                    continue;
+                }
+                // Through to the surface: the probability of no collision before it.
+                let tr = exp(-sigma_t * t_hit);
+                let p_pass = dot(tr, vec3f(1.0 / 3.0));
+                if !(p_pass > 0.0) {
+                    break;
+                }
+                throughput *= tr / p_pass;
+            }
+        }
         if hit.prim == NO_HIT {
             // Camera rays see the environment only when it is shown as background.
             let visible = bounce > 0u || (frame.settings.env_flags & ENV_SHOW_BACKGROUND) != 0u;
@@ -376,6 +476,19 @@ fn trace_path(pixel: vec2u) -> vec3f {
         var mat = scene_material(s.material);
         if HAS_TEXTURES {
             mat = textured_material(mat, s.uv);
+        }
+        if HAS_MEDIA && (mat.flags & MATERIAL_INDEX_MATCHED) != 0u {
+            // No surface: the ray goes on into or out of the medium, and this is no
+            // scattering event (not counted as a bounce; MIS keeps the last vertex's pdf).
+            crossings += 1u;
+            if crossings > MAX_CROSSINGS {
+                break;
+            }
+            medium_id = medium_after(s.material, mat, s.ng, ray.dir, medium_id);
+            let side = select(-s.ng, s.ng, dot(s.ng, ray.dir) > 0.0);
+            ray = Ray(leave(s, on_sphere, side, ray.dir), ray.dir);
+            bounce -= 1u;
+            continue;
         }
         let front = dot(s.ng, ray.dir) < 0.0;
         let two_sided = (mat.flags & MATERIAL_TWO_SIDED) != 0u;
@@ -406,20 +519,22 @@ fn trace_path(pixel: vec2u) -> vec3f {
         let p_env = env_select_prob();
         // (BSDF sampling only: point, spot and directional lights, which no ray can hit.)
         if (has_lights || p_env > 0.0) && wo.z > 0.0 {
-            var ls: LightSample;
-            if rand() < p_env {
-                let es = sample_env(rand(), rand2());
-                ls = LightSample(es.wi, F32_MAX, es.radiance, es.pdf * p_env, 0.0, false);
-            } else {
-                ls = sample_light(s.p, bounce);
-            }
+            let ls = sample_next_event(s.p, bounce, p_env);
             let wanted = ls.delta || frame.strategy != STRATEGY_BSDF;
             if wanted && ls.pdf > 0.0 && dot(ng, ls.wi) * select(-1.0, 1.0, front || flip) > 0.0 {
                 let e = eval_bsdf(mat, wo, to_local * ls.wi);
                 if e.pdf > 0.0 || any(e.f_cos > vec3f(0.0)) {
                     let shadow = Ray(leave(s, on_sphere, select(-ng, ng, dot(ng, ls.wi) > 0.0), ls.wi), ls.wi);
                     ray_count += 1u;
-                    if !occluded(shadow, ls.dist - ls.margin) {
+                    if HAS_MEDIA {
+                        // Through the media on the way, across index-matched boundaries.
+                        let start = medium_after(s.material, mat, s.ng, ls.wi, medium_id);
+                        let tr = shadow_transmittance(shadow, ls.dist - ls.margin, start);
+                        if any(tr > vec3f(0.0)) {
+                            let w = select(light_weight(ls.pdf, e.pdf), 1.0, ls.delta);
+                            radiance += throughput * e.f_cos * ls.radiance * tr * (w / ls.pdf);
+                        }
+                    } else if !occluded(shadow, ls.dist - ls.margin) {
                         let w = select(light_weight(ls.pdf, e.pdf), 1.0, ls.delta);
                         radiance += throughput * e.f_cos * ls.radiance * (w / ls.pdf);
                     }
@@ -434,6 +549,9 @@ fn trace_path(pixel: vec2u) -> vec3f {
             break;
         }
         let wi = basis * bs.wi;
+        if HAS_MEDIA {
+            medium_id = medium_after(s.material, mat, s.ng, wi, medium_id);
+        }
         // Leave from the side of the surface the new ray goes to.
         let side = select(-ng, ng, dot(ng, wi) > 0.0);
         throughput *= bs.weight;
@@ -454,12 +572,41 @@ fn trace_path(pixel: vec2u) -> vec3f {
 }
 
 @compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) id: vec3u) {
+fn main(
+    @builtin(global_invocation_id) id: vec3u,
+    @builtin(workgroup_id) group: vec3u,
+    @builtin(num_workgroups) groups: vec3u,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    var at = id.xy;
+    var trace = true;
+    if ADAPTIVE {
+        // A pixel adaptive sampling stopped takes no samples and outputs alpha 0. The pixels
+        // still sampling are traced by the first invocations, in the order the adaptive pass
+        // listed them (workgroup by workgroup), so whole workgroups at the end idle.
+        if all(id.xy < frame.window.zw) && adaptive_stopped[id.y * frame.window.z + id.x] != 0u {
+            textureStore(output, id.xy, vec4f(0.0));
+        }
+        let k = (group.y * groups.x + group.x) * 64u + lane;
+        trace = k < adaptive_active[0];
+        if trace {
+            let packed = adaptive_active[1u + k];
+            at = vec2u(packed & 0xffffu, packed >> 16u);
+        }
+    }
+    if trace {
+        trace_pixel(at);
+    }
+    first_hit_aovs(id.xy);
+}
+
+// Traces the pixel `at` of the window (`samples_per_frame` paths) and writes their mean.
+fn trace_pixel(at: vec2u) {
     let w = frame.settings.width;
     let h = frame.settings.height;
     // The pixel of the whole image: tiles sample and trace exactly as the whole image does.
-    let pixel = id.xy + frame.window.xy;
-    if any(id.xy >= frame.window.zw) || pixel.x >= w || pixel.y >= h {
+    let pixel = at + frame.window.xy;
+    if any(at >= frame.window.zw) || pixel.x >= w || pixel.y >= h {
         return;
     }
     let pixel_index = pixel.y * w + pixel.x;
@@ -495,8 +642,23 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     if before > 0xffffffffu - ray_count {
         atomicAdd(&stats[2], 1u);
     }
-    textureStore(output, id.xy, vec4f(sum / f32(max(n, 1u)), 1.0));
+    let mean = sum / f32(max(n, 1u));
+    textureStore(output, at, vec4f(mean, 1.0));
+    if ADAPTIVE {
+        // Frames alternate two replicates: the even ones make one half, the odd the other.
+        let odd = ((frame.sample_offset / max(n, 1u)) & 1u) == 1u;
+        let i = 2u * (at.y * frame.window.z + at.x) + select(0u, 1u, odd);
+        adaptive_halves[i] += vec4f(mean, 1.0);
+        atomicAdd(&stats[3], n);
+    }
+}
 
+// First hit through the center of the window's pixel `at`: what a raster G-buffer sees.
+fn first_hit_aovs(at: vec2u) {
+    let pixel = at + frame.window.xy;
+    if any(at >= frame.window.zw) || pixel.x >= frame.settings.width || pixel.y >= frame.settings.height {
+        return;
+    }
     if WRITE_AOVS {
         // First hit through the pixel center: what a raster G-buffer sees.
         let ray = pinhole_ray(pixel, vec2f(0.5));
@@ -523,8 +685,8 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
             normal = s.ns;
             depth = hit.t;
         }
-        textureStore(out_albedo, id.xy, vec4f(albedo, flag));
-        textureStore(out_normal, id.xy, vec4f(normal, 1.0));
-        textureStore(out_depth, id.xy, vec4f(depth, 0.0, 0.0, 0.0));
+        textureStore(out_albedo, at, vec4f(albedo, flag));
+        textureStore(out_normal, at, vec4f(normal, 1.0));
+        textureStore(out_depth, at, vec4f(depth, 0.0, 0.0, 0.0));
     }
 }

@@ -13,6 +13,8 @@ const TRI_VERTEX_NORMALS: u32 = 1u;
 const MATERIAL_TWO_SIDED: u32 = 1u;
 const MATERIAL_CONDUCTOR: u32 = 2u;
 const MATERIAL_SINGLE_SCATTER: u32 = 4u;
+const MATERIAL_MEDIUM: u32 = 8u;
+const MATERIAL_INDEX_MATCHED: u32 = 16u;
 const LIGHT_SPHERE: u32 = 1u;
 const LIGHT_TWO_SIDED: u32 = 2u;
 const LIGHT_POINT: u32 = 4u;
@@ -31,6 +33,7 @@ const FEATURE_TEXTURES: u32 = 4u;
 const FEATURE_ENVIRONMENT: u32 = 8u;
 const FEATURE_LIGHTS: u32 = 16u;
 const FEATURE_METAL: u32 = 32u;
+const FEATURE_MEDIA: u32 = 64u;
 
 // BVH node, 32 bytes. Depth-first order: an inner node's first child is the next node.
 //   bits 0-1: split axis (inner); bit 2: leaf kind (1 = spheres, 0 = triangles);
@@ -76,7 +79,7 @@ struct Sphere {
     pad1: u32,
 }
 
-// Material, 80 bytes. Texture indices: 16 bits each, 0xffff = none; each texture
+// Material, 160 bytes. Texture indices: 16 bits each, 0xffff = none; each texture
 // multiplies its factor (see textures.wgsl).
 struct Material {
     base_color: vec3<f32>,
@@ -93,7 +96,8 @@ struct Material {
     normal_scale: f32,
     tex_transmission_specular: u32,
     tex_specular_color: u32,
-    pad0: u32,
+    // Roughness of the diffuse base: 0 Lambertian, else energy-preserving Oren-Nayar (EON).
+    diffuse_roughness: f32,
     pad1: u32,
     // Complex index of refraction of a conductor (MATERIAL_CONDUCTOR), and its metal
     // lobe's cosine-weighted average Fresnel reflectance.
@@ -103,6 +107,12 @@ struct Material {
     pad3: u32,
     f_avg: vec3<f32>,
     pad4: u32,
+    // Homogeneous medium inside (MATERIAL_MEDIUM): absorption and scattering coefficients
+    // per unit length, and the Henyey-Greenstein asymmetry of its phase function.
+    sigma_a: vec3<f32>,
+    phase_g: f32,
+    sigma_s: vec3<f32>,
+    pad5: u32,
 }
 
 // A triangle's tangents (xyz, w = handedness) and UVs at its corners, 80 bytes, same index as

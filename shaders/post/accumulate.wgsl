@@ -4,7 +4,8 @@
 //   comp[i].rgb Kahan compensation (the low-order bits the sum lost).
 // Mirrored by `cpu::KahanMean`.
 //
-// When `params.variance` is 1, a third buffer keeps Welford's second moment of the frames
+// When VARIANCE (accumulate_options.wgsl, set per node) is 1, a third buffer keeps
+// Welford's second moment of the frames
 //   m2[i].rgb  sum of (x - mean_before)(x - mean_after) per channel,  m2[i].a  the same of
 //   the luminance,
 // with the means taken from the Kahan sums above (which it never changes), and `variance_out`
@@ -14,6 +15,12 @@
 // luminance (what Denoise reads) a robust one from the median absolute deviation, so a wall
 // pixel beside the light does not look noisy.
 //
+// Pixels whose input alpha is 0 took no sample this frame (adaptive sampling): nothing is
+// added there and the pixel's mean and variance are written as they stand, so each pixel's
+// mean is over its own frames (`sum.a` counts them per pixel). The frame's arithmetic is
+// otherwise unchanged (a separate early-out path, calling `present`, made the pass twice as
+// slow on lavapipe).
+//
 // When `params.present` is 1 (a merge of partial renders, `lumagraph merge`), the pass adds
 // nothing: it writes the mean and variance of the history as it stands, with the same
 // arithmetic as the frame that added the last sample.
@@ -22,8 +29,11 @@
 // operation exact), which silently turns Kahan summation into a plain sum. Multiplying by
 // `params.one` (1.0, but unknown to the compiler) keeps the compensation term alive.
 
+#import "post/accumulate_options.wgsl"
+
 struct Params {
     one: f32,
+    // The same as VARIANCE (accumulate_options.wgsl), for the layout the node writes.
     variance: u32,
     size: vec2u,
     present: u32,
@@ -41,7 +51,7 @@ struct Params {
 
 const LUMA = vec3f(0.2126, 0.7152, 0.0722);
 
-// `params.variance`: no variance, from Welford's second moment over frames, or from halves.
+// VARIANCE: no variance, from Welford's second moment over frames, or from halves.
 const VARIANCE_OFF: u32 = 0u;
 const VARIANCE_FRAMES: u32 = 1u;
 const VARIANCE_HALVES: u32 = 2u;
@@ -117,30 +127,39 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         present(id.xy, i);
         return;
     }
-    let x = textureLoad(input, id.xy, 0).rgb;
+    let input_px = textureLoad(input, id.xy, 0);
+    let x = input_px.rgb;
     var s = sum[i];
-    let c = comp[i].rgb;
-    let y = x - c;
-    let t = (s.rgb + y) * params.one;
-    comp[i] = vec4f((t - s.rgb) - y, 0.0);
     let before = s;
-    s = vec4f(t, s.a + 1.0);
-    sum[i] = s;
+    // A pixel of alpha 0 took no sample this frame (PathTrace's adaptive sampling stopped
+    // it): it adds nothing, once the history has a frame.
+    let add = input_px.a != 0.0 || s.a == 0.0;
+    if add {
+        let c = comp[i].rgb;
+        let y = x - c;
+        let t = (s.rgb + y) * params.one;
+        comp[i] = vec4f((t - s.rgb) - y, 0.0);
+        s = vec4f(t, s.a + 1.0);
+        sum[i] = s;
+    }
     let mean = s.rgb / s.a;
     textureStore(output, id.xy, vec4f(mean, 1.0));
 
-    if params.variance == VARIANCE_FRAMES {
-        let mean_before = select(x, before.rgb / before.a, before.a > 0.0);
-        let d = vec4f(x - mean_before, dot(x - mean_before, LUMA));
-        let e = vec4f(x - mean, dot(x - mean, LUMA));
-        let moment = m2[i] + d * e;
-        m2[i] = moment;
+    if VARIANCE == VARIANCE_FRAMES {
+        var moment = m2[i];
+        if add {
+            let mean_before = select(x, before.rgb / before.a, before.a > 0.0);
+            let d = vec4f(x - mean_before, dot(x - mean_before, LUMA));
+            let e = vec4f(x - mean, dot(x - mean, LUMA));
+            moment += d * e;
+            m2[i] = moment;
+        }
         textureStore(variance_out, id.xy, frames_variance(moment, s.a, vec2i(id.xy)));
-    } else if params.variance == VARIANCE_HALVES {
+    } else if VARIANCE == VARIANCE_HALVES {
         // Odd frames of the render (the path tracer's second Sobol replicate) make the
         // second half.
         var odd = m2[i];
-        if ((u32(before.a) + params.parity) & 1u) == 1u {
+        if add && ((u32(before.a) + params.parity) & 1u) == 1u {
             odd += vec4f(x, 1.0);
             m2[i] = odd;
         }
@@ -180,9 +199,9 @@ fn halves_variance(sum: vec4f, odd: vec4f, p: vec2i) -> vec4f {
 fn present(p: vec2u, i: u32) {
     let s = sum[i];
     textureStore(output, p, vec4f(s.rgb / s.a, 1.0));
-    if params.variance == VARIANCE_FRAMES {
+    if VARIANCE == VARIANCE_FRAMES {
         textureStore(variance_out, p, frames_variance(m2[i], s.a, vec2i(p)));
-    } else if params.variance == VARIANCE_HALVES {
+    } else if VARIANCE == VARIANCE_HALVES {
         textureStore(variance_out, p, halves_variance(s, m2[i], vec2i(p)));
     }
 }

@@ -44,7 +44,37 @@ pub struct Args<'a> {
     pub target_relmse: Option<f64>,
     pub out: &'a Path,
     pub overrides: &'a [String],
+    /// `LABEL:OVERRIDE[;OVERRIDE...]`: the graph again with these overrides, as more curves.
+    pub variants: &'a [String],
     pub library: &'a NodeLibrary,
+}
+
+/// One graph being measured: the graph as given, or a variant of it.
+struct Run {
+    /// The variant's label (none for the graph as given).
+    label: Option<String>,
+    exec: Executor,
+    /// Wall seconds of rendering so far.
+    render_secs: f64,
+    /// Its next checkpoint would pass the time budget.
+    done: bool,
+}
+
+/// `(label, overrides)` of a `--variant`.
+fn parse_variant(text: &str) -> Result<(String, Vec<String>)> {
+    let Some((label, overrides)) = text.split_once(':') else {
+        bail!("--variant {text:?}: expected LABEL:NODE.PARAM=VALUE[;NODE.PARAM=VALUE...]");
+    };
+    let overrides: Vec<String> = overrides
+        .split(';')
+        .map(str::trim)
+        .filter(|o| !o.is_empty())
+        .map(str::to_owned)
+        .collect();
+    if label.trim().is_empty() || overrides.is_empty() {
+        bail!("--variant {text:?}: give a label and at least one override");
+    }
+    Ok((label.trim().to_owned(), overrides))
 }
 
 /// One scored output at one checkpoint.
@@ -151,57 +181,86 @@ pub fn run(args: &Args<'_>) -> Result<()> {
         (None, None) => bail!("give --reference FILE.exr or --reference-spp N"),
     };
     let keep: Vec<String> = ports.iter().map(|(p, _)| p.clone()).collect();
-    let mut exec = executor(&ctx, args.library, &graph, &keep, &scene.gpu)?;
-    let extent = exec.plan().passes.first().map(|p| p.extent);
-    if extent.is_some_and(|e| (e.width, e.height) != (reference.width, reference.height)) {
-        bail!(
-            "the reference is {}x{}, the render {}",
-            reference.width,
-            reference.height,
-            extent.map_or_else(String::new, |e| e.to_string())
-        );
+    let mut runs = Vec::new();
+    for variant in std::iter::once(None).chain(args.variants.iter().map(Some)) {
+        let (label, g) = match variant {
+            None => (None, graph.clone()),
+            Some(text) => {
+                let (label, overrides) = parse_variant(text)?;
+                let mut g = graph.clone();
+                for o in &overrides {
+                    g.apply_override(o)
+                        .with_context(|| format!("--variant {label:?}"))?;
+                }
+                (Some(label), g)
+            }
+        };
+        let mut exec = executor(&ctx, args.library, &g, &keep, &scene.gpu)?;
+        let extent = exec.plan().passes.first().map(|p| p.extent);
+        if extent.is_some_and(|e| (e.width, e.height) != (reference.width, reference.height)) {
+            bail!(
+                "the reference is {}x{}, the render {}",
+                reference.width,
+                reference.height,
+                extent.map_or_else(String::new, |e| e.to_string())
+            );
+        }
+        exec.warm_up()?;
+        runs.push(Run {
+            label,
+            exec,
+            render_secs: 0.0,
+            done: false,
+        });
     }
-    exec.warm_up()?;
 
     let mut rows = Vec::new();
-    let mut render_secs = 0.0;
     let mut spp = 1;
-    let mut clock;
-    let last_tail_ms = loop {
-        let t = Instant::now();
-        let frames = spp - u32::try_from(exec.frames()).unwrap_or(spp);
-        exec.run_frames(frames, false)?;
-        render_secs += t.elapsed().as_secs_f64();
-        let tail = exec.run_tail()?;
-        let tail_secs = tail.wall.as_secs_f64();
-        clock = tail.pass_clock;
-        let pass_ms = tail.pass_ms.unwrap_or_default();
-        for (port, denoised) in &ports {
-            let image = exec.read_port(port)?;
-            let node = port.split('.').next().unwrap_or(port);
-            rows.push(Row {
-                output: node.to_owned(),
-                spp,
-                seconds: render_secs + if *denoised { tail_secs } else { 0.0 },
-                rmse: metrics::rmse(&image, &reference),
-                relmse: metrics::relmse(&image, &reference),
-                ssim: metrics::ssim(&image, &reference),
-                gpu_ms: denoised
-                    .then(|| pass_ms.iter().find(|(n, _)| n == node).map(|(_, ms)| *ms))
-                    .flatten(),
-            });
-        }
-        // Stop when the next checkpoint (twice the rendering) would pass the budget.
-        if 2.0 * render_secs + tail_secs > args.seconds || spp >= 1 << 20 {
-            break pass_ms;
+    let mut clock = None;
+    let mut last_tail_ms = Vec::new();
+    while runs.iter().any(|r| !r.done) {
+        // The runs take turns, checkpoint by checkpoint.
+        for run in runs.iter_mut().filter(|r| !r.done) {
+            let exec = &mut run.exec;
+            let t = Instant::now();
+            let frames = spp - u32::try_from(exec.frames()).unwrap_or(spp);
+            exec.run_frames(frames, false)?;
+            run.render_secs += t.elapsed().as_secs_f64();
+            let tail = exec.run_tail()?;
+            let tail_secs = tail.wall.as_secs_f64();
+            let pass_ms = tail.pass_ms.unwrap_or_default();
+            for (port, denoised) in &ports {
+                let image = exec.read_port(port)?;
+                let node = port.split('.').next().unwrap_or(port);
+                rows.push(Row {
+                    output: run
+                        .label
+                        .as_ref()
+                        .map_or_else(|| node.to_owned(), |l| format!("{l}: {node}")),
+                    spp,
+                    seconds: run.render_secs + if *denoised { tail_secs } else { 0.0 },
+                    rmse: metrics::rmse(&image, &reference),
+                    relmse: metrics::relmse(&image, &reference),
+                    ssim: metrics::ssim(&image, &reference),
+                    gpu_ms: denoised
+                        .then(|| pass_ms.iter().find(|(n, _)| n == node).map(|(_, ms)| *ms))
+                        .flatten(),
+                });
+            }
+            // Stop when the next checkpoint (twice the rendering) would pass the budget.
+            run.done = 2.0 * run.render_secs + tail_secs > args.seconds || spp >= 1 << 20;
+            if run.label.is_none() {
+                clock = Some(tail.pass_clock);
+                last_tail_ms = pass_ms;
+            }
         }
         spp *= 2;
-    };
+    }
 
     print_table(&rows);
     println!(
         "time per pass of the part run after rendering (last checkpoint; {}):",
-        clock.describe()
+        clock.map_or("", crate::render::PassClock::describe)
     );
     if last_tail_ms.is_empty() {
         println!("  not available (adapter has no timestamp queries)");

@@ -3,7 +3,8 @@
 //! (resized to 384×192, the test chart as a second input) with their registry `example`
 //! params and are tone-mapped (`agx`) for display; the nodes of a path-tracing graph show
 //! their first output on the Cornell box after 64 frames of `graphs/pathtrace_denoise.ron`
-//! (or of `graphs/pathtrace_regression.ron`, for the kinds only it has);
+//! (or of `graphs/pathtrace_regression.ron` or `graphs/pathtrace_temporal.ron`, for the
+//! kinds only they have);
 //! a source that reads no file shows its first output with its `example` params.
 
 use std::fmt::Write as _;
@@ -20,9 +21,10 @@ const SOURCE: &str = "assets/hdri/venice_sunset_1k.hdr";
 const SECOND: &str = "assets/test_chart.exr";
 const SCENE: &str = "assets/cornell.ron";
 /// The path-tracing graphs, searched in order for a node of the kind shown.
-const RENDER_GRAPHS: [&str; 2] = [
+const RENDER_GRAPHS: [&str; 3] = [
     "graphs/pathtrace_denoise.ron",
     "graphs/pathtrace_regression.ron",
+    "graphs/pathtrace_temporal.ron",
 ];
 const RENDER_FRAMES: u32 = 64;
 
@@ -195,7 +197,8 @@ pub fn markdown(registry: &Registry) -> String {
          chart is a second input) with the params listed, tone-mapped with AgX for display; \
          the nodes of the path-tracing graph show their first output on the Cornell box \
          after 64 frames of `graphs/pathtrace_denoise.ron` (`RegressionDenoise`: of \
-         `graphs/pathtrace_regression.ron`).\n",
+         `graphs/pathtrace_regression.ron`; `TemporalReuse`, which has no camera move to \
+         reuse history across there: of `graphs/pathtrace_temporal.ron`).\n",
     );
     let mut categories: Vec<_> = registry.kinds().iter().map(|k| k.category).collect();
     categories.sort();

@@ -200,11 +200,25 @@ fn report_speed(exec: &mut Executor, wall: Duration, before: (u64, u64)) -> Resu
     let extent = super::progressive_source(exec.plan()).map(|p| p.extent);
     let pixels = extent.map_or(0, crate::graph::Extent::pixels);
     let secs = wall.as_secs_f64();
+    // Adaptive sampling counts the samples it took (since the checkpoint, if any).
+    let adaptive = counters.iter().any(|(_, c)| c.name == "adaptive_samples");
+    let taken = if adaptive {
+        get("adaptive_samples")
+    } else {
+        pixels * samples.saturating_sub(before.0)
+    };
     #[expect(clippy::cast_precision_loss, reason = "report figures")]
-    let (paths, rays) = (
-        (pixels * samples.saturating_sub(before.0)) as f64,
-        get("rays").saturating_sub(before.1) as f64,
-    );
+    let (paths, rays) = (taken as f64, get("rays").saturating_sub(before.1) as f64);
+    if adaptive && pixels > 0 && samples > 0 {
+        #[expect(clippy::cast_precision_loss, reason = "report figures")]
+        let mean = taken as f64 / pixels as f64;
+        #[expect(clippy::cast_precision_loss, reason = "report figures")]
+        let share = 100.0 * mean / samples.saturating_sub(before.0).max(1) as f64;
+        println!(
+            "adaptive sampling: {mean:.1} samples per pixel on average, {share:.1} % of {} spp uniform",
+            samples.saturating_sub(before.0)
+        );
+    }
     println!(
         "rendered {samples} spp at {} in {secs:.2} s: {:.3} M paths/s, {:.3} M rays/s, {} NaN/Inf samples dropped",
         extent.map_or_else(String::new, |e| e.to_string()),

@@ -39,6 +39,11 @@ pub struct PreviewScene {
     /// Changes whenever another scene (or the same file again) is loaded, so the preview
     /// restarts.
     pub generation: u64,
+    /// The camera moved in the preview (`gpu.camera` until then). A move is not a new
+    /// scene: the preview keeps its executor, accumulation restarts, and a
+    /// `TemporalReuse` node carries its history into the new view
+    /// ([`Executor::move_camera`]).
+    pub camera: Option<lumagraph_scene::GpuCamera>,
 }
 
 /// A preview image: 8-bit RGBA as a PNG written by an Output node would hold it.
@@ -74,6 +79,8 @@ pub struct PreviewStats {
     pub last_update: Vec<String>,
     /// Times the GPU device was lost and a new one opened.
     pub devices_reopened: u64,
+    /// Camera moves handed to the running executor (no rebuild).
+    pub camera_moves: u64,
 }
 
 /// The preview state.
@@ -83,6 +90,8 @@ pub struct Preview {
     exec: Option<Executor>,
     key: Option<(Graph, String, PathBuf, u64)>,
     scene: Option<Arc<GpuScene>>,
+    /// The camera moved in the preview ([`PreviewScene::camera`]).
+    camera: Option<lumagraph_scene::GpuCamera>,
     /// Samples per pixel accumulated so far, when the plan path-traces.
     pub samples: Option<u64>,
     /// Whether the plan has a node with history, so frames keep coming.
@@ -274,6 +283,7 @@ impl Preview {
             exec: None,
             key: None,
             scene: None,
+            camera: None,
             samples: None,
             progressive: false,
             target_spp: 0,
@@ -361,8 +371,9 @@ impl Preview {
         g.origin = None;
         let generation = scene.map_or(0, |s| s.generation);
         let key = (g, port.to_owned(), base.to_owned(), generation);
+        let camera = scene.and_then(|s| s.camera);
         if self.key.as_ref() == Some(&key) {
-            return false;
+            return self.follow_camera(camera, port);
         }
         let scene_changed = self.key.as_ref().is_none_or(|k| k.3 != generation);
         self.key = Some(key);
@@ -371,6 +382,7 @@ impl Preview {
             self.exec = None;
             self.scene = scene.map(|s| Arc::clone(&s.gpu));
         }
+        self.camera = camera;
         match self.render(registry, graph, base, port) {
             Ok(()) => {
                 self.error = None;
@@ -381,6 +393,25 @@ impl Preview {
                 false
             }
         }
+    }
+
+    /// Moves the running executor's camera to `camera` when it moved, and runs a frame
+    /// from there. Returns whether a frame ran.
+    fn follow_camera(&mut self, camera: Option<lumagraph_scene::GpuCamera>, port: &str) -> bool {
+        if camera == self.camera {
+            return false;
+        }
+        self.camera = camera;
+        let to = camera.or_else(|| self.scene.as_ref().map(|s| s.camera));
+        let (Some(exec), Some(to)) = (&mut self.exec, to) else {
+            return false;
+        };
+        if !exec.move_camera(&to) {
+            return false;
+        }
+        self.stats.camera_moves += 1;
+        self.stats.restarts += u64::from(self.progressive);
+        self.step(port).is_ok()
     }
 
     /// Drops the executor, so the next update builds every pipeline again (the kinds
@@ -459,8 +490,11 @@ impl Preview {
                 scene: self.scene.clone(),
                 ..Resources::default()
             };
-            let exec = Executor::with_library(&self.gpu, plan, &paths, &self.library)
+            let mut exec = Executor::with_library(&self.gpu, plan, &paths, &self.library)
                 .map_err(|e| e.to_string())?;
+            if let Some(camera) = &self.camera {
+                exec.move_camera(camera);
+            }
             self.progressive = exec.plan().passes.iter().any(|p| p.kind.history);
             self.target_spp = self
                 .scene

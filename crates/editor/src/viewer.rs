@@ -146,9 +146,36 @@ fn upload(
     }
 }
 
+/// A camera move asked for on the image in camera mode ([`ImageView::camera_mode`]): drag
+/// orbits, Shift-drag or middle-drag pans, the wheel dollies.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CameraGesture {
+    /// Degrees about the up axis (positive: the camera goes right around the target).
+    pub yaw: f32,
+    /// Degrees about the camera's right axis (positive: the camera goes up).
+    pub pitch: f32,
+    /// Pan to the right and up, in fractions of the distance to the target.
+    pub pan: [f32; 2],
+    /// Distance to the target multiplied by this (1: no dolly).
+    pub dolly: f32,
+}
+
+impl CameraGesture {
+    /// Degrees of orbit per point dragged.
+    pub const DEGREES_PER_POINT: f32 = 0.3;
+
+    /// Whether it moves nothing.
+    pub fn is_none(&self) -> bool {
+        self.yaw == 0.0 && self.pitch == 0.0 && self.pan == [0.0; 2] && self.dolly == 1.0
+    }
+}
+
 /// The viewer's state.
 #[derive(Default)]
 pub struct ImageView {
+    /// Drag, Shift-drag and the wheel move the scene's camera instead of the view
+    /// ([`ImageView::show`] returns the move).
+    pub camera_mode: bool,
     /// Screen points per image pixel; `None`: the image fits the panel's width.
     pub zoom: Option<f32>,
     /// The image point (in pixels) at the middle of the view, when zoomed.
@@ -242,10 +269,41 @@ impl ImageView {
         self.center = under - (at - view.center()) / new_z;
     }
 
+    /// Wheel zooms about the pointer, drag pans.
+    fn pan_and_zoom(&mut self, ui: &Ui, response: &egui::Response, view: Rect, size: Vec2) {
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0
+                && let Some(p) = response.hover_pos()
+            {
+                self.zoom_about(view, size, p, (scroll / 200.0).exp());
+            }
+        }
+        if response.dragged() {
+            let delta = response.drag_delta();
+            if self.zoom.is_none() {
+                let rect = self.image_rect(view, size);
+                self.zoom = Some(rect.width() / size.x.max(1.0));
+                self.center = (view.center() - rect.min) / self.zoom.unwrap_or(1.0);
+            }
+            if let Some(z) = self.zoom {
+                self.center -= delta / z;
+            }
+        }
+    }
+
     /// Draws the live image (`live`, its port type and a frame counter that changes with
     /// it) and, when comparing, the snapshot; handles zoom (wheel), pan (drag), fit
-    /// (double-click) and the readout. `height` is the view's height.
-    pub fn show(&mut self, ui: &mut Ui, live: &Image, ty: PortType, frame: u64, height: f32) {
+    /// (double-click) and the readout. `height` is the view's height. In camera mode, drag
+    /// and wheel are returned as a camera move instead.
+    pub fn show(
+        &mut self,
+        ui: &mut Ui,
+        live: &Image,
+        ty: PortType,
+        frame: u64,
+        height: f32,
+    ) -> Option<CameraGesture> {
         let size = vec2(live.width as f32, live.height as f32);
         let (view, response) =
             ui.allocate_exact_size(vec2(ui.available_width(), height), Sense::click_and_drag());
@@ -288,25 +346,12 @@ impl ImageView {
         if response.double_clicked() {
             self.zoom = None;
         }
-        if response.hovered() {
-            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
-            if scroll != 0.0
-                && let Some(p) = response.hover_pos()
-            {
-                self.zoom_about(view, size, p, (scroll / 200.0).exp());
-            }
-        }
-        if response.dragged() {
-            let delta = response.drag_delta();
-            if self.zoom.is_none() {
-                let rect = self.image_rect(view, size);
-                self.zoom = Some(rect.width() / size.x.max(1.0));
-                self.center = (view.center() - rect.min) / self.zoom.unwrap_or(1.0);
-            }
-            if let Some(z) = self.zoom {
-                self.center -= delta / z;
-            }
-        }
+        let gesture = if self.camera_mode {
+            camera_gesture(ui, &response, view)
+        } else {
+            self.pan_and_zoom(ui, &response, view, size);
+            None
+        };
 
         // Drawing.
         let painter = ui.painter_at(view);
@@ -366,5 +411,37 @@ impl ImageView {
                 from_snapshot: in_snapshot && self.pinned.is_some(),
             })
         });
+        gesture
     }
+}
+
+/// The camera move of this frame's drag and wheel on `view` (see [`CameraGesture`]).
+fn camera_gesture(ui: &Ui, response: &egui::Response, view: Rect) -> Option<CameraGesture> {
+    let mut g = CameraGesture {
+        dolly: 1.0,
+        ..CameraGesture::default()
+    };
+    let (shift, middle) = ui.input(|i| {
+        (
+            i.modifiers.shift,
+            i.pointer.button_down(egui::PointerButton::Middle),
+        )
+    });
+    if response.dragged() {
+        let d = response.drag_delta();
+        if shift || middle || response.dragged_by(egui::PointerButton::Middle) {
+            // The scene follows the pointer: the camera moves the other way.
+            g.pan = [-d.x / view.width().max(1.0), d.y / view.height().max(1.0)];
+        } else {
+            g.yaw = -d.x * CameraGesture::DEGREES_PER_POINT;
+            g.pitch = d.y * CameraGesture::DEGREES_PER_POINT;
+        }
+    }
+    if response.hovered() {
+        let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+        if scroll != 0.0 {
+            g.dolly = (-scroll / 200.0).exp();
+        }
+    }
+    (!g.is_none()).then_some(g)
 }

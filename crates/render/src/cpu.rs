@@ -35,6 +35,7 @@ impl Image {
 
 mod regression;
 pub use regression::{RegressionParams, regression};
+pub mod temporal;
 
 type V3 = [f32; 3];
 

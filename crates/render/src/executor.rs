@@ -88,6 +88,8 @@ pub struct Executor {
     only: Vec<bool>,
     /// Sinks do not write their files (a tiled render assembles them).
     hold_sinks: bool,
+    /// Where [`Executor::move_camera`] last put the camera.
+    camera: Option<lumagraph_scene::GpuCamera>,
 }
 
 impl std::fmt::Debug for Executor {
@@ -175,6 +177,7 @@ impl Executor {
             every_frame,
             only: Vec::new(),
             hold_sinks: false,
+            camera: None,
         })
     }
 
@@ -223,6 +226,27 @@ impl Executor {
         for node in &mut self.nodes {
             node.reset();
         }
+    }
+
+    /// Moves the camera of the nodes that render the scene to `camera`, the scene being
+    /// otherwise the same: each node gets [`NodeExec::move_camera`], so progressive
+    /// accumulation restarts while a node that reprojects its history (`TemporalReuse`)
+    /// keeps it. Returns whether anything moved (`false` when `camera` is where the nodes
+    /// already are).
+    pub fn move_camera(&mut self, camera: &lumagraph_scene::GpuCamera) -> bool {
+        if self.camera.as_ref() == Some(camera) {
+            return false;
+        }
+        self.camera = Some(*camera);
+        for node in &mut self.nodes {
+            node.move_camera(camera);
+        }
+        true
+    }
+
+    /// The camera of the last [`Executor::move_camera`]; `None` before one.
+    pub fn camera(&self) -> Option<&lumagraph_scene::GpuCamera> {
+        self.camera.as_ref()
     }
 
     /// Takes a recompiled plan that differs from the current one only in params: each

@@ -72,6 +72,7 @@ macro_rules! param_block {
 pub const BLOCKS: &[BlockLayout] = &[
     <crate::nodes::tonemap::TonemapParams as ParamBlock>::LAYOUT,
     <crate::nodes::accumulate::AccumulateParams as ParamBlock>::LAYOUT,
+    <crate::nodes::temporal::TemporalParams as ParamBlock>::LAYOUT,
     <crate::nodes::denoise::DenoiseParams as ParamBlock>::LAYOUT,
     <crate::nodes::regression::RegressionParams as ParamBlock>::LAYOUT,
     <crate::nodes::pathtrace::Frame as ParamBlock>::LAYOUT,

@@ -256,10 +256,16 @@ pub fn merge_path_tracers(states: &[&[u8]]) -> std::result::Result<Vec<u8>, Stri
     let mut merged = [0u64; 3];
     for state in states {
         if state.len() != 24 {
-            return Err(format!(
-                "a path tracer's state is 24 bytes, this one {}",
-                state.len()
-            ));
+            return Err(if state.len() > 24 {
+                "adaptive sampling cannot be split into sample ranges: each part would stop \
+                 pixels by its own samples (render it whole, or tile it)"
+                    .to_owned()
+            } else {
+                format!(
+                    "a path tracer's state is 24 bytes, this one {}",
+                    state.len()
+                )
+            });
         }
         let word =
             |i: usize| u64::from_le_bytes(state[8 * i..8 * i + 8].try_into().unwrap_or_default());

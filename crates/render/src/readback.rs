@@ -36,6 +36,30 @@ pub fn map_read<T>(
     Ok(out)
 }
 
+/// Copies a `COPY_SRC` buffer back after the work submitted so far and appends its bytes
+/// to `out` (through a staging buffer that lives as long as the call).
+///
+/// # Errors
+/// When mapping fails or the GPU does not finish.
+pub fn append_buffer(ctx: &GpuContext, buffer: &wgpu::Buffer, out: &mut Vec<u8>) -> Result<()> {
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("state readback"),
+        size: buffer.size(),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = ctx
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("state readback"),
+        });
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
+    ctx.queue.submit([encoder.finish()]);
+    map_read(ctx, &staging, buffer.size(), |bytes| {
+        out.extend_from_slice(bytes);
+    })
+}
+
 /// Runs a compute job that writes `count` values of `T` into a storage buffer and reads them
 /// back: `record` gets a fresh encoder and the output buffer (`STORAGE | COPY_SRC`) and
 /// records the dispatch; the copy, the submission and the wait follow.

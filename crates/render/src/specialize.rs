@@ -167,13 +167,17 @@ fn materials_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
                 l.f(m.normal_scale),
                 u(m.tex_transmission_specular),
                 u(m.tex_specular_color),
-                u(0),
+                l.f(m.diffuse_roughness),
                 u(0),
                 l.v3(m.eta),
                 u(0),
                 l.v3(m.k),
                 u(0),
                 l.v3(m.f_avg),
+                u(0),
+                l.v3(m.sigma_a),
+                l.f(m.phase_g),
+                l.v3(m.sigma_s),
                 u(0),
             ]
         })
@@ -287,7 +291,8 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
         return None;
     }
     let material_types = [
-        f3, f1, f3, f1, f1, f1, f1, f1, u1, u1, u1, f1, u1, u1, u1, u1, f3, u1, f3, u1, f3, u1,
+        f3, f1, f3, f1, f1, f1, f1, f1, u1, u1, u1, f1, u1, u1, f1, u1, f3, u1, f3, u1, f3, u1, f3,
+        f1, f3, u1,
     ];
     Some(format!(
         "// Generated for this scene: {} materials, {} lights, {} triangles and {} spheres,
@@ -340,6 +345,8 @@ pub struct PathTraceOptions {
     pub cpu_adapter: bool,
     /// Write the first-hit AOVs (albedo, normal, depth): something reads them.
     pub aovs: bool,
+    /// Adaptive sampling (`adaptive_error` > 0): per-pixel statistics and skipping.
+    pub adaptive: bool,
     /// With `specialize`, keep materials, lights and shading data in their storage buffers
     /// even where the scene is small enough to write them into the shader (tests and
     /// benchmarks compare the two; images are bit-identical).
@@ -424,11 +431,6 @@ fn textures_reason(scene: &GpuScene, all: bool) -> String {
 pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
     let all = !options.specialize;
     let m = &scene.materials;
-    let count =
-        |f: &dyn Fn(&lumagraph_scene::GpuMaterial) -> bool| m.iter().filter(|x| f(x)).count();
-    let specular = count(&|x| x.specular > 0.0 && x.metallic < 1.0 && x.transmission < 1.0);
-    let metal = count(&|x| x.metallic > 0.0);
-    let glass = count(&|x| x.transmission > 0.0 && x.metallic < 1.0);
     let prims = scene.tri_positions.len() + scene.spheres.len();
     let inline = options.specialize && options.cpu_adapter && prims <= INLINE_MAX_PRIMITIVES;
     let env = scene.settings.env_kind != lumagraph_scene::ENV_NONE;
@@ -440,16 +442,7 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
         && !textured
         && m.len() <= INLINE_MAX_MATERIALS
         && inline_scene_data(scene).is_some();
-    let why = |n: usize, what: &str| {
-        if all {
-            "general shader (specialization off)".to_owned()
-        } else if n > 0 {
-            format!("{n} {what}")
-        } else {
-            format!("no {what}")
-        }
-    };
-    vec![
+    let mut out = vec![
         feature(
             "BVH traversal",
             !inline,
@@ -473,7 +466,7 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
         feature(
             "light sampling (NEE + MIS)",
             all || lights > 0,
-            why(lights, "emissive primitives"),
+            why(all, lights, "emissive primitives"),
         ),
         feature(
             "environment",
@@ -493,6 +486,61 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
                 "no environment map"
             },
         ),
+    ];
+    out.extend(material_features(m, all));
+    out.extend([
+        feature(
+            "first-hit AOVs",
+            options.aovs,
+            if options.aovs {
+                "albedo, normal or depth is read"
+            } else {
+                "nothing reads albedo, normal or depth"
+            },
+        ),
+        feature(
+            "adaptive sampling",
+            options.adaptive,
+            if options.adaptive {
+                "adaptive_error > 0"
+            } else {
+                "adaptive_error is 0"
+            },
+        ),
+        feature(
+            "material textures",
+            all || textured,
+            textures_reason(scene, all),
+        ),
+    ]);
+    out
+}
+
+/// `n` things that need a feature, or the general shader's reason.
+fn why(all: bool, n: usize, what: &str) -> String {
+    if all {
+        "general shader (specialization off)".to_owned()
+    } else if n > 0 {
+        format!("{n} {what}")
+    } else {
+        format!("no {what}")
+    }
+}
+
+/// The lobes and media some material of the scene uses (all of them without `specialize`).
+fn material_features(m: &[lumagraph_scene::GpuMaterial], all: bool) -> Vec<Feature> {
+    let count =
+        |f: &dyn Fn(&lumagraph_scene::GpuMaterial) -> bool| m.iter().filter(|x| f(x)).count();
+    let specular = count(&|x| x.specular > 0.0 && x.metallic < 1.0 && x.transmission < 1.0);
+    let metal = count(&|x| x.metallic > 0.0);
+    let glass = count(&|x| x.transmission > 0.0 && x.metallic < 1.0);
+    let rough_diffuse =
+        count(&|x| x.diffuse_roughness > 0.0 && x.metallic < 1.0 && x.transmission < 1.0);
+    let media = count(&|x| {
+        x.flags & (lumagraph_scene::MATERIAL_MEDIUM | lumagraph_scene::MATERIAL_INDEX_MATCHED) != 0
+    });
+    let why = |n: usize, what: &str| why(all, n, what);
+    vec![
         feature(
             "dielectric specular lobe",
             all || specular > 0,
@@ -509,18 +557,17 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
             why(glass, "materials with transmission > 0"),
         ),
         feature(
-            "first-hit AOVs",
-            options.aovs,
-            if options.aovs {
-                "albedo, normal or depth is read"
-            } else {
-                "nothing reads albedo, normal or depth"
-            },
+            "rough diffuse (EON)",
+            all || rough_diffuse > 0,
+            why(rough_diffuse, "materials with diffuse_roughness > 0"),
         ),
         feature(
-            "material textures",
-            all || textured,
-            textures_reason(scene, all),
+            "participating media",
+            all || media > 0,
+            why(
+                media,
+                "materials with a medium inside or an index-matched boundary",
+            ),
         ),
     ]
 }
@@ -536,10 +583,12 @@ pub fn pathtrace_source(
     let features = features(scene, options);
     let on = |name: &str| features.iter().any(|f| f.name == name && f.included);
     let consts = format!(
-        "const WRITE_AOVS: bool = {};\nconst HAS_SPECULAR: bool = {};\nconst HAS_METAL: bool = {};\n\
+        "const WRITE_AOVS: bool = {};\nconst ADAPTIVE: bool = {};\nconst HAS_SPECULAR: bool = {};\nconst HAS_METAL: bool = {};\n\
          const HAS_GLASS: bool = {};\nconst HAS_LIGHTS: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
-         const HAS_ENV_MAP: bool = {};\nconst HAS_TEXTURES: bool = {};\n",
+         const HAS_ENV_MAP: bool = {};\nconst HAS_TEXTURES: bool = {};\nconst HAS_ROUGH_DIFFUSE: bool = {};\n\
+         const HAS_MEDIA: bool = {};\n",
         on("first-hit AOVs"),
+        on("adaptive sampling"),
         on("dielectric specular lobe"),
         on("metal lobe"),
         on("glass lobe"),
@@ -547,6 +596,8 @@ pub fn pathtrace_source(
         on("environment"),
         on("environment map sampling"),
         on("material textures"),
+        on("rough diffuse (EON)"),
+        on("participating media"),
     );
     let mut overrides = vec![("pathtrace/options.wgsl", consts)];
     if on("inline intersection")

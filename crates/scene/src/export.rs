@@ -62,6 +62,7 @@ struct MaterialOut {
     base_color: [f32; 3],
     emission: [f32; 3],
     roughness: f32,
+    diffuse_roughness: f32,
     metallic: f32,
     specular: f32,
     specular_tint: f32,
@@ -72,6 +73,18 @@ struct MaterialOut {
     k: Option<[f32; 3]>,
     multiscatter: bool,
     textured: bool,
+    /// The homogeneous medium inside, if any.
+    medium: Option<MediumOut>,
+    /// No surface (an index-matched medium boundary).
+    index_matched: bool,
+}
+
+#[derive(Serialize)]
+struct MediumOut {
+    sigma_a: [f32; 3],
+    sigma_s: [f32; 3],
+    /// Henyey–Greenstein asymmetry.
+    g: f32,
 }
 
 #[derive(Serialize)]
@@ -199,6 +212,7 @@ fn material_out(m: &crate::scene::Material) -> MaterialOut {
         base_color: m.base_color.to_array(),
         emission: m.emission.to_array(),
         roughness: m.roughness,
+        diffuse_roughness: m.diffuse_roughness,
         metallic: m.metallic,
         specular: m.specular,
         specular_tint: m.specular_tint,
@@ -209,6 +223,12 @@ fn material_out(m: &crate::scene::Material) -> MaterialOut {
         k: m.conductor.map(|c| c.k.to_array()),
         multiscatter: m.multiscatter,
         textured: m.textures.any(),
+        medium: m.medium.map(|x| MediumOut {
+            sigma_a: x.sigma_a.to_array(),
+            sigma_s: x.sigma_s.to_array(),
+            g: x.g,
+        }),
+        index_matched: m.index_matched,
     }
 }
 

@@ -123,6 +123,9 @@ pub struct MaterialDesc {
     pub emission: V3,
     /// Perceptual roughness in [0, 1] (α = roughness²). Default 0.5.
     pub roughness: f32,
+    /// Roughness of the diffuse base in [0, 1] (`OpenPBR`'s `base_diffuse_roughness`): 0 is
+    /// Lambertian, above 0 the energy-preserving Oren–Nayar model (EON). Default 0.
+    pub diffuse_roughness: f32,
     /// 0 dielectric, 1 metal. Default 0, or 1 with `conductor`, `eta` or `k`.
     pub metallic: Option<f32>,
     /// A measured conductor by name (`"Au"`, `"Ag"`, `"Al"`, `"Cu"`, …; see
@@ -150,6 +153,43 @@ pub struct MaterialDesc {
     pub ior: f32,
     /// Emission leaves both sides. Default false (front only).
     pub two_sided: bool,
+    /// glTF `KHR_materials_volume`: the color white light turns into after
+    /// `attenuation_distance` inside the shape (Beer–Lambert absorption,
+    /// `σ_a = −ln(color) / distance`). Default white (none).
+    pub attenuation_color: Option<V3>,
+    /// The distance, in scene units, at which light inside has `attenuation_color`.
+    /// Default infinite (no absorption).
+    pub attenuation_distance: Option<f32>,
+    /// A homogeneous medium inside the shapes of this material (excludes the
+    /// `attenuation_*` fields). Default none.
+    pub medium: Option<MediumDesc>,
+    /// No surface: rays cross the shape's boundary unchanged, into or out of its `medium`
+    /// (an index-matched boundary, Mitsuba's `null` BSDF). Default false.
+    pub index_matched: bool,
+}
+
+/// A homogeneous participating medium: coefficients per unit length of the scene
+/// (extinction `σ_t = σ_a + σ_s`, single-scattering albedo `σ_s / σ_t`), linear RGB.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MediumDesc {
+    /// Absorption coefficient `σ_a`. Default 0.
+    pub sigma_a: V3,
+    /// Scattering coefficient `σ_s`. Default 0.
+    pub sigma_s: V3,
+    /// Henyey–Greenstein asymmetry of the phase function, in (−1, 1); 0 is isotropic,
+    /// > 0 forward. Default 0.
+    pub g: f32,
+}
+
+impl Default for MediumDesc {
+    fn default() -> Self {
+        Self {
+            sigma_a: [0.0; 3],
+            sigma_s: [0.0; 3],
+            g: 0.0,
+        }
+    }
 }
 
 impl Default for MaterialDesc {
@@ -158,6 +198,7 @@ impl Default for MaterialDesc {
             base_color: [0.8, 0.8, 0.8],
             emission: [0.0; 3],
             roughness: 0.5,
+            diffuse_roughness: 0.0,
             metallic: None,
             conductor: None,
             eta: None,
@@ -168,6 +209,10 @@ impl Default for MaterialDesc {
             transmission: 0.0,
             ior: 1.5,
             two_sided: false,
+            attenuation_color: None,
+            attenuation_distance: None,
+            medium: None,
+            index_matched: false,
         }
     }
 }

@@ -11,11 +11,12 @@ use crate::error::{ErrorKind, SceneError};
 use crate::file::Environment;
 use crate::gpu::{
     ENV_CONSTANT, ENV_MAP, ENV_NONE, ENV_SHOW_BACKGROUND, FEATURE_ENVIRONMENT, FEATURE_LIGHTS,
-    FEATURE_METAL, FEATURE_SPHERES, FEATURE_TEXTURES, FEATURE_TRANSMISSION, GpuAliasEntry,
-    GpuBvhNode, GpuBvhRecord, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere,
-    GpuTriShading, GpuTriTexcoords, GpuTriangle, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPHERE,
-    LIGHT_SPOT, LIGHT_TWO_SIDED, MATERIAL_CONDUCTOR, MATERIAL_SINGLE_SCATTER, MATERIAL_TWO_SIDED,
-    NO_LIGHT, TRI_VERTEX_NORMALS,
+    FEATURE_MEDIA, FEATURE_METAL, FEATURE_SPHERES, FEATURE_TEXTURES, FEATURE_TRANSMISSION,
+    GpuAliasEntry, GpuBvhNode, GpuBvhRecord, GpuCamera, GpuHeader, GpuLight, GpuMaterial,
+    GpuSettings, GpuSphere, GpuTriShading, GpuTriTexcoords, GpuTriangle, LIGHT_DIRECTIONAL,
+    LIGHT_POINT, LIGHT_SPHERE, LIGHT_SPOT, LIGHT_TWO_SIDED, MATERIAL_CONDUCTOR,
+    MATERIAL_INDEX_MATCHED, MATERIAL_MEDIUM, MATERIAL_SINGLE_SCATTER, MATERIAL_TWO_SIDED, NO_LIGHT,
+    TRI_VERTEX_NORMALS,
 };
 use crate::scene::{Material, NO_TEXTURE, PunctualLight, Scene};
 
@@ -84,6 +85,17 @@ impl From<&Material> for GpuMaterial {
         if !m.multiscatter {
             flags |= MATERIAL_SINGLE_SCATTER;
         }
+        if m.medium.is_some() {
+            flags |= MATERIAL_MEDIUM;
+        }
+        if m.index_matched {
+            flags |= MATERIAL_INDEX_MATCHED;
+        }
+        let medium = m.medium.unwrap_or(crate::scene::Medium {
+            sigma_a: Vec3::ZERO,
+            sigma_s: Vec3::ZERO,
+            g: 0.0,
+        });
         let (eta, k, f_avg) = m.conductor.map_or(([0.0; 3], [0.0; 3], [0.0; 3]), |c| {
             (
                 c.eta.to_array(),
@@ -100,6 +112,7 @@ impl From<&Material> for GpuMaterial {
             specular_tint: m.specular_tint,
             transmission: m.transmission,
             ior: m.ior,
+            diffuse_roughness: m.diffuse_roughness,
             tex_base_mr: tex16(m.textures.base_color)
                 | (tex16(m.textures.metallic_roughness) << 16),
             tex_emissive_normal: tex16(m.textures.emissive) | (tex16(m.textures.normal) << 16),
@@ -111,6 +124,9 @@ impl From<&Material> for GpuMaterial {
             eta,
             k,
             f_avg,
+            sigma_a: medium.sigma_a.to_array(),
+            phase_g: medium.g,
+            sigma_s: medium.sigma_s.to_array(),
             ..GpuMaterial::default()
         }
     }
@@ -256,6 +272,34 @@ pub fn alias_table(w: &[f32]) -> Vec<GpuAliasEntry> {
 }
 
 impl GpuScene {
+    /// The GPU camera of `c` over this scene: its aspect from the scene's image size, its
+    /// focus distance, with `autofocus`, the distance to what the image center sees (a
+    /// moved camera keeps the scene, so the scene's own camera is rebuilt the same way).
+    pub fn camera_for(&self, c: &crate::Camera) -> GpuCamera {
+        let (right, up, forward) = c.basis();
+        let s = self.settings;
+        let mut camera = GpuCamera {
+            position: c.position.to_array(),
+            tan_half_fov: (c.fov_y_deg.to_radians() * 0.5).tan(),
+            right: right.to_array(),
+            aspect: s.width as f32 / s.height as f32,
+            up: up.to_array(),
+            aperture_radius: c.aperture_radius,
+            forward: forward.to_array(),
+            focus_distance: c.focus_distance,
+        };
+        if c.autofocus {
+            let center = crate::traverse::Ray {
+                origin: c.position,
+                dir: c.forward,
+            };
+            if let Some(hit) = crate::traverse::intersect(self, &center) {
+                camera.focus_distance = hit.t * c.forward.length();
+            }
+        }
+        camera
+    }
+
     /// The `bvh_nodes` buffer: each node with its skip links. An empty scene gets one leaf
     /// over triangle 0, which the zeroed stand-in triangle buffer makes a degenerate
     /// triangle no ray hits, so the traversal needs no special case.
@@ -344,18 +388,8 @@ impl GpuScene {
         }
         out.light_alias = alias_table(&light_selection(&weights));
         out.header = header(scene, &out, flat.depth, weights.iter().sum());
-        out.camera = camera(scene);
-        if scene.camera.autofocus {
-            let c = &scene.camera;
-            let center = crate::traverse::Ray {
-                origin: c.position,
-                dir: c.forward,
-            };
-            if let Some(hit) = crate::traverse::intersect(&out, &center) {
-                out.camera.focus_distance = hit.t * c.forward.length();
-            }
-        }
         out.settings = settings(scene);
+        out.camera = out.camera_for(&scene.camera);
         Ok(out)
     }
 
@@ -507,6 +541,13 @@ fn header(scene: &Scene, g: &GpuScene, depth: usize, total_power: f32) -> GpuHea
     if scene.materials.iter().any(|m| m.textures.any()) {
         features |= FEATURE_TEXTURES;
     }
+    if scene
+        .materials
+        .iter()
+        .any(|m| m.medium.is_some() || m.index_matched)
+    {
+        features |= FEATURE_MEDIA;
+    }
     let lit = match &scene.environment {
         Environment::Constant(c) => c.iter().any(|&x| x > 0.0),
         Environment::Map { intensity, .. } => *intensity > 0.0,
@@ -524,22 +565,6 @@ fn header(scene: &Scene, g: &GpuScene, depth: usize, total_power: f32) -> GpuHea
         bvh_depth: depth as u32,
         features,
         total_light_power: total_power,
-    }
-}
-
-fn camera(scene: &Scene) -> GpuCamera {
-    let c = &scene.camera;
-    let (right, up, forward) = c.basis();
-    let s = scene.settings;
-    GpuCamera {
-        position: c.position.to_array(),
-        tan_half_fov: (c.fov_y_deg.to_radians() * 0.5).tan(),
-        right: right.to_array(),
-        aspect: s.width as f32 / s.height as f32,
-        up: up.to_array(),
-        aperture_radius: c.aperture_radius,
-        forward: forward.to_array(),
-        focus_distance: c.focus_distance,
     }
 }
 

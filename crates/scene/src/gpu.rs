@@ -32,6 +32,12 @@ pub const MATERIAL_CONDUCTOR: u32 = 2;
 /// [`GpuMaterial::flags`]: no multiple-scattering compensation (the metal lobe's
 /// Kulla–Conty term, rough glass's reflections into the surface sent back out).
 pub const MATERIAL_SINGLE_SCATTER: u32 = 4;
+/// [`GpuMaterial::flags`]: the inside of the material's shapes is a homogeneous medium
+/// (`sigma_a`, `sigma_s`, `phase_g`).
+pub const MATERIAL_MEDIUM: u32 = 8;
+/// [`GpuMaterial::flags`]: no surface: rays cross it unchanged (an index-matched medium
+/// boundary).
+pub const MATERIAL_INDEX_MATCHED: u32 = 16;
 /// [`GpuLight::flags`]: the light is a sphere (else a triangle).
 pub const LIGHT_SPHERE: u32 = 1;
 /// [`GpuLight::flags`]: emission leaves both sides of the triangle.
@@ -67,6 +73,8 @@ pub const FEATURE_ENVIRONMENT: u32 = 8;
 pub const FEATURE_LIGHTS: u32 = 16;
 /// [`GpuHeader::features`]: some material is metallic.
 pub const FEATURE_METAL: u32 = 32;
+/// [`GpuHeader::features`]: some material has a medium inside or is index-matched.
+pub const FEATURE_MEDIA: u32 = 64;
 
 /// A BVH node, 32 bytes. See [`crate::bvh`] for the encoding.
 #[repr(C)]
@@ -150,7 +158,7 @@ pub struct GpuSphere {
     pub pad1: u32,
 }
 
-/// A material, 128 bytes (eight vec4s). Texture ids index the scene's textures (see
+/// A material, 160 bytes (ten vec4s). Texture ids index the scene's textures (see
 /// [`crate::texture::pack_textures`]), 16 bits each, 0xFFFF = none; each texture multiplies
 /// its factor.
 #[repr(C)]
@@ -188,8 +196,9 @@ pub struct GpuMaterial {
     /// Specular color texture (low 16 bits, RGB sRGB); the high 16 bits are 0xFFFF
     /// (offset 68).
     pub tex_specular_color: u32,
-    /// Padding (offset 72).
-    pub pad0: u32,
+    /// Roughness of the diffuse base: 0 Lambertian, else energy-preserving Oren–Nayar
+    /// (offset 72).
+    pub diffuse_roughness: f32,
     /// Padding (offset 76).
     pub pad1: u32,
     /// A conductor's index of refraction, real part ([`MATERIAL_CONDUCTOR`]; offset 80).
@@ -205,6 +214,14 @@ pub struct GpuMaterial {
     pub f_avg: [f32; 3],
     /// Padding (offset 124).
     pub pad4: u32,
+    /// Absorption coefficient of the medium inside ([`MATERIAL_MEDIUM`]; offset 128).
+    pub sigma_a: [f32; 3],
+    /// Henyey–Greenstein asymmetry of the medium's phase function (offset 140).
+    pub phase_g: f32,
+    /// Scattering coefficient of the medium inside (offset 144).
+    pub sigma_s: [f32; 3],
+    /// Padding (offset 156).
+    pub pad5: u32,
 }
 
 /// A triangle's texture coordinates and tangents, 80 bytes, same index as its

@@ -29,6 +29,7 @@ mod flatten;
 pub mod gpu;
 pub mod import;
 mod load;
+pub mod orbit;
 pub mod save;
 mod scene;
 pub mod texture;

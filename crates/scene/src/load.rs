@@ -17,7 +17,7 @@ use crate::file::{
 };
 use crate::import::import_mesh;
 use crate::scene::{
-    Camera, LoadReport, Material, PunctualLight, Scene, Sphere, cube_quads, push_triangle,
+    Camera, LoadReport, Material, Medium, PunctualLight, Scene, Sphere, cube_quads, push_triangle,
     quad_triangles, rectangle_quad, transform_triangle,
 };
 
@@ -233,6 +233,52 @@ fn conductor_from_desc(d: &MaterialDesc) -> Result<Option<Conductor>, SceneError
     }
 }
 
+/// The medium inside a material's shapes: `medium`, or the absorption of
+/// `attenuation_color` and `attenuation_distance`.
+fn medium_from_desc(d: &MaterialDesc) -> Result<Option<Medium>, SceneError> {
+    let attenuation = d.attenuation_color.is_some() || d.attenuation_distance.is_some();
+    if let Some(m) = d.medium {
+        if attenuation {
+            return Err(bad(
+                "medium",
+                "give either a `medium` or `attenuation_color` and `attenuation_distance`, not both",
+            ));
+        }
+        let sigma_a = non_negative3("sigma_a", m.sigma_a)?;
+        let sigma_s = non_negative3("sigma_s", m.sigma_s)?;
+        if !(m.g > -1.0 && m.g < 1.0) {
+            return Err(bad("g", format!("{} is outside (-1, 1)", m.g)));
+        }
+        if (sigma_a + sigma_s).max_element() <= 0.0 {
+            return Ok(None);
+        }
+        return Ok(Some(Medium {
+            sigma_a,
+            sigma_s,
+            g: m.g,
+        }));
+    }
+    if !attenuation {
+        return Ok(None);
+    }
+    let color = d.attenuation_color.unwrap_or([1.0; 3]);
+    let color = non_negative3("attenuation_color", color)?;
+    if color.max_element() > 1.0 {
+        return Err(bad(
+            "attenuation_color",
+            format!("{color} has a component above 1"),
+        ));
+    }
+    let distance = d.attenuation_distance.unwrap_or(f32::INFINITY);
+    if distance.is_nan() || distance <= 0.0 {
+        return Err(bad(
+            "attenuation_distance",
+            format!("{distance} must be positive"),
+        ));
+    }
+    Ok(Medium::attenuation(color, distance))
+}
+
 fn material_from_desc(name: &str, d: &MaterialDesc) -> Result<Material, SceneError> {
     let ior = d.ior;
     if !(ior > 0.0 && ior.is_finite()) {
@@ -254,11 +300,25 @@ fn material_from_desc(name: &str, d: &MaterialDesc) -> Result<Material, SceneErr
         Some(c) => c.normal_reflectance(),
         None => non_negative3("base_color", d.base_color)?,
     };
+    let medium = medium_from_desc(d)?;
+    if d.index_matched && medium.is_none() {
+        return Err(bad(
+            "index_matched",
+            "an index-matched boundary needs a `medium` inside (without one the shape is invisible)",
+        ));
+    }
+    if d.index_matched && d.emission.iter().any(|&x| x != 0.0) {
+        return Err(bad(
+            "emission",
+            "an index-matched boundary has no surface to emit",
+        ));
+    }
     Ok(Material {
         name: name.to_owned(),
         base_color,
         emission: non_negative3("emission", d.emission)?,
         roughness: unit_range("roughness", d.roughness)?,
+        diffuse_roughness: unit_range("diffuse_roughness", d.diffuse_roughness)?,
         metallic: unit_range("metallic", metallic)?,
         specular: unit_range("specular", d.specular)?,
         specular_tint: unit_range("specular_tint", d.specular_tint)?,
@@ -267,6 +327,8 @@ fn material_from_desc(name: &str, d: &MaterialDesc) -> Result<Material, SceneErr
         two_sided: d.two_sided,
         conductor,
         multiscatter: d.multiscatter,
+        medium,
+        index_matched: d.index_matched,
         ..Material::named(name)
     })
 }
@@ -447,6 +509,28 @@ struct Builder<'a> {
     report: LoadReport,
     /// Cameras of each named `Mesh` shape.
     mesh_cameras: BTreeMap<String, Vec<Camera>>,
+    /// The shapes with a medium inside so far: their label and bounds.
+    media: Vec<MediumBounds>,
+}
+
+/// Where a shape's medium is: a sphere's, or a box around the triangles whose material has
+/// a medium.
+#[derive(Clone)]
+struct MediumBounds {
+    label: String,
+    min: Vec3,
+    max: Vec3,
+    sphere: Option<(Vec3, f32)>,
+}
+
+impl MediumBounds {
+    /// Whether the two may share space: spheres exactly, otherwise by their boxes.
+    fn overlaps(&self, other: &Self) -> bool {
+        if let (Some((c0, r0)), Some((c1, r1))) = (self.sphere, other.sphere) {
+            return c0.distance(c1) < r0 + r1;
+        }
+        self.min.cmplt(other.max).all() && other.min.cmplt(self.max).all()
+    }
 }
 
 impl<'a> Builder<'a> {
@@ -463,7 +547,58 @@ impl<'a> Builder<'a> {
             textures: Vec::new(),
             report: LoadReport::default(),
             mesh_cameras: BTreeMap::new(),
+            media: Vec::new(),
         }
+    }
+
+    /// Records the medium of the shape just built (its primitives from `first_tri` and
+    /// `first_sphere` on), refusing one that overlaps an earlier shape's medium: a path
+    /// is in one medium at a time.
+    fn check_medium(
+        &mut self,
+        label: &str,
+        first_tri: usize,
+        first_sphere: usize,
+    ) -> Result<(), SceneError> {
+        let has = |m: u32| self.materials[m as usize].medium.is_some();
+        let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        let mut spheres = Vec::new();
+        for t in &self.scene_triangles[first_tri..] {
+            if has(t.material) {
+                for p in t.positions {
+                    min = min.min(p);
+                    max = max.max(p);
+                }
+            }
+        }
+        for sph in &self.spheres[first_sphere..] {
+            if has(sph.material) {
+                min = min.min(sph.center - sph.radius);
+                max = max.max(sph.center + sph.radius);
+                spheres.push((sph.center, sph.radius));
+            }
+        }
+        if min.x > max.x {
+            return Ok(());
+        }
+        let bounds = MediumBounds {
+            label: label.to_owned(),
+            min,
+            max,
+            sphere: (spheres.len() == 1 && min == spheres[0].0 - spheres[0].1).then(|| spheres[0]),
+        };
+        if let Some(other) = self.media.iter().find(|o| o.overlaps(&bounds)) {
+            return Err(bad(
+                "medium",
+                format!(
+                    "the medium inside overlaps that of {}: media may neither overlap nor nest \
+                     (a path is in one medium at a time)",
+                    other.label
+                ),
+            ));
+        }
+        self.media.push(bounds);
+        Ok(())
     }
 
     fn build(mut self, file: &SceneFile) -> Result<Scene, SceneError> {
@@ -485,14 +620,17 @@ impl<'a> Builder<'a> {
                 Some(n) => format!("shape \"{n}\""),
                 None => format!("shape {i} ({})", shape.kind()),
             };
-            self.shape(shape).map_err(|e| {
-                let needle = match &e.kind {
-                    ErrorKind::UnknownMaterial { material, .. } => format!("\"{material}\""),
-                    ErrorKind::BadValue { field, .. } => (*field).to_owned(),
-                    _ => String::new(),
-                };
-                e.about(label).at(self.loc.in_shape(i, &needle))
-            })?;
+            let (first_tri, first_sphere) = (self.scene_triangles.len(), self.spheres.len());
+            self.shape(shape)
+                .and_then(|()| self.check_medium(&label, first_tri, first_sphere))
+                .map_err(|e| {
+                    let needle = match &e.kind {
+                        ErrorKind::UnknownMaterial { material, .. } => format!("\"{material}\""),
+                        ErrorKind::BadValue { field, .. } => (*field).to_owned(),
+                        _ => String::new(),
+                    };
+                    e.about(label).at(self.loc.in_shape(i, &needle))
+                })?;
         }
         for (i, light) in file.lights.iter().enumerate() {
             let l = light_from_desc(light).map_err(|e| {
@@ -565,6 +703,12 @@ impl<'a> Builder<'a> {
             None if !two_sided => return Ok(base),
             None => self.materials[base as usize].emission,
         };
+        if self.materials[base as usize].index_matched && emission.max_element() > 0.0 {
+            return Err(bad(
+                "emission",
+                "an index-matched boundary has no surface to emit",
+            ));
+        }
         let key = (base, emission.to_array().map(f32::to_bits), two_sided);
         if let Some(&id) = self.derived.get(&key) {
             return Ok(id);

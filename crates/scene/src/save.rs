@@ -284,6 +284,11 @@ fn material_value(m: &MaterialDesc) -> Val {
             given("base_color", vec3(m.base_color), &vec3(d.base_color)),
             given("emission", vec3(m.emission), &vec3(d.emission)),
             given("roughness", num(m.roughness), &num(d.roughness)),
+            given(
+                "diffuse_roughness",
+                num(m.diffuse_roughness),
+                &num(d.diffuse_roughness),
+            ),
             optional("metallic", m.metallic, num),
             optional("conductor", m.conductor.as_deref(), string),
             optional("eta", m.eta, vec3),
@@ -301,6 +306,21 @@ fn material_value(m: &MaterialDesc) -> Val {
                 "two_sided",
                 m.two_sided.to_string(),
                 &d.two_sided.to_string(),
+            ),
+            optional("attenuation_color", m.attenuation_color, vec3),
+            optional("attenuation_distance", m.attenuation_distance, num),
+            optional("medium", m.medium, |x| {
+                format!(
+                    "(sigma_a: {}, sigma_s: {}, g: {})",
+                    vec3(x.sigma_a),
+                    vec3(x.sigma_s),
+                    num(x.g)
+                )
+            }),
+            given(
+                "index_matched",
+                m.index_matched.to_string(),
+                &d.index_matched.to_string(),
             ),
         ],
     }

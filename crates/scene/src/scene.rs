@@ -87,6 +87,9 @@ pub struct Material {
     pub emission: Vec3,
     /// Perceptual roughness in [0, 1].
     pub roughness: f32,
+    /// Roughness of the diffuse base in [0, 1]: 0 Lambertian, else energy-preserving
+    /// Oren–Nayar (EON).
+    pub diffuse_roughness: f32,
     /// 0 dielectric, 1 metal.
     pub metallic: f32,
     /// Dielectric specular strength (0.5 means F0 = 0.04).
@@ -110,6 +113,46 @@ pub struct Material {
     pub conductor: Option<crate::conductor::Conductor>,
     /// Compensate the energy single-scattering microfacet lobes lose (default true).
     pub multiscatter: bool,
+    /// The homogeneous medium inside the shapes of this material (absorbing glass, or a
+    /// scattering medium), if any.
+    pub medium: Option<Medium>,
+    /// No surface: rays cross it unchanged (the index-matched boundary of a `medium`,
+    /// Mitsuba's `null` BSDF).
+    pub index_matched: bool,
+}
+
+/// A homogeneous participating medium: coefficients per unit length of the scene, linear RGB.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Medium {
+    /// Absorption coefficient `σ_a`.
+    pub sigma_a: Vec3,
+    /// Scattering coefficient `σ_s`.
+    pub sigma_s: Vec3,
+    /// Henyey–Greenstein asymmetry g in (−1, 1): > 0 scatters forward.
+    pub g: f32,
+}
+
+impl Medium {
+    /// The absorbing medium of glTF's `KHR_materials_volume`: white light turns into
+    /// `color` after `distance` (`σ_a = −ln(color) / distance`); none for an infinite distance
+    /// or a white color.
+    pub fn attenuation(color: Vec3, distance: f32) -> Option<Self> {
+        if !distance.is_finite() || color.min_element() >= 1.0 {
+            return None;
+        }
+        let sigma_a = Vec3::new(
+            -color.x.max(1e-30).ln(),
+            -color.y.max(1e-30).ln(),
+            -color.z.max(1e-30).ln(),
+        )
+        .max(Vec3::ZERO)
+            / distance;
+        Some(Self {
+            sigma_a,
+            sigma_s: Vec3::ZERO,
+            g: 0.0,
+        })
+    }
 }
 
 impl Material {
@@ -120,6 +163,7 @@ impl Material {
             base_color: Vec3::splat(0.8),
             emission: Vec3::ZERO,
             roughness: 0.5,
+            diffuse_roughness: 0.0,
             metallic: 0.0,
             specular: 0.5,
             specular_tint: 0.0,
@@ -130,6 +174,8 @@ impl Material {
             normal_scale: 1.0,
             conductor: None,
             multiscatter: true,
+            medium: None,
+            index_matched: false,
         }
     }
 

@@ -76,6 +76,42 @@ macro_rules! layout {
     };
 }
 
+/// `Material`'s expected layout (long enough for a function of its own).
+fn material_layout() -> (&'static str, usize, Vec<(&'static str, usize)>) {
+    layout!(
+        GpuMaterial,
+        "Material",
+        [
+            base_color,
+            roughness,
+            emission,
+            metallic,
+            specular,
+            specular_tint,
+            transmission,
+            ior,
+            tex_base_mr,
+            tex_emissive_normal,
+            flags,
+            normal_scale,
+            tex_transmission_specular,
+            tex_specular_color,
+            diffuse_roughness,
+            pad1,
+            eta,
+            pad2,
+            k,
+            pad3,
+            f_avg,
+            pad4,
+            sigma_a,
+            phase_g,
+            sigma_s,
+            pad5
+        ]
+    )
+}
+
 #[test]
 fn wgsl_layouts_match_rust() {
     let expected = [
@@ -91,34 +127,7 @@ fn wgsl_layouts_match_rust() {
             "Sphere",
             [center, radius, material, light, pad0, pad1]
         ),
-        layout!(
-            GpuMaterial,
-            "Material",
-            [
-                base_color,
-                roughness,
-                emission,
-                metallic,
-                specular,
-                specular_tint,
-                transmission,
-                ior,
-                tex_base_mr,
-                tex_emissive_normal,
-                flags,
-                normal_scale,
-                tex_transmission_specular,
-                tex_specular_color,
-                pad0,
-                pad1,
-                eta,
-                pad2,
-                k,
-                pad3,
-                f_avg,
-                pad4
-            ]
-        ),
+        material_layout(),
         layout!(
             GpuTriTexcoords,
             "TriTexcoords",

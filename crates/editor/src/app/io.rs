@@ -338,6 +338,7 @@ impl Editor {
             preview: PreviewScene {
                 gpu: Arc::new(gpu),
                 generation: self.scene_generation,
+                camera: None,
             },
             built: (doc.file.clone(), doc.furnace),
             doc,
@@ -364,6 +365,55 @@ impl Editor {
                 self.scene_error = Some(format!("cannot use the edited scene: {e}"));
             }
         }
+    }
+
+    /// Moves the scene's camera by `g` (orbit, pan, dolly on the preview): the camera in the
+    /// scene panel (and the file, when saved) moves, and the preview renders from there
+    /// without rebuilding the scene ([`PreviewScene::camera`]). A glTF camera cannot move:
+    /// the status bar says so.
+    pub fn move_camera(&mut self, g: &crate::viewer::CameraGesture) {
+        use lumagraph_scene::file::CameraDesc;
+        use lumagraph_scene::orbit;
+        let Some(s) = &mut self.scene else {
+            self.say("load a scene to move its camera", true);
+            return;
+        };
+        let CameraDesc::Perspective {
+            position,
+            target,
+            up,
+            fov_y,
+            aperture_radius,
+            focus_distance,
+            autofocus,
+        } = &mut s.doc.file.camera
+        else {
+            self.say(
+                "a glTF camera cannot move in the preview: give the scene a Perspective \
+                 camera (its numbers are in the glTF file)",
+                true,
+            );
+            return;
+        };
+        let mut p = orbit::orbit(*position, *target, *up, g.yaw, g.pitch);
+        let (np, nt) = orbit::pan(p, *target, *up, g.pan[0], g.pan[1]);
+        p = orbit::dolly(np, nt, g.dolly);
+        *position = p;
+        *target = nt;
+        let forward = glam::Vec3::from(nt) - glam::Vec3::from(p);
+        let camera = lumagraph_scene::Camera {
+            position: p.into(),
+            forward: forward.normalize(),
+            up: (*up).into(),
+            fov_y_deg: *fov_y,
+            aperture_radius: *aperture_radius,
+            focus_distance: focus_distance.unwrap_or(forward.length()),
+            autofocus: *autofocus,
+        };
+        let gpu = s.preview.gpu.camera_for(&camera);
+        s.preview.camera = Some(gpu);
+        // The preview's scene is the edited one but for the camera, which it follows.
+        s.built.0.camera = s.doc.file.camera.clone();
     }
 
     /// Saves the edited scene into its file, keeping the file's comments and layout.

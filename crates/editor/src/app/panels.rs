@@ -68,7 +68,9 @@ impl Editor {
             let aspect = image.height as f32 / image.width.max(1) as f32;
             let w = ui.available_width().min(2.0 * image.width as f32);
             let h = (w * aspect).clamp(64.0, 320.0);
-            self.view.show(ui, image, *ty, self.preview.stats.frames, h);
+            if let Some(g) = self.view.show(ui, image, *ty, self.preview.stats.frames, h) {
+                self.move_camera(&g);
+            }
             self.viewer_controls(ui, port);
             let size = self
                 .preview
@@ -146,6 +148,11 @@ impl Editor {
             let zoom = v
                 .zoom
                 .map_or_else(|| "fit".to_owned(), |z| format!("{:.0} %", z * 100.0));
+            ui.toggle_value(&mut v.camera_mode, "🎥 camera")
+                .on_hover_text(
+                    "on: drag orbits the scene's camera about its target, Shift- or middle-drag \
+                 pans it, the wheel dollies it; off: they zoom and pan the image",
+                );
             ui.weak(zoom)
                 .on_hover_text("scroll to zoom, drag to pan, double-click to fit");
             if ui.small_button("fit").clicked() {

@@ -558,6 +558,15 @@ fn material(ui: &mut Ui, name: &str, m: &mut MaterialDesc) {
                 ui.add(egui::Slider::new(&mut m.roughness, 0.0..=1.0))
                     .labelled_by(l);
             });
+            row(
+                ui,
+                "diffuse roughness",
+                "0 Lambertian; above 0 energy-preserving Oren–Nayar (EON)",
+                |ui, l| {
+                    ui.add(egui::Slider::new(&mut m.diffuse_roughness, 0.0..=1.0))
+                        .labelled_by(l);
+                },
+            );
             row(ui, "metallic", "0 dielectric, 1 metal", |ui, l| {
                 let auto = m.conductor.is_some() || m.eta.is_some() || m.k.is_some();
                 let mut v = m.metallic.unwrap_or(if auto { 1.0 } else { 0.0 });

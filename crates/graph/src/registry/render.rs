@@ -4,7 +4,7 @@ use super::{COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, Reac
 use crate::types::{ParamType, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
-    vec![path_trace(), accumulate(), gbuffer()]
+    vec![path_trace(), accumulate(), gbuffer(), temporal_reuse()]
 }
 
 fn path_trace() -> NodeKind {
@@ -38,6 +38,13 @@ fn path_trace() -> NodeKind {
                 "depth",
                 PortType::Depth,
                 "distance from the camera to that hit (0 on a miss)",
+            ),
+            OutputDef::new(
+                "samples",
+                PortType::HdrColor,
+                "where adaptive sampling put its samples: rgb the share of the frames so far \
+                  that sampled the pixel (1 everywhere without `adaptive_error`), alpha its \
+                  samples per pixel",
             ),
         ],
         params: vec![
@@ -75,6 +82,8 @@ fn path_trace() -> NodeKind {
             },
             sampler_param(),
             replicates_param(),
+            adaptive_error_param(),
+            adaptive_min_spp_param(),
             ParamDef {
                 name: "strategy",
                 ty: ParamType::Enum {
@@ -108,7 +117,46 @@ fn path_trace() -> NodeKind {
         renders_scene: true,
         shader: None,
         example: Vec::new(),
-        reach: Reach::Pixel,
+        // Adaptive sampling stops a pixel by the error over its 5×5 neighborhood.
+        reach: Reach::Within(|p| {
+            if p.float("adaptive_error") > 0.0 {
+                2
+            } else {
+                0
+            }
+        }),
+    }
+}
+
+/// `PathTrace`'s `adaptive_error` param.
+fn adaptive_error_param() -> ParamDef {
+    ParamDef {
+        name: "adaptive_error",
+        ty: ParamType::Float {
+            default: 0.0,
+            min: 0.0,
+            max: 10.0,
+        },
+        doc: "adaptive sampling: a pixel stops taking samples once the relative error \
+          of its mean, estimated from two independent halves of its frames and \
+          pooled over its 5×5 neighborhood, is below this (per channel, the standard \
+          deviation of the mean over √(mean² + 0.01), the weight relMSE gives it: 0.02 \
+          stops pixels near a relMSE of 4e-4); 0 is off. On, the \
+          frames alternate two Sobol replicates (as `replicates: 2`) and skipped \
+          pixels output alpha 0, which Accumulate does not add (docs/pathtracer.md)",
+    }
+}
+
+/// `PathTrace`'s `adaptive_min_spp` param.
+fn adaptive_min_spp_param() -> ParamDef {
+    ParamDef {
+        name: "adaptive_min_spp",
+        ty: ParamType::Int {
+            default: 16,
+            min: 2,
+            max: 1 << 20,
+        },
+        doc: "samples every pixel takes before adaptive sampling may stop it",
     }
 }
 
@@ -248,5 +296,89 @@ fn gbuffer() -> NodeKind {
         shader: None,
         example: Vec::new(),
         reach: Reach::Pixel,
+    }
+}
+
+fn temporal_reuse() -> NodeKind {
+    NodeKind {
+        name: "TemporalReuse",
+        category: Category::Render,
+        doc: "Keeps a progressive render's samples across camera moves (the editor's \
+          preview). Reads Accumulate's mean and the depth (normal, albedo) of the first hit \
+          through each pixel center. When the camera moves, the image it last wrote is \
+          reprojected into the new view: each pixel's first hit is looked up in the old \
+          image, bilinear over the taps whose depth, normal and emitter flag agree and that \
+          are not on the border of a surface with an emitter or the background; pixels that \
+          were hidden or off screen get no history. The output is the mean of the new \
+          frames and that history, weighted by their frame counts, the history's weight \
+          capped at `history_frames`, so it fades as new frames arrive. Without a move it \
+          passes Accumulate's mean through unchanged.",
+        inputs: vec![
+            InputDef::new(
+                "color",
+                &[PortType::HdrColor],
+                "Accumulate's mean since the camera last moved",
+            ),
+            InputDef::new(
+                "depth",
+                &[PortType::Depth],
+                "distance to the first hit through the pixel center (GBuffer or PathTrace)",
+            ),
+            InputDef::new(
+                "normal",
+                &[PortType::Normal],
+                "shading normal there; when connected, taps whose normals differ by more \
+                  than `normal_angle` are dropped too",
+            )
+            .optional(),
+            InputDef::new(
+                "albedo",
+                &[PortType::Albedo],
+                "albedo there, alpha 2 on emitters; when connected, a tap is dropped unless \
+                  it is an emitter exactly when the new hit is one (a light set in a ceiling \
+                  does not bleed into it)",
+            )
+            .optional(),
+        ],
+        outputs: vec![
+            OutputDef::new(
+                "color",
+                PortType::HdrColor,
+                "the new frames blended with the reprojected history",
+            ),
+            OutputDef::new(
+                "weight",
+                PortType::HdrColor,
+                "per pixel: the history's weight in frames (r), the new frames (g) and their \
+                  sum (b); r is 0 where the history was dropped",
+            ),
+        ],
+        params: vec![
+            ParamDef::int(
+                "history_frames",
+                64,
+                [0, 1 << 20],
+                "most frames of reprojected history a pixel keeps (0: no reuse)",
+            ),
+            ParamDef::float(
+                "depth_tolerance",
+                0.02,
+                [0.0, 1.0],
+                "largest relative difference between a tap's depth and the distance the old \
+                  camera would see the new hit at",
+            ),
+            ParamDef::float(
+                "normal_angle",
+                25.0,
+                [0.0, 180.0],
+                "largest angle in degrees between a tap's normal and the new one",
+            ),
+        ],
+        sink: false,
+        history: true,
+        renders_scene: false,
+        shader: None,
+        example: Vec::new(),
+        reach: Reach::Image("the history it reprojects may come from anywhere in the image"),
     }
 }

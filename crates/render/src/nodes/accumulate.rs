@@ -86,10 +86,19 @@ pub(crate) struct Accumulate {
     unused: [PooledTexture; 2],
 }
 
+/// The shader for variance mode `variance`: the code of the other modes is left out
+/// (`post/accumulate_options.wgsl`).
+fn kernel(ctx: &GpuContext, variance: u32) -> Result<Kernel> {
+    let name = "post/accumulate.wgsl";
+    let options = format!("const VARIANCE: u32 = {variance}u;\n");
+    let source = crate::shader::resolve_with(name, &[("post/accumulate_options.wgsl", options)])?;
+    Kernel::from_source(ctx, name, &source)
+}
+
 impl Accumulate {
     pub(crate) fn new(ctx: &GpuContext, pass: &Pass) -> Result<Self> {
-        let kernel = Kernel::new(ctx, "post/accumulate.wgsl")?;
         let variance = variance_mode(pass);
+        let kernel = kernel(ctx, variance)?;
         let block = AccumulateParams {
             one: 1.0,
             variance,
@@ -172,22 +181,7 @@ impl NodeExec for Accumulate {
             out.extend_from_slice(&b.size().to_le_bytes());
         }
         for b in [sum, comp, m2] {
-            let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("accumulate state readback"),
-                size: b.size(),
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let mut encoder = ctx
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("accumulate state"),
-                });
-            encoder.copy_buffer_to_buffer(b, 0, &staging, 0, b.size());
-            ctx.queue.submit([encoder.finish()]);
-            crate::readback::map_read(ctx, &staging, b.size(), |bytes| {
-                out.extend_from_slice(bytes);
-            })?;
+            crate::readback::append_buffer(ctx, b, &mut out)?;
         }
         Ok(Some(out))
     }
@@ -245,10 +239,12 @@ impl NodeExec for Accumulate {
         Ok(())
     }
 
-    fn update(&mut self, _ctx: &GpuContext, pass: &Pass) -> Result<()> {
-        // Another estimate keeps other numbers in the third buffer: start again.
+    fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
+        // Another estimate keeps other numbers in the third buffer (and has its own
+        // shader): start again.
         let variance = variance_mode(pass);
         if variance != self.variance {
+            self.kernel = kernel(ctx, variance)?;
             self.variance = variance;
             self.history = None;
             self.clear = true;

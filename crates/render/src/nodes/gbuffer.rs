@@ -44,6 +44,8 @@ pub(crate) const IMPL: NodeImpl = NodeImpl::new("GBuffer", |ctx, pass, resources
 
 pub(crate) struct GBuffer {
     scene: std::sync::Arc<GpuScene>,
+    /// The camera rasterized from: the scene's, until [`NodeExec::move_camera`].
+    camera_now: lumagraph_scene::GpuCamera,
     pipeline: wgpu::RenderPipeline,
     bind_group: wgpu::BindGroup,
     vertices: Option<(wgpu::Buffer, u32)>,
@@ -75,7 +77,7 @@ impl GBuffer {
         let camera = uniform_buffer(
             ctx,
             "gbuffer camera",
-            bytemuck::bytes_of(&raster_camera(&scene, [0, 0], pass.extent)),
+            bytemuck::bytes_of(&raster_camera(&scene, &scene.camera, [0, 0], pass.extent)),
         );
         // The materials are always read (their emission marks emitters); the textures only
         // with textures: without, a zeroed stand-in.
@@ -120,6 +122,7 @@ impl GBuffer {
             ],
         });
         let mut node = Self {
+            camera_now: scene.camera,
             scene,
             pipeline,
             bind_group,
@@ -250,8 +253,12 @@ crate::param_block! {
     }
 }
 
-fn raster_camera(scene: &GpuScene, origin: [u32; 2], extent: Extent) -> RasterCamera {
-    let c = &scene.camera;
+fn raster_camera(
+    scene: &GpuScene,
+    c: &lumagraph_scene::GpuCamera,
+    origin: [u32; 2],
+    extent: Extent,
+) -> RasterCamera {
     #[expect(clippy::cast_precision_loss, reason = "image sizes are small")]
     let window = [
         origin[0] as f32,
@@ -420,10 +427,14 @@ impl NodeExec for GBuffer {
         self.origin = origin;
     }
 
+    fn move_camera(&mut self, camera: &lumagraph_scene::GpuCamera) {
+        self.camera_now = *camera;
+    }
+
     fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
         let (ctx, encoder, io, timer) = rec.parts();
         let extent = pass.extent;
-        let camera = raster_camera(&self.scene, self.origin, extent);
+        let camera = raster_camera(&self.scene, &self.camera_now, self.origin, extent);
         if self.written != Some(camera) {
             ctx.queue
                 .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));

@@ -13,6 +13,7 @@ pub mod output;
 pub(crate) mod pathtrace;
 pub mod post_filter;
 pub(crate) mod regression;
+pub(crate) mod temporal;
 pub(crate) mod tonemap;
 
 use std::path::{Path, PathBuf};
@@ -169,6 +170,14 @@ pub trait NodeExec {
 
     /// Forgets history kept across frames (progressive accumulation restarts).
     fn reset(&mut self) {}
+
+    /// The camera moved to `camera` (the scene is otherwise the same): nodes that render
+    /// the scene render from it from the next frame on. By default the node's history
+    /// restarts ([`NodeExec::reset`]); a node that can carry its history into the new
+    /// view (`TemporalReuse`) keeps it.
+    fn move_camera(&mut self, _camera: &lumagraph_scene::GpuCamera) {
+        self.reset();
+    }
 
     /// The image a sink writes, as recorded in the last finishing frame (rows of
     /// `extent.width` pixels of `format`, no padding); `None` for other nodes. A tiled
@@ -360,6 +369,7 @@ pub static IMPLEMENTATIONS: &[NodeImpl] = &[
     image_input::IMPL,
     pathtrace::IMPL,
     accumulate::IMPL,
+    temporal::IMPL,
     gbuffer::IMPL,
     denoise::IMPL,
     regression::IMPL,

@@ -15,7 +15,8 @@ use crate::pool::{PooledTexture, create};
 use crate::readback::map_read;
 use crate::scene_gpu::SceneBuffers;
 
-/// `stats` slots: dropped (non-finite) samples, rays traced (low, high 32 bits).
+/// `stats` slots: dropped (non-finite) samples, rays traced (low, high 32 bits), samples
+/// adaptive sampling took (since the last read).
 const STATS: u64 = 4;
 
 /// The `PathTrace` kind.
@@ -24,7 +25,22 @@ pub(crate) const IMPL: NodeImpl = NodeImpl::new("PathTrace", |ctx, pass, resourc
 })
 .with_features(|pass, scene, cpu_adapter| {
     crate::specialize::features(scene, options(pass, &Resources::default(), cpu_adapter))
+})
+.owning(|pass| {
+    adaptive_on(pass).then(|| {
+        (
+            40 * pass.extent.pixels(),
+            "adaptive sampling: 40 B per pixel (the sums of two halves of the frames, \
+             whether it stopped, the list of pixels still sampling)"
+                .to_owned(),
+        )
+    })
 });
+
+/// Whether `pass` samples adaptively.
+fn adaptive_on(pass: &Pass) -> bool {
+    pass.params.float("adaptive_error") > 0.0
+}
 
 /// How a pass's shader is specialized: to the scene unless the resources ask for the
 /// general shader, to the kind of adapter, with first-hit AOVs when something reads them.
@@ -40,6 +56,7 @@ fn options(
         aovs: ["albedo", "normal", "depth"]
             .iter()
             .any(|p| pass.output(p).is_some()),
+        adaptive: adaptive_on(pass),
     }
 }
 
@@ -68,9 +85,140 @@ crate::param_block! {
     }
 }
 
+crate::param_block! {
+    /// The adaptive sampling pass's params (`pathtrace/adaptive.wgsl`).
+    pub(crate) struct AdaptiveParams in "pathtrace/adaptive.wgsl" as "Params" {
+        size: [u32; 2],
+        min_frames: u32,
+        error2: f32,
+        frames: u32,
+        samples_per_frame: u32,
+        pad0: u32,
+        pad1: u32,
+    }
+}
+
+/// Adaptive sampling's pass and per-pixel state (16-byte stand-ins while it is off).
+struct Adaptive {
+    kernel: Kernel,
+    params: wgpu::Buffer,
+    /// Per pixel of the window: the sums (rgb) and frame counts of the even and odd frames.
+    halves: wgpu::Buffer,
+    /// Per pixel: 1 once it stopped.
+    stopped: wgpu::Buffer,
+    /// This frame's pixels still sampling: their count, then each one's position.
+    active: wgpu::Buffer,
+    /// The window size the buffers are for (0×0: stand-ins).
+    extent: lumagraph_graph::Extent,
+    /// Clear the buffers before the next frame.
+    clear: bool,
+    /// `adaptive_error` (0: off) and the frames every pixel takes first.
+    error: f32,
+    min_spp: u32,
+}
+
+impl Adaptive {
+    fn new(ctx: &GpuContext) -> Result<Self> {
+        Ok(Self {
+            kernel: Kernel::new(ctx, "pathtrace/adaptive.wgsl")?,
+            params: uniform_buffer(
+                ctx,
+                "adaptive params",
+                bytemuck::bytes_of(&AdaptiveParams::default()),
+            ),
+            halves: storage(ctx, "adaptive halves", 16),
+            stopped: storage(ctx, "adaptive stopped", 16),
+            active: storage(ctx, "adaptive active", 16),
+            extent: lumagraph_graph::Extent::new(0, 0),
+            clear: true,
+            error: 0.0,
+            min_spp: 16,
+        })
+    }
+
+    fn on(&self) -> bool {
+        self.error > 0.0
+    }
+
+    /// Records the pass that stops pixels before a frame and writes `samples`; `frames` is
+    /// the frames run before this one and the samples each takes.
+    fn record(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: &Pass,
+        [frames, samples_per_frame]: [u32; 2],
+        samples: &wgpu::TextureView,
+        timer: Option<&mut crate::timing::GpuTimer>,
+    ) -> Result<()> {
+        self.fit(ctx, pass.extent);
+        if self.clear && self.on() {
+            encoder.clear_buffer(&self.halves, 0, None);
+            encoder.clear_buffer(&self.stopped, 0, None);
+            self.clear = false;
+        }
+        if self.on() {
+            encoder.clear_buffer(&self.active, 0, Some(4));
+        }
+        let block = AdaptiveParams {
+            size: [pass.extent.width, pass.extent.height],
+            min_frames: self.min_spp.div_ceil(samples_per_frame).max(2),
+            error2: if self.on() {
+                self.error * self.error
+            } else {
+                -1.0
+            },
+            frames,
+            samples_per_frame,
+            ..AdaptiveParams::default()
+        };
+        let staging = ctx
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("adaptive params staging"),
+                contents: bytemuck::bytes_of(&block),
+                usage: wgpu::BufferUsages::COPY_SRC,
+            });
+        encoder.copy_buffer_to_buffer(&staging, 0, &self.params, 0, self.params.size());
+        self.kernel
+            .pass(&format!("{} (adaptive)", pass.node))
+            .uniform(&self.params)
+            .buffer(&self.halves)
+            .buffer(&self.stopped)
+            .write(samples)
+            .buffer(&self.active)
+            .dispatch_2d(ctx, encoder, pass.extent, timer)
+    }
+
+    /// Buffers for a window of `extent` (new ones, to be cleared, when it changed).
+    fn fit(&mut self, ctx: &GpuContext, extent: lumagraph_graph::Extent) {
+        if self.on() && self.extent != extent {
+            self.halves = storage(ctx, "adaptive halves", 32 * extent.pixels());
+            self.stopped = storage(ctx, "adaptive stopped", 4 * extent.pixels());
+            self.active = storage(ctx, "adaptive active", 4 + 4 * extent.pixels());
+            self.extent = extent;
+            self.clear = true;
+        }
+    }
+}
+
+/// A storage buffer of `size` bytes that can be cleared and read back.
+fn storage(ctx: &GpuContext, label: &str, size: u64) -> wgpu::Buffer {
+    ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(16),
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    })
+}
+
 pub(crate) struct PathTrace {
     kernel: Kernel,
     scene: std::sync::Arc<lumagraph_scene::GpuScene>,
+    /// The camera rendered from: the scene's, until [`NodeExec::move_camera`].
+    camera: lumagraph_scene::GpuCamera,
     buffers: SceneBuffers,
     frame: wgpu::Buffer,
     stats: wgpu::Buffer,
@@ -83,8 +231,8 @@ pub(crate) struct PathTrace {
     rays: u64,
     /// How the shader was specialized, for reports.
     how: String,
-    /// Stand-ins for outputs nothing reads (color, albedo, normal, depth).
-    unused: [PooledTexture; 4],
+    /// Stand-ins for outputs nothing reads (color, albedo, normal, depth, samples).
+    unused: [PooledTexture; 5],
     /// GGX albedo tables of the material model.
     ggx_table: wgpu::Buffer,
     /// The environment map and its sampling tables (a 1x1 stand-in without one).
@@ -100,6 +248,9 @@ pub(crate) struct PathTrace {
     replicates: u32,
     /// Where the pass's image lies in the whole image (tiled renders).
     origin: [u32; 2],
+    adaptive: Adaptive,
+    /// Samples adaptive sampling took since the last reset, read back so far.
+    adaptive_samples: u64,
 }
 
 impl PathTrace {
@@ -128,6 +279,7 @@ impl PathTrace {
             create(ctx, "unused albedo", TexFormat::Rgba32Float, one),
             create(ctx, "unused normal", TexFormat::Rgba32Float, one),
             create(ctx, "unused depth", TexFormat::R32Float, one),
+            create(ctx, "unused samples", TexFormat::Rgba32Float, one),
         ];
         let buffers = SceneBuffers::upload(ctx, &scene);
         let frame = uniform_buffer(
@@ -151,6 +303,7 @@ impl PathTrace {
         });
         let mut node = Self {
             kernel,
+            camera: scene.camera,
             scene,
             buffers,
             frame,
@@ -169,6 +322,8 @@ impl PathTrace {
             strategy: 0,
             replicates: 1,
             origin: [0, 0],
+            adaptive: Adaptive::new(ctx)?,
+            adaptive_samples: 0,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -178,7 +333,7 @@ impl PathTrace {
         let s = &self.scene;
         Frame {
             settings: s.settings,
-            camera: s.camera,
+            camera: self.camera,
             header: s.header,
             sample_offset: self.samples,
             samples_per_frame: self.samples_per_frame,
@@ -187,9 +342,47 @@ impl PathTrace {
             firefly_clamp: self.firefly_clamp,
             sampler: self.sampler,
             strategy: self.strategy,
-            replicates: self.replicates,
+            // Adaptive sampling estimates the error from two independent halves.
+            replicates: if self.adaptive.on() {
+                2
+            } else {
+                self.replicates
+            },
             window: [self.origin[0], self.origin[1], extent.width, extent.height],
         }
+    }
+}
+
+impl PathTrace {
+    /// Restores adaptive sampling's buffers from what follows the counters in a saved state
+    /// (nothing: adaptive sampling was off, or no frame had run).
+    fn load_adaptive(&mut self, ctx: &GpuContext, pass: &Pass, rest: &[u8]) -> Result<()> {
+        let a = &mut self.adaptive;
+        if rest.is_empty() {
+            a.clear = true;
+            return Ok(());
+        }
+        let px = usize::try_from(pass.extent.pixels()).unwrap_or(usize::MAX);
+        let expected = 8 + 36 * px;
+        let size = rest.get(..8).map(|b| {
+            [&b[..4], &b[4..]].map(|w| u32::from_le_bytes(w.try_into().unwrap_or_default()))
+        });
+        if !a.on()
+            || rest.len() != expected
+            || size != Some([pass.extent.width, pass.extent.height])
+        {
+            return Err(RenderError::Gpu(format!(
+                "a path tracer's adaptive sampling state does not fit: {} bytes for {} \
+                 ({expected} expected; is adaptive_error on in both?)",
+                rest.len(),
+                pass.extent
+            )));
+        }
+        a.fit(ctx, pass.extent);
+        ctx.queue.write_buffer(&a.halves, 0, &rest[8..8 + 32 * px]);
+        ctx.queue.write_buffer(&a.stopped, 0, &rest[8 + 32 * px..]);
+        a.clear = false;
+        Ok(())
     }
 }
 
@@ -202,6 +395,10 @@ impl NodeExec for PathTrace {
         self.sampler = crate::params::enum_index(pass, "sampler")?;
         self.strategy = crate::params::enum_index(pass, "strategy")?;
         self.replicates = u32::try_from(pass.params.int("replicates")).unwrap_or(1);
+        #[expect(clippy::cast_possible_truncation, reason = "GPU math is f32")]
+        let error = pass.params.float("adaptive_error") as f32;
+        self.adaptive.error = error;
+        self.adaptive.min_spp = u32::try_from(pass.params.int("adaptive_min_spp")).unwrap_or(16);
         Ok(())
     }
 
@@ -213,10 +410,17 @@ impl NodeExec for PathTrace {
         self.samples = 0;
         self.dropped = 0;
         self.rays = 0;
+        self.adaptive_samples = 0;
+        self.adaptive.clear = true;
+    }
+
+    fn move_camera(&mut self, camera: &lumagraph_scene::GpuCamera) {
+        self.camera = *camera;
+        self.reset();
     }
 
     fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
-        let (ctx, encoder, io, timer) = rec.parts();
+        let (ctx, encoder, io, mut timer) = rec.parts();
         // Each frame has its own uniform contents: stage them through a copy recorded in
         // order, so many frames can share one submission.
         let staging = ctx
@@ -227,6 +431,19 @@ impl NodeExec for PathTrace {
                 usage: wgpu::BufferUsages::COPY_SRC,
             });
         encoder.copy_buffer_to_buffer(&staging, 0, &self.frame, 0, self.frame.size());
+        let samples = pass.output("samples");
+        if samples.is_some() || self.adaptive.on() {
+            let view = samples.map_or(&self.unused[4].view, |t| &io.texture(t).view);
+            let spf = self.samples_per_frame.max(1);
+            self.adaptive.record(
+                ctx,
+                encoder,
+                pass,
+                [self.samples / spf, spf],
+                view,
+                timer.as_deref_mut(),
+            )?;
+        }
         self.samples += self.samples_per_frame;
         let b = &self.buffers;
         let aov = |port: &str, i: usize| {
@@ -253,6 +470,9 @@ impl NodeExec for PathTrace {
             .buffer(&self.env.alias)
             .buffer(&b.tri_texcoords)
             .buffer(&b.textures)
+            .buffer(&self.adaptive.halves)
+            .buffer(&self.adaptive.stopped)
+            .buffer(&self.adaptive.active)
             .dispatch_2d(ctx, encoder, pass.extent, timer)
     }
 
@@ -274,24 +494,31 @@ impl NodeExec for PathTrace {
         for v in [u64::from(self.samples), self.dropped, self.rays] {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
+        // Adaptive sampling's state follows: the window size, the halves, the stopped flags.
+        let a = &self.adaptive;
+        if a.on() && !a.clear && a.extent.pixels() > 0 {
+            bytes.extend_from_slice(&a.extent.width.to_le_bytes());
+            bytes.extend_from_slice(&a.extent.height.to_le_bytes());
+            crate::readback::append_buffer(ctx, &a.halves, &mut bytes)?;
+            crate::readback::append_buffer(ctx, &a.stopped, &mut bytes)?;
+        }
         Ok(Some(bytes))
     }
 
-    fn load_state(&mut self, _ctx: &GpuContext, _pass: &Pass, state: &[u8]) -> Result<()> {
+    fn load_state(&mut self, ctx: &GpuContext, pass: &Pass, state: &[u8]) -> Result<()> {
         let word = |i: usize| {
             state
                 .get(8 * i..8 * i + 8)
                 .and_then(|b| b.try_into().ok())
                 .map(u64::from_le_bytes)
         };
-        let (Some(samples), Some(dropped), Some(rays), 24) =
-            (word(0), word(1), word(2), state.len())
-        else {
+        let (Some(samples), Some(dropped), Some(rays)) = (word(0), word(1), word(2)) else {
             return Err(RenderError::Gpu(format!(
-                "a path tracer's state is 24 bytes, this one {}",
+                "a path tracer's state is at least 24 bytes, this one {}",
                 state.len()
             )));
         };
+        self.load_adaptive(ctx, pass, &state[24..])?;
         self.samples = u32::try_from(samples)
             .map_err(|_| RenderError::Gpu(format!("{samples} samples per pixel is too many")))?;
         self.dropped = dropped;
@@ -332,10 +559,15 @@ impl NodeExec for PathTrace {
         )?;
         self.dropped += u64::from(v[0]);
         self.rays += u64::from(v[1]) | (u64::from(v[2]) << 32);
-        Ok(vec![
+        self.adaptive_samples += u64::from(v[3]);
+        let mut counters = vec![
             Counter::new("samples_per_pixel", u64::from(self.samples)),
             Counter::new("dropped_samples", self.dropped),
             Counter::new("rays", self.rays),
-        ])
+        ];
+        if self.adaptive.on() {
+            counters.push(Counter::new("adaptive_samples", self.adaptive_samples));
+        }
+        Ok(counters)
     }
 }

@@ -2,7 +2,7 @@
 //! perspective cameras, metallic-roughness materials with their base color,
 //! metallic-roughness, normal and emissive textures, `KHR_materials_emissive_strength`,
 //! `KHR_materials_ior`, `KHR_materials_transmission` and `KHR_materials_specular` (factors
-//! and textures). Texture coordinates are `TEXCOORD_0`; tangents are the file's `TANGENT`
+//! and textures), `KHR_materials_diffuse_roughness` (its factor). Texture coordinates are `TEXCOORD_0`; tangents are the file's `TANGENT`
 //! when present (else generated when the scene is flattened).
 //!
 //! `KHR_lights_punctual` lights become [`PunctualLight`]s, converted as Blender's importer
@@ -680,6 +680,28 @@ pub fn gltf_specular(ior: f32, specular_factor: f32, specular_color: [f32; 3]) -
     layer * specular_factor * color
 }
 
+/// `KHR_materials_diffuse_roughness` (read from the raw extension JSON):
+/// `diffuseRoughnessFactor`, clamped to [0, 1], default 0; its texture is not read (a
+/// warning says so).
+fn diffuse_roughness(m: &::gltf::Material<'_>, warnings: &mut Vec<String>) -> f32 {
+    let Some(ext) = m.extension_value("KHR_materials_diffuse_roughness") else {
+        return 0.0;
+    };
+    if ext.get("diffuseRoughnessTexture").is_some() {
+        warnings.push(format!(
+            "material {}: diffuseRoughnessTexture is not read (its factor is)",
+            material_name(m)
+        ));
+    }
+    #[expect(
+        clippy::cast_possible_truncation,
+        reason = "a factor in [0, 1] read as JSON f64"
+    )]
+    ext.get("diffuseRoughnessFactor")
+        .and_then(::gltf::json::Value::as_f64)
+        .map_or(0.0, |f| f.clamp(0.0, 1.0) as f32)
+}
+
 fn material(
     m: &::gltf::Material<'_>,
     dec: &mut Decoder<'_>,
@@ -721,6 +743,7 @@ fn material(
         base_color: Vec3::new(r, g, b),
         emission: Vec3::from(m.emissive_factor()) * strength,
         roughness: pbr.roughness_factor(),
+        diffuse_roughness: diffuse_roughness(m, warnings),
         metallic: pbr.metallic_factor(),
         specular,
         specular_tint: 0.0,
@@ -739,5 +762,17 @@ fn material(
         normal_scale: normal_info.map_or(1.0, |n| n.scale()),
         conductor: None,
         multiscatter: true,
+        // KHR_materials_volume: absorption inside a thick transmissive volume (a thickness
+        // of 0 is thin-walled: no volume).
+        medium: m
+            .volume()
+            .filter(|v| v.thickness_factor() > 0.0)
+            .and_then(|v| {
+                crate::scene::Medium::attenuation(
+                    Vec3::from(v.attenuation_color()),
+                    v.attenuation_distance(),
+                )
+            }),
+        index_matched: false,
     })
 }
