@@ -214,20 +214,37 @@ fn first_hit_aovs_see_the_back_wall() {
 /// written into the shader or read from their buffers, or with BVH traversal as GPU
 /// adapters run it: color, albedo, normal and depth, and how the shader was specialized.
 fn render_small(name: &str, spp: u32, in_buffers: bool, bvh: bool) -> Option<(Vec<Image>, String)> {
+    render_with(
+        name,
+        (64, 64),
+        spp,
+        Resources {
+            scene_data_in_buffers: in_buffers,
+            traverse_bvh: bvh,
+            ..Resources::default()
+        },
+    )
+}
+
+/// `scene` rendered at `size` and `spp` with `resources` (the scene set here): color,
+/// albedo, normal and depth, and how the shader was specialized.
+fn render_with(
+    name: &str,
+    size: (u32, u32),
+    spp: u32,
+    resources: Resources,
+) -> Option<(Vec<Image>, String)> {
     let ctx = common::gpu()?;
     let mut gpu =
         GpuScene::build(&Scene::load(&common::repo(&format!("assets/{name}"))).unwrap()).unwrap();
-    gpu.settings.width = 64;
-    gpu.settings.height = 64;
+    (gpu.settings.width, gpu.settings.height) = size;
     let gpu = Arc::new(gpu);
     let ports = ["acc.color", "pt.albedo", "pt.normal", "pt.depth"];
     let outputs: Vec<String> = ports.iter().map(|p| (*p).to_owned()).collect();
     let plan = compile(&progressive_graph(4), &outputs, Some(&gpu)).unwrap();
     let resources = Resources {
         scene: Some(Arc::clone(&gpu)),
-        scene_data_in_buffers: in_buffers,
-        traverse_bvh: bvh,
-        ..Resources::default()
+        ..resources
     };
     let mut exec = Executor::new(ctx, plan, &resources).unwrap();
     let how = exec
@@ -292,6 +309,53 @@ fn inlined_scene_data_renders_bit_identical_images() {
         assert!(
             inline[0].pixels.iter().any(|p| p[0] > 0.0),
             "{name}: black image"
+        );
+    }
+}
+
+/// On a CPU adapter the path tracer's workgroups trace rows of tiles spread over the image
+/// (llvmpipe gives each thread one contiguous range of workgroups), which must be the same
+/// work in another order: every pixel traced once, bit for bit as in image order. Sizes
+/// that are not multiples of the 8×8 tile, with 11 and 7 rows of tiles (the spread is a
+/// stride prime to the number of rows), inline intersection (Cornell) and BVH traversal
+/// under an environment map (the sphere grid).
+#[test]
+fn spreading_workgroups_over_the_image_renders_bit_identical_images() {
+    for (name, size) in [("cornell.ron", (60, 84)), ("spheregrid.ron", (90, 50))] {
+        let run = |in_order| {
+            render_with(
+                name,
+                size,
+                8,
+                Resources {
+                    workgroups_in_image_order: in_order,
+                    ..Resources::default()
+                },
+            )
+        };
+        let Some((spread, how_spread)) = run(false) else {
+            return;
+        };
+        let (in_order, how_in_order) = run(true).unwrap();
+        println!("{name}: {how_spread}\n{name}: {how_in_order}");
+        assert!(!how_spread.contains("spread workgroups"), "{how_spread}");
+        assert!(how_in_order.contains("spread workgroups"), "{how_in_order}");
+        for (i, (a, b)) in spread.iter().zip(&in_order).enumerate() {
+            let differ = differing(a, b, None);
+            println!(
+                "{name}: output {i}: {differ} of {} pixels differ",
+                a.pixels.len()
+            );
+            assert_eq!(differ, 0, "{name}: output {i} differs");
+        }
+        let black = spread[0]
+            .pixels
+            .iter()
+            .filter(|p| p[..3] == [0.0; 3])
+            .count();
+        assert!(
+            black < spread[0].pixels.len() / 10,
+            "{name}: {black} black pixels"
         );
     }
 }

@@ -613,6 +613,7 @@ fn plan_lists_textures_for_textured_scenes_only() {
         aovs: false,
         adaptive: false,
         data_in_buffers: false,
+        in_image_order: false,
     };
     let on = |path: &Path| {
         let scene = GpuScene::build(&Scene::load(path).unwrap()).unwrap();
@@ -1322,12 +1323,14 @@ fn small_scenes_are_inlined_on_cpu_adapters_only() {
             aovs: false,
             adaptive: false,
             data_in_buffers: false,
+            in_image_order: false,
         };
         let f = features(&scene, opts);
         let on = |name: &str| f.iter().find(|x| x.name == name).unwrap();
         assert_eq!(on("inline intersection").included, cpu_adapter);
         assert_eq!(on("inline materials and lights").included, cpu_adapter);
         assert_eq!(on("BVH traversal").included, !cpu_adapter);
+        assert_eq!(on("spread workgroups").included, cpu_adapter);
         if !cpu_adapter {
             let why = &on("BVH traversal").reason;
             assert!(why.contains("a GPU adapter"), "{why}");

@@ -7,6 +7,9 @@ const WRITE_AOVS: bool = true;
 // Adaptive sampling: skip the pixels `pathtrace/adaptive.wgsl` has stopped, and keep the
 // statistics it stops them by.
 const ADAPTIVE: bool = true;
+// Workgroups trace rows of tiles spread over the image (CPU adapters: llvmpipe gives each
+// thread one contiguous range of a dispatch's workgroups).
+const SPREAD_WORKGROUPS: bool = true;
 
 // Lobes some material of the scene uses; the code of the others is left out.
 const HAS_SPECULAR: bool = true;

@@ -571,23 +571,53 @@ fn trace_path(pixel: vec2u) -> vec3f {
     return radiance;
 }
 
+// The row of 8×8 tiles that workgroup row `row` of `rows` traces: rows a stride apart, the
+// stride near rows / golden ratio and prime to `rows` (so every row is traced once). llvmpipe
+// splits a dispatch into one contiguous range of workgroups per thread; in image order, a
+// thread given the sky would idle while another traces the ground.
+fn spread_row(row: u32, rows: u32) -> u32 {
+    var stride = max(u32(f32(rows) * 0.618034), 1u);
+    loop {
+        var a = stride;
+        var b = rows;
+        while b != 0u {
+            let r = a % b;
+            a = b;
+            b = r;
+        }
+        if a == 1u {
+            break;
+        }
+        stride += 1u;
+    }
+    return (row * stride) % rows;
+}
+
 @compute @workgroup_size(8, 8)
 fn main(
-    @builtin(global_invocation_id) id: vec3u,
     @builtin(workgroup_id) group: vec3u,
     @builtin(num_workgroups) groups: vec3u,
+    @builtin(local_invocation_id) local: vec3u,
     @builtin(local_invocation_index) lane: u32,
 ) {
-    var at = id.xy;
+    // The tile this workgroup traces: the workgroup's own, or with SPREAD_WORKGROUPS (CPU
+    // adapters) the rows of tiles spread over the image, which is the same work in another
+    // order (the images are bit-identical).
+    var tile = group.xy;
+    if SPREAD_WORKGROUPS {
+        tile.y = spread_row(group.y, groups.y);
+    }
+    let id = tile * 8u + local.xy;
+    var at = id;
     var trace = true;
     if ADAPTIVE {
         // A pixel adaptive sampling stopped takes no samples and outputs alpha 0. The pixels
         // still sampling are traced by the first invocations, in the order the adaptive pass
         // listed them (workgroup by workgroup), so whole workgroups at the end idle.
-        if all(id.xy < frame.window.zw) && adaptive_stopped[id.y * frame.window.z + id.x] != 0u {
-            textureStore(output, id.xy, vec4f(0.0));
+        if all(id < frame.window.zw) && adaptive_stopped[id.y * frame.window.z + id.x] != 0u {
+            textureStore(output, id, vec4f(0.0));
         }
-        let k = (group.y * groups.x + group.x) * 64u + lane;
+        let k = (tile.y * groups.x + tile.x) * 64u + lane;
         trace = k < adaptive_active[0];
         if trace {
             let packed = adaptive_active[1u + k];
@@ -597,7 +627,7 @@ fn main(
     if trace {
         trace_pixel(at);
     }
-    first_hit_aovs(id.xy);
+    first_hit_aovs(id);
 }
 
 // Traces the pixel `at` of the window (`samples_per_frame` paths) and writes their mean.

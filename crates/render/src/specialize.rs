@@ -351,6 +351,9 @@ pub struct PathTraceOptions {
     /// even where the scene is small enough to write them into the shader (tests and
     /// benchmarks compare the two; images are bit-identical).
     pub data_in_buffers: bool,
+    /// On a CPU adapter, trace workgroups in image order instead of spreading them over the
+    /// image (the images are bit-identical; a test compares the two).
+    pub in_image_order: bool,
 }
 
 /// One feature of the path tracer, compiled in or left out for a scene, and why.
@@ -512,6 +515,17 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
             all || textured,
             textures_reason(scene, all),
         ),
+        feature(
+            "spread workgroups",
+            options.cpu_adapter && !options.in_image_order,
+            if !options.cpu_adapter {
+                "a GPU adapter: workgroups in image order"
+            } else if options.in_image_order {
+                "image order asked for"
+            } else {
+                "a CPU adapter: each driver thread takes one contiguous range of workgroups"
+            },
+        ),
     ]);
     out
 }
@@ -583,12 +597,13 @@ pub fn pathtrace_source(
     let features = features(scene, options);
     let on = |name: &str| features.iter().any(|f| f.name == name && f.included);
     let consts = format!(
-        "const WRITE_AOVS: bool = {};\nconst ADAPTIVE: bool = {};\nconst HAS_SPECULAR: bool = {};\nconst HAS_METAL: bool = {};\n\
+        "const WRITE_AOVS: bool = {};\nconst ADAPTIVE: bool = {};\nconst SPREAD_WORKGROUPS: bool = {};\nconst HAS_SPECULAR: bool = {};\nconst HAS_METAL: bool = {};\n\
          const HAS_GLASS: bool = {};\nconst HAS_LIGHTS: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
          const HAS_ENV_MAP: bool = {};\nconst HAS_TEXTURES: bool = {};\nconst HAS_ROUGH_DIFFUSE: bool = {};\n\
          const HAS_MEDIA: bool = {};\n",
         on("first-hit AOVs"),
         on("adaptive sampling"),
+        on("spread workgroups"),
         on("dielectric specular lobe"),
         on("metal lobe"),
         on("glass lobe"),

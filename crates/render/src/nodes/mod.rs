@@ -44,6 +44,9 @@ pub struct Resources {
     /// Traverse the BVH even where a CPU adapter would intersect a small scene inline: what
     /// GPU adapters run (tests compare the two on lavapipe).
     pub traverse_bvh: bool,
+    /// Trace workgroups in image order even on a CPU adapter, where they are otherwise
+    /// spread over the image to balance the driver's threads (a test compares the two).
+    pub workgroups_in_image_order: bool,
 }
 
 /// An image a sink would write: its pixels and what they are.

@@ -53,6 +53,7 @@ fn options(
         specialize: !resources.general_shaders,
         cpu_adapter,
         data_in_buffers: resources.scene_data_in_buffers,
+        in_image_order: resources.workgroups_in_image_order,
         aovs: ["albedo", "normal", "depth"]
             .iter()
             .any(|p| pass.output(p).is_some()),
