@@ -49,13 +49,13 @@ fn ray_aabb(origin: vec3<f32>, inv_dir: vec3<f32>, bmin: vec3<f32>, bmax: vec3<f
     return near <= far;
 }
 
-// Moller-Trumbore. Returns vec4(hit ? 1 : 0, t, u, v).
+// Moller-Trumbore. Returns vec4(hit ? 1 : 0, t, u, v); t, u, v only mean something on a hit.
 fn intersect_triangle(origin: vec3<f32>, dir: vec3<f32>, v0: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>, t_max: f32) -> vec4<f32> {
     let p = cross(dir, e2);
     let det = dot(e1, p);
-    if (det == 0.0) {
-        return vec4<f32>(0.0);
-    }
+    // A ray parallel to the plane (det 0) gets infinite or NaN u, v, t, which fail `inside`
+    // below: no early return, which llvmpipe would not take anyway (it runs an if's body
+    // whether or not a lane needs it) and whose masking cost 1.47x on the Cornell box.
     let inv_det = 1.0 / det;
     let s = origin - v0;
     let u = dot(s, p) * inv_det;
@@ -74,13 +74,15 @@ fn intersect_triangle(origin: vec3<f32>, dir: vec3<f32>, v0: vec3<f32>, e1: vec3
     // `origin_slab` is one the origin, rounded to behind the plane it leaves, sees from inside.
     let n = cross(e1, e2);
     let on_plane = abs(t * det) <= dot(abs(n), origin_err);
-    if (inside && (on_plane || (t > 0.0 && t <= origin_slab))) {
-        let a0 = -dot(s, origin_n);
-        let concave = max(a0, a0 + max(dot(e1, origin_n), dot(e2, origin_n))) > origin_off;
-        let along = dot(n, origin_n);
-        let parallel = along * along > PARALLEL_COS2 * dot(n, n);
-        hit = select(concave, det > 0.0 && concave && !parallel, on_plane);
-    }
+    // Computed for every triangle and chosen with select, not behind an if: llvmpipe runs an
+    // if's body whether or not a lane needs it, and masking it cost more than these few
+    // operations (1.28x on the Cornell box, docs/benchmarks.md).
+    let a0 = -dot(s, origin_n);
+    let concave = max(a0, a0 + max(dot(e1, origin_n), dot(e2, origin_n))) > origin_off;
+    let along = dot(n, origin_n);
+    let parallel = along * along > PARALLEL_COS2 * dot(n, n);
+    let near_origin = inside && (on_plane || (t > 0.0 && t <= origin_slab));
+    hit = select(hit, select(concave, det > 0.0 && concave && !parallel, on_plane), near_origin);
     return vec4<f32>(select(0.0, 1.0, hit), t, u, v);
 }
 
@@ -92,26 +94,23 @@ fn sphere_roots(origin: vec3<f32>, dir: vec3<f32>, center: vec3<f32>, radius: f3
     let b = -dot(f, dir);
     let l = f + (b / a) * dir;
     let disc = a * (radius * radius - dot(l, l));
-    if (!(disc >= 0.0)) {
-        return vec2<f32>(-1.0);
-    }
+    // Selected, not returned early: llvmpipe runs an if's body anyway (see intersect_triangle).
     let c = dot(f, f) - radius * radius;
     let root = sqrt(disc);
     let q = b + select(root, -root, b < 0.0);
     let t0 = c / q;
     let t1 = q / a;
-    return vec2<f32>(min(t0, t1), max(t0, t1));
+    return select(vec2<f32>(-1.0), vec2<f32>(min(t0, t1), max(t0, t1)), disc >= 0.0);
 }
 
 // The nearest ray/sphere t in (0, t_max), or -1.
 fn intersect_sphere(origin: vec3<f32>, dir: vec3<f32>, center: vec3<f32>, radius: f32, t_max: f32) -> f32 {
-    let r = sphere_roots(origin, dir, center, radius);
-    if (r.x > 0.0 && r.x < t_max) {
-        return r.x;
-    } else if (r.y > 0.0 && r.y < t_max) {
-        return r.y;
-    }
-    return -1.0;
+    return nearest_root(sphere_roots(origin, dir, center, radius), t_max);
+}
+
+// The first of the roots `r` (near, far) in (0, t_max), or -1.
+fn nearest_root(r: vec2<f32>, t_max: f32) -> f32 {
+    return select(select(-1.0, r.y, r.y > 0.0 && r.y < t_max), r.x, r.x > 0.0 && r.x < t_max);
 }
 
 // `intersect_sphere` for sphere `prim` (its index | PRIM_SPHERE) by a ray that may be the one
@@ -119,9 +118,7 @@ fn intersect_sphere(origin: vec3<f32>, dir: vec3<f32>, center: vec3<f32>, radius
 // convex sphere again; going in (`skip_inward`), only at the far root, the near one being its
 // own origin whichever side of the surface rounding put that.
 fn intersect_sphere_from(prim: u32, origin: vec3<f32>, dir: vec3<f32>, center: vec3<f32>, radius: f32, t_max: f32) -> f32 {
-    if (prim != skip_prim) {
-        return intersect_sphere(origin, dir, center, radius, t_max);
-    }
     let r = sphere_roots(origin, dir, center, radius);
-    return select(-1.0, r.y, skip_inward && r.y > 0.0 && r.y < t_max);
+    let own = select(-1.0, r.y, skip_inward && r.y > 0.0 && r.y < t_max);
+    return select(own, nearest_root(r, t_max), prim != skip_prim);
 }
