@@ -360,6 +360,51 @@ fn spreading_workgroups_over_the_image_renders_bit_identical_images() {
     }
 }
 
+/// The specialized shader leaves out the leaf and surface code of a primitive kind the
+/// scene lacks (`HAS_TRIANGLES`, `HAS_SPHERES`); the general shader keeps both and chooses
+/// by the BVH node's and the hit's flags. Same arithmetic on the path taken, so the images
+/// must agree bit for bit: a triangles-only scene (the textured box) and a spheres-only one
+/// (the material furnace), both traversing the BVH with data in buffers.
+#[test]
+fn leaving_out_a_missing_primitive_kind_renders_bit_identical_images() {
+    for (name, left_out) in [
+        ("boxtextured.ron", "sphere tests"),
+        ("furnace_materials.ron", "triangle tests"),
+    ] {
+        let run = |general| {
+            render_with(
+                name,
+                (48, 40),
+                8,
+                Resources {
+                    general_shaders: general,
+                    traverse_bvh: true,
+                    scene_data_in_buffers: true,
+                    ..Resources::default()
+                },
+            )
+        };
+        let Some((specialized, how)) = run(false) else {
+            return;
+        };
+        let (general, how_general) = run(true).unwrap();
+        println!("{name}: {how}\n{name}: {how_general}");
+        assert!(how.contains(left_out), "{how}");
+        for (i, (a, b)) in specialized.iter().zip(&general).enumerate() {
+            let differ = differing(a, b, None);
+            println!(
+                "{name}: output {i}: {differ} of {} pixels differ",
+                a.pixels.len()
+            );
+            assert_eq!(differ, 0, "{name}: output {i} differs");
+        }
+        assert!(
+            specialized[0].pixels.iter().any(|p| p[0] > 0.0),
+            "{name}: black image"
+        );
+    }
+}
+
 /// What GPU adapters run for small scenes, BVH traversal with unused features left out,
 /// renders what the inline intersection renders (the inline path is the one the Mitsuba
 /// suite checks on lavapipe). Same primitives and samples; the two differ in the order they

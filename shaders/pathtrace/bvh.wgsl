@@ -5,6 +5,8 @@
 //   var<storage, read> bvh_nodes: array<vec4<u32>>;
 //   var<storage, read> tri_positions: array<TriPositions>;
 //   var<storage, read> spheres: array<Sphere>;
+// and the constants HAS_TRIANGLES and HAS_SPHERES (false where the scene has none of them:
+// that leaf test is left out).
 // Hits count for 0 < t < t_max; callers offset ray origins off surfaces.
 //
 // `bvh_nodes` holds one 64-byte record per node (4 vec4s): the BvhNode (aabb_min, index;
@@ -39,7 +41,7 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                 continue;
             }
             let first = lo.w;
-            if ((hi.w & NODE_SPHERES) == 0u) {
+            if (HAS_TRIANGLES && (!HAS_SPHERES || (hi.w & NODE_SPHERES) == 0u)) {
                 for (var i = first; i < first + count; i = i + 1u) {
                     let tri = tri_positions[i];
                     let r = intersect_triangle(ray.origin, ray.dir, tri.v0, tri.e1, tri.e2, hit.t);
@@ -50,7 +52,7 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                         }
                     }
                 }
-            } else {
+            } else if (HAS_SPHERES) {
                 for (var i = first; i < first + count; i = i + 1u) {
                     let s = spheres[i];
                     let t = intersect_sphere_from(i | PRIM_SPHERE, ray.origin, ray.dir, s.center, s.radius, hit.t);

@@ -78,7 +78,7 @@ fn shadow_transmittance(shadow: Ray, t_max: f32, medium: u32) -> vec3f {
         current = medium_after(s.material, m, s.ng, ray.dir, current);
         skip_prim = hit.prim;
         let side = select(-s.ng, s.ng, dot(s.ng, ray.dir) > 0.0);
-        ray = Ray(leave(s, (hit.prim & PRIM_SPHERE) != 0u, side, ray.dir), ray.dir);
+        ray = Ray(leave(s, is_sphere(hit.prim), side, ray.dir), ray.dir);
         left -= t;
         ray_count += 1u;
     }

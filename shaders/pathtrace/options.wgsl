@@ -11,6 +11,11 @@ const ADAPTIVE: bool = true;
 // thread one contiguous range of a dispatch's workgroups).
 const SPREAD_WORKGROUPS: bool = true;
 
+// The scene has triangles; it has spheres. The BVH leaf and surface code of a kind the scene
+// lacks is left out (llvmpipe would run it at every node visit and bounce, masked).
+const HAS_TRIANGLES: bool = true;
+const HAS_SPHERES: bool = true;
+
 // Lobes some material of the scene uses; the code of the others is left out.
 const HAS_SPECULAR: bool = true;
 const HAS_METAL: bool = true;

@@ -122,12 +122,17 @@ fn barycentric_err(v0: vec3f, e1: vec3f, e2: vec3f, u: f32, v: f32) -> vec3f {
     return POSITION_ERR * (abs(v0) + abs(u * e1) + abs(v * e2)) + EDGE_ERR * (abs(e1) + abs(e2));
 }
 
+// Whether `prim` (a hit's) is a sphere; a constant where the scene has one kind only.
+fn is_sphere(prim: u32) -> bool {
+    return HAS_SPHERES && (!HAS_TRIANGLES || (prim & PRIM_SPHERE) != 0u);
+}
+
 fn surface_at(ray: Ray, hit: Hit) -> Surface {
     var s: Surface;
     s.p = ray.origin + hit.t * ray.dir;
     s.err = vec3f(0.0);
     s.uv = vec2f(0.0);
-    if (hit.prim & PRIM_SPHERE) != 0u {
+    if is_sphere(hit.prim) {
         let sph = scene_sphere(hit.prim & ~PRIM_SPHERE);
         s.ng = normalize(s.p - sph.center);
         s.ns = s.ng;
@@ -471,7 +476,7 @@ fn trace_path(pixel: vec2u) -> vec3f {
         // Rays leaving a surface start at the hit position itself and skip the primitive
         // left: a triangle ignores what is within the position's error (see `leave`), a
         // sphere is met again only by a ray going into it, at its far side.
-        let on_sphere = (hit.prim & PRIM_SPHERE) != 0u;
+        let on_sphere = is_sphere(hit.prim);
         skip_prim = hit.prim;
         var mat = scene_material(s.material);
         if HAS_TEXTURES {

@@ -22,6 +22,10 @@ struct Params {
 
 #import "pathtrace/bvh.wgsl"
 
+// Ray queries are not specialized to the scene: both primitive kinds' tests are compiled.
+const HAS_TRIANGLES: bool = true;
+const HAS_SPHERES: bool = true;
+
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3u) {
     let i = id.y * 65535u * 64u + id.x;

@@ -490,6 +490,19 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
             },
         ),
     ];
+    let (triangles, spheres) = (scene.tri_positions.len(), scene.spheres.len());
+    out.extend([
+        feature(
+            "triangle tests",
+            all || triangles > 0,
+            why(all, triangles, "triangles"),
+        ),
+        feature(
+            "sphere tests",
+            all || spheres > 0,
+            why(all, spheres, "spheres"),
+        ),
+    ]);
     out.extend(material_features(m, all));
     out.extend([
         feature(
@@ -597,13 +610,15 @@ pub fn pathtrace_source(
     let features = features(scene, options);
     let on = |name: &str| features.iter().any(|f| f.name == name && f.included);
     let consts = format!(
-        "const WRITE_AOVS: bool = {};\nconst ADAPTIVE: bool = {};\nconst SPREAD_WORKGROUPS: bool = {};\nconst HAS_SPECULAR: bool = {};\nconst HAS_METAL: bool = {};\n\
+        "const WRITE_AOVS: bool = {};\nconst ADAPTIVE: bool = {};\nconst SPREAD_WORKGROUPS: bool = {};\nconst HAS_TRIANGLES: bool = {};\nconst HAS_SPHERES: bool = {};\nconst HAS_SPECULAR: bool = {};\nconst HAS_METAL: bool = {};\n\
          const HAS_GLASS: bool = {};\nconst HAS_LIGHTS: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
          const HAS_ENV_MAP: bool = {};\nconst HAS_TEXTURES: bool = {};\nconst HAS_ROUGH_DIFFUSE: bool = {};\n\
          const HAS_MEDIA: bool = {};\n",
         on("first-hit AOVs"),
         on("adaptive sampling"),
         on("spread workgroups"),
+        on("triangle tests"),
+        on("sphere tests"),
         on("dielectric specular lobe"),
         on("metal lobe"),
         on("glass lobe"),
