@@ -408,12 +408,18 @@ fn leaving_out_a_missing_primitive_kind_renders_bit_identical_images() {
 /// What GPU adapters run for small scenes, BVH traversal with unused features left out,
 /// renders what the inline intersection renders (the inline path is the one the Mitsuba
 /// suite checks on lavapipe). Same primitives and samples; the two differ in the order they
-/// test primitives and in float rounding of the inlined constants. Color and depth: within
-/// 1e-4 relative in all but 0.1 % of the pixels (measured: 0 of 4096 on the Cornell box, 1
-/// on the spheres). Albedo and normal are taken by one ray through each pixel center, which
-/// on a 64×64 Cornell box grazes box edges exactly: there both primitives are hit at the
-/// same distance (depth agrees) and either may be taken; allowed in 1 % of the pixels
-/// (measured 22 and 31 of 4096).
+/// test primitives, in float rounding of the inlined constants, and in the inline path
+/// testing each quad's two triangles as one parallelogram, so that hits on its second
+/// triangle are computed from the first one's edges (t, u and v round differently). A path
+/// whose bounce rounds to another side of an edge then goes elsewhere. Color and depth:
+/// within 1e-4 relative in all but 0.5 % of the pixels (measured, color: 0 of 4096 on the
+/// Cornell box, 5 on the spheres, where it was 0 and 1 before parallelograms; depth: 3 and
+/// 3), and color nowhere beyond 1e-2 (a missed or extra primitive changes a pixel by its
+/// whole value; measured at most 1.6e-5 and 1.3e-3).
+/// Albedo and normal are taken by one ray through each pixel center, which on a 64×64
+/// Cornell box grazes box edges exactly: there both primitives are hit at the same distance
+/// (depth agrees) and either may be taken; allowed in 1 % of the pixels (measured 30 and 36
+/// of 4096).
 #[test]
 fn bvh_traversal_renders_what_inline_intersection_renders() {
     for name in SMALL_SCENES {
@@ -432,12 +438,22 @@ fn bvh_traversal_renders_what_inline_intersection_renders() {
             let allowed = if i == 1 || i == 2 {
                 a.pixels.len() / 100
             } else {
-                a.pixels.len() / 1000
+                a.pixels.len() / 200
             };
             assert!(
                 far <= allowed,
                 "{name}: output {i}: {far} pixels differ by more than 1e-4"
             );
+            if i == 0 {
+                let worst = a
+                    .pixels
+                    .iter()
+                    .zip(&b.pixels)
+                    .flat_map(|(x, y)| (0..3).map(|c| (x[c] - y[c]).abs() / (x[c].abs() + 1e-3)))
+                    .fold(0.0f32, f32::max);
+                println!("{name}: color differs by at most {worst:.2e} relative");
+                assert!(worst <= 1e-2, "{name}: color differs by {worst} relative");
+            }
         }
     }
 }

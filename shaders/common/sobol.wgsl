@@ -42,6 +42,19 @@ fn sobol_rev(index_rev: u32, dim: u32) -> u32 {
     if dim == 0u {
         return index;
     }
+    if dim == 1u {
+        // Direction vector k of dimension 1 is row k of Pascal's triangle mod 2, whose bit j
+        // is set where j's bits are a subset of k's (Lucas), so bit j of the point is the
+        // parity of the index's bits at the supersets of j: that sum over the 4-bit
+        // positions, one position bit at a time (4 steps, where the loop below takes one
+        // step per index bit, 16 for most indices). The same integer.
+        var x = index;
+        x ^= (x >> 1u) & 0x5555u;
+        x ^= (x >> 2u) & 0x3333u;
+        x ^= (x >> 4u) & 0x0f0fu;
+        x ^= (x >> 8u) & 0x00ffu;
+        return x;
+    }
     var sobol = 0u;
     // The previous three direction vectors.
     var h1 = 0u;

@@ -51,6 +51,18 @@ fn ray_aabb(origin: vec3<f32>, inv_dir: vec3<f32>, bmin: vec3<f32>, bmax: vec3<f
 
 // Moller-Trumbore. Returns vec4(hit ? 1 : 0, t, u, v); t, u, v only mean something on a hit.
 fn intersect_triangle(origin: vec3<f32>, dir: vec3<f32>, v0: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>, t_max: f32) -> vec4<f32> {
+    return intersect_planar(origin, dir, v0, e1, e2, t_max, false);
+}
+
+// The parallelogram of the triangles (v0, v0 + e1, v0 + e2) and (v0, v0 + e2, v0 + e2 - e1)
+// (a quad split along v0 -> v0 + e2), in one test: the first triangle's, u, v and t bit for
+// bit, with the second's hits at u < 0 (u in [-1, 0], u + v in [0, 1]). The scene-specialized
+// intersection of small scenes tests a quad's two triangles so.
+fn intersect_parallelogram(origin: vec3<f32>, dir: vec3<f32>, v0: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>, t_max: f32) -> vec4<f32> {
+    return intersect_planar(origin, dir, v0, e1, e2, t_max, true);
+}
+
+fn intersect_planar(origin: vec3<f32>, dir: vec3<f32>, v0: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>, t_max: f32, parallelogram: bool) -> vec4<f32> {
     let p = cross(dir, e2);
     let det = dot(e1, p);
     // A ray parallel to the plane (det 0) gets infinite or NaN u, v, t, which fail `inside`
@@ -62,14 +74,15 @@ fn intersect_triangle(origin: vec3<f32>, dir: vec3<f32>, v0: vec3<f32>, e1: vec3
     let q = cross(s, e1);
     let v = dot(dir, q) * inv_det;
     let t = dot(e2, q) * inv_det;
-    let inside = u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t < t_max;
+    let inside = select(u >= 0.0, u + v >= 0.0 && v <= 1.0, parallelogram) && v >= 0.0 && u + v <= 1.0 && t < t_max;
     var hit = inside && t > 0.0;
     // Rays leaving a triangle: near their origin, within its error, a hit may be an artefact
     // of that error. Where the origin is within its error of this triangle's plane (|t det| is
     // the distance to it times |n|), a parallel plane is the one left (a coplanar neighbour:
     // never hit), and another one meets it at an edge: hit, at t ~ 0 whatever the sign of the
-    // computed t, only at a concave corner (a corner of this triangle is in front of the plane
-    // left, as a wall over a floor) by a ray crossing it towards its back (det > 0).
+    // computed t, only at a concave corner (a corner of this triangle, or parallelogram, is in
+    // front of the plane left, as a wall over a floor) by a ray crossing it towards its back
+    // (det > 0).
     // Elsewhere, at a convex edge (as the top of a box seen from its side), a hit closer than
     // `origin_slab` is one the origin, rounded to behind the plane it leaves, sees from inside.
     let n = cross(e1, e2);
@@ -78,7 +91,10 @@ fn intersect_triangle(origin: vec3<f32>, dir: vec3<f32>, v0: vec3<f32>, e1: vec3
     // if's body whether or not a lane needs it, and masking it cost more than these few
     // operations (1.28x on the Cornell box, docs/benchmarks.md).
     let a0 = -dot(s, origin_n);
-    let concave = max(a0, a0 + max(dot(e1, origin_n), dot(e2, origin_n))) > origin_off;
+    let d1 = dot(e1, origin_n);
+    let d2 = dot(e2, origin_n);
+    let corner = select(max(d1, d2), max(max(d1, d2), d2 - d1), parallelogram);
+    let concave = max(a0, a0 + corner) > origin_off;
     let along = dot(n, origin_n);
     let parallel = along * along > PARALLEL_COS2 * dot(n, n);
     let near_origin = inside && (on_plane || (t > 0.0 && t <= origin_slab));

@@ -20,6 +20,50 @@ fn v3(v: [f32; 3]) -> String {
     format!("vec3<f32>({:?}, {:?}, {:?})", v[0], v[1], v[2])
 }
 
+/// The triangles to test inline, in order: `(a, Some(b))` where triangles `a` and `b` are
+/// the two halves of a parallelogram, tested as one (`intersect_parallelogram`): `a` is
+/// (v0, v0 + e1, v0 + e2) and `b` is (v0, v0 + e2, v0 + e2 - e1), to the rounding of f32, as
+/// `quad_triangles` splits a quad whose corners form a parallelogram (every `Quad`,
+/// `Rectangle` and `Box` face of the shipped scenes). `(i, None)`: a triangle on its own.
+pub fn parallelograms(tris: &[lumagraph_scene::GpuTriangle]) -> Vec<(usize, Option<usize>)> {
+    let key = |v0: [f32; 3], e: [f32; 3]| (v0.map(f32::to_bits), e.map(f32::to_bits));
+    let by_first_edge: std::collections::HashMap<_, usize> = tris
+        .iter()
+        .enumerate()
+        .map(|(i, t)| (key(t.v0, t.e1), i))
+        .collect();
+    // The second half of each first half, wherever each is in the list (BVH order).
+    let mut second: Vec<Option<usize>> = vec![None; tris.len()];
+    let mut paired = vec![false; tris.len()];
+    for (a, t) in tris.iter().enumerate() {
+        let (e1, e2) = (glam::Vec3::from(t.e1), glam::Vec3::from(t.e2));
+        // The second triangle's last corner where the parallelogram's is, within the
+        // rounding of the subtraction that made its edge (corners given to 7 or 8 digits
+        // rarely make an exact parallelogram in f32).
+        let tolerance = 2.0 * f32::EPSILON * e1.abs().max(e2.abs()).max_element();
+        let b = by_first_edge.get(&key(t.v0, t.e2)).copied().filter(|&b| {
+            b != a
+                && !paired[a]
+                && !paired[b]
+                && (glam::Vec3::from(tris[b].e2) - (e2 - e1))
+                    .abs()
+                    .max_element()
+                    <= tolerance
+        });
+        if let Some(b) = b {
+            (second[a], paired[a], paired[b]) = (Some(b), true, true);
+        }
+    }
+    // Each pair where its first triangle was, every other triangle on its own.
+    let mut out = Vec::new();
+    for (i, b) in second.iter().enumerate() {
+        if b.is_some() || !paired[i] {
+            out.push((i, *b));
+        }
+    }
+    out
+}
+
 /// Generated replacement for `pathtrace/intersect.wgsl`, or `None` when the scene is too
 /// large to inline.
 pub fn inline_intersection(scene: &GpuScene) -> Option<String> {
@@ -29,16 +73,33 @@ pub fn inline_intersection(scene: &GpuScene) -> Option<String> {
     }
     let mut closest = String::new();
     let mut any = String::new();
-    for (i, t) in tris.iter().enumerate() {
+    for (a, b) in parallelograms(tris) {
+        let t = &tris[a];
         let args = format!("{}, {}, {}", v3(t.v0), v3(t.e1), v3(t.e2));
-        let _ = writeln!(
-            closest,
-            "    r = intersect_triangle(ray.origin, ray.dir, {args}, hit.t);\n    if (r.x != 0.0 && skip_prim != {i}u) {{ hit = Hit({i}u, r.y, r.z, r.w); }}"
-        );
-        let _ = writeln!(
-            any,
-            "    if (skip_prim != {i}u && intersect_triangle(ray.origin, ray.dir, {args}, t_max).x != 0.0) {{ return true; }}"
-        );
+        match b {
+            None => {
+                let _ = writeln!(
+                    closest,
+                    "    r = intersect_triangle(ray.origin, ray.dir, {args}, hit.t);\n    if (r.x != 0.0 && skip_prim != {a}u) {{ hit = Hit({a}u, r.y, r.z, r.w); }}"
+                );
+                let _ = writeln!(
+                    any,
+                    "    if (skip_prim != {a}u && intersect_triangle(ray.origin, ray.dir, {args}, t_max).x != 0.0) {{ return true; }}"
+                );
+            }
+            Some(b) => {
+                // Hits with u < 0 are on the second triangle, (v0, v0 + e2, v0 + e2 - e1):
+                // its barycentrics are (u + v, -u).
+                let _ = writeln!(
+                    closest,
+                    "    r = intersect_parallelogram(ray.origin, ray.dir, {args}, hit.t);\n    if (r.x != 0.0 && skip_prim != {a}u && skip_prim != {b}u) {{ let second = r.z < 0.0; hit = Hit(select({a}u, {b}u, second), r.y, select(r.z, r.z + r.w, second), select(r.w, -r.z, second)); }}"
+                );
+                let _ = writeln!(
+                    any,
+                    "    if (skip_prim != {a}u && skip_prim != {b}u && intersect_parallelogram(ray.origin, ray.dir, {args}, t_max).x != 0.0) {{ return true; }}"
+                );
+            }
+        }
     }
     for (i, s) in spheres.iter().enumerate() {
         let args = format!("{}, {:?}", v3(s.center), s.radius);
@@ -460,7 +521,21 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
                 format!("{} nodes", scene.bvh_nodes.len())
             },
         ),
-        feature("inline intersection", inline, format!("{prims} primitives")),
+        feature("inline intersection", inline, {
+            let pairs = if inline {
+                parallelograms(&scene.tri_positions)
+                    .iter()
+                    .filter(|(_, b)| b.is_some())
+                    .count()
+            } else {
+                0
+            };
+            if pairs > 0 {
+                format!("{prims} primitives, {pairs} parallelograms of 2 triangles tested as one")
+            } else {
+                format!("{prims} primitives")
+            }
+        }),
         feature(
             "inline materials and lights",
             inline_data,
