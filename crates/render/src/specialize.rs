@@ -437,6 +437,23 @@ fn feature(name: &'static str, included: bool, reason: impl Into<String>) -> Fea
 }
 
 /// Why materials, lights and shading data are (or are not) written into the shader.
+fn inline_intersection_reason(scene: &GpuScene, inline: bool) -> String {
+    let prims = scene.tri_positions.len() + scene.spheres.len();
+    let pairs = if inline {
+        parallelograms(&scene.tri_positions)
+            .iter()
+            .filter(|(_, b)| b.is_some())
+            .count()
+    } else {
+        0
+    };
+    if pairs > 0 {
+        format!("{prims} primitives, {pairs} parallelograms of 2 triangles tested as one")
+    } else {
+        format!("{prims} primitives")
+    }
+}
+
 fn inline_data_reason(scene: &GpuScene, options: PathTraceOptions, included: bool) -> String {
     let m = scene.materials.len();
     let prims = scene.tri_positions.len() + scene.spheres.len();
@@ -521,21 +538,11 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
                 format!("{} nodes", scene.bvh_nodes.len())
             },
         ),
-        feature("inline intersection", inline, {
-            let pairs = if inline {
-                parallelograms(&scene.tri_positions)
-                    .iter()
-                    .filter(|(_, b)| b.is_some())
-                    .count()
-            } else {
-                0
-            };
-            if pairs > 0 {
-                format!("{prims} primitives, {pairs} parallelograms of 2 triangles tested as one")
-            } else {
-                format!("{prims} primitives")
-            }
-        }),
+        feature(
+            "inline intersection",
+            inline,
+            inline_intersection_reason(scene, inline),
+        ),
         feature(
             "inline materials and lights",
             inline_data,
