@@ -11,6 +11,11 @@ const ADAPTIVE: bool = true;
 // thread one contiguous range of a dispatch's workgroups).
 const SPREAD_WORKGROUPS: bool = true;
 
+// One loop over the bounces of all of a pixel's samples, where a lane whose path ended
+// starts its next sample (CPU adapters, scenes intersected inline), instead of one bounce
+// loop per sample.
+const REGENERATE_PATHS: bool = true;
+
 // The scene has triangles; it has spheres. The BVH leaf and surface code of a kind the scene
 // lacks is left out (llvmpipe would run it at every node visit and bounce, masked).
 const HAS_TRIANGLES: bool = true;

@@ -37,7 +37,18 @@ struct Frame {
     // The pixels this pass renders: left, top, width and height in the whole image (all of
     // it unless the render is tiled); the output holds them from (0, 0).
     window: vec4<u32>,
+    // The samples of the frame this dispatch traces: `chunk_count` from `chunk_first`. On CPU
+    // adapters a frame takes several dispatches (llvmpipe ends a dispatch's loops after 65 535
+    // iterations in all); their sums are kept in `chunk_sums` and the last writes the mean.
+    chunk_first: u32,
+    chunk_count: u32,
+    // CHUNK_FIRST | CHUNK_LAST.
+    chunk_flags: u32,
+    pad0: u32,
 }
+
+const CHUNK_FIRST: u32 = 1u;
+const CHUNK_LAST: u32 = 2u;
 
 const STRATEGY_MIS: u32 = 0u;
 const STRATEGY_LIGHT: u32 = 1u;
@@ -87,6 +98,8 @@ fn light_weight(light_pdf: f32, bsdf_pdf: f32) -> f32 {
 @group(0) @binding(19) var<storage, read> adaptive_stopped: array<u32>;
 // The pixels still sampling this frame: their count, then each one's x | y << 16.
 @group(0) @binding(20) var<storage, read> adaptive_active: array<u32>;
+// Per pixel of the window: the sum of the frame's samples traced by its earlier dispatches.
+@group(0) @binding(21) var<storage, read_write> chunk_sums: array<vec4f>;
 
 #import "pathtrace/intersect.wgsl"
 #import "pathtrace/scene_data.wgsl"
@@ -387,29 +400,53 @@ fn medium_next_event(p: vec3f, dir: vec3f, g: f32, bounce: u32, has_lights: bool
     return phase * ls.radiance * tr * (w / ls.pdf);
 }
 
-fn trace_path(pixel: vec2u) -> vec3f {
-    var ray = camera_ray(pixel, sample_2d(PAIR_PIXEL));
-    var throughput = vec3f(1.0);
-    var radiance = vec3f(0.0);
-    // Solid-angle pdf of the BSDF sample that made `ray` (0: a mirror, interface or camera
-    // ray, which light sampling cannot produce), and where it left from (for MIS).
-    var bsdf_pdf = 0.0;
-    var prev_p = ray.origin;
-    let max_bounces = frame.settings.max_bounces;
-    let has_lights = HAS_LIGHTS && frame.header.num_lights > 0u;
+// The path being traced: `start_path` begins one, `path_step` takes it one bounce on.
+var<private> path_ray: Ray;
+var<private> path_throughput: vec3f;
+var<private> path_radiance: vec3f;
+// Solid-angle pdf of the BSDF sample that made `path_ray` (0: a mirror, interface or camera
+// ray, which light sampling cannot produce), and where it left from (for MIS).
+var<private> path_bsdf_pdf: f32;
+var<private> path_prev_p: vec3f;
+var<private> path_bounce: u32;
+// The index-matched boundaries crossed so far.
+var<private> path_crossings: u32;
+
+// Starts the path of the current sample (`sampler_init`) through `pixel`.
+fn start_path(pixel: vec2u) {
+    path_ray = camera_ray(pixel, sample_2d(PAIR_PIXEL));
+    path_throughput = vec3f(1.0);
+    path_radiance = vec3f(0.0);
+    path_bsdf_pdf = 0.0;
+    path_prev_p = path_ray.origin;
+    path_bounce = 0u;
+    path_crossings = 0u;
     // The triangle the current ray leaves (never hit again); camera rays leave none.
     skip_prim = NO_HIT;
     origin_n = vec3f(0.0);
     origin_err = vec3f(0.0);
     origin_off = 0.0;
     origin_slab = 0.0;
-    // The medium the ray travels in (paths start in none) and the index-matched boundaries
-    // crossed so far.
-    var crossings = 0u;
+    // The medium the ray travels in: paths start in none.
     if HAS_MEDIA {
         medium_id = NO_MEDIUM;
     }
-    for (var bounce = 0u; ; bounce++) {
+}
+
+// Takes the path one bounce on; true once it ended (its radiance is `path_radiance`).
+fn path_step() -> bool {
+    var ray = path_ray;
+    var throughput = path_throughput;
+    var radiance = path_radiance;
+    var bsdf_pdf = path_bsdf_pdf;
+    var prev_p = path_prev_p;
+    var bounce = path_bounce;
+    var crossings = path_crossings;
+    let max_bounces = frame.settings.max_bounces;
+    let has_lights = HAS_LIGHTS && frame.header.num_lights > 0u;
+    var ended = false;
+    // One pass: `break` leaves the bounce, `ended` says whether the path ends with it.
+    loop {
         let hit = intersect_scene(ray);
         ray_count += 1u;
         if HAS_MEDIA && medium_id != NO_MEDIUM {
@@ -428,6 +465,7 @@ fn trace_path(pixel: vec2u) -> vec3f {
                     let tr = exp(-sigma_t * t);
                     let pdf = dot(sigma_t * tr, vec3f(1.0 / 3.0));
                     if !(pdf > 0.0) || bounce >= max_bounces {
+                        ended = true;
                         break;
                     }
                     throughput *= m.sigma_s * tr / pdf;
@@ -445,16 +483,18 @@ fn trace_path(pixel: vec2u) -> vec3f {
                     if bounce + 1u >= RR_START {
                         let q = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
                         if rand() >= q {
+                            ended = true;
                             break;
                         }
                         throughput /= q;
                     }
-                    continue;
+                    break;
                 }
                 // Through to the surface: the probability of no collision before it.
                 let tr = exp(-sigma_t * t_hit);
                 let p_pass = dot(tr, vec3f(1.0 / 3.0));
                 if !(p_pass > 0.0) {
+                    ended = true;
                     break;
                 }
                 throughput *= tr / p_pass;
@@ -470,6 +510,7 @@ fn trace_path(pixel: vec2u) -> vec3f {
                 let e = env_eval(ray.dir);
                 radiance += throughput * e.rgb * hit_weight(bsdf_pdf, e.a * env_select_prob());
             }
+            ended = true;
             break;
         }
         let s = surface_at(ray, hit);
@@ -487,13 +528,14 @@ fn trace_path(pixel: vec2u) -> vec3f {
             // scattering event (not counted as a bounce; MIS keeps the last vertex's pdf).
             crossings += 1u;
             if crossings > MAX_CROSSINGS {
+                ended = true;
                 break;
             }
             medium_id = medium_after(s.material, mat, s.ng, ray.dir, medium_id);
             let side = select(-s.ng, s.ng, dot(s.ng, ray.dir) > 0.0);
             ray = Ray(leave(s, on_sphere, side, ray.dir), ray.dir);
             bounce -= 1u;
-            continue;
+            break;
         }
         let front = dot(s.ng, ray.dir) < 0.0;
         let two_sided = (mat.flags & MATERIAL_TWO_SIDED) != 0u;
@@ -509,6 +551,7 @@ fn trace_path(pixel: vec2u) -> vec3f {
         }
         // One-sided opaque materials are black from behind; an interface has two sides.
         if !(front || two_sided || glass) || bounce >= max_bounces {
+            ended = true;
             break;
         }
         // Shading frame: opaque surfaces face the ray; an interface keeps its orientation
@@ -551,6 +594,7 @@ fn trace_path(pixel: vec2u) -> vec3f {
         let u_dir = sample_2d_at(PAIR_BSDF, bounce);
         let bs = sample_bsdf(mat, wo, u_lobe, vec3f(u_dir, rand()));
         if !bs.valid {
+            ended = true;
             break;
         }
         let wi = basis * bs.wi;
@@ -568,12 +612,32 @@ fn trace_path(pixel: vec2u) -> vec3f {
         if bounce + 1u >= RR_START {
             let q = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
             if rand() >= q {
+                ended = true;
                 break;
             }
             throughput /= q;
         }
+        break;
     }
-    return radiance;
+    path_ray = ray;
+    path_throughput = throughput;
+    path_radiance = radiance;
+    path_bsdf_pdf = bsdf_pdf;
+    path_prev_p = prev_p;
+    path_bounce = bounce + 1u;
+    path_crossings = crossings;
+    return ended;
+}
+
+// The radiance of one path through `pixel` for the current sample (`sampler_init`).
+fn trace_path(pixel: vec2u) -> vec3f {
+    start_path(pixel);
+    loop {
+        if path_step() {
+            break;
+        }
+    }
+    return path_radiance;
 }
 
 // The row of 8×8 tiles that workgroup row `row` of `rows` traces: rows a stride apart, the
@@ -635,6 +699,21 @@ fn main(
     first_hit_aovs(id);
 }
 
+// Adds a path's radiance `l` to `sum`, clamped (`firefly_clamp`), or counts it in `dropped`
+// when it is not finite.
+fn add_sample(radiance: vec3f, sum: ptr<function, vec3f>, dropped: ptr<function, u32>) {
+    var l = radiance;
+    if frame.firefly_clamp > 0.0 {
+        let peak = max(l.x, max(l.y, l.z));
+        l *= select(1.0, frame.firefly_clamp / peak, peak > frame.firefly_clamp);
+    }
+    if all_finite(l) {
+        *sum += l;
+    } else {
+        *dropped += 1u;
+    }
+}
+
 // Traces the pixel `at` of the window (`samples_per_frame` paths) and writes their mean.
 fn trace_pixel(at: vec2u) {
     let w = frame.settings.width;
@@ -649,24 +728,32 @@ fn trace_pixel(at: vec2u) {
     var dropped = 0u;
     ray_count = 0u;
     let n = frame.samples_per_frame;
-    for (var i = 0u; i < n; i++) {
-        sampler_init(
-            pixel_index,
-            frame.sample_offset + i,
-            frame.settings.seed,
-            frame.sampler,
-            n,
-            frame.replicates,
-        );
-        var l = trace_path(pixel);
-        if frame.firefly_clamp > 0.0 {
-            let peak = max(l.x, max(l.y, l.z));
-            l *= select(1.0, frame.firefly_clamp / peak, peak > frame.firefly_clamp);
+    let first = frame.chunk_first;
+    let end = first + frame.chunk_count;
+    if REGENERATE_PATHS {
+        // One loop over the bounces of all the samples: a lane whose path ended starts its
+        // next sample at once instead of idling until the longest path of its SIMD vector
+        // ends (the same samples, traced and summed in the same order).
+        var i = first;
+        if i < end {
+            sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler, n, frame.replicates);
+            start_path(pixel);
+            loop {
+                if path_step() {
+                    add_sample(path_radiance, &sum, &dropped);
+                    i++;
+                    if i >= end {
+                        break;
+                    }
+                    sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler, n, frame.replicates);
+                    start_path(pixel);
+                }
+            }
         }
-        if all_finite(l) {
-            sum += l;
-        } else {
-            dropped += 1u;
+    } else {
+        for (var i = first; i < end; i++) {
+            sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler, n, frame.replicates);
+            add_sample(trace_path(pixel), &sum, &dropped);
         }
     }
     if dropped > 0u {
@@ -676,6 +763,14 @@ fn trace_pixel(at: vec2u) {
     let before = atomicAdd(&stats[1], ray_count);
     if before > 0xffffffffu - ray_count {
         atomicAdd(&stats[2], 1u);
+    }
+    let slot = at.y * frame.window.z + at.x;
+    if (frame.chunk_flags & CHUNK_FIRST) == 0u {
+        sum += chunk_sums[slot].xyz;
+    }
+    if (frame.chunk_flags & CHUNK_LAST) == 0u {
+        chunk_sums[slot] = vec4f(sum, 0.0);
+        return;
     }
     let mean = sum / f32(max(n, 1u));
     textureStore(output, at, vec4f(mean, 1.0));

@@ -610,6 +610,14 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
             all || textured,
             textures_reason(scene, all),
         ),
+    ]);
+    out.extend(cpu_features(options, inline));
+    out
+}
+
+/// How the work is laid out for a CPU adapter's driver threads and SIMD lanes.
+fn cpu_features(options: PathTraceOptions, inline: bool) -> [Feature; 2] {
+    [
         feature(
             "spread workgroups",
             options.cpu_adapter && !options.in_image_order,
@@ -621,8 +629,18 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
                 "a CPU adapter: each driver thread takes one contiguous range of workgroups"
             },
         ),
-    ]);
-    out
+        feature(
+            "path regeneration",
+            options.cpu_adapter && inline,
+            if !options.cpu_adapter {
+                "a GPU adapter: one bounce loop per sample"
+            } else if inline {
+                "a CPU adapter: a SIMD lane whose path ended starts its next sample at once"
+            } else {
+                "BVH traversal: no gain measured on a CPU adapter"
+            },
+        ),
+    ]
 }
 
 /// `n` things that need a feature, or the general shader's reason.
@@ -692,13 +710,14 @@ pub fn pathtrace_source(
     let features = features(scene, options);
     let on = |name: &str| features.iter().any(|f| f.name == name && f.included);
     let consts = format!(
-        "const WRITE_AOVS: bool = {};\nconst ADAPTIVE: bool = {};\nconst SPREAD_WORKGROUPS: bool = {};\nconst HAS_TRIANGLES: bool = {};\nconst HAS_SPHERES: bool = {};\nconst HAS_SPECULAR: bool = {};\nconst HAS_METAL: bool = {};\n\
+        "const WRITE_AOVS: bool = {};\nconst ADAPTIVE: bool = {};\nconst SPREAD_WORKGROUPS: bool = {};\nconst REGENERATE_PATHS: bool = {};\nconst HAS_TRIANGLES: bool = {};\nconst HAS_SPHERES: bool = {};\nconst HAS_SPECULAR: bool = {};\nconst HAS_METAL: bool = {};\n\
          const HAS_GLASS: bool = {};\nconst HAS_LIGHTS: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
          const HAS_ENV_MAP: bool = {};\nconst HAS_TEXTURES: bool = {};\nconst HAS_ROUGH_DIFFUSE: bool = {};\n\
          const HAS_MEDIA: bool = {};\n",
         on("first-hit AOVs"),
         on("adaptive sampling"),
         on("spread workgroups"),
+        on("path regeneration"),
         on("triangle tests"),
         on("sphere tests"),
         on("dielectric specular lobe"),

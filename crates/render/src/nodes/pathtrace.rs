@@ -83,8 +83,30 @@ crate::param_block! {
         /// The pixels this pass renders: left, top, width and height in the whole image
         /// (all of it unless the render is tiled).
         window: [u32; 4],
+        /// The samples of the frame this dispatch traces: from `chunk_first`, `chunk_count`
+        /// of them (a frame is traced in several dispatches on CPU adapters, see
+        /// [`CPU_SAMPLES_PER_DISPATCH`]).
+        chunk_first: u32,
+        chunk_count: u32,
+        /// `CHUNK_FIRST` | `CHUNK_LAST` (`pathtrace/pathtrace.wgsl`).
+        chunk_flags: u32,
+        pad0: u32,
     }
 }
+
+/// At most this many samples per pixel in one dispatch on a CPU adapter (llvmpipe), by how
+/// the scene is intersected: through the BVH, or inline. llvmpipe ends every loop of a
+/// dispatch's invocation, silently, once all its loops together have run 65 535 iterations
+/// (`LP_MAX_TGSI_LOOP_ITERATIONS` in Mesa's gallivm), and a BVH path tracer runs one per
+/// node visit: on the 81 920-triangle mesh scene, 64 samples in one dispatch already traced
+/// 9 % fewer rays (truncated traversals), 32 a few. A frame of more samples is traced in
+/// dispatches of at most this many, summed in a buffer, with the same sample indices.
+pub(crate) const CPU_SAMPLES_PER_DISPATCH: [u32; 2] = [8, 256];
+
+/// `Frame::chunk_flags`: the frame's first dispatch (starts the sums), its last (writes the
+/// mean).
+const CHUNK_FIRST: u32 = 1;
+const CHUNK_LAST: u32 = 2;
 
 crate::param_block! {
     /// The adaptive sampling pass's params (`pathtrace/adaptive.wgsl`).
@@ -252,6 +274,11 @@ pub(crate) struct PathTrace {
     adaptive: Adaptive,
     /// Samples adaptive sampling took since the last reset, read back so far.
     adaptive_samples: u64,
+    /// Most samples per pixel one dispatch traces (`u32::MAX` on GPU adapters).
+    samples_per_dispatch: u32,
+    /// Per pixel of the window, the sum of a frame's samples traced so far while it takes
+    /// several dispatches (a 16-byte stand-in until one does).
+    chunk_sums: wgpu::Buffer,
 }
 
 impl PathTrace {
@@ -259,10 +286,18 @@ impl PathTrace {
         let scene = resources.scene.clone().ok_or_else(|| {
             RenderError::Gpu("PathTrace needs a scene (lumagraph render --scene FILE)".into())
         })?;
-        let (source, how) = crate::specialize::pathtrace_source(
-            &scene,
-            options(pass, resources, ctx.is_cpu() && !resources.traverse_bvh),
-        )?;
+        let opts = options(pass, resources, ctx.is_cpu() && !resources.traverse_bvh);
+        let (source, how) = crate::specialize::pathtrace_source(&scene, opts)?;
+        let samples_per_dispatch = if !ctx.is_cpu() {
+            u32::MAX
+        } else if crate::specialize::features(&scene, opts)
+            .iter()
+            .any(|f| f.name == "inline intersection" && f.included)
+        {
+            CPU_SAMPLES_PER_DISPATCH[1]
+        } else {
+            CPU_SAMPLES_PER_DISPATCH[0]
+        };
         let kernel = Kernel::from_source(ctx, "pathtrace/pathtrace.wgsl", &source)?;
         let env = match &scene.environment_map {
             Some(path) => crate::env_map::EnvMap::load(
@@ -325,6 +360,8 @@ impl PathTrace {
             origin: [0, 0],
             adaptive: Adaptive::new(ctx)?,
             adaptive_samples: 0,
+            samples_per_dispatch,
+            chunk_sums: storage(ctx, "pathtrace chunk sums", 16),
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -350,6 +387,10 @@ impl PathTrace {
                 self.replicates
             },
             window: [self.origin[0], self.origin[1], extent.width, extent.height],
+            chunk_first: 0,
+            chunk_count: self.samples_per_frame,
+            chunk_flags: CHUNK_FIRST | CHUNK_LAST,
+            pad0: 0,
         }
     }
 }
@@ -422,16 +463,6 @@ impl NodeExec for PathTrace {
 
     fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
         let (ctx, encoder, io, mut timer) = rec.parts();
-        // Each frame has its own uniform contents: stage them through a copy recorded in
-        // order, so many frames can share one submission.
-        let staging = ctx
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("pathtrace frame staging"),
-                contents: bytemuck::bytes_of(&self.frame(pass.extent)),
-                usage: wgpu::BufferUsages::COPY_SRC,
-            });
-        encoder.copy_buffer_to_buffer(&staging, 0, &self.frame, 0, self.frame.size());
         let samples = pass.output("samples");
         if samples.is_some() || self.adaptive.on() {
             let view = samples.map_or(&self.unused[4].view, |t| &io.texture(t).view);
@@ -445,36 +476,69 @@ impl NodeExec for PathTrace {
                 timer.as_deref_mut(),
             )?;
         }
+        let frame = self.frame(pass.extent);
         self.samples += self.samples_per_frame;
-        let b = &self.buffers;
-        let aov = |port: &str, i: usize| {
-            pass.output(port)
-                .map_or(&self.unused[i].view, |t| &io.texture(t).view)
-        };
-        self.kernel
-            .pass(&pass.node)
-            .write(aov("color", 0))
-            .uniform(&self.frame)
-            .buffer(&b.bvh_nodes)
-            .buffer(&b.tri_positions)
-            .buffer(&b.tri_shading)
-            .buffer(&b.spheres)
-            .buffer(&b.materials)
-            .buffer(&b.lights)
-            .buffer(&b.light_alias)
-            .buffer(&self.stats)
-            .write(aov("albedo", 1))
-            .write(aov("normal", 2))
-            .write(aov("depth", 3))
-            .buffer(&self.ggx_table)
-            .buffer(&self.env.texels)
-            .buffer(&self.env.alias)
-            .buffer(&b.tri_texcoords)
-            .buffer(&b.textures)
-            .buffer(&self.adaptive.halves)
-            .buffer(&self.adaptive.stopped)
-            .buffer(&self.adaptive.active)
-            .dispatch_2d(ctx, encoder, pass.extent, timer)
+        // The frame's samples in dispatches of at most `samples_per_dispatch` (one on GPU
+        // adapters), the partial sums kept per pixel between them.
+        let n = self.samples_per_frame.max(1);
+        let per_dispatch = self.samples_per_dispatch.clamp(1, n);
+        let sums_size = 16 * pass.extent.pixels();
+        if per_dispatch < n && self.chunk_sums.size() < sums_size {
+            self.chunk_sums = storage(ctx, "pathtrace chunk sums", sums_size);
+        }
+        let mut first = 0;
+        while first < n {
+            let count = per_dispatch.min(n - first);
+            let chunk = Frame {
+                chunk_first: first,
+                chunk_count: count,
+                chunk_flags: if first == 0 { CHUNK_FIRST } else { 0 }
+                    | if first + count == n { CHUNK_LAST } else { 0 },
+                ..frame
+            };
+            // Each dispatch has its own uniform contents: stage them through a copy recorded
+            // in order, so many frames can share one submission.
+            let staging = ctx
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("pathtrace frame staging"),
+                    contents: bytemuck::bytes_of(&chunk),
+                    usage: wgpu::BufferUsages::COPY_SRC,
+                });
+            encoder.copy_buffer_to_buffer(&staging, 0, &self.frame, 0, self.frame.size());
+            let b = &self.buffers;
+            let aov = |port: &str, i: usize| {
+                pass.output(port)
+                    .map_or(&self.unused[i].view, |t| &io.texture(t).view)
+            };
+            self.kernel
+                .pass(&pass.node)
+                .write(aov("color", 0))
+                .uniform(&self.frame)
+                .buffer(&b.bvh_nodes)
+                .buffer(&b.tri_positions)
+                .buffer(&b.tri_shading)
+                .buffer(&b.spheres)
+                .buffer(&b.materials)
+                .buffer(&b.lights)
+                .buffer(&b.light_alias)
+                .buffer(&self.stats)
+                .write(aov("albedo", 1))
+                .write(aov("normal", 2))
+                .write(aov("depth", 3))
+                .buffer(&self.ggx_table)
+                .buffer(&self.env.texels)
+                .buffer(&self.env.alias)
+                .buffer(&b.tri_texcoords)
+                .buffer(&b.textures)
+                .buffer(&self.adaptive.halves)
+                .buffer(&self.adaptive.stopped)
+                .buffer(&self.adaptive.active)
+                .buffer(&self.chunk_sums)
+                .dispatch_2d(ctx, encoder, pass.extent, timer.as_deref_mut())?;
+            first += count;
+        }
+        Ok(())
     }
 
     fn notes(&self) -> Vec<String> {
