@@ -145,6 +145,11 @@ fn resize_matches_cpu() {
     let cases: Vec<Case> = vec![
         (vec![], scaled(0.5)),
         (vec![("scale", ParamValue::Float(0.13))], scaled(0.13)),
+        // The most lanczos3 shrinks in one node: 192 × 193 taps' loop iterations per pixel.
+        (
+            vec![("scale", ParamValue::Float(1.0 / 32.0))],
+            scaled(1.0 / 32.0),
+        ),
         (
             vec![("width", int(37))],
             (37, (f64::from(ih) * 37.0 / f64::from(iw)).round() as u32),
@@ -209,6 +214,20 @@ fn resize_sizes_its_output_in_the_plan() {
     assert_eq!(out.width, 40);
     assert_eq!(plan.pass("t").unwrap().extent, out);
     assert!(plan.to_string().contains("40x"), "{plan}");
+
+    // Shrinking 100× with lanczos3 would sum 600² texels per pixel in one invocation, past
+    // the 65 535 loop iterations after which llvmpipe ends loops (it came out 40× too
+    // dark): an error naming the node and the limit. Bilinear has no loop.
+    g.nodes[1] = Node::new("r", "Resize").with("scale", ParamValue::Float(0.01));
+    let m = compile(&g, &[], None).unwrap_err().to_string();
+    assert!(
+        m.contains("node \"r\"") && m.contains("shrinks by at most 32×"),
+        "{m}"
+    );
+    g.nodes[1] = g.nodes[1]
+        .clone()
+        .with("kernel", ParamValue::Str("bilinear".into()));
+    compile(&g, &[], None).unwrap();
 
     // 16384 high at the chart's 2:1 aspect ratio is 32768 wide.
     g.nodes[1] = Node::new("r", "Resize").with("height", ParamValue::Int(16384));

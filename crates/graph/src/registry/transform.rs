@@ -81,7 +81,7 @@ fn resize() -> NodeKind {
          output pixel's center with the GPU's filtering sampler (fine up to 2× down; smaller \
          scales alias); `lanczos3` weighs the texels within 3 input pixels (3 output pixels \
          when shrinking, so no aliasing) by the Lanczos-3 kernel, normalized, and clips the \
-         negative values its lobes can give to 0.",
+         negative values its lobes can give to 0; it shrinks by at most 32× per node.",
         vec![
             ParamDef::int(
                 "width",
@@ -123,6 +123,13 @@ fn resize() -> NodeKind {
     kind
 }
 
+/// The most a `lanczos3` Resize shrinks an axis. Each output pixel sums the input texels
+/// within 3 output pixels, (6 × shrink)² of them, in one shader invocation: at 32× that is
+/// 192 × 193 loop iterations. Far beyond, llvmpipe (Mesa's CPU driver) ends the loops
+/// silently after 65 535 iterations in all (a 100× shrink came out 40× too dark), and a GPU
+/// spends 360 000 texel reads on each pixel.
+pub const MAX_LANCZOS_SHRINK: f64 = 32.0;
+
 /// The output size of a Resize of an `input`-sized image.
 fn resize_extent(input: Extent, params: &Params) -> Result<Extent, String> {
     let (w, h) = (params.int("width"), params.int("height"));
@@ -143,6 +150,17 @@ fn resize_extent(input: Extent, params: &Params) -> Result<Extent, String> {
     let max = MAX_SIDE as f64;
     if w > max || h > max {
         return Err(format!("{w}x{h} pixels: a side is more than {MAX_SIDE}"));
+    }
+    let shrink = (iw / w.max(1.0)).max(ih / h.max(1.0));
+    if params.str("kernel") == "lanczos3" && shrink > MAX_LANCZOS_SHRINK {
+        return Err(format!(
+            "{}x{} to {}x{} pixels shrinks {shrink:.1}×: lanczos3 shrinks by at most \
+             {MAX_LANCZOS_SHRINK}× in one Resize (chain Resize nodes, or use bilinear)",
+            input.width,
+            input.height,
+            w.max(1.0),
+            h.max(1.0)
+        ));
     }
     #[expect(
         clippy::cast_possible_truncation,
