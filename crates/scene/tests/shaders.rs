@@ -30,6 +30,8 @@ fn validate(source: &str, what: &str) -> naga::Module {
 }
 
 const STUB: &str = r#"
+const HAS_TRIANGLES: bool = true;
+const HAS_SPHERES: bool = true;
 @group(0) @binding(0) var<storage, read> bvh_nodes: array<vec4<u32>>;
 @group(0) @binding(1) var<storage, read> tri_positions: array<TriPositions>;
 @group(0) @binding(2) var<storage, read> spheres: array<Sphere>;
