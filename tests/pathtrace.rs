@@ -326,6 +326,18 @@ fn differing(a: &Image, b: &Image, rel: Option<f32>) -> usize {
         .count()
 }
 
+/// Each output of `a` equal to `b`'s bit for bit (the pixels that differ are printed).
+fn assert_bit_identical(name: &str, a: &[Image], b: &[Image]) {
+    for (i, (a, b)) in a.iter().zip(b).enumerate() {
+        let differ = differing(a, b, None);
+        println!(
+            "{name}: output {i}: {differ} of {} pixels differ",
+            a.pixels.len()
+        );
+        assert_eq!(differ, 0, "{name}: output {i} differs");
+    }
+}
+
 #[test]
 fn inlined_scene_data_renders_bit_identical_images() {
     // Same math, only where the data comes from differs.
@@ -343,14 +355,7 @@ fn inlined_scene_data_renders_bit_identical_images() {
             !how_buffers.contains("materials and lights inlined"),
             "{how_buffers}"
         );
-        for (i, (a, b)) in inline.iter().zip(&buffers).enumerate() {
-            let differ = differing(a, b, None);
-            println!(
-                "{name}: output {i}: {differ} of {} pixels differ",
-                a.pixels.len()
-            );
-            assert_eq!(differ, 0, "{name}: output {i} differs");
-        }
+        assert_bit_identical(name, &inline, &buffers);
         assert!(
             inline[0].pixels.iter().any(|p| p[0] > 0.0),
             "{name}: black image"
@@ -385,14 +390,7 @@ fn spreading_workgroups_over_the_image_renders_bit_identical_images() {
         println!("{name}: {how_spread}\n{name}: {how_in_order}");
         assert!(!how_spread.contains("spread workgroups"), "{how_spread}");
         assert!(how_in_order.contains("spread workgroups"), "{how_in_order}");
-        for (i, (a, b)) in spread.iter().zip(&in_order).enumerate() {
-            let differ = differing(a, b, None);
-            println!(
-                "{name}: output {i}: {differ} of {} pixels differ",
-                a.pixels.len()
-            );
-            assert_eq!(differ, 0, "{name}: output {i} differs");
-        }
+        assert_bit_identical(name, &spread, &in_order);
         let black = spread[0]
             .pixels
             .iter()
@@ -435,14 +433,7 @@ fn leaving_out_a_missing_primitive_kind_renders_bit_identical_images() {
         let (general, how_general) = run(true).unwrap();
         println!("{name}: {how}\n{name}: {how_general}");
         assert!(how.contains(left_out), "{how}");
-        for (i, (a, b)) in specialized.iter().zip(&general).enumerate() {
-            let differ = differing(a, b, None);
-            println!(
-                "{name}: output {i}: {differ} of {} pixels differ",
-                a.pixels.len()
-            );
-            assert_eq!(differ, 0, "{name}: output {i} differs");
-        }
+        assert_bit_identical(name, &specialized, &general);
         assert!(
             specialized[0].pixels.iter().any(|p| p[0] > 0.0),
             "{name}: black image"

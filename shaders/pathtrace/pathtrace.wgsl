@@ -355,6 +355,16 @@ fn camera_ray(pixel: vec2u, u: vec2f) -> Ray {
     return ray;
 }
 
+// For a ray that leaves no surface (a camera ray, a ray from a point in a medium): no
+// primitive skipped, no origin error.
+fn leave_no_surface() {
+    skip_prim = NO_HIT;
+    origin_n = vec3f(0.0);
+    origin_err = vec3f(0.0);
+    origin_off = 0.0;
+    origin_slab = 0.0;
+}
+
 // The origin of a ray leaving `s` towards the side `n` faces, and its error for the
 // intersection routines (`origin_n`, `origin_err`, `origin_off`, `origin_slab`,
 // `skip_inward`). Rays start at the hit itself, never offset (`skip_prim`).
@@ -389,11 +399,7 @@ fn medium_next_event(p: vec3f, dir: vec3f, g: f32, bounce: u32, has_lights: bool
         return vec3f(0.0);
     }
     let phase = hg_eval(dot(dir, ls.wi), g);
-    skip_prim = NO_HIT;
-    origin_n = vec3f(0.0);
-    origin_err = vec3f(0.0);
-    origin_off = 0.0;
-    origin_slab = 0.0;
+    leave_no_surface();
     ray_count += 1u;
     let tr = shadow_transmittance(Ray(p, ls.wi), ls.dist - ls.margin, medium_id);
     let w = select(light_weight(ls.pdf, phase), 1.0, ls.delta);
@@ -422,11 +428,7 @@ fn start_path(pixel: vec2u) {
     path_bounce = 0u;
     path_crossings = 0u;
     // The triangle the current ray leaves (never hit again); camera rays leave none.
-    skip_prim = NO_HIT;
-    origin_n = vec3f(0.0);
-    origin_err = vec3f(0.0);
-    origin_off = 0.0;
-    origin_slab = 0.0;
+    leave_no_surface();
     // The medium the ray travels in: paths start in none.
     if HAS_MEDIA {
         medium_id = NO_MEDIUM;
@@ -474,11 +476,7 @@ fn path_step() -> bool {
                     let wi = hg_sample(ray.dir, m.phase_g, rand2());
                     bsdf_pdf = hg_eval(dot(ray.dir, wi), m.phase_g);
                     prev_p = p;
-                    skip_prim = NO_HIT;
-                    origin_n = vec3f(0.0);
-                    origin_err = vec3f(0.0);
-                    origin_off = 0.0;
-                    origin_slab = 0.0;
+                    leave_no_surface();
                     ray = Ray(p, wi);
                     if bounce + 1u >= RR_START {
                         let q = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
@@ -792,11 +790,7 @@ fn first_hit_aovs(at: vec2u) {
     if WRITE_AOVS {
         // First hit through the pixel center: what a raster G-buffer sees.
         let ray = pinhole_ray(pixel, vec2f(0.5));
-        skip_prim = NO_HIT;
-        origin_n = vec3f(0.0);
-        origin_err = vec3f(0.0);
-        origin_off = 0.0;
-        origin_slab = 0.0;
+        leave_no_surface();
         let hit = intersect_scene(ray);
         var albedo = vec3f(0.0);
         var normal = vec3f(0.0);
