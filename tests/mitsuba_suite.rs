@@ -180,6 +180,7 @@ suite!(
     layer,
     media_absorbing_glass,
     media_scattering,
+    mesh_env,
     punctual_lights,
     thin_lens,
 );

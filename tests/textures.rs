@@ -619,6 +619,7 @@ fn plan_lists_textures_for_textured_scenes_only() {
         adaptive: false,
         data_in_buffers: false,
         in_image_order: false,
+        host_rays: false,
     };
     let on = |path: &Path| {
         let scene = GpuScene::build(&Scene::load(path).unwrap()).unwrap();
@@ -1329,6 +1330,7 @@ fn small_scenes_are_inlined_on_cpu_adapters_only() {
             adaptive: false,
             data_in_buffers: false,
             in_image_order: false,
+            host_rays: false,
         };
         let f = features(&scene, opts);
         let on = |name: &str| f.iter().find(|x| x.name == name).unwrap();

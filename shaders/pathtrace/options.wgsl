@@ -40,3 +40,8 @@ const HAS_ROUGH_DIFFUSE: bool = true;
 // index-matched boundary: medium tracking, distance sampling and shadow-ray transmittance
 // compiled in.
 const HAS_MEDIA: bool = true;
+
+// The host intersects the rays (CPU adapters with Embree, scenes of triangles without
+// media): each dispatch takes every path one step, between the host's answers (`wave_step`
+// in pathtrace.wgsl), instead of tracing whole paths.
+const HOST_RAYS: bool = true;

@@ -44,7 +44,13 @@ struct Frame {
     chunk_count: u32,
     // CHUNK_FIRST | CHUNK_LAST.
     chunk_flags: u32,
+    // With HOST_RAYS: WAVE_START, WAVE_CONTINUE or WAVE_FINISH (below); the first slot of
+    // the batch of slots being traced, and how many slots `wave`'s sections hold.
+    wave: u32,
+    wave_base: u32,
+    wave_capacity: u32,
     pad0: u32,
+    pad1: u32,
 }
 
 const CHUNK_FIRST: u32 = 1u;
@@ -100,6 +106,9 @@ fn light_weight(light_pdf: f32, bsdf_pdf: f32) -> f32 {
 @group(0) @binding(20) var<storage, read> adaptive_active: array<u32>;
 // Per pixel of the window: the sum of the frame's samples traced by its earlier dispatches.
 @group(0) @binding(21) var<storage, read_write> chunk_sums: array<vec4f>;
+// With HOST_RAYS, the paths in flight and the rays the host intersects (a 16-byte stand-in
+// otherwise): see `wave_step`.
+@group(0) @binding(22) var<storage, read_write> wave: array<vec4<u32>>;
 
 #import "pathtrace/intersect.wgsl"
 #import "pathtrace/scene_data.wgsl"
@@ -418,6 +427,15 @@ var<private> path_bounce: u32;
 // The index-matched boundaries crossed so far.
 var<private> path_crossings: u32;
 
+// With HOST_RAYS: the shadow ray of the step's next-event estimate, which the host traces
+// (from `shadow_near` to `shadow_far` along it), and what it adds to the path's radiance
+// unless occluded.
+var<private> shadow_pending: bool;
+var<private> shadow_ray: Ray;
+var<private> shadow_near: f32;
+var<private> shadow_far: f32;
+var<private> shadow_contribution: vec3f;
+
 // Starts the path of the current sample (`sampler_init`) through `pixel`.
 fn start_path(pixel: vec2u) {
     path_ray = camera_ray(pixel, sample_2d(PAIR_PIXEL));
@@ -437,6 +455,11 @@ fn start_path(pixel: vec2u) {
 
 // Takes the path one bounce on; true once it ended (its radiance is `path_radiance`).
 fn path_step() -> bool {
+    return path_step_from(intersect_scene(path_ray));
+}
+
+// `path_step` with the closest hit of `path_ray` given (`hit`).
+fn path_step_from(first_hit: Hit) -> bool {
     var ray = path_ray;
     var throughput = path_throughput;
     var radiance = path_radiance;
@@ -449,7 +472,7 @@ fn path_step() -> bool {
     var ended = false;
     // One pass: `break` leaves the bounce, `ended` says whether the path ends with it.
     loop {
-        let hit = intersect_scene(ray);
+        let hit = first_hit;
         ray_count += 1u;
         if HAS_MEDIA && medium_id != NO_MEDIUM {
             let m = scene_material(medium_id);
@@ -580,9 +603,19 @@ fn path_step() -> bool {
                             let w = select(light_weight(ls.pdf, e.pdf), 1.0, ls.delta);
                             radiance += throughput * e.f_cos * ls.radiance * tr * (w / ls.pdf);
                         }
-                    } else if !occluded(shadow, ls.dist - ls.margin) {
+                    } else {
                         let w = select(light_weight(ls.pdf, e.pdf), 1.0, ls.delta);
-                        radiance += throughput * e.f_cos * ls.radiance * (w / ls.pdf);
+                        let contribution = throughput * e.f_cos * ls.radiance * (w / ls.pdf);
+                        if HOST_RAYS {
+                            // The host answers the shadow ray before the next step.
+                            shadow_ray = shadow;
+                            shadow_near = origin_slab;
+                            shadow_far = ls.dist - ls.margin;
+                            shadow_contribution = contribution;
+                            shadow_pending = true;
+                        } else if !occluded(shadow, ls.dist - ls.margin) {
+                            radiance += contribution;
+                        }
                     }
                 }
             }
@@ -690,6 +723,27 @@ fn main(
             let packed = adaptive_active[1u + k];
             at = vec2u(packed & 0xffffu, packed >> 16u);
         }
+    }
+    if HOST_RAYS {
+        if frame.wave == WAVE_FINISH {
+            let slot = id.y * frame.window.z + id.x;
+            if all(id < frame.window.zw) {
+                let n = f32(max(frame.samples_per_frame, 1u));
+                textureStore(output, id, vec4f(chunk_sums[slot].xyz / n, 1.0));
+            }
+            first_hit_aovs(id);
+            return;
+        }
+        // A 1D dispatch: each invocation takes the slots of the step one `threads` apart
+        // (every slot at the first step, then those the host listed): llvmpipe pays a
+        // fixed cost per invocation, as much as a step of a path when the kernel is this
+        // large, so an invocation per slot would pay it for every step.
+        let threads = groups.x * 64u;
+        let count = wave_word(wave_list_at(), 0u);
+        for (var j = group.x * 64u + lane; j < count; j += threads) {
+            wave_step(wave_word(wave_list_at(), 1u + j), j);
+        }
+        return;
     }
     if trace {
         trace_pixel(at);
@@ -813,4 +867,167 @@ fn first_hit_aovs(at: vec2u) {
         textureStore(out_normal, at, vec4f(normal, 1.0));
         textureStore(out_depth, at, vec4f(depth, 0.0, 0.0, 0.0));
     }
+}
+
+// Host intersection (HOST_RAYS). The paths of a frame are traced in steps: each dispatch
+// takes every pixel's path one bounce on, as `path_step` does, from the closest hit the host
+// found for its ray, and writes the rays the host is to trace next (the path's next ray and
+// the step's shadow ray); the host intersects them and dispatches again, until every pixel
+// has traced its `chunk_count` samples. A slot per pixel of the window (y * width + x),
+// traced in batches of at most `wave_slots()` (S) from `frame.wave_base`; `wave` has
+// sections of S entries each. The first holds each slot's path in flight;
+// the others hold the step's slots in the step's order (the lane's slots at the first
+// step, then those the host lists, those with a ray out), the j-th of the step at j:
+//   [0, 8S)     the path in flight: 8 vec4 per slot (`save_slot`)
+//   [8S, 10S)   the next ray the step wrote, 2 vec4 (origin, t_near; direction, t_far;
+//               t_far < 0: none)
+//   [10S, 12S)  the shadow ray the step wrote, the same
+//   [12S, 13S)  the host's closest hit of the ray the step reads: t, u, v (bits) and the
+//               primitive
+//   [13S, L)    the host's answer for its shadow ray, one u32 each (1: occluded)
+//   [L, ...)    the step's slots: their count, then each one, a u32 each (`wave_list_at`)
+// The random numbers, their order and the arithmetic are `trace_pixel`'s; only the hits are
+// the host's.
+const WAVE_START: u32 = 0u;
+const WAVE_CONTINUE: u32 = 1u;
+// Writes the pixels' means from `chunk_sums` (and the AOVs): recorded with the graph.
+const WAVE_FINISH: u32 = 2u;
+
+// Slot flags: a shadow ray is out; the path ended (its last shadow ray still out); the
+// pixel traced all its samples.
+const SLOT_SHADOW: u32 = 1u;
+const SLOT_ENDED: u32 = 2u;
+const SLOT_DONE: u32 = 4u;
+
+fn wave_slots() -> u32 {
+    return frame.wave_capacity;
+}
+
+fn put_ray(index: u32, ray: Ray, t_near: f32, t_far: f32) {
+    wave[index] = vec4u(bitcast<vec3u>(ray.origin), bitcast<u32>(t_near));
+    wave[index + 1u] = vec4u(bitcast<vec3u>(ray.dir), bitcast<u32>(t_far));
+}
+
+fn no_ray(index: u32) {
+    wave[index + 1u].w = bitcast<u32>(-1.0);
+}
+
+fn save_slot(slot: u32, flags: u32, i: u32, sum: vec3f, dropped: u32) {
+    let b = 8u * (slot - frame.wave_base);
+    wave[b] = vec4u(bitcast<vec3u>(path_ray.origin), bitcast<u32>(path_bsdf_pdf));
+    wave[b + 1u] = vec4u(bitcast<vec3u>(path_ray.dir), path_bounce);
+    wave[b + 2u] = vec4u(bitcast<vec3u>(path_throughput), path_crossings);
+    wave[b + 3u] = vec4u(bitcast<vec3u>(path_radiance), rng_state);
+    wave[b + 4u] = vec4u(bitcast<vec3u>(path_prev_p), sampler_index);
+    wave[b + 5u] = vec4u(bitcast<vec3u>(sum), sampler_seed);
+    wave[b + 6u] = vec4u(bitcast<vec3u>(shadow_contribution), flags);
+    wave[b + 7u] = vec4u(i, dropped, ray_count, 0u);
+}
+
+// The u32 at position `i` from the vec4 at `at` of `wave`.
+fn wave_word(at: u32, i: u32) -> u32 {
+    return wave[at + i / 4u][i % 4u];
+}
+
+// Where the host's list of the slots to step starts: their count, then each one.
+fn wave_list_at() -> u32 {
+    let slots = wave_slots();
+    return 13u * slots + (slots + 3u) / 4u;
+}
+
+// One step of the paths of window slot `slot`, the `j`-th of the step (see above).
+fn wave_step(slot: u32, j: u32) {
+    let at = vec2u(slot % frame.window.z, slot / frame.window.z);
+    let w = frame.settings.width;
+    let h = frame.settings.height;
+    let pixel = at + frame.window.xy;
+    let n = frame.samples_per_frame;
+    let slots = wave_slots();
+    let pixel_index = pixel.y * w + pixel.x;
+    let end = frame.chunk_first + frame.chunk_count;
+    var flags = 0u;
+    var i = frame.chunk_first;
+    var sum = vec3f(0.0);
+    var dropped = 0u;
+    shadow_pending = false;
+    shadow_contribution = vec3f(0.0);
+    if frame.wave == WAVE_START {
+        ray_count = 0u;
+        sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler, n, frame.replicates);
+        start_path(pixel);
+    } else {
+        let b = 8u * (slot - frame.wave_base);
+        let s6 = wave[b + 6u];
+        flags = s6.w;
+        let s0 = wave[b];
+        let s1 = wave[b + 1u];
+        let s2 = wave[b + 2u];
+        let s3 = wave[b + 3u];
+        let s4 = wave[b + 4u];
+        let s5 = wave[b + 5u];
+        let s7 = wave[b + 7u];
+        path_ray = Ray(bitcast<vec3f>(s0.xyz), bitcast<vec3f>(s1.xyz));
+        path_bsdf_pdf = bitcast<f32>(s0.w);
+        path_bounce = s1.w;
+        path_throughput = bitcast<vec3f>(s2.xyz);
+        path_crossings = s2.w;
+        path_radiance = bitcast<vec3f>(s3.xyz);
+        rng_state = s3.w;
+        path_prev_p = bitcast<vec3f>(s4.xyz);
+        sampler_index = s4.w;
+        sum = bitcast<vec3f>(s5.xyz);
+        sampler_seed = s5.w;
+        sampler_sobol = frame.sampler == SAMPLER_SOBOL;
+        i = s7.x;
+        dropped = s7.y;
+        ray_count = s7.z;
+        if (flags & SLOT_SHADOW) != 0u {
+            let occluded = wave_word(13u * slots, j);
+            if occluded == 0u {
+                path_radiance += bitcast<vec3f>(s6.xyz);
+            }
+        }
+        var ended = (flags & SLOT_ENDED) != 0u;
+        flags = 0u;
+        if !ended {
+            let hv = wave[12u * slots + j];
+            ended = path_step_from(Hit(hv.w, bitcast<f32>(hv.x), bitcast<f32>(hv.y), bitcast<f32>(hv.z)));
+        }
+        if ended && shadow_pending {
+            // The path's last shadow ray is still to be answered.
+            flags = SLOT_ENDED;
+        } else if ended {
+            add_sample(path_radiance, &sum, &dropped);
+            i++;
+            if i >= end {
+                flags = SLOT_DONE;
+                chunk_sums[slot] = vec4f(sum, 0.0);
+                if dropped > 0u {
+                    atomicAdd(&stats[0], dropped);
+                }
+                let before = atomicAdd(&stats[1], ray_count);
+                if before > 0xffffffffu - ray_count {
+                    atomicAdd(&stats[2], 1u);
+                }
+            } else {
+                sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler, n, frame.replicates);
+                start_path(pixel);
+            }
+        }
+    }
+    let next = 8u * slots + 2u * j;
+    if flags == 0u {
+        // Within `origin_slab` of its origin a hit is the origin's own error (see `leave`).
+        put_ray(next, path_ray, origin_slab, F32_MAX);
+    } else {
+        no_ray(next);
+    }
+    let shadow = 10u * slots + 2u * j;
+    if shadow_pending {
+        put_ray(shadow, shadow_ray, shadow_near, shadow_far);
+        flags |= SLOT_SHADOW;
+    } else {
+        no_ray(shadow);
+    }
+    save_slot(slot, flags, i, sum, dropped);
 }

@@ -1,6 +1,6 @@
 //! `lumagraph bench`: path tracing throughput on the current adapter, with the
-//! scene-specialized shader (with its scene data inlined, then read from buffers) and the
-//! general (BVH) one side by side.
+//! scene-specialized shader (with its scene data inlined, then read from buffers; with the
+//! host intersecting the rays, then the WGSL BVH) and the general (BVH) one side by side.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -40,6 +40,7 @@ fn measure(
     scene: &Arc<GpuScene>,
     general: bool,
     data_in_buffers: bool,
+    wgsl_intersection: bool,
     spp: u32,
     runs: u32,
 ) -> Result<Figures> {
@@ -58,6 +59,7 @@ fn measure(
         scene: Some(Arc::clone(scene)),
         general_shaders: general,
         scene_data_in_buffers: data_in_buffers,
+        wgsl_intersection,
         ..Resources::default()
     };
     let mut exec = Executor::new(ctx, plan, &resources)?;
@@ -111,18 +113,31 @@ pub fn run(scene: &Arc<GpuScene>, spp: u32, runs: u32) -> Result<()> {
         "{}x{}, {} bounces, {spp} spp per run, best of {runs}:",
         scene.settings.width, scene.settings.height, scene.settings.max_bounces
     );
-    let special = measure(&ctx, scene, false, false, spp, runs)?;
+    let special = measure(&ctx, scene, false, false, false, spp, runs)?;
     print("specialized", &special);
+    let wgsl = if special.how.contains("rays intersected on the host") {
+        let wgsl = measure(&ctx, scene, false, false, true, spp, runs)?;
+        print("WGSL BVH", &wgsl);
+        Some(wgsl)
+    } else {
+        None
+    };
     let inlined = special.how.contains("materials and lights inlined");
     let buffers = if inlined {
-        let buffers = measure(&ctx, scene, false, true, spp, runs)?;
+        let buffers = measure(&ctx, scene, false, true, false, spp, runs)?;
         print("buffers", &buffers);
         Some(buffers)
     } else {
         None
     };
-    let general = measure(&ctx, scene, true, false, spp, runs)?;
+    let general = measure(&ctx, scene, true, false, false, spp, runs)?;
     print("general", &general);
+    if let Some(wgsl) = wgsl {
+        println!(
+            "  specialized (host intersection) / WGSL BVH: {:.2}x",
+            special.wall / wgsl.wall
+        );
+    }
     if let Some(buffers) = buffers {
         println!(
             "  specialized / buffers: {:.2}x",

@@ -11,6 +11,8 @@
 //! - [`Executor`]: runs a [`lumagraph_graph::Plan`] frame by frame.
 //! - [`image_io`] and [`cpu`]: image files, and plain-Rust references of every post node.
 //! - [`custom`]: node kinds declared in graph files, their shaders generated and checked.
+//! - [`embree`]: the path tracer's rays traced on the host with Embree 3, loaded at run
+//!   time (for CPU adapters, where the WGSL BVH traversal is slow).
 
 pub mod bsdf_check;
 pub mod bsdf_tables;
@@ -18,9 +20,11 @@ pub mod checkpoint;
 mod context;
 pub mod cpu;
 pub mod custom;
+pub mod embree;
 pub mod env_map;
 mod error;
 mod executor;
+mod host_rays;
 pub mod image_io;
 pub mod kernel;
 mod library;

@@ -415,6 +415,10 @@ pub struct PathTraceOptions {
     /// On a CPU adapter, trace workgroups in image order instead of spreading them over the
     /// image (the images are bit-identical; a test compares the two).
     pub in_image_order: bool,
+    /// On a CPU adapter, whether the host can intersect the path tracer's rays (Embree was
+    /// found, [`crate::embree`]) and may: the scene's rays are then traced there when the
+    /// BVH would be traversed, and the scene allows (see [`features`]).
+    pub host_rays: bool,
 }
 
 /// One feature of the path tracer, compiled in or left out for a scene, and why.
@@ -612,7 +616,58 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
         ),
     ]);
     out.extend(cpu_features(options, inline));
+    out.push(host_rays_feature(scene, options, inline));
     out
+}
+
+/// Whether the host intersects the rays (`HOST_RAYS`), and why (not).
+fn host_rays_feature(scene: &GpuScene, options: PathTraceOptions, inline: bool) -> Feature {
+    let media = scene.materials.iter().any(|x| {
+        x.flags & (lumagraph_scene::MATERIAL_MEDIUM | lumagraph_scene::MATERIAL_INDEX_MATCHED) != 0
+    });
+    let (included, reason) = if !options.cpu_adapter || !options.specialize {
+        (
+            false,
+            "a GPU adapter or the general shader: traced in WGSL".to_owned(),
+        )
+    } else if inline {
+        (false, "intersected inline".to_owned())
+    } else if !options.host_rays {
+        (
+            false,
+            format!("no host intersector: {}", host_rays_unavailable()),
+        )
+    } else if scene.tri_positions.is_empty() || !scene.spheres.is_empty() {
+        (
+            false,
+            "spheres or no triangles: the host intersects triangles only".to_owned(),
+        )
+    } else if media {
+        (
+            false,
+            "participating media: shadow rays cross boundaries in WGSL".to_owned(),
+        )
+    } else if options.adaptive {
+        (false, "adaptive sampling: traced in WGSL".to_owned())
+    } else {
+        (
+            true,
+            format!(
+                "a CPU adapter: {} intersects the {} triangles on the host's threads, the                  WGSL shades",
+                crate::embree::Embree::load().map_or_else(|e| e, |e| e.version()),
+                scene.tri_positions.len()
+            ),
+        )
+    };
+    feature("host intersection", included, reason)
+}
+
+/// Why the host intersector is not used, for the plan.
+fn host_rays_unavailable() -> String {
+    match crate::embree::Embree::load() {
+        Ok(_) => "turned off (LUMAGRAPH_EMBREE=off or asked for WGSL)".to_owned(),
+        Err(e) => e,
+    }
 }
 
 /// How the work is laid out for a CPU adapter's driver threads and SIMD lanes.
@@ -713,7 +768,7 @@ pub fn pathtrace_source(
         "const WRITE_AOVS: bool = {};\nconst ADAPTIVE: bool = {};\nconst SPREAD_WORKGROUPS: bool = {};\nconst REGENERATE_PATHS: bool = {};\nconst HAS_TRIANGLES: bool = {};\nconst HAS_SPHERES: bool = {};\nconst HAS_SPECULAR: bool = {};\nconst HAS_METAL: bool = {};\n\
          const HAS_GLASS: bool = {};\nconst HAS_LIGHTS: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
          const HAS_ENV_MAP: bool = {};\nconst HAS_TEXTURES: bool = {};\nconst HAS_ROUGH_DIFFUSE: bool = {};\n\
-         const HAS_MEDIA: bool = {};\n",
+         const HAS_MEDIA: bool = {};\nconst HOST_RAYS: bool = {};\n",
         on("first-hit AOVs"),
         on("adaptive sampling"),
         on("spread workgroups"),
@@ -729,6 +784,7 @@ pub fn pathtrace_source(
         on("material textures"),
         on("rough diffuse (EON)"),
         on("participating media"),
+        on("host intersection"),
     );
     let mut overrides = vec![("pathtrace/options.wgsl", consts)];
     if on("inline intersection")
@@ -750,6 +806,8 @@ pub fn pathtrace_source(
         "{}; left out: {}",
         if on("inline materials and lights") {
             "intersection inlined, materials and lights inlined"
+        } else if on("host intersection") {
+            "rays intersected on the host"
         } else if on("inline intersection") {
             "intersection inlined"
         } else {

@@ -37,6 +37,9 @@ pub struct GpuScene {
     pub bvh_skips: Vec<[u32; crate::bvh::BVH_OCTANTS]>,
     /// Triangle intersection data in BVH order (buffer `tri_positions`).
     pub tri_positions: Vec<GpuTriangle>,
+    /// Each GPU triangle's corners in BVH order, as the scene gave them (CPU side only: the
+    /// host intersector, `lumagraph_render::embree`).
+    pub tri_corners: Vec<[[f32; 3]; 3]>,
     /// Triangle shading data, same order (buffer `tri_shading`).
     pub tri_shading: Vec<GpuTriShading>,
     /// Spheres in BVH order (buffer `spheres`).
@@ -407,6 +410,8 @@ impl GpuScene {
                 e2: e2.to_array(),
                 ..GpuTriangle::default()
             });
+            self.tri_corners
+                .push([p0.to_array(), p1.to_array(), p2.to_array()]);
             let flat_n = e1.cross(e2).normalize();
             let ns = t.normals.unwrap_or([flat_n; 3]);
             if textured {

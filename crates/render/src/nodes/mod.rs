@@ -47,6 +47,9 @@ pub struct Resources {
     /// Trace workgroups in image order even on a CPU adapter, where they are otherwise
     /// spread over the image to balance the driver's threads (a test compares the two).
     pub workgroups_in_image_order: bool,
+    /// Intersect in WGSL even on a CPU adapter where the host could (Embree found): what
+    /// the path tracer runs without Embree (tests compare the two).
+    pub wgsl_intersection: bool,
 }
 
 /// An image a sink would write: its pixels and what they are.

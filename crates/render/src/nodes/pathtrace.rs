@@ -10,7 +10,9 @@ use crate::error::{RenderError, Result};
 use crate::kernel::{Kernel, uniform_buffer};
 use lumagraph_graph::TexFormat;
 
-use crate::nodes::{Counter, NodeExec, NodeImpl, Recording, Resources, boxed};
+use crate::host_rays::HostRays;
+use crate::kernel::PassBuilder;
+use crate::nodes::{Counter, FrameIo, NodeExec, NodeImpl, Recording, Resources, boxed};
 use crate::pool::{PooledTexture, create};
 use crate::readback::map_read;
 use crate::scene_gpu::SceneBuffers;
@@ -58,6 +60,9 @@ fn options(
             .iter()
             .any(|p| pass.output(p).is_some()),
         adaptive: adaptive_on(pass),
+        host_rays: cpu_adapter
+            && !resources.wgsl_intersection
+            && crate::embree::Embree::load().is_ok(),
     }
 }
 
@@ -90,7 +95,13 @@ crate::param_block! {
         chunk_count: u32,
         /// `CHUNK_FIRST` | `CHUNK_LAST` (`pathtrace/pathtrace.wgsl`).
         chunk_flags: u32,
+        /// With host intersection: `WAVE_START`, `WAVE_CONTINUE` or `WAVE_FINISH`; the
+        /// batch of slots traced: its first, and the slots the `wave` buffer holds.
+        wave: u32,
+        wave_base: u32,
+        wave_capacity: u32,
         pad0: u32,
+        pad1: u32,
     }
 }
 
@@ -279,6 +290,10 @@ pub(crate) struct PathTrace {
     /// Per pixel of the window, the sum of a frame's samples traced so far while it takes
     /// several dispatches (a 16-byte stand-in until one does).
     chunk_sums: wgpu::Buffer,
+    /// Host intersection's state, when the plan says "host intersection".
+    host: Option<HostRays>,
+    /// The `wave` binding's stand-in without host intersection.
+    wave_stand_in: wgpu::Buffer,
 }
 
 impl PathTrace {
@@ -297,6 +312,14 @@ impl PathTrace {
             CPU_SAMPLES_PER_DISPATCH[1]
         } else {
             CPU_SAMPLES_PER_DISPATCH[0]
+        };
+        let host = if crate::specialize::features(&scene, opts)
+            .iter()
+            .any(|f| f.name == "host intersection" && f.included)
+        {
+            Some(HostRays::new(ctx, &scene)?)
+        } else {
+            None
         };
         let kernel = Kernel::from_source(ctx, "pathtrace/pathtrace.wgsl", &source)?;
         let env = match &scene.environment_map {
@@ -362,6 +385,8 @@ impl PathTrace {
             adaptive_samples: 0,
             samples_per_dispatch,
             chunk_sums: storage(ctx, "pathtrace chunk sums", 16),
+            host,
+            wave_stand_in: storage(ctx, "pathtrace wave stand-in", 16),
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -390,9 +415,144 @@ impl PathTrace {
             chunk_first: 0,
             chunk_count: self.samples_per_frame,
             chunk_flags: CHUNK_FIRST | CHUNK_LAST,
+            wave: 0,
+            wave_base: 0,
+            wave_capacity: 0,
             pad0: 0,
+            pad1: 0,
         }
     }
+}
+
+impl PathTrace {
+    /// The views of the color and AOV outputs (1×1 stand-ins for those nothing reads).
+    fn views<'a>(&'a self, pass: &Pass, io: &'a FrameIo<'_>) -> [&'a wgpu::TextureView; 4] {
+        ["color", "albedo", "normal", "depth"]
+            .iter()
+            .enumerate()
+            .map(|(i, port)| {
+                pass.output(port)
+                    .map_or(&self.unused[i].view, |t| &io.texture(t).view)
+            })
+            .collect::<Vec<_>>()
+            .try_into()
+            .unwrap_or([&self.unused[0].view; 4])
+    }
+
+    /// The path tracer's pass with every binding: the output `views` (color, albedo,
+    /// normal, depth), the per-pixel `sums` and the host intersection's `wave` buffer.
+    fn bind<'a>(
+        &'a self,
+        name: &'a str,
+        [color, albedo, normal, depth]: [&'a wgpu::TextureView; 4],
+        sums: &'a wgpu::Buffer,
+        wave: &'a wgpu::Buffer,
+    ) -> PassBuilder<'a> {
+        let b = &self.buffers;
+        self.kernel
+            .pass(name)
+            .write(color)
+            .uniform(&self.frame)
+            .buffer(&b.bvh_nodes)
+            .buffer(&b.tri_positions)
+            .buffer(&b.tri_shading)
+            .buffer(&b.spheres)
+            .buffer(&b.materials)
+            .buffer(&b.lights)
+            .buffer(&b.light_alias)
+            .buffer(&self.stats)
+            .write(albedo)
+            .write(normal)
+            .write(depth)
+            .buffer(&self.ggx_table)
+            .buffer(&self.env.texels)
+            .buffer(&self.env.alias)
+            .buffer(&b.tri_texcoords)
+            .buffer(&b.textures)
+            .buffer(&self.adaptive.halves)
+            .buffer(&self.adaptive.stopped)
+            .buffer(&self.adaptive.active)
+            .buffer(sums)
+            .buffer(wave)
+    }
+
+    /// Records a frame traced with host intersection: the steps of its paths are
+    /// dispatched and submitted here, the host intersecting the rays of each step; the pass
+    /// that writes the pixels' means (and AOVs) is recorded into `encoder` with the graph.
+    fn record_host(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        io: &FrameIo<'_>,
+        pass: &Pass,
+        frame: Frame,
+        timer: Option<&mut crate::timing::GpuTimer>,
+    ) -> Result<()> {
+        let Some(mut host) = self.host.take() else {
+            return Ok(());
+        };
+        let extent = pass.extent;
+        host.fit(ctx, extent);
+        // The frame's sums: a buffer of its own, which the finish pass, recorded now and
+        // run later, reads whatever frames follow before it runs.
+        let sums = storage(ctx, "pathtrace host sums", 16 * extent.pixels());
+        let views = self.views(pass, io);
+        // Each step at most one bounce of one path per pixel, or a path's last shadow ray.
+        let max_steps = u64::from(frame.samples_per_frame.max(1))
+            * (2 * u64::from(self.scene.settings.max_bounces) + 4)
+            + 2;
+        let result = host.trace_frame(ctx, max_steps, |step, enc, wave| {
+            let f = Frame {
+                wave: if step.first {
+                    WAVE_START
+                } else {
+                    WAVE_CONTINUE
+                },
+                wave_base: step.base,
+                wave_capacity: step.capacity,
+                ..frame
+            };
+            ctx.queue
+                .write_buffer(&self.frame, 0, bytemuck::bytes_of(&f));
+            self.bind(&pass.node, views, &sums, wave)
+                .dispatch(ctx, enc, [step.groups, 1, 1], None)
+        });
+        let finish = result.and_then(|()| {
+            let f = Frame {
+                wave: WAVE_FINISH,
+                ..frame
+            };
+            stage_frame(ctx, encoder, &f, &self.frame);
+            self.bind(&pass.node, views, &sums, host.wave())
+                .dispatch_2d(ctx, encoder, extent, timer)
+        });
+        self.host = Some(host);
+        finish
+    }
+}
+
+/// `Frame::wave` (`pathtrace/pathtrace.wgsl`): the first step of a frame's paths, a later
+/// one, the pass writing the means.
+const WAVE_START: u32 = 0;
+const WAVE_CONTINUE: u32 = 1;
+const WAVE_FINISH: u32 = 2;
+
+/// Records a copy of `frame` into the uniform buffer `dst` through a staging buffer, in
+/// order with the passes recorded around it.
+fn stage_frame(
+    ctx: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    frame: &Frame,
+    dst: &wgpu::Buffer,
+) {
+    let staging = ctx
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("pathtrace frame staging"),
+            contents: bytemuck::bytes_of(frame),
+            usage: wgpu::BufferUsages::COPY_SRC,
+        });
+    encoder.copy_buffer_to_buffer(&staging, 0, dst, 0, dst.size());
 }
 
 impl PathTrace {
@@ -478,6 +638,9 @@ impl NodeExec for PathTrace {
         }
         let frame = self.frame(pass.extent);
         self.samples += self.samples_per_frame;
+        if self.host.is_some() {
+            return self.record_host(ctx, encoder, io, pass, frame, timer);
+        }
         // The frame's samples in dispatches of at most `samples_per_dispatch` (one on GPU
         // adapters), the partial sums kept per pixel between them.
         let n = self.samples_per_frame.max(1);
@@ -498,43 +661,9 @@ impl NodeExec for PathTrace {
             };
             // Each dispatch has its own uniform contents: stage them through a copy recorded
             // in order, so many frames can share one submission.
-            let staging = ctx
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("pathtrace frame staging"),
-                    contents: bytemuck::bytes_of(&chunk),
-                    usage: wgpu::BufferUsages::COPY_SRC,
-                });
-            encoder.copy_buffer_to_buffer(&staging, 0, &self.frame, 0, self.frame.size());
-            let b = &self.buffers;
-            let aov = |port: &str, i: usize| {
-                pass.output(port)
-                    .map_or(&self.unused[i].view, |t| &io.texture(t).view)
-            };
-            self.kernel
-                .pass(&pass.node)
-                .write(aov("color", 0))
-                .uniform(&self.frame)
-                .buffer(&b.bvh_nodes)
-                .buffer(&b.tri_positions)
-                .buffer(&b.tri_shading)
-                .buffer(&b.spheres)
-                .buffer(&b.materials)
-                .buffer(&b.lights)
-                .buffer(&b.light_alias)
-                .buffer(&self.stats)
-                .write(aov("albedo", 1))
-                .write(aov("normal", 2))
-                .write(aov("depth", 3))
-                .buffer(&self.ggx_table)
-                .buffer(&self.env.texels)
-                .buffer(&self.env.alias)
-                .buffer(&b.tri_texcoords)
-                .buffer(&b.textures)
-                .buffer(&self.adaptive.halves)
-                .buffer(&self.adaptive.stopped)
-                .buffer(&self.adaptive.active)
-                .buffer(&self.chunk_sums)
+            stage_frame(ctx, encoder, &chunk, &self.frame);
+            let views = self.views(pass, io);
+            self.bind(&pass.node, views, &self.chunk_sums, &self.wave_stand_in)
                 .dispatch_2d(ctx, encoder, pass.extent, timer.as_deref_mut())?;
             first += count;
         }
