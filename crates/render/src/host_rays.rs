@@ -58,6 +58,8 @@ pub(crate) struct HostRays {
     /// batch of [`MAX_SLOTS`]).
     extent: lumagraph_graph::Extent,
     capacity: u64,
+    /// What was built, and how long it took, for the node's notes.
+    pub(crate) note: String,
 }
 
 /// One lane: its `wave` buffer, the readback of its rays, the host's copies.
@@ -219,13 +221,21 @@ impl HostRays {
     pub(crate) fn new(ctx: &GpuContext, scene: &lumagraph_scene::GpuScene) -> Result<Self> {
         let fail = |e: String| RenderError::Gpu(format!("host intersection: {e}"));
         let embree = Embree::load().map_err(fail)?;
+        let version = embree.version();
+        let start = std::time::Instant::now();
         let scene = HostScene::new(embree, &scene.tri_corners).map_err(fail)?;
+        let note = format!(
+            "host intersection: {version}, {} triangles built in {:.0} ms",
+            scene.len(),
+            start.elapsed().as_secs_f64() * 1e3
+        );
         let extent = lumagraph_graph::Extent::new(1, 1);
         Ok(Self {
             scene,
             lanes: (0..LANES).map(|_| Lane::new(ctx, 1)).collect(),
             extent,
             capacity: 1,
+            note,
         })
     }
 

@@ -653,7 +653,7 @@ fn host_rays_feature(scene: &GpuScene, options: PathTraceOptions, inline: bool) 
         (
             true,
             format!(
-                "a CPU adapter: {} intersects the {} triangles on the host's threads, the                  WGSL shades",
+                "a CPU adapter: {} intersects the {} triangles on the host's threads, the WGSL shades",
                 crate::embree::Embree::load().map_or_else(|e| e, |e| e.version()),
                 scene.tri_positions.len()
             ),
@@ -665,7 +665,7 @@ fn host_rays_feature(scene: &GpuScene, options: PathTraceOptions, inline: bool) 
 /// Why the host intersector is not used, for the plan.
 fn host_rays_unavailable() -> String {
     match crate::embree::Embree::load() {
-        Ok(_) => "turned off (LUMAGRAPH_EMBREE=off or asked for WGSL)".to_owned(),
+        Ok(_) => "WGSL intersection asked for".to_owned(),
         Err(e) => e,
     }
 }

@@ -672,6 +672,9 @@ impl NodeExec for PathTrace {
 
     fn notes(&self) -> Vec<String> {
         let mut notes = vec![format!("shader: {}", self.how)];
+        if let Some(host) = &self.host {
+            notes.push(host.note.clone());
+        }
         if self.firefly_clamp > 0.0 {
             notes.push(format!(
                 "firefly clamp ON: each sample's channels are scaled to at most {} (biased: energy is lost)",
