@@ -887,7 +887,7 @@ fn first_hit_aovs(at: vec2u) {
 //   [13S, L)    the host's answer for its shadow ray, one u32 each (1: occluded)
 //   [L, ...)    the step's slots: their count, then each one, a u32 each (`wave_list_at`)
 // The random numbers, their order and the arithmetic are `trace_pixel`'s; only the hits are
-// the host's.
+// the host's. The host counts the rays (`ray_count` is not kept).
 const WAVE_START: u32 = 0u;
 const WAVE_CONTINUE: u32 = 1u;
 // Writes the pixels' means from `chunk_sums` (and the AOVs): recorded with the graph.
@@ -912,16 +912,25 @@ fn no_ray(index: u32) {
     wave[index + 1u].w = bitcast<u32>(-1.0);
 }
 
-fn save_slot(slot: u32, flags: u32, i: u32, sum: vec3f, dropped: u32) {
-    let b = 8u * (slot - frame.wave_base);
+// A slot's path state, 8 vec4 from `b`: [0, 5) every step (the ray, its BSDF pdf, the
+// bounce, throughput, crossings, radiance, random state, previous vertex, slot flags); [5]
+// the shadow ray's contribution and the Sobol index, only while a shadow ray is out or the
+// first hit is next; [6] the pixel's sum and the Sobol seed, [7] the sample index and the
+// dropped samples, only when a path ends or starts. (llvmpipe loads and stores a buffer
+// word lane by lane: the fewer words a step moves, the faster it runs.)
+fn save_slot(b: u32, flags: u32, moved: bool, i: u32, sum: vec3f, dropped: u32) {
     wave[b] = vec4u(bitcast<vec3u>(path_ray.origin), bitcast<u32>(path_bsdf_pdf));
     wave[b + 1u] = vec4u(bitcast<vec3u>(path_ray.dir), path_bounce);
     wave[b + 2u] = vec4u(bitcast<vec3u>(path_throughput), path_crossings);
     wave[b + 3u] = vec4u(bitcast<vec3u>(path_radiance), rng_state);
-    wave[b + 4u] = vec4u(bitcast<vec3u>(path_prev_p), sampler_index);
-    wave[b + 5u] = vec4u(bitcast<vec3u>(sum), sampler_seed);
-    wave[b + 6u] = vec4u(bitcast<vec3u>(shadow_contribution), flags);
-    wave[b + 7u] = vec4u(i, dropped, ray_count, 0u);
+    wave[b + 4u] = vec4u(bitcast<vec3u>(path_prev_p), flags);
+    if shadow_pending || path_bounce == 0u {
+        wave[b + 5u] = vec4u(bitcast<vec3u>(shadow_contribution), sampler_index);
+    }
+    if moved {
+        wave[b + 6u] = vec4u(bitcast<vec3u>(sum), sampler_seed);
+        wave[b + 7u] = vec4u(i, dropped, 0u, 0u);
+    }
 }
 
 // The u32 at position `i` from the vec4 at `at` of `wave`.
@@ -949,23 +958,21 @@ fn wave_step(slot: u32, j: u32) {
     var i = frame.chunk_first;
     var sum = vec3f(0.0);
     var dropped = 0u;
+    // Whether the sum or the sample moved on (a path ended): [6] and [7] are saved.
+    var moved = true;
     shadow_pending = false;
     shadow_contribution = vec3f(0.0);
+    let b = 8u * (slot - frame.wave_base);
     if frame.wave == WAVE_START {
-        ray_count = 0u;
         sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler, n, frame.replicates);
         start_path(pixel);
     } else {
-        let b = 8u * (slot - frame.wave_base);
-        let s6 = wave[b + 6u];
-        flags = s6.w;
+        moved = false;
         let s0 = wave[b];
         let s1 = wave[b + 1u];
         let s2 = wave[b + 2u];
         let s3 = wave[b + 3u];
         let s4 = wave[b + 4u];
-        let s5 = wave[b + 5u];
-        let s7 = wave[b + 7u];
         path_ray = Ray(bitcast<vec3f>(s0.xyz), bitcast<vec3f>(s1.xyz));
         path_bsdf_pdf = bitcast<f32>(s0.w);
         path_bounce = s1.w;
@@ -974,18 +981,18 @@ fn wave_step(slot: u32, j: u32) {
         path_radiance = bitcast<vec3f>(s3.xyz);
         rng_state = s3.w;
         path_prev_p = bitcast<vec3f>(s4.xyz);
-        sampler_index = s4.w;
-        sum = bitcast<vec3f>(s5.xyz);
-        sampler_seed = s5.w;
+        flags = s4.w;
         sampler_sobol = frame.sampler == SAMPLER_SOBOL;
-        i = s7.x;
-        dropped = s7.y;
-        ray_count = s7.z;
-        if (flags & SLOT_SHADOW) != 0u {
-            let occluded = wave_word(13u * slots, j);
-            if occluded == 0u {
-                path_radiance += bitcast<vec3f>(s6.xyz);
+        let shadow_out = (flags & SLOT_SHADOW) != 0u;
+        if shadow_out || path_bounce == 0u {
+            let s5 = wave[b + 5u];
+            sampler_index = s5.w;
+            if shadow_out && wave_word(13u * slots, j) == 0u {
+                path_radiance += bitcast<vec3f>(s5.xyz);
             }
+        }
+        if path_bounce == 0u {
+            sampler_seed = wave[b + 6u].w;
         }
         var ended = (flags & SLOT_ENDED) != 0u;
         flags = 0u;
@@ -997,6 +1004,13 @@ fn wave_step(slot: u32, j: u32) {
             // The path's last shadow ray is still to be answered.
             flags = SLOT_ENDED;
         } else if ended {
+            moved = true;
+            let s6 = wave[b + 6u];
+            let s7 = wave[b + 7u];
+            sum = bitcast<vec3f>(s6.xyz);
+            sampler_seed = s6.w;
+            i = s7.x;
+            dropped = s7.y;
             add_sample(path_radiance, &sum, &dropped);
             i++;
             if i >= end {
@@ -1004,10 +1018,6 @@ fn wave_step(slot: u32, j: u32) {
                 chunk_sums[slot] = vec4f(sum, 0.0);
                 if dropped > 0u {
                     atomicAdd(&stats[0], dropped);
-                }
-                let before = atomicAdd(&stats[1], ray_count);
-                if before > 0xffffffffu - ray_count {
-                    atomicAdd(&stats[2], 1u);
                 }
             } else {
                 sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler, n, frame.replicates);
@@ -1024,10 +1034,11 @@ fn wave_step(slot: u32, j: u32) {
     }
     let shadow = 10u * slots + 2u * j;
     if shadow_pending {
-        put_ray(shadow, shadow_ray, shadow_near, shadow_far);
+        // A shadow ray ending before it starts is still a ray (never occluded), not none.
+        put_ray(shadow, shadow_ray, shadow_near, max(shadow_far, 0.0));
         flags |= SLOT_SHADOW;
     } else {
         no_ray(shadow);
     }
-    save_slot(slot, flags, i, sum, dropped);
+    save_slot(b, flags, moved, i, sum, dropped);
 }

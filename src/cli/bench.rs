@@ -122,7 +122,8 @@ pub fn run(scene: &Arc<GpuScene>, spp: u32, runs: u32) -> Result<()> {
     } else {
         None
     };
-    let inlined = special.how.contains("materials and lights inlined");
+    let inlined = special.how.contains("materials and lights inlined")
+        || special.how.contains("materials inlined");
     let buffers = if inlined {
         let buffers = measure(&ctx, scene, false, true, false, spp, runs)?;
         print("buffers", &buffers);

@@ -84,6 +84,8 @@ struct Lane {
     in_flight: Option<(wgpu::SubmissionIndex, u64)>,
     /// Steps submitted in this batch.
     steps: u64,
+    /// Rays traced (next and shadow rays, not the "none" entries) since the last count.
+    traced: u64,
 }
 
 impl Lane {
@@ -104,6 +106,7 @@ impl Lane {
             list_occluded: Vec::new(),
             in_flight: None,
             steps: 0,
+            traced: 0,
         }
     }
 
@@ -185,6 +188,7 @@ impl Lane {
             rays.copy_from_slice(bytemuck::cast_slice(b));
         })?;
         let (next, shadow) = self.rays[..2 * c].split_at(c);
+        self.traced += next.iter().chain(shadow).filter(|r| r.tfar >= 0.0).count() as u64;
         scene.intersect(next, &mut self.hits[..c]);
         scene.occluded(shadow, &mut self.occluded[..c]);
         // The next step's slots: those with a ray out, those whose ray hit nothing (or
@@ -237,6 +241,14 @@ impl HostRays {
             capacity: 1,
             note,
         })
+    }
+
+    /// The rays traced since the last call: the kernel counts none.
+    pub(crate) fn take_rays(&mut self) -> u64 {
+        self.lanes
+            .iter_mut()
+            .map(|l| std::mem::take(&mut l.traced))
+            .sum()
     }
 
     /// A `wave` buffer (for the pass that reads none).
@@ -331,7 +343,7 @@ fn map_read_after<T>(
     ctx.device
         .poll(wgpu::PollType::Wait {
             submission_index: Some(index),
-            timeout: Some(std::time::Duration::from_secs(60)),
+            timeout: Some(crate::context::GPU_TIMEOUT),
         })
         .map_err(|e| RenderError::Gpu(e.to_string()))?;
     rx.recv()

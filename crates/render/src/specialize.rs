@@ -394,6 +394,79 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
     ))
 }
 
+/// Generated replacement for `pathtrace/scene_data.wgsl` for scenes whose primitives are
+/// too many to write into the code: the materials, and the lights and their alias table
+/// where there are at most [`INLINE_MAX_MATERIALS`] of them, written into the code; the
+/// primitives' positions and shading data read from their buffers. `None` where
+/// [`inline_scene_data`] would also refuse the materials (too many, textured, a value not
+/// finite).
+pub fn inline_materials_data(scene: &GpuScene) -> Option<String> {
+    if scene.materials.len() > INLINE_MAX_MATERIALS
+        || scene.header.features & lumagraph_scene::FEATURE_TEXTURES != 0
+    {
+        return None;
+    }
+    let l = Literals::default();
+    let (f3, f1, u1) = ("vec3f", "f32", "u32");
+    let materials = materials_rows(scene, &l);
+    let few_lights = scene.lights.len() <= INLINE_MAX_MATERIALS;
+    let (lights, alias) = if few_lights {
+        (lights_rows(scene, &l), alias_rows(scene, &l))
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    if l.not_finite.get() {
+        return None;
+    }
+    let material_types = [
+        f3, f1, f3, f1, f1, f1, f1, f1, u1, u1, u1, f1, u1, u1, f1, u1, f3, u1, f3, u1, f3, u1, f3,
+        f1, f3, u1,
+    ];
+    let light_fns = if few_lights {
+        format!(
+            "{}{}",
+            table_fns(
+                "scene_light",
+                "Light",
+                &[f3, u1, f3, u1, f3, f1, f3, f1],
+                &lights
+            ),
+            table_fns("scene_light_alias", "AliasEntry", &[f1, u1], &alias)
+        )
+    } else {
+        "fn scene_light(id: u32) -> Light {\n    return lights[id];\n}\n\n\
+         fn scene_light_alias(i: u32) -> AliasEntry {\n    return light_alias[i];\n}\n\n"
+            .to_owned()
+    };
+    Some(format!(
+        "// Generated for this scene: {} materials{} returned by id with their values in the
+// code; the {} triangles' and {} spheres' data read from their buffers.
+#import \"pathtrace/scene_types.wgsl\"
+
+{}{light_fns}fn scene_tri_positions(i: u32) -> TriPositions {{
+    return tri_positions[i];
+}}
+
+fn scene_tri_shading(i: u32) -> TriShading {{
+    return tri_shading[i];
+}}
+
+fn scene_sphere(i: u32) -> Sphere {{
+    return spheres[i];
+}}
+",
+        materials.len(),
+        if few_lights {
+            format!(" and {} lights", lights.len())
+        } else {
+            String::new()
+        },
+        scene.tri_positions.len(),
+        scene.spheres.len(),
+        table_fns("scene_material", "Material", &material_types, &materials),
+    ))
+}
+
 /// What the graph needs of the path tracer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PathTraceOptions {
@@ -458,21 +531,29 @@ fn inline_intersection_reason(scene: &GpuScene, inline: bool) -> String {
     }
 }
 
-fn inline_data_reason(scene: &GpuScene, options: PathTraceOptions, included: bool) -> String {
+fn inline_data_reason(
+    scene: &GpuScene,
+    options: PathTraceOptions,
+    included: bool,
+    all: bool,
+) -> String {
     let m = scene.materials.len();
+    let lights = scene.lights.len();
     let prims = scene.tri_positions.len() + scene.spheres.len();
     let textured = scene.header.features & lumagraph_scene::FEATURE_TEXTURES != 0;
-    if included {
+    if included && all {
+        format!("{m} materials, {lights} lights, {prims} primitives' shading data")
+    } else if included && lights <= INLINE_MAX_MATERIALS {
         format!(
-            "{m} materials, {} lights, {prims} primitives' shading data",
-            scene.lights.len()
+            "{m} materials, {lights} lights ({prims} primitives > {INLINE_MAX_PRIMITIVES}: \
+             their data read from buffers)"
         )
+    } else if included {
+        format!("{m} materials ({lights} lights and {prims} primitives: read from buffers)")
     } else if !options.specialize {
         "general shader (specialization off)".to_owned()
     } else if !options.cpu_adapter {
         "a GPU adapter: read from buffers, with BVH traversal".to_owned()
-    } else if prims > INLINE_MAX_PRIMITIVES {
-        format!("{prims} primitives > {INLINE_MAX_PRIMITIVES}: read from buffers")
     } else if options.data_in_buffers {
         "forced off: read from buffers".to_owned()
     } else if textured {
@@ -522,11 +603,18 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
     let env_map = scene.settings.env_kind == lumagraph_scene::ENV_MAP;
     let lights = scene.lights.len();
     let textured = scene.header.features & lumagraph_scene::FEATURE_TEXTURES != 0;
-    let inline_data = inline
+    // Small scenes have all their data written into the code; larger ones on a CPU adapter
+    // their materials (and few lights), the primitives' data staying in buffers.
+    let inline_data = options.specialize
+        && options.cpu_adapter
         && !options.data_in_buffers
         && !textured
         && m.len() <= INLINE_MAX_MATERIALS
-        && inline_scene_data(scene).is_some();
+        && if inline {
+            inline_scene_data(scene).is_some()
+        } else {
+            inline_materials_data(scene).is_some()
+        };
     let mut out = vec![
         feature(
             "BVH traversal",
@@ -550,7 +638,7 @@ pub fn features(scene: &GpuScene, options: PathTraceOptions) -> Vec<Feature> {
         feature(
             "inline materials and lights",
             inline_data,
-            inline_data_reason(scene, options, inline_data),
+            inline_data_reason(scene, options, inline_data, inline),
         ),
         feature(
             "light sampling (NEE + MIS)",
@@ -792,10 +880,15 @@ pub fn pathtrace_source(
     {
         overrides.push(("pathtrace/intersect.wgsl", code));
     }
-    if on("inline materials and lights")
-        && let Some(code) = inline_scene_data(scene)
-    {
-        overrides.push(("pathtrace/scene_data.wgsl", code));
+    if on("inline materials and lights") {
+        let code = if on("inline intersection") {
+            inline_scene_data(scene)
+        } else {
+            inline_materials_data(scene)
+        };
+        if let Some(code) = code {
+            overrides.push(("pathtrace/scene_data.wgsl", code));
+        }
     }
     let left_out: Vec<&str> = features
         .iter()
@@ -804,10 +897,14 @@ pub fn pathtrace_source(
         .collect();
     let how = format!(
         "{}; left out: {}",
-        if on("inline materials and lights") {
+        if on("inline materials and lights") && on("inline intersection") {
             "intersection inlined, materials and lights inlined"
+        } else if on("host intersection") && on("inline materials and lights") {
+            "rays intersected on the host, materials inlined"
         } else if on("host intersection") {
             "rays intersected on the host"
+        } else if on("inline materials and lights") {
+            "BVH traversal, materials inlined"
         } else if on("inline intersection") {
             "intersection inlined"
         } else {

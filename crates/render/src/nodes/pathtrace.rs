@@ -756,6 +756,9 @@ impl NodeExec for PathTrace {
         )?;
         self.dropped += u64::from(v[0]);
         self.rays += u64::from(v[1]) | (u64::from(v[2]) << 32);
+        if let Some(host) = &mut self.host {
+            self.rays += host.take_rays();
+        }
         self.adaptive_samples += u64::from(v[3]);
         let mut counters = vec![
             Counter::new("samples_per_pixel", u64::from(self.samples)),
