@@ -210,7 +210,10 @@ fn a_frame_of_many_samples_traces_every_path() {
     let (host_one, _) = run(512, 1, false).unwrap();
     let (host_many, _) = run(1, 512, false).unwrap();
     println!("host intersection: one frame {host_one} rays, 512 frames {host_many}");
-    assert_eq!(host_one, host_many, "host intersection: rays of one frame of 512");
+    assert_eq!(
+        host_one, host_many,
+        "host intersection: rays of one frame of 512"
+    );
     assert!(
         host_one.abs_diff(rays_one) * 200 <= rays_one,
         "host intersection traced {host_one} rays, the WGSL BVH {rays_one}"
