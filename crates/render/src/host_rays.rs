@@ -11,6 +11,7 @@
 use crate::context::GpuContext;
 use crate::embree::{Embree, HostHit, HostRay, HostScene};
 use crate::error::{RenderError, Result};
+use crate::readback::map_read_after;
 
 /// `wave` holds per pixel of the window: the path in flight (8 vec4), its next ray and its
 /// shadow ray (2 vec4 each), the hit of its ray (1 vec4), and in the last section the
@@ -321,42 +322,6 @@ impl HostRays {
         }
         Ok(())
     }
-}
-
-/// Maps the first `size` bytes of a `MAP_READ` buffer once submission `index` is done
-/// (not the work submitted after it) and passes them to `f`.
-fn map_read_after<T>(
-    ctx: &GpuContext,
-    buffer: &wgpu::Buffer,
-    index: wgpu::SubmissionIndex,
-    size: u64,
-    f: impl FnOnce(&[u8]) -> T,
-) -> Result<T> {
-    if size == 0 {
-        return Ok(f(&[]));
-    }
-    let slice = buffer.slice(..size);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    ctx.device
-        .poll(wgpu::PollType::Wait {
-            submission_index: Some(index),
-            timeout: Some(crate::context::GPU_TIMEOUT),
-        })
-        .map_err(|e| RenderError::Gpu(e.to_string()))?;
-    rx.recv()
-        .map_err(|_| RenderError::Gpu("buffer map callback was dropped".into()))?
-        .map_err(|e| RenderError::Gpu(e.to_string()))?;
-    let out = {
-        let view = slice
-            .get_mapped_range()
-            .map_err(|e| RenderError::Gpu(e.to_string()))?;
-        f(&view)
-    };
-    buffer.unmap();
-    Ok(out)
 }
 
 fn buffer(ctx: &GpuContext, label: &str, size: u64, read: bool) -> wgpu::Buffer {

@@ -18,12 +18,49 @@ pub fn map_read<T>(
     size: u64,
     f: impl FnOnce(&[u8]) -> T,
 ) -> Result<T> {
+    map_read_when(buffer, size, f, || ctx.wait())
+}
+
+/// [`map_read`] once submission `index` is done, not waiting for the work submitted after
+/// it (so the host can read one step's results while the GPU runs the next).
+///
+/// # Errors
+/// When mapping fails or the GPU does not finish.
+pub fn map_read_after<T>(
+    ctx: &GpuContext,
+    buffer: &wgpu::Buffer,
+    index: wgpu::SubmissionIndex,
+    size: u64,
+    f: impl FnOnce(&[u8]) -> T,
+) -> Result<T> {
+    map_read_when(buffer, size, f, || {
+        ctx.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(index),
+                timeout: Some(crate::context::GPU_TIMEOUT),
+            })
+            .map(|_| ())
+            .map_err(|e| ctx.error(e))
+    })
+}
+
+/// Maps the first `size` bytes of `buffer` for reading, `wait`s for the GPU, and passes the
+/// bytes to `f`.
+fn map_read_when<T>(
+    buffer: &wgpu::Buffer,
+    size: u64,
+    f: impl FnOnce(&[u8]) -> T,
+    wait: impl FnOnce() -> Result<()>,
+) -> Result<T> {
+    if size == 0 {
+        return Ok(f(&[]));
+    }
     let slice = buffer.slice(..size);
     let (tx, rx) = mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
-    ctx.wait()?;
+    wait()?;
     rx.recv()
         .map_err(|_| RenderError::Gpu("buffer map callback was dropped".into()))??;
     let out = {
