@@ -346,6 +346,16 @@ fn differing(a: &Image, b: &Image, rel: Option<f32>) -> usize {
         .count()
 }
 
+/// The largest relative difference of a color channel between `a` and `b` (against
+/// |a| + 1e-3, as `differing` measures).
+fn worst_relative(a: &Image, b: &Image) -> f32 {
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .flat_map(|(x, y)| (0..3).map(|c| (x[c] - y[c]).abs() / (x[c].abs() + 1e-3)))
+        .fold(0.0f32, f32::max)
+}
+
 /// Each output of `a` equal to `b`'s bit for bit (the pixels that differ are printed).
 fn assert_bit_identical(name: &str, a: &[Image], b: &[Image]) {
     for (i, (a, b)) in a.iter().zip(b).enumerate() {
@@ -501,12 +511,7 @@ fn bvh_traversal_renders_what_inline_intersection_renders() {
                 "{name}: output {i}: {far} pixels differ by more than 1e-4"
             );
             if i == 0 {
-                let worst = a
-                    .pixels
-                    .iter()
-                    .zip(&b.pixels)
-                    .flat_map(|(x, y)| (0..3).map(|c| (x[c] - y[c]).abs() / (x[c].abs() + 1e-3)))
-                    .fold(0.0f32, f32::max);
+                let worst = worst_relative(a, b);
                 println!("{name}: color differs by at most {worst:.2e} relative");
                 assert!(worst <= 1e-2, "{name}: color differs by {worst} relative");
             }
@@ -564,12 +569,7 @@ fn host_intersection_renders_what_wgsl_traversal_renders() {
     assert_bit_identical("mesh_env AOVs", &host[1..], &wgsl[1..]);
     let (a, b) = (&host[0], &wgsl[0]);
     beyond(a, b, 200, "mesh_env color");
-    let worst = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .flat_map(|(x, y)| (0..3).map(|c| (x[c] - y[c]).abs() / (x[c].abs() + 1e-3)))
-        .fold(0.0f32, f32::max);
+    let worst = worst_relative(a, b);
     println!("mesh_env color: at most {worst:.2e} relative");
     assert!(worst <= 2e-2, "color differs by {worst} relative");
     assert!(a.pixels.iter().any(|p| p[0] > 0.0));
