@@ -164,6 +164,9 @@ enum Command {
         /// Timed runs; the best is reported.
         #[arg(long, default_value_t = 3)]
         runs: u32,
+        /// Measure the specialized shader only (not the variants it is compared with).
+        #[arg(long)]
+        specialized_only: bool,
     },
     /// Render one image per node kind into OUT/gallery/ and the page that shows them,
     /// OUT/gallery.md (the docs' node gallery).
@@ -583,9 +586,14 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             let ctx = GpuContext::headless()?;
             gallery::run(&ctx, library, &out, &kinds)
         }
-        Command::Bench { scene, spp, runs } => {
+        Command::Bench {
+            scene,
+            spp,
+            runs,
+            specialized_only,
+        } => {
             let loaded = load_scene(Some(&scene))?.context("no scene")?;
-            bench::run(&loaded.gpu, spp, runs)
+            bench::run(&loaded.gpu, spp, runs, specialized_only)
         }
         Command::Edit {
             graph,

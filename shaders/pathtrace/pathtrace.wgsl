@@ -879,13 +879,12 @@ fn first_hit_aovs(at: vec2u) {
 // the others hold the step's slots in the step's order (the lane's slots at the first
 // step, then those the host lists, those with a ray out), the j-th of the step at j:
 //   [0, 8S)     the path in flight: 8 vec4 per slot (`save_slot`)
-//   [8S, 10S)   the next ray the step wrote, 2 vec4 (origin, t_near; direction, t_far;
-//               t_far < 0: none)
-//   [10S, 12S)  the shadow ray the step wrote, the same
-//   [12S, 13S)  the host's closest hit of the ray the step reads: t, u, v (bits) and the
-//               primitive
-//   [13S, L)    the host's answer for its shadow ray, one u32 each (1: occluded)
-//   [L, ...)    the step's slots: their count, then each one, a u32 each (`wave_list_at`)
+//   [8S, 11S)   the rays the step wrote, which leave from one point: 3 vec4 (origin, the
+//               next ray's t_near, < 0: no next ray; its direction, the shadow ray's
+//               t_near; the shadow ray's direction and t_far, < 0: no shadow ray)
+//   [11S, 12S)  the host's closest hit of the ray the step reads: t, u, v (bits) and the
+//               primitive; t's sign bit set when the slot's shadow ray was occluded
+//   [12S, ...)  the step's slots: their count, then each one, a u32 each (`wave_list_at`)
 // The random numbers, their order and the arithmetic are `trace_pixel`'s; only the hits are
 // the host's. The host counts the rays (`ray_count` is not kept).
 const WAVE_START: u32 = 0u;
@@ -898,38 +897,37 @@ const WAVE_FINISH: u32 = 2u;
 const SLOT_SHADOW: u32 = 1u;
 const SLOT_ENDED: u32 = 2u;
 const SLOT_DONE: u32 = 4u;
+// Where the flags sit in the word that holds the bounce (the plan keeps bounces below 2^24).
+const SLOT_FLAGS_SHIFT: u32 = 24u;
+const SLOT_BOUNCE_MASK: u32 = 0xffffffu;
 
 fn wave_slots() -> u32 {
     return frame.wave_capacity;
 }
 
-fn put_ray(index: u32, ray: Ray, t_near: f32, t_far: f32) {
-    wave[index] = vec4u(bitcast<vec3u>(ray.origin), bitcast<u32>(t_near));
-    wave[index + 1u] = vec4u(bitcast<vec3u>(ray.dir), bitcast<u32>(t_far));
-}
-
-fn no_ray(index: u32) {
-    wave[index + 1u].w = bitcast<u32>(-1.0);
-}
-
-// A slot's path state, 8 vec4 from `b`: [0, 5) every step (the ray, its BSDF pdf, the
-// bounce, throughput, crossings, radiance, random state, previous vertex, slot flags); [5]
-// the shadow ray's contribution and the Sobol index, only while a shadow ray is out or the
-// first hit is next; [6] the pixel's sum and the Sobol seed, [7] the sample index and the
-// dropped samples, only when a path ends or starts. (llvmpipe loads and stores a buffer
-// word lane by lane: the fewer words a step moves, the faster it runs.)
+// A slot's path state, 8 vec4 from `b`, the first 64 bytes what every step moves: [0, 3)
+// every step (direction, BSDF pdf; throughput, random state; radiance, bounce and slot
+// flags in its top 8 bits); [3] the previous vertex and crossings, only for scenes with
+// emitters or media (no origin: host intersection hits only triangles, whose points come
+// from the barycentrics); [4] the shadow ray's contribution and the Sobol index, only while
+// a shadow ray is out or the first hit is next; [5] the pixel's sum and the Sobol seed, [6]
+// the sample index and the dropped samples, only when a path ends or starts. (llvmpipe
+// loads and stores a buffer word lane by lane, and a step touches every slot's state: the
+// fewer words and cache lines a step moves, the faster it runs.)
 fn save_slot(b: u32, flags: u32, moved: bool, i: u32, sum: vec3f, dropped: u32) {
-    wave[b] = vec4u(bitcast<vec3u>(path_ray.origin), bitcast<u32>(path_bsdf_pdf));
-    wave[b + 1u] = vec4u(bitcast<vec3u>(path_ray.dir), path_bounce);
-    wave[b + 2u] = vec4u(bitcast<vec3u>(path_throughput), path_crossings);
-    wave[b + 3u] = vec4u(bitcast<vec3u>(path_radiance), rng_state);
-    wave[b + 4u] = vec4u(bitcast<vec3u>(path_prev_p), flags);
+    wave[b] = vec4u(bitcast<vec3u>(path_ray.dir), bitcast<u32>(path_bsdf_pdf));
+    wave[b + 1u] = vec4u(bitcast<vec3u>(path_throughput), rng_state);
+    wave[b + 2u] = vec4u(bitcast<vec3u>(path_radiance), path_bounce | (flags << SLOT_FLAGS_SHIFT));
+    if HAS_LIGHTS || HAS_MEDIA {
+        wave[b + 3u] = vec4u(bitcast<vec3u>(path_prev_p), path_crossings);
+    }
     if shadow_pending || path_bounce == 0u {
-        wave[b + 5u] = vec4u(bitcast<vec3u>(shadow_contribution), sampler_index);
+        wave[b + 4u] = vec4u(bitcast<vec3u>(shadow_contribution), sampler_index);
     }
     if moved {
-        wave[b + 6u] = vec4u(bitcast<vec3u>(sum), sampler_seed);
-        wave[b + 7u] = vec4u(i, dropped, 0u, 0u);
+        wave[b + 5u] = vec4u(bitcast<vec3u>(sum), sampler_seed);
+        wave[b + 6u].x = i;
+        wave[b + 6u].y = dropped;
     }
 }
 
@@ -940,8 +938,7 @@ fn wave_word(at: u32, i: u32) -> u32 {
 
 // Where the host's list of the slots to step starts: their count, then each one.
 fn wave_list_at() -> u32 {
-    let slots = wave_slots();
-    return 13u * slots + (slots + 3u) / 4u;
+    return 12u * wave_slots();
 }
 
 // One step of the paths of window slot `slot`, the `j`-th of the step (see above).
@@ -971,46 +968,48 @@ fn wave_step(slot: u32, j: u32) {
         let s0 = wave[b];
         let s1 = wave[b + 1u];
         let s2 = wave[b + 2u];
-        let s3 = wave[b + 3u];
-        let s4 = wave[b + 4u];
-        path_ray = Ray(bitcast<vec3f>(s0.xyz), bitcast<vec3f>(s1.xyz));
+        // No origin: a hit's point comes from its triangle's barycentrics.
+        path_ray = Ray(vec3f(0.0), bitcast<vec3f>(s0.xyz));
         path_bsdf_pdf = bitcast<f32>(s0.w);
-        path_bounce = s1.w;
-        path_throughput = bitcast<vec3f>(s2.xyz);
-        path_crossings = s2.w;
-        path_radiance = bitcast<vec3f>(s3.xyz);
-        rng_state = s3.w;
-        path_prev_p = bitcast<vec3f>(s4.xyz);
-        flags = s4.w;
+        path_throughput = bitcast<vec3f>(s1.xyz);
+        rng_state = s1.w;
+        path_radiance = bitcast<vec3f>(s2.xyz);
+        path_bounce = s2.w & SLOT_BOUNCE_MASK;
+        flags = s2.w >> SLOT_FLAGS_SHIFT;
+        if HAS_LIGHTS || HAS_MEDIA {
+            let s3 = wave[b + 3u];
+            path_prev_p = bitcast<vec3f>(s3.xyz);
+            path_crossings = s3.w;
+        }
         sampler_sobol = frame.sampler == SAMPLER_SOBOL;
+        let hv = wave[11u * slots + j];
         let shadow_out = (flags & SLOT_SHADOW) != 0u;
         if shadow_out || path_bounce == 0u {
-            let s5 = wave[b + 5u];
-            sampler_index = s5.w;
-            if shadow_out && wave_word(13u * slots, j) == 0u {
-                path_radiance += bitcast<vec3f>(s5.xyz);
+            let s4 = wave[b + 4u];
+            sampler_index = s4.w;
+            if shadow_out && (hv.x >> 31u) == 0u {
+                path_radiance += bitcast<vec3f>(s4.xyz);
             }
         }
         if path_bounce == 0u {
-            sampler_seed = wave[b + 6u].w;
+            sampler_seed = wave[b + 5u].w;
         }
         var ended = (flags & SLOT_ENDED) != 0u;
         flags = 0u;
         if !ended {
-            let hv = wave[12u * slots + j];
-            ended = path_step_from(Hit(hv.w, bitcast<f32>(hv.x), bitcast<f32>(hv.y), bitcast<f32>(hv.z)));
+            let t = bitcast<f32>(hv.x & 0x7fffffffu);
+            ended = path_step_from(Hit(hv.w, t, bitcast<f32>(hv.y), bitcast<f32>(hv.z)));
         }
         if ended && shadow_pending {
             // The path's last shadow ray is still to be answered.
             flags = SLOT_ENDED;
         } else if ended {
             moved = true;
-            let s6 = wave[b + 6u];
-            let s7 = wave[b + 7u];
-            sum = bitcast<vec3f>(s6.xyz);
-            sampler_seed = s6.w;
-            i = s7.x;
-            dropped = s7.y;
+            let s5 = wave[b + 5u];
+            sum = bitcast<vec3f>(s5.xyz);
+            sampler_seed = s5.w;
+            i = wave[b + 6u].x;
+            dropped = wave[b + 6u].y;
             add_sample(path_radiance, &sum, &dropped);
             i++;
             if i >= end {
@@ -1025,20 +1024,27 @@ fn wave_step(slot: u32, j: u32) {
             }
         }
     }
-    let next = 8u * slots + 2u * j;
-    if flags == 0u {
+    // The rays leave from one point (`leave`): the next ray's origin is the shadow ray's.
+    let r = 8u * slots + 3u * j;
+    let next = flags == 0u;
+    if next || shadow_pending {
+        let origin = select(shadow_ray.origin, path_ray.origin, next);
         // Within `origin_slab` of its origin a hit is the origin's own error (see `leave`).
-        put_ray(next, path_ray, origin_slab, F32_MAX);
+        wave[r] = vec4u(bitcast<vec3u>(origin), bitcast<u32>(select(-1.0, origin_slab, next)));
     } else {
-        no_ray(next);
+        wave[r].w = bitcast<u32>(-1.0);
     }
-    let shadow = 10u * slots + 2u * j;
-    if shadow_pending {
+    if next {
         // A shadow ray ending before it starts is still a ray (never occluded), not none.
-        put_ray(shadow, shadow_ray, shadow_near, max(shadow_far, 0.0));
+        wave[r + 1u] = vec4u(bitcast<vec3u>(path_ray.dir), bitcast<u32>(shadow_near));
+    } else if shadow_pending {
+        wave[r + 1u].w = bitcast<u32>(shadow_near);
+    }
+    if shadow_pending {
+        wave[r + 2u] = vec4u(bitcast<vec3u>(shadow_ray.dir), bitcast<u32>(max(shadow_far, 0.0)));
         flags |= SLOT_SHADOW;
     } else {
-        no_ray(shadow);
+        wave[r + 2u].w = bitcast<u32>(-1.0);
     }
     save_slot(b, flags, moved, i, sum, dropped);
 }

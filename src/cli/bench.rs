@@ -5,6 +5,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use super::progressive::counter;
 use crate::graph::{Edge, Graph, Node, ParamValue};
 use crate::render::{Executor, GpuContext, Resources, compile};
 use crate::scene::GpuScene;
@@ -32,6 +33,19 @@ struct Figures {
     cpu: Option<f64>,
     /// The shader's notes.
     how: String,
+    /// Host intersection's figures over all runs, where it was used.
+    host: Option<HostFigures>,
+}
+
+/// Where host intersection's time went, summed over the timed runs.
+#[derive(Default)]
+struct HostFigures {
+    frames: u64,
+    steps: u64,
+    wall_ns: u64,
+    wait_ns: u64,
+    embree_ns: u64,
+    other_ns: u64,
 }
 
 /// Best paths/s of `runs` renders of `spp` samples per pixel.
@@ -75,11 +89,24 @@ fn measure(
     let paths = pixels * f64::from(frames * spf);
     let mut best = 0.0_f64;
     let mut best_cpu: Option<f64> = None;
+    let mut host: Option<HostFigures> = None;
     for _ in 0..runs.max(1) {
+        let before = exec.counters()?;
         let cpu_start = cpu_time();
         let start = Instant::now();
         exec.run_frames(frames, false)?;
         let secs = start.elapsed().as_secs_f64();
+        let after = exec.counters()?;
+        let diff = |name: &str| counter(&after, name).saturating_sub(counter(&before, name));
+        if after.iter().any(|(_, c)| c.name == "host_steps") {
+            let h = host.get_or_insert_with(HostFigures::default);
+            h.frames += u64::from(frames);
+            h.steps += diff("host_steps");
+            h.wall_ns += u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
+            h.wait_ns += diff("host_wait_ns");
+            h.embree_ns += diff("host_embree_ns");
+            h.other_ns += diff("host_other_ns");
+        }
         best = best.max(paths / secs);
         if let (Some(a), Some(b)) = (cpu_start, cpu_time()) {
             best_cpu = Some(best_cpu.unwrap_or(0.0).max(paths / (b - a)));
@@ -89,6 +116,7 @@ fn measure(
         wall: best,
         cpu: best_cpu,
         how,
+        host,
     })
 }
 
@@ -103,10 +131,23 @@ fn print(label: &str, f: &Figures) {
         f.wall / 1e6,
         f.how
     );
+    if let Some(h) = &f.host {
+        #[expect(clippy::cast_precision_loss, reason = "milliseconds")]
+        let ms = |ns: u64| ns as f64 * 1e-6 / h.frames.max(1) as f64;
+        println!(
+            "  {:<12} host thread, per frame of {} steps: {:.0} ms waiting for the kernel, {:.0} ms in Embree, {:.0} ms reading back, listing and recording (of {:.0} ms)",
+            "",
+            h.steps / h.frames.max(1),
+            ms(h.wait_ns),
+            ms(h.embree_ns),
+            ms(h.other_ns),
+            ms(h.wall_ns)
+        );
+    }
 }
 
 /// Runs the benchmark and prints the figures.
-pub fn run(scene: &Arc<GpuScene>, spp: u32, runs: u32) -> Result<()> {
+pub fn run(scene: &Arc<GpuScene>, spp: u32, runs: u32, specialized_only: bool) -> Result<()> {
     let ctx = GpuContext::headless()?;
     println!("adapter: {}", ctx.describe());
     println!(
@@ -115,6 +156,9 @@ pub fn run(scene: &Arc<GpuScene>, spp: u32, runs: u32) -> Result<()> {
     );
     let special = measure(&ctx, scene, false, false, false, spp, runs)?;
     print("specialized", &special);
+    if specialized_only {
+        return Ok(());
+    }
     let wgsl = if special.how.contains("rays intersected on the host") {
         let wgsl = measure(&ctx, scene, false, false, true, spp, runs)?;
         print("WGSL BVH", &wgsl);

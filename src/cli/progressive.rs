@@ -177,7 +177,7 @@ fn stopped(exec: &mut Executor, spp: u32, frames: u32, ck: &Checkpoints) -> anyh
 }
 
 /// The value of the counter called `name` (0 when no node keeps one).
-fn counter(counters: &[(String, crate::render::Counter)], name: &str) -> u64 {
+pub(crate) fn counter(counters: &[(String, crate::render::Counter)], name: &str) -> u64 {
     counters
         .iter()
         .find(|(_, c)| c.name == name)

@@ -13,13 +13,13 @@ use crate::embree::{Embree, HostHit, HostRay, HostScene};
 use crate::error::{RenderError, Result};
 use crate::readback::map_read_after;
 
-/// `wave` holds per pixel of the window: the path in flight (8 vec4), its next ray and its
-/// shadow ray (2 vec4 each), the hit of its ray (1 vec4), and in the last section the
-/// shadow ray's answer, a u32.
+/// `wave` holds per pixel of the window: the path in flight (8 vec4), the rays of its step
+/// (3 vec4: they share their origin), the hit of its ray (1 vec4, its `t`'s sign bit the
+/// answer for its shadow ray), then the list of slots to step.
 const STATE_VEC4S: u64 = 8;
 const RAYS_AT: u64 = STATE_VEC4S;
-const HITS_AT: u64 = RAYS_AT + 4;
-const OCCLUDED_AT: u64 = HITS_AT + 1;
+const HITS_AT: u64 = RAYS_AT + 3;
+const LIST_AT: u64 = HITS_AT + 1;
 
 /// At most this many workgroups of 64 per step: each invocation steps every slot one
 /// `64 * STEP_GROUPS` apart (see `main` in the shader).
@@ -29,7 +29,7 @@ const STEP_GROUPS: u32 = 64;
 const LANES: u32 = 2;
 
 /// At most this many slots (pixels) in the buffers: larger windows are traced in batches
-/// of this many pixels, one after the other (its buffers take 212 bytes per slot and lane).
+/// of this many pixels, one after the other (its buffers take 244 bytes per slot and lane).
 const MAX_SLOTS: u64 = 1 << 18;
 
 /// What the kernel's step is to do, for the caller that records it.
@@ -77,46 +77,77 @@ struct Lane {
     /// The slots of the step being traced, in its order.
     order: Vec<u32>,
     /// The next step's slots: their count first, then each one; the hits of their rays
-    /// and the answers for their shadow rays, in that order.
+    /// (with the answers for their shadow rays), in that order.
     list: Vec<u32>,
     list_hits: Vec<HostHit>,
-    list_occluded: Vec<u32>,
     /// The submission of the step in flight and the bytes of rays it copies back.
     in_flight: Option<(wgpu::SubmissionIndex, u64)>,
     /// Steps submitted in this batch.
     steps: u64,
-    /// Rays traced (next and shadow rays, not the "none" entries) since the last count.
-    traced: u64,
+    /// What was done since the last count.
+    counts: HostCounts,
+}
+
+/// What host intersection did, for the node's counters: rays, steps, and where the host
+/// thread's time went (nanoseconds).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct HostCounts {
+    /// Rays traced (next and shadow rays, not the "none" entries).
+    pub rays: u64,
+    /// Kernel steps submitted.
+    pub steps: u64,
+    /// Waiting for a step's rays (the kernel running, or the driver's queue).
+    pub wait_ns: u64,
+    /// In Embree.
+    pub embree_ns: u64,
+    /// Reading rays back, listing the next step's slots, writing its hits and recording it.
+    pub other_ns: u64,
+}
+
+impl std::ops::AddAssign for HostCounts {
+    fn add_assign(&mut self, o: Self) {
+        self.rays += o.rays;
+        self.steps += o.steps;
+        self.wait_ns += o.wait_ns;
+        self.embree_ns += o.embree_ns;
+        self.other_ns += o.other_ns;
+    }
+}
+
+/// Nanoseconds since `t`, and `t` moved on to now.
+fn lap(t: &mut std::time::Instant) -> u64 {
+    let now = std::time::Instant::now();
+    let ns = u64::try_from((now - *t).as_nanos()).unwrap_or(u64::MAX);
+    *t = now;
+    ns
 }
 
 impl Lane {
     fn new(ctx: &GpuContext, slots: u64) -> Self {
         // The sections of `wave` (see the shader), the last the list of slots to step,
         // their count first.
-        let vec4s = OCCLUDED_AT * slots + slots.div_ceil(4) + (slots + 1).div_ceil(4);
+        let vec4s = LIST_AT * slots + (slots + 1).div_ceil(4);
         let n = usize::try_from(slots).unwrap_or(usize::MAX);
         Self {
             wave: buffer(ctx, "pathtrace wave", 16 * vec4s, false),
-            rays_read: buffer(ctx, "pathtrace wave rays readback", 64 * slots, true),
+            rays_read: buffer(ctx, "pathtrace wave rays readback", 48 * slots, true),
             rays: vec![HostRay::default(); 2 * n],
             hits: vec![HostHit::default(); n],
             occluded: vec![0; n],
             order: Vec::new(),
             list: Vec::new(),
             list_hits: Vec::new(),
-            list_occluded: Vec::new(),
             in_flight: None,
             steps: 0,
-            traced: 0,
+            counts: HostCounts::default(),
         }
     }
 
-    /// Writes the next step's list, hits and shadow answers into `wave`.
+    /// Writes the next step's list and hits (with the shadow answers) into `wave`.
     fn upload(&mut self, ctx: &GpuContext, slots: u64) {
         let count = self.list.len() - 1;
         self.list[0] = u32::try_from(count).unwrap_or(u32::MAX);
         self.list.resize(self.list.len().next_multiple_of(4), 0);
-        self.list_occluded.resize(count.next_multiple_of(4), 0);
         let q = &ctx.queue;
         if !self.list_hits.is_empty() {
             q.write_buffer(
@@ -124,15 +155,10 @@ impl Lane {
                 16 * HITS_AT * slots,
                 bytemuck::cast_slice(&self.list_hits),
             );
-            q.write_buffer(
-                &self.wave,
-                16 * OCCLUDED_AT * slots,
-                bytemuck::cast_slice(&self.list_occluded),
-            );
         }
         q.write_buffer(
             &self.wave,
-            16 * (OCCLUDED_AT * slots + slots.div_ceil(4)),
+            16 * LIST_AT * slots,
             bytemuck::cast_slice(&self.list),
         );
         self.order.clear();
@@ -146,6 +172,7 @@ impl Lane {
         [base, capacity]: [u64; 2],
         step: &mut StepFn<'_>,
     ) -> Result<()> {
+        let mut t = std::time::Instant::now();
         let c = self.order.len();
         let what = WaveStep {
             first: self.steps == 0,
@@ -161,19 +188,19 @@ impl Lane {
                 label: Some("pathtrace step"),
             });
         step(what, &mut encoder, &self.wave)?;
-        // Its next rays, then its shadow rays: the first `c` of each section.
-        let bytes = 32 * c as u64;
-        let at = 16 * RAYS_AT * capacity;
-        encoder.copy_buffer_to_buffer(&self.wave, at, &self.rays_read, 0, bytes);
+        // The rays of its first `c` slots.
+        let bytes = 48 * c as u64;
         encoder.copy_buffer_to_buffer(
             &self.wave,
-            at + 32 * capacity,
+            16 * RAYS_AT * capacity,
             &self.rays_read,
-            bytes,
+            0,
             bytes,
         );
-        self.in_flight = Some((ctx.queue.submit([encoder.finish()]), 2 * bytes));
+        self.in_flight = Some((ctx.queue.submit([encoder.finish()]), bytes));
         self.steps += 1;
+        self.counts.steps += 1;
+        self.counts.other_ns += lap(&mut t);
         Ok(())
     }
 
@@ -184,14 +211,34 @@ impl Lane {
             return Ok(false);
         };
         let c = self.order.len();
-        let rays = &mut self.rays[..2 * c];
+        let (next, shadow) = self.rays[..2 * c].split_at_mut(c);
+        let mut t = std::time::Instant::now();
+        let mut wait = 0;
         map_read_after(ctx, &self.rays_read, index, bytes, |b| {
-            rays.copy_from_slice(bytemuck::cast_slice(b));
+            wait = lap(&mut t);
+            let words: &[[f32; 12]] = bytemuck::cast_slice(b);
+            for ((w, n), s) in words.iter().zip(next.iter_mut()).zip(shadow.iter_mut()) {
+                *n = HostRay {
+                    origin: [w[0], w[1], w[2]],
+                    tnear: w[3],
+                    dir: [w[4], w[5], w[6]],
+                    tfar: if w[3] < 0.0 { -1.0 } else { f32::MAX },
+                };
+                *s = HostRay {
+                    origin: [w[0], w[1], w[2]],
+                    tnear: w[7],
+                    dir: [w[8], w[9], w[10]],
+                    tfar: w[11],
+                };
+            }
         })?;
+        self.counts.wait_ns += wait;
         let (next, shadow) = self.rays[..2 * c].split_at(c);
-        self.traced += next.iter().chain(shadow).filter(|r| r.tfar >= 0.0).count() as u64;
+        self.counts.rays += next.iter().chain(shadow).filter(|r| r.tfar >= 0.0).count() as u64;
+        self.counts.other_ns += lap(&mut t);
         scene.intersect(next, &mut self.hits[..c]);
         scene.occluded(shadow, &mut self.occluded[..c]);
+        self.counts.embree_ns += lap(&mut t);
         // The next step's slots: those with a ray out, those whose ray hit nothing (or
         // that only await a shadow ray) first, then those that shade a hit. llvmpipe runs a
         // SIMD vector's lanes through every branch any of them takes, so lanes taking the
@@ -199,21 +246,25 @@ impl Lane {
         self.list.clear();
         self.list.push(0);
         self.list_hits.clear();
-        self.list_occluded.clear();
         for shade in [false, true] {
             for (j, (a, b)) in next.iter().zip(shadow).enumerate() {
                 let out = a.tfar >= 0.0 || b.tfar >= 0.0;
                 if out && (a.tfar >= 0.0 && self.hits[j].is_hit()) == shade {
+                    let mut hit = self.hits[j];
+                    if self.occluded[j] != 0 {
+                        hit.t = -hit.t;
+                    }
                     self.list.push(self.order[j]);
-                    self.list_hits.push(self.hits[j]);
-                    self.list_occluded.push(self.occluded[j]);
+                    self.list_hits.push(hit);
                 }
             }
         }
         if self.list.len() == 1 {
+            self.counts.other_ns += lap(&mut t);
             return Ok(false);
         }
         self.upload(ctx, capacity);
+        self.counts.other_ns += lap(&mut t);
         Ok(true)
     }
 }
@@ -244,12 +295,13 @@ impl HostRays {
         })
     }
 
-    /// The rays traced since the last call: the kernel counts none.
-    pub(crate) fn take_rays(&mut self) -> u64 {
-        self.lanes
-            .iter_mut()
-            .map(|l| std::mem::take(&mut l.traced))
-            .sum()
+    /// What was done since the last call (the kernel counts no rays).
+    pub(crate) fn take_counts(&mut self) -> HostCounts {
+        let mut all = HostCounts::default();
+        for lane in &mut self.lanes {
+            all += std::mem::take(&mut lane.counts);
+        }
+        all
     }
 
     /// A `wave` buffer (for the pass that reads none).
@@ -290,7 +342,6 @@ impl HostRays {
                 lane.list.clear();
                 lane.list.push(0);
                 lane.list_hits.clear();
-                lane.list_occluded.clear();
                 lane.list.extend(
                     (base..end)
                         .filter(|s| (s / width) % u64::from(LANES) == l)

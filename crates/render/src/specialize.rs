@@ -737,6 +737,14 @@ fn host_rays_feature(scene: &GpuScene, options: PathTraceOptions, inline: bool) 
         )
     } else if options.adaptive {
         (false, "adaptive sampling: traced in WGSL".to_owned())
+    } else if scene.settings.max_bounces >= HOST_RAYS_MAX_BOUNCES {
+        (
+            false,
+            format!(
+                "{} bounces: a step keeps at most {HOST_RAYS_MAX_BOUNCES}",
+                scene.settings.max_bounces
+            ),
+        )
     } else {
         (
             true,
@@ -751,6 +759,9 @@ fn host_rays_feature(scene: &GpuScene, options: PathTraceOptions, inline: bool) 
 }
 
 /// Why the host intersector is not used, for the plan.
+/// Host intersection's steps keep the bounce in 24 bits of a word (`save_slot` in the shader).
+const HOST_RAYS_MAX_BOUNCES: u32 = 1 << 24;
+
 fn host_rays_unavailable() -> String {
     match crate::embree::Embree::load() {
         Ok(_) => "WGSL intersection asked for".to_owned(),

@@ -10,7 +10,7 @@ use crate::error::{RenderError, Result};
 use crate::kernel::{Kernel, uniform_buffer};
 use lumagraph_graph::TexFormat;
 
-use crate::host_rays::HostRays;
+use crate::host_rays::{HostCounts, HostRays};
 use crate::kernel::PassBuilder;
 use crate::nodes::{Counter, FrameIo, NodeExec, NodeImpl, Recording, Resources, boxed};
 use crate::pool::{PooledTexture, create};
@@ -292,6 +292,8 @@ pub(crate) struct PathTrace {
     chunk_sums: wgpu::Buffer,
     /// Host intersection's state, when the plan says "host intersection".
     host: Option<HostRays>,
+    /// Host intersection's steps and times since the last reset (its rays go to `rays`).
+    host_counts: HostCounts,
     /// The `wave` binding's stand-in without host intersection.
     wave_stand_in: wgpu::Buffer,
 }
@@ -383,6 +385,7 @@ impl PathTrace {
             origin: [0, 0],
             adaptive: Adaptive::new(ctx)?,
             adaptive_samples: 0,
+            host_counts: HostCounts::default(),
             samples_per_dispatch,
             chunk_sums: storage(ctx, "pathtrace chunk sums", 16),
             host,
@@ -613,6 +616,7 @@ impl NodeExec for PathTrace {
         self.dropped = 0;
         self.rays = 0;
         self.adaptive_samples = 0;
+        self.host_counts = HostCounts::default();
         self.adaptive.clear = true;
     }
 
@@ -757,7 +761,8 @@ impl NodeExec for PathTrace {
         self.dropped += u64::from(v[0]);
         self.rays += u64::from(v[1]) | (u64::from(v[2]) << 32);
         if let Some(host) = &mut self.host {
-            self.rays += host.take_rays();
+            self.host_counts += host.take_counts();
+            self.rays += std::mem::take(&mut self.host_counts.rays);
         }
         self.adaptive_samples += u64::from(v[3]);
         let mut counters = vec![
@@ -765,6 +770,15 @@ impl NodeExec for PathTrace {
             Counter::new("dropped_samples", self.dropped),
             Counter::new("rays", self.rays),
         ];
+        if self.host.is_some() {
+            let h = self.host_counts;
+            counters.extend([
+                Counter::new("host_steps", h.steps),
+                Counter::new("host_wait_ns", h.wait_ns),
+                Counter::new("host_embree_ns", h.embree_ns),
+                Counter::new("host_other_ns", h.other_ns),
+            ]);
+        }
         if self.adaptive.on() {
             counters.push(Counter::new("adaptive_samples", self.adaptive_samples));
         }
