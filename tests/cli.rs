@@ -1013,3 +1013,44 @@ fn checkpoints_every_few_seconds_and_at_the_end() {
     let (ok, _, stderr) = run("d", "64", &["--resume", ck]);
     assert!(!ok && stderr.contains("nothing to resume"), "{stderr}");
 }
+
+/// `bench --specialized-only` measures the specialized shader alone and, where the host
+/// intersects the rays (a CPU adapter with Embree), says where the host thread's time went:
+/// a number of steps per frame and milliseconds that add up to no more than the frame.
+#[test]
+fn bench_reports_where_host_intersection_spends_its_time() {
+    let Some(gpu) = common::gpu() else { return };
+    let o = lumagraph(&[
+        "bench",
+        "--scene",
+        "tests/scenes/mesh_env.ron",
+        "--spp",
+        "2",
+        "--runs",
+        "1",
+        "--specialized-only",
+    ]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{out}\n{err}");
+    assert!(out.contains("specialized"), "{out}");
+    assert!(!out.contains("general"), "{out}");
+    if !gpu.is_cpu() || !out.contains("rays intersected on the host") {
+        return;
+    }
+    let line = out
+        .lines()
+        .find(|l| l.contains("host thread, per frame of"))
+        .unwrap_or_else(|| panic!("no host thread line: {out}"));
+    let numbers: Vec<f64> = line
+        .split_whitespace()
+        .filter_map(|w| w.trim_end_matches([',', ':', ')']).parse().ok())
+        .collect();
+    // Steps, waiting, Embree, the rest, and the frame.
+    assert_eq!(numbers.len(), 5, "{line}");
+    assert!(numbers[0] >= 2.0, "{line}");
+    assert!(
+        numbers[1] + numbers[2] + numbers[3] <= numbers[4] * 1.01 + 1.0,
+        "{line}"
+    );
+    assert!(numbers[2] > 0.0, "{line}");
+}

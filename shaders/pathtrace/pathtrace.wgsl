@@ -878,13 +878,14 @@ fn first_hit_aovs(at: vec2u) {
 // sections of S entries each. The first holds each slot's path in flight;
 // the others hold the step's slots in the step's order (the lane's slots at the first
 // step, then those the host lists, those with a ray out), the j-th of the step at j:
-//   [0, 8S)     the path in flight: 8 vec4 per slot (`save_slot`)
-//   [8S, 11S)   the rays the step wrote, which leave from one point: 3 vec4 (origin, the
+//   [0, 3S)     the path in flight, what every step moves: 3 vec4 per slot (`save_slot`)
+//   [3S, 7S)    the rest of it: 4 vec4 per slot
+//   [7S, 10S)   the rays the step wrote, which leave from one point: 3 vec4 (origin, the
 //               next ray's t_near, < 0: no next ray; its direction, the shadow ray's
 //               t_near; the shadow ray's direction and t_far, < 0: no shadow ray)
-//   [11S, 12S)  the host's closest hit of the ray the step reads: t, u, v (bits) and the
+//   [10S, 11S)  the host's closest hit of the ray the step reads: t, u, v (bits) and the
 //               primitive; t's sign bit set when the slot's shadow ray was occluded
-//   [12S, ...)  the step's slots: their count, then each one, a u32 each (`wave_list_at`)
+//   [11S, ...)  the step's slots: their count, then each one, a u32 each (`wave_list_at`)
 // The random numbers, their order and the arithmetic are `trace_pixel`'s; only the hits are
 // the host's. The host counts the rays (`ray_count` is not kept).
 const WAVE_START: u32 = 0u;
@@ -905,29 +906,30 @@ fn wave_slots() -> u32 {
     return frame.wave_capacity;
 }
 
-// A slot's path state, 8 vec4 from `b`, the first 64 bytes what every step moves: [0, 3)
-// every step (direction, BSDF pdf; throughput, random state; radiance, bounce and slot
-// flags in its top 8 bits); [3] the previous vertex and crossings, only for scenes with
-// emitters or media (no origin: host intersection hits only triangles, whose points come
-// from the barycentrics); [4] the shadow ray's contribution and the Sobol index, only while
-// a shadow ray is out or the first hit is next; [5] the pixel's sum and the Sobol seed, [6]
-// the sample index and the dropped samples, only when a path ends or starts. (llvmpipe
-// loads and stores a buffer word lane by lane, and a step touches every slot's state: the
-// fewer words and cache lines a step moves, the faster it runs.)
-fn save_slot(b: u32, flags: u32, moved: bool, i: u32, sum: vec3f, dropped: u32) {
+// A slot's path state: 3 vec4 from `b` that every step moves (direction, BSDF pdf;
+// throughput, random state; radiance, bounce and slot flags in its top 8 bits), kept apart
+// from the rest so that a step's loads and stores stream through 48 bytes per slot; 4 vec4
+// from `c`: [0] the previous vertex and crossings, only for scenes with emitters or media
+// (no origin: host intersection hits only triangles, whose points come from the
+// barycentrics); [1] the shadow ray's contribution and the Sobol index, only while a shadow
+// ray is out or the first hit is next; [2] the pixel's sum and the Sobol seed, [3] the
+// sample index and the dropped samples, only when a path ends or starts. (llvmpipe loads
+// and stores a buffer word lane by lane, and a step touches every slot's state: the fewer
+// words and cache lines a step moves, the faster it runs.)
+fn save_slot(b: u32, c: u32, flags: u32, moved: bool, i: u32, sum: vec3f, dropped: u32) {
     wave[b] = vec4u(bitcast<vec3u>(path_ray.dir), bitcast<u32>(path_bsdf_pdf));
     wave[b + 1u] = vec4u(bitcast<vec3u>(path_throughput), rng_state);
     wave[b + 2u] = vec4u(bitcast<vec3u>(path_radiance), path_bounce | (flags << SLOT_FLAGS_SHIFT));
     if HAS_LIGHTS || HAS_MEDIA {
-        wave[b + 3u] = vec4u(bitcast<vec3u>(path_prev_p), path_crossings);
+        wave[c] = vec4u(bitcast<vec3u>(path_prev_p), path_crossings);
     }
     if shadow_pending || path_bounce == 0u {
-        wave[b + 4u] = vec4u(bitcast<vec3u>(shadow_contribution), sampler_index);
+        wave[c + 1u] = vec4u(bitcast<vec3u>(shadow_contribution), sampler_index);
     }
     if moved {
-        wave[b + 5u] = vec4u(bitcast<vec3u>(sum), sampler_seed);
-        wave[b + 6u].x = i;
-        wave[b + 6u].y = dropped;
+        wave[c + 2u] = vec4u(bitcast<vec3u>(sum), sampler_seed);
+        wave[c + 3u].x = i;
+        wave[c + 3u].y = dropped;
     }
 }
 
@@ -938,7 +940,7 @@ fn wave_word(at: u32, i: u32) -> u32 {
 
 // Where the host's list of the slots to step starts: their count, then each one.
 fn wave_list_at() -> u32 {
-    return 12u * wave_slots();
+    return 11u * wave_slots();
 }
 
 // One step of the paths of window slot `slot`, the `j`-th of the step (see above).
@@ -959,7 +961,9 @@ fn wave_step(slot: u32, j: u32) {
     var moved = true;
     shadow_pending = false;
     shadow_contribution = vec3f(0.0);
-    let b = 8u * (slot - frame.wave_base);
+    // The slot's state: what every step moves, then the rest (see `save_slot`).
+    let b = 3u * (slot - frame.wave_base);
+    let c = 3u * slots + 4u * (slot - frame.wave_base);
     if frame.wave == WAVE_START {
         sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler, n, frame.replicates);
         start_path(pixel);
@@ -977,22 +981,22 @@ fn wave_step(slot: u32, j: u32) {
         path_bounce = s2.w & SLOT_BOUNCE_MASK;
         flags = s2.w >> SLOT_FLAGS_SHIFT;
         if HAS_LIGHTS || HAS_MEDIA {
-            let s3 = wave[b + 3u];
+            let s3 = wave[c];
             path_prev_p = bitcast<vec3f>(s3.xyz);
             path_crossings = s3.w;
         }
         sampler_sobol = frame.sampler == SAMPLER_SOBOL;
-        let hv = wave[11u * slots + j];
+        let hv = wave[10u * slots + j];
         let shadow_out = (flags & SLOT_SHADOW) != 0u;
         if shadow_out || path_bounce == 0u {
-            let s4 = wave[b + 4u];
+            let s4 = wave[c + 1u];
             sampler_index = s4.w;
             if shadow_out && (hv.x >> 31u) == 0u {
                 path_radiance += bitcast<vec3f>(s4.xyz);
             }
         }
         if path_bounce == 0u {
-            sampler_seed = wave[b + 5u].w;
+            sampler_seed = wave[c + 2u].w;
         }
         var ended = (flags & SLOT_ENDED) != 0u;
         flags = 0u;
@@ -1005,11 +1009,11 @@ fn wave_step(slot: u32, j: u32) {
             flags = SLOT_ENDED;
         } else if ended {
             moved = true;
-            let s5 = wave[b + 5u];
+            let s5 = wave[c + 2u];
             sum = bitcast<vec3f>(s5.xyz);
             sampler_seed = s5.w;
-            i = wave[b + 6u].x;
-            dropped = wave[b + 6u].y;
+            i = wave[c + 3u].x;
+            dropped = wave[c + 3u].y;
             add_sample(path_radiance, &sum, &dropped);
             i++;
             if i >= end {
@@ -1025,7 +1029,7 @@ fn wave_step(slot: u32, j: u32) {
         }
     }
     // The rays leave from one point (`leave`): the next ray's origin is the shadow ray's.
-    let r = 8u * slots + 3u * j;
+    let r = 7u * slots + 3u * j;
     let next = flags == 0u;
     if next || shadow_pending {
         let origin = select(shadow_ray.origin, path_ray.origin, next);
@@ -1046,5 +1050,5 @@ fn wave_step(slot: u32, j: u32) {
     } else {
         wave[r + 2u].w = bitcast<u32>(-1.0);
     }
-    save_slot(b, flags, moved, i, sum, dropped);
+    save_slot(b, c, flags, moved, i, sum, dropped);
 }

@@ -11,12 +11,13 @@
 use crate::context::GpuContext;
 use crate::embree::{Embree, HostHit, HostRay, HostScene};
 use crate::error::{RenderError, Result};
-use crate::readback::map_read_after;
+use crate::readback::{map_read_after, map_write_after};
 
-/// `wave` holds per pixel of the window: the path in flight (8 vec4), the rays of its step
-/// (3 vec4: they share their origin), the hit of its ray (1 vec4, its `t`'s sign bit the
-/// answer for its shadow ray), then the list of slots to step.
-const STATE_VEC4S: u64 = 8;
+/// `wave` holds per pixel of the window: the path in flight (3 vec4 every step moves, 4 more
+/// it moves now and then), the rays of its step (3 vec4: they share their origin), the hit
+/// of its ray (1 vec4, its `t`'s sign bit the answer for its shadow ray), then the list of
+/// slots to step.
+const STATE_VEC4S: u64 = 7;
 const RAYS_AT: u64 = STATE_VEC4S;
 const HITS_AT: u64 = RAYS_AT + 3;
 const LIST_AT: u64 = HITS_AT + 1;
@@ -25,11 +26,15 @@ const LIST_AT: u64 = HITS_AT + 1;
 /// `64 * STEP_GROUPS` apart (see `main` in the shader).
 const STEP_GROUPS: u32 = 64;
 
-/// Lanes of slots traced in turn (see `HostRays`).
-const LANES: u32 = 2;
+/// Lanes of slots traced in turn (see `HostRays`): one. With two (even and odd rows), the
+/// host traced one lane's rays while the kernel stepped the other's, but on a 2-core machine
+/// the four threads only contend for the cores and caches: one lane ran 1.09× the paths/s of
+/// two (four alternating pairs of `bench` runs; `docs/benchmarks.md`).
+const LANES: u32 = 1;
 
 /// At most this many slots (pixels) in the buffers: larger windows are traced in batches
-/// of this many pixels, one after the other (its buffers take 244 bytes per slot and lane).
+/// of this many pixels, one after the other (its buffers take 248 bytes per slot and lane,
+/// with the upload and readback copies).
 const MAX_SLOTS: u64 = 1 << 18;
 
 /// What the kernel's step is to do, for the caller that records it.
@@ -47,13 +52,12 @@ pub(crate) struct WaveStep {
 /// Records a step of the kernel into the encoder, bound to the `wave` buffer given.
 type StepFn<'a> = dyn FnMut(WaveStep, &mut wgpu::CommandEncoder, &wgpu::Buffer) -> Result<()> + 'a;
 
-/// The scene in Embree and two lanes of slots traced in turn.
+/// The scene in Embree and the lanes of slots traced in turn.
 pub(crate) struct HostRays {
     scene: HostScene,
-    /// The window's rows alternate between two lanes (even rows, odd rows), each with its
-    /// own buffers: while the kernel steps one lane's paths, the host intersects the other
-    /// lane's rays, so neither waits for the other (the driver's threads and the host's
-    /// share the cores).
+    /// The window's rows alternate between the lanes (with two, even rows and odd rows),
+    /// each with its own buffers: while the kernel steps one lane's paths, the host
+    /// intersects another lane's rays.
     lanes: Vec<Lane>,
     /// The window the buffers are for, and the slots they hold (all of its pixels, or a
     /// batch of [`MAX_SLOTS`]).
@@ -69,6 +73,12 @@ struct Lane {
     wave: wgpu::Buffer,
     /// `MAP_READ` copy of the step's rays.
     rays_read: wgpu::Buffer,
+    /// `MAP_WRITE` buffer of the next step's hits and list, copied into `wave` in its
+    /// encoder; and the bytes of each, for that copy.
+    upload: wgpu::Buffer,
+    uploaded: (u64, u64),
+    /// The last submission that used `upload` (`None`: mapped since its creation).
+    last: Option<wgpu::SubmissionIndex>,
     /// The step's next rays, then its shadow rays.
     rays: Vec<HostRay>,
     hits: Vec<HostHit>,
@@ -131,6 +141,14 @@ impl Lane {
         Self {
             wave: buffer(ctx, "pathtrace wave", 16 * vec4s, false),
             rays_read: buffer(ctx, "pathtrace wave rays readback", 48 * slots, true),
+            upload: ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("pathtrace wave upload"),
+                size: 16 * slots + 4 * (slots + 1).next_multiple_of(4),
+                usage: wgpu::BufferUsages::MAP_WRITE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: true,
+            }),
+            uploaded: (0, 0),
+            last: None,
             rays: vec![HostRay::default(); 2 * n],
             hits: vec![HostHit::default(); n],
             occluded: vec![0; n],
@@ -143,26 +161,23 @@ impl Lane {
         }
     }
 
-    /// Writes the next step's list and hits (with the shadow answers) into `wave`.
-    fn upload(&mut self, ctx: &GpuContext, slots: u64) {
+    /// Writes the next step's hits (with the shadow answers) and list into `upload`, for
+    /// `submit` to copy into `wave`.
+    fn upload(&mut self, ctx: &GpuContext) -> Result<()> {
         let count = self.list.len() - 1;
         self.list[0] = u32::try_from(count).unwrap_or(u32::MAX);
         self.list.resize(self.list.len().next_multiple_of(4), 0);
-        let q = &ctx.queue;
-        if !self.list_hits.is_empty() {
-            q.write_buffer(
-                &self.wave,
-                16 * HITS_AT * slots,
-                bytemuck::cast_slice(&self.list_hits),
-            );
-        }
-        q.write_buffer(
-            &self.wave,
-            16 * LIST_AT * slots,
-            bytemuck::cast_slice(&self.list),
-        );
+        let hits: &[u8] = bytemuck::cast_slice(&self.list_hits);
+        let list: &[u8] = bytemuck::cast_slice(&self.list);
+        map_write_after(ctx, &self.upload, self.last.take(), |view| {
+            view.slice(..hits.len()).copy_from_slice(hits);
+            view.slice(hits.len()..hits.len() + list.len())
+                .copy_from_slice(list);
+        })?;
+        self.uploaded = (hits.len() as u64, list.len() as u64);
         self.order.clear();
         self.order.extend_from_slice(&self.list[1..=count]);
+        Ok(())
     }
 
     /// Records and submits the lane's next step and the copy of the rays it writes.
@@ -187,6 +202,23 @@ impl Lane {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("pathtrace step"),
             });
+        let (hits, list) = self.uploaded;
+        if hits > 0 {
+            encoder.copy_buffer_to_buffer(
+                &self.upload,
+                0,
+                &self.wave,
+                16 * HITS_AT * capacity,
+                hits,
+            );
+        }
+        encoder.copy_buffer_to_buffer(
+            &self.upload,
+            hits,
+            &self.wave,
+            16 * LIST_AT * capacity,
+            list,
+        );
         step(what, &mut encoder, &self.wave)?;
         // The rays of its first `c` slots.
         let bytes = 48 * c as u64;
@@ -197,7 +229,9 @@ impl Lane {
             0,
             bytes,
         );
-        self.in_flight = Some((ctx.queue.submit([encoder.finish()]), bytes));
+        let index = ctx.queue.submit([encoder.finish()]);
+        self.last = Some(index.clone());
+        self.in_flight = Some((index, bytes));
         self.steps += 1;
         self.counts.steps += 1;
         self.counts.other_ns += lap(&mut t);
@@ -206,7 +240,7 @@ impl Lane {
 
     /// Waits for the step in flight, intersects its rays and lists the slots that wrote
     /// any for the next step; false when none did (the lane is done).
-    fn trace(&mut self, ctx: &GpuContext, scene: &HostScene, capacity: u64) -> Result<bool> {
+    fn trace(&mut self, ctx: &GpuContext, scene: &HostScene) -> Result<bool> {
         let Some((index, bytes)) = self.in_flight.take() else {
             return Ok(false);
         };
@@ -263,7 +297,7 @@ impl Lane {
             self.counts.other_ns += lap(&mut t);
             return Ok(false);
         }
-        self.upload(ctx, capacity);
+        self.upload(ctx)?;
         self.counts.other_ns += lap(&mut t);
         Ok(true)
     }
@@ -319,9 +353,9 @@ impl HostRays {
     }
 
     /// Traces a frame: `step` records a lane's next step, which is submitted; the host
-    /// intersects the rays it wrote while the other lane's step runs, and lists the slots
-    /// that wrote any for the lane's next step, until no slot of either lane did; batch
-    /// after batch of slots.
+    /// intersects the rays it wrote (while another lane's step runs, where there are
+    /// several), and lists the slots that wrote any for the lane's next step, until no slot
+    /// of any lane did; batch after batch of slots.
     ///
     /// # Errors
     /// When `step` fails, a readback fails, or the paths are not done after `max_steps`.
@@ -348,7 +382,7 @@ impl HostRays {
                         .map(|s| u32::try_from(s).unwrap_or(u32::MAX)),
                 );
                 if lane.list.len() > 1 {
-                    lane.upload(ctx, capacity);
+                    lane.upload(ctx)?;
                     lane.submit(ctx, [base, capacity], &mut step)?;
                 }
             }
@@ -358,7 +392,7 @@ impl HostRays {
                     if !live[l] {
                         continue;
                     }
-                    live[l] = lane.trace(ctx, &self.scene, capacity)?;
+                    live[l] = lane.trace(ctx, &self.scene)?;
                     if live[l] {
                         if lane.steps > max_steps {
                             return Err(RenderError::Gpu(format!(

@@ -44,6 +44,44 @@ pub fn map_read_after<T>(
     })
 }
 
+/// Maps a whole `MAP_WRITE` buffer once submission `index` (its last use) is done, passes
+/// the mapping to `f` to write, and unmaps it (a persistent upload buffer: `Queue::write_buffer`
+/// takes a fresh staging buffer per call, whose new pages the OS faults in one by one).
+/// `index` `None`: the buffer is mapped already (`mapped_at_creation`).
+///
+/// # Errors
+/// When mapping fails or the GPU does not finish.
+pub fn map_write_after(
+    ctx: &GpuContext,
+    buffer: &wgpu::Buffer,
+    index: Option<wgpu::SubmissionIndex>,
+    f: impl FnOnce(&mut wgpu::BufferViewMut),
+) -> Result<()> {
+    let slice = buffer.slice(..);
+    if let Some(index) = index {
+        let (tx, rx) = mpsc::channel();
+        slice.map_async(wgpu::MapMode::Write, move |r| {
+            let _ = tx.send(r);
+        });
+        ctx.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(index),
+                timeout: Some(crate::context::GPU_TIMEOUT),
+            })
+            .map_err(|e| ctx.error(e))?;
+        rx.recv()
+            .map_err(|_| RenderError::Gpu("buffer map callback was dropped".into()))??;
+    }
+    {
+        let mut view = slice
+            .get_mapped_range_mut()
+            .map_err(|e| RenderError::Gpu(e.to_string()))?;
+        f(&mut view);
+    }
+    buffer.unmap();
+    Ok(())
+}
+
 /// Maps the first `size` bytes of `buffer` for reading, `wait`s for the GPU, and passes the
 /// bytes to `f`.
 fn map_read_when<T>(
