@@ -44,12 +44,13 @@ struct Frame {
     chunk_count: u32,
     // CHUNK_FIRST | CHUNK_LAST.
     chunk_flags: u32,
-    // With HOST_RAYS: WAVE_START, WAVE_CONTINUE or WAVE_FINISH (below); the first slot of
-    // the batch of slots being traced, and how many slots `wave`'s sections hold.
+    // With HOST_RAYS: WAVE_STEP or WAVE_FINISH (below); the first slot of the batch of
+    // slots being traced, how many slots `wave`'s sections hold, and how many of the step's
+    // listed slots `wave_misses` takes (`wave_hits` the rest).
     wave: u32,
     wave_base: u32,
     wave_capacity: u32,
-    pad0: u32,
+    wave_split: u32,
     pad1: u32,
 }
 
@@ -455,11 +456,12 @@ fn start_path(pixel: vec2u) {
 
 // Takes the path one bounce on; true once it ended (its radiance is `path_radiance`).
 fn path_step() -> bool {
-    return path_step_from(intersect_scene(path_ray));
+    return path_step_from(intersect_scene(path_ray), true);
 }
 
-// `path_step` with the closest hit of `path_ray` given (`hit`).
-fn path_step_from(first_hit: Hit) -> bool {
+// `path_step` with the closest hit of `path_ray` given (`hit`); `may_miss` false where the
+// caller knows the ray hit (a constant: the compiler leaves the miss's code out).
+fn path_step_from(first_hit: Hit, may_miss: bool) -> bool {
     var ray = path_ray;
     var throughput = path_throughput;
     var radiance = path_radiance;
@@ -521,7 +523,7 @@ fn path_step_from(first_hit: Hit) -> bool {
                 throughput *= tr / p_pass;
             }
         }
-        if hit.prim == NO_HIT {
+        if may_miss && hit.prim == NO_HIT {
             // Camera rays see the environment only when it is shown as background.
             let visible = bounce > 0u || (frame.settings.env_flags & ENV_SHOW_BACKGROUND) != 0u;
             if HAS_ENVIRONMENT && visible && frame.settings.env_kind == ENV_CONSTANT {
@@ -734,15 +736,7 @@ fn main(
             first_hit_aovs(id);
             return;
         }
-        // A 1D dispatch: each invocation takes the slots of the step one `threads` apart
-        // (every slot at the first step, then those the host listed): llvmpipe pays a
-        // fixed cost per invocation, as much as a step of a path when the kernel is this
-        // large, so an invocation per slot would pay it for every step.
-        let threads = groups.x * 64u;
-        let count = wave_word(wave_list_at(), 0u);
-        for (var j = group.x * 64u + lane; j < count; j += threads) {
-            wave_step(wave_word(wave_list_at(), 1u + j), j);
-        }
+        // The steps are the entry points below.
         return;
     }
     if trace {
@@ -888,8 +882,7 @@ fn first_hit_aovs(at: vec2u) {
 //   [11S, ...)  the step's slots: their count, then each one, a u32 each (`wave_list_at`)
 // The random numbers, their order and the arithmetic are `trace_pixel`'s; only the hits are
 // the host's. The host counts the rays (`ray_count` is not kept).
-const WAVE_START: u32 = 0u;
-const WAVE_CONTINUE: u32 = 1u;
+const WAVE_STEP: u32 = 1u;
 // Writes the pixels' means from `chunk_sums` (and the AOVs): recorded with the graph.
 const WAVE_FINISH: u32 = 2u;
 
@@ -944,7 +937,7 @@ fn wave_list_at() -> u32 {
 }
 
 // One step of the paths of window slot `slot`, the `j`-th of the step (see above).
-fn wave_step(slot: u32, j: u32) {
+fn wave_step(slot: u32, j: u32, kind: u32) {
     let at = vec2u(slot % frame.window.z, slot / frame.window.z);
     let w = frame.settings.width;
     let h = frame.settings.height;
@@ -964,7 +957,7 @@ fn wave_step(slot: u32, j: u32) {
     // The slot's state: what every step moves, then the rest (see `save_slot`).
     let b = 3u * (slot - frame.wave_base);
     let c = 3u * slots + 4u * (slot - frame.wave_base);
-    if frame.wave == WAVE_START {
+    if kind == WAVE_KIND_START {
         sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler, n, frame.replicates);
         start_path(pixel);
     } else {
@@ -1001,8 +994,12 @@ fn wave_step(slot: u32, j: u32) {
         var ended = (flags & SLOT_ENDED) != 0u;
         flags = 0u;
         if !ended {
-            let t = bitcast<f32>(hv.x & 0x7fffffffu);
-            ended = path_step_from(Hit(hv.w, t, bitcast<f32>(hv.y), bitcast<f32>(hv.z)));
+            if kind == WAVE_KIND_MISS {
+                ended = path_step_from(Hit(NO_HIT, F32_MAX, 0.0, 0.0), true);
+            } else {
+                let t = bitcast<f32>(hv.x & 0x7fffffffu);
+                ended = path_step_from(Hit(hv.w, t, bitcast<f32>(hv.y), bitcast<f32>(hv.z)), false);
+            }
         }
         if ended && shadow_pending {
             // The path's last shadow ray is still to be answered.
@@ -1051,4 +1048,48 @@ fn wave_step(slot: u32, j: u32) {
         wave[r + 2u].w = bitcast<u32>(-1.0);
     }
     save_slot(b, c, flags, moved, i, sum, dropped);
+}
+
+// The steps of host intersection, one entry point per kind of step, each compiled on its
+// own: llvmpipe runs the code behind every `if`, taken or not, so a step that started paths,
+// shaded misses and shaded hits in one kernel paid for all three at every slot. The host
+// lists a step's slots whose ray missed (or that only await a shadow ray) first, then those
+// whose ray hit (`frame.wave_split` of them first), and dispatches `wave_misses` over the
+// first and `wave_hits` over the others; `wave_start` starts the batch's first paths.
+const WAVE_KIND_START: u32 = 0u;
+const WAVE_KIND_MISS: u32 = 1u;
+const WAVE_KIND_HIT: u32 = 2u;
+
+// A 1D dispatch: each invocation takes the listed slots of its kind one `threads` apart:
+// llvmpipe pays a fixed cost per invocation, as much as a step of a path when the kernel is
+// this large, so an invocation per slot would pay it for every step.
+fn wave_run(kind: u32, group: u32, groups: u32, lane: u32) {
+    let threads = groups * 64u;
+    let count = wave_word(wave_list_at(), 0u);
+    let first = select(0u, frame.wave_split, kind == WAVE_KIND_HIT);
+    let end = select(count, min(frame.wave_split, count), kind == WAVE_KIND_MISS);
+    for (var j = first + group * 64u + lane; j < end; j += threads) {
+        wave_step(wave_word(wave_list_at(), 1u + j), j, kind);
+    }
+}
+
+@compute @workgroup_size(8, 8)
+fn wave_start(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) groups: vec3u, @builtin(local_invocation_index) lane: u32) {
+    if HOST_RAYS {
+        wave_run(WAVE_KIND_START, group.x, groups.x, lane);
+    }
+}
+
+@compute @workgroup_size(8, 8)
+fn wave_misses(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) groups: vec3u, @builtin(local_invocation_index) lane: u32) {
+    if HOST_RAYS {
+        wave_run(WAVE_KIND_MISS, group.x, groups.x, lane);
+    }
+}
+
+@compute @workgroup_size(8, 8)
+fn wave_hits(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) groups: vec3u, @builtin(local_invocation_index) lane: u32) {
+    if HOST_RAYS {
+        wave_run(WAVE_KIND_HIT, group.x, groups.x, lane);
+    }
 }

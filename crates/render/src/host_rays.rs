@@ -40,13 +40,22 @@ const MAX_SLOTS: u64 = 1 << 18;
 /// What the kernel's step is to do, for the caller that records it.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct WaveStep {
-    /// The batch's first step: start each slot's first path.
+    /// The batch's first step: start each slot's first path (`wave_start` over all the
+    /// listed slots); else `wave_misses` over the first `misses` listed slots and
+    /// `wave_hits` over the `hits` after them.
     pub first: bool,
     /// The batch's first slot, and the slots the buffers hold.
     pub base: u32,
     pub capacity: u32,
-    /// Workgroups to dispatch (1D, 64 invocations each).
-    pub groups: u32,
+    pub misses: u32,
+    pub hits: u32,
+}
+
+impl WaveStep {
+    /// Workgroups (1D, 64 invocations each) to dispatch over `slots` listed slots.
+    pub(crate) fn groups(slots: u32) -> u32 {
+        slots.div_ceil(64).clamp(1, STEP_GROUPS)
+    }
 }
 
 /// Records a step of the kernel into the encoder, bound to the `wave` buffer given.
@@ -84,8 +93,10 @@ struct Lane {
     hits: Vec<HostHit>,
     /// 1 where the shadow ray is occluded.
     occluded: Vec<u32>,
-    /// The slots of the step being traced, in its order.
+    /// The slots of the step being traced, in its order, and how many of them come first
+    /// as those whose ray missed (or that only await a shadow ray).
     order: Vec<u32>,
+    misses: usize,
     /// The next step's slots: their count first, then each one; the hits of their rays
     /// (with the answers for their shadow rays), in that order.
     list: Vec<u32>,
@@ -153,6 +164,7 @@ impl Lane {
             hits: vec![HostHit::default(); n],
             occluded: vec![0; n],
             order: Vec::new(),
+            misses: 0,
             list: Vec::new(),
             list_hits: Vec::new(),
             in_flight: None,
@@ -189,13 +201,14 @@ impl Lane {
     ) -> Result<()> {
         let mut t = std::time::Instant::now();
         let c = self.order.len();
+        let first = self.steps == 0;
+        let misses = if first { c } else { self.misses.min(c) };
         let what = WaveStep {
-            first: self.steps == 0,
+            first,
             base: u32::try_from(base).unwrap_or(u32::MAX),
             capacity: u32::try_from(capacity).unwrap_or(u32::MAX),
-            groups: u32::try_from(c.div_ceil(64))
-                .unwrap_or(u32::MAX)
-                .clamp(1, STEP_GROUPS),
+            misses: u32::try_from(misses).unwrap_or(u32::MAX),
+            hits: u32::try_from(c - misses).unwrap_or(u32::MAX),
         };
         let mut encoder = ctx
             .device
@@ -267,6 +280,7 @@ impl Lane {
             }
         })?;
         self.counts.wait_ns += wait;
+
         let (next, shadow) = self.rays[..2 * c].split_at(c);
         self.counts.rays += next.iter().chain(shadow).filter(|r| r.tfar >= 0.0).count() as u64;
         self.counts.other_ns += lap(&mut t);
@@ -281,6 +295,7 @@ impl Lane {
         self.list.push(0);
         self.list_hits.clear();
         for shade in [false, true] {
+            self.misses = self.list.len() - 1;
             for (j, (a, b)) in next.iter().zip(shadow).enumerate() {
                 let out = a.tfar >= 0.0 || b.tfar >= 0.0;
                 if out && (a.tfar >= 0.0 && self.hits[j].is_hit()) == shade {

@@ -261,11 +261,14 @@ pub fn linear_sampler(ctx: &GpuContext) -> wgpu::Sampler {
     })
 }
 
-/// A compute pipeline with the bindings its shader declares.
+/// A compute pipeline with the bindings its shader declares (and, where asked for, one per
+/// further entry point of the same shader, bound alike).
 #[derive(Debug)]
 pub struct Kernel {
     label: String,
     pipeline: wgpu::ComputePipeline,
+    /// The further entry points' pipelines, by name.
+    entries: Vec<(String, wgpu::ComputePipeline)>,
     layout: wgpu::BindGroupLayout,
     bindings: Vec<Binding>,
     workgroup: [u32; 3],
@@ -287,6 +290,22 @@ impl Kernel {
     /// # Errors
     /// When the shader does not compile or declares bindings kernels do not support.
     pub fn from_source(ctx: &GpuContext, label: &str, source: &str) -> Result<Self> {
+        Self::with_entries(ctx, label, source, &[])
+    }
+
+    /// [`Kernel::from_source`] with a pipeline for each of the further entry points
+    /// `entry_points` too, chosen with [`PassBuilder::entry`]: a driver compiles each entry point
+    /// on its own, with only the code it reaches (llvmpipe runs the code behind every `if`,
+    /// taken or not, so a smaller entry point runs faster).
+    ///
+    /// # Errors
+    /// As [`Kernel::from_source`], and when an entry point is missing.
+    pub fn with_entries(
+        ctx: &GpuContext,
+        label: &str,
+        source: &str,
+        entry_points: &[&str],
+    ) -> Result<Self> {
         let (bindings, workgroup) = reflect(label, source)?;
         let device = &ctx.device;
         if bindings
@@ -327,14 +346,21 @@ impl Kernel {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(label),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: wgpu::PipelineCompilationOptions::default(),
-            cache: None,
-        });
+        let create = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: wgpu::PipelineCompilationOptions::default(),
+                cache: None,
+            })
+        };
+        let pipeline = create("main");
+        let entries: Vec<_> = entry_points
+            .iter()
+            .map(|e| ((*e).to_owned(), create(e)))
+            .collect();
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Shader {
                 name: label.to_owned(),
@@ -344,6 +370,7 @@ impl Kernel {
         Ok(Self {
             label: label.to_owned(),
             pipeline,
+            entries,
             layout,
             bindings,
             workgroup,
@@ -359,6 +386,7 @@ impl Kernel {
     pub fn pass<'a>(&'a self, name: &'a str) -> PassBuilder<'a> {
         PassBuilder {
             kernel: self,
+            entry: None,
             name,
             resources: Vec::with_capacity(self.bindings.len()),
             methods: Vec::with_capacity(self.bindings.len()),
@@ -374,6 +402,8 @@ impl Kernel {
 #[derive(Debug)]
 pub struct PassBuilder<'a> {
     kernel: &'a Kernel,
+    /// A further entry point to run instead of `main`.
+    entry: Option<&'a str>,
     name: &'a str,
     resources: Vec<wgpu::BindingResource<'a>>,
     methods: Vec<&'static str>,
@@ -383,6 +413,14 @@ impl<'a> PassBuilder<'a> {
     fn push(mut self, method: &'static str, resource: wgpu::BindingResource<'a>) -> Self {
         self.resources.push(resource);
         self.methods.push(method);
+        self
+    }
+
+    /// Runs the kernel's further entry point `entry` (one given to
+    /// [`Kernel::with_entries`]) instead of `main`.
+    #[must_use]
+    pub fn entry(mut self, entry: &'a str) -> Self {
+        self.entry = Some(entry);
         self
     }
 
@@ -474,6 +512,19 @@ impl<'a> PassBuilder<'a> {
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         self.check()?;
+        let pipeline = match self.entry {
+            None => &self.kernel.pipeline,
+            Some(entry) => self
+                .kernel
+                .entries
+                .iter()
+                .find(|(e, _)| e == entry)
+                .map(|(_, p)| p)
+                .ok_or_else(|| RenderError::Shader {
+                    name: self.kernel.label.clone(),
+                    message: format!("pass `{}`: no entry point `{entry}` built", self.name),
+                })?,
+        };
         let entries: Vec<_> = self
             .resources
             .into_iter()
@@ -493,7 +544,7 @@ impl<'a> PassBuilder<'a> {
             label: Some(self.name),
             timestamp_writes,
         });
-        pass.set_pipeline(&self.kernel.pipeline);
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
         Ok(())

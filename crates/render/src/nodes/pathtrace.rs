@@ -10,7 +10,7 @@ use crate::error::{RenderError, Result};
 use crate::kernel::{Kernel, uniform_buffer};
 use lumagraph_graph::TexFormat;
 
-use crate::host_rays::{HostCounts, HostRays};
+use crate::host_rays::{HostCounts, HostRays, WaveStep};
 use crate::kernel::PassBuilder;
 use crate::nodes::{Counter, FrameIo, NodeExec, NodeImpl, Recording, Resources, boxed};
 use crate::pool::{PooledTexture, create};
@@ -95,12 +95,13 @@ crate::param_block! {
         chunk_count: u32,
         /// `CHUNK_FIRST` | `CHUNK_LAST` (`pathtrace/pathtrace.wgsl`).
         chunk_flags: u32,
-        /// With host intersection: `WAVE_START`, `WAVE_CONTINUE` or `WAVE_FINISH`; the
-        /// batch of slots traced: its first, and the slots the `wave` buffer holds.
+        /// With host intersection: `WAVE_STEP` or `WAVE_FINISH`; the batch of slots
+        /// traced: its first, and the slots the `wave` buffer holds; how many of a step's
+        /// listed slots `wave_misses` takes (`wave_hits` the rest).
         wave: u32,
         wave_base: u32,
         wave_capacity: u32,
-        pad0: u32,
+        wave_split: u32,
         pad1: u32,
     }
 }
@@ -323,7 +324,8 @@ impl PathTrace {
         } else {
             None
         };
-        let kernel = Kernel::from_source(ctx, "pathtrace/pathtrace.wgsl", &source)?;
+        let entries: &[&str] = if host.is_some() { &WAVE_ENTRIES } else { &[] };
+        let kernel = Kernel::with_entries(ctx, "pathtrace/pathtrace.wgsl", &source, entries)?;
         let env = match &scene.environment_map {
             Some(path) => crate::env_map::EnvMap::load(
                 ctx,
@@ -421,7 +423,7 @@ impl PathTrace {
             wave: 0,
             wave_base: 0,
             wave_capacity: 0,
-            pad0: 0,
+            wave_split: 0,
             pad1: 0,
         }
     }
@@ -506,19 +508,27 @@ impl PathTrace {
             + 2;
         let result = host.trace_frame(ctx, max_steps, |step, enc, wave| {
             let f = Frame {
-                wave: if step.first {
-                    WAVE_START
-                } else {
-                    WAVE_CONTINUE
-                },
+                wave: WAVE_STEP,
                 wave_base: step.base,
                 wave_capacity: step.capacity,
+                wave_split: step.misses,
                 ..frame
             };
             ctx.queue
                 .write_buffer(&self.frame, 0, bytemuck::bytes_of(&f));
-            self.bind(&pass.node, views, &sums, wave)
-                .dispatch(ctx, enc, [step.groups, 1, 1], None)
+            let passes = if step.first {
+                [("wave_start", step.misses), ("wave_hits", 0)]
+            } else {
+                [("wave_misses", step.misses), ("wave_hits", step.hits)]
+            };
+            for (entry, slots) in passes {
+                if slots > 0 {
+                    self.bind(&pass.node, views, &sums, wave)
+                        .entry(entry)
+                        .dispatch(ctx, enc, [WaveStep::groups(slots), 1, 1], None)?;
+                }
+            }
+            Ok(())
         });
         let finish = result.and_then(|()| {
             let f = Frame {
@@ -534,11 +544,13 @@ impl PathTrace {
     }
 }
 
-/// `Frame::wave` (`pathtrace/pathtrace.wgsl`): the first step of a frame's paths, a later
-/// one, the pass writing the means.
-const WAVE_START: u32 = 0;
-const WAVE_CONTINUE: u32 = 1;
+/// `Frame::wave` (`pathtrace/pathtrace.wgsl`): a step of a frame's paths (its entry points
+/// `wave_start`, `wave_misses`, `wave_hits`), the pass writing the means.
+const WAVE_STEP: u32 = 1;
 const WAVE_FINISH: u32 = 2;
+
+/// The path tracer's entry points for host intersection's steps (see [`WaveStep`]).
+const WAVE_ENTRIES: [&str; 3] = ["wave_start", "wave_misses", "wave_hits"];
 
 /// Records a copy of `frame` into the uniform buffer `dst` through a staging buffer, in
 /// order with the passes recorded around it.
