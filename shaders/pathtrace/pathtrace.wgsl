@@ -875,7 +875,8 @@ fn first_hit_aovs(at: vec2u) {
 //   [0, 3S)     the path in flight, what every step moves: 3 vec4 per slot (`save_slot`)
 //   [3S, 7S)    the rest of it: 4 vec4 per slot
 //   [7S, 10S)   the rays the step wrote, which leave from one point: 3 vec4 (origin, the
-//               next ray's t_near, < 0: no next ray; its direction, the shadow ray's
+//               next ray's t_near, < 0: no next ray, -2: none, but list the slot for the
+//               next step all the same; its direction, the shadow ray's
 //               t_near; the shadow ray's direction and t_far, < 0: no shadow ray)
 //   [10S, 11S)  the host's closest hit of the ray the step reads: t, u, v (bits) and the
 //               primitive; t's sign bit set when the slot's shadow ray was occluded
@@ -1001,8 +1002,10 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
                 ended = path_step_from(Hit(hv.w, t, bitcast<f32>(hv.y), bitcast<f32>(hv.z)), false);
             }
         }
-        if ended && shadow_pending {
-            // The path's last shadow ray is still to be answered.
+        if ended && (shadow_pending || kind == WAVE_KIND_HIT) {
+            // The path's last shadow ray is still to be answered; or the path ended at a
+            // surface, and the next step's `wave_misses` adds its sample and starts the next
+            // one (so `wave_hits` carries none of that code).
             flags = SLOT_ENDED;
         } else if ended {
             moved = true;
@@ -1033,7 +1036,8 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
         // Within `origin_slab` of its origin a hit is the origin's own error (see `leave`).
         wave[r] = vec4u(bitcast<vec3u>(origin), bitcast<u32>(select(-1.0, origin_slab, next)));
     } else {
-        wave[r].w = bitcast<u32>(-1.0);
+        // No ray: -2 asks the host to list the slot all the same (an ended path to finish).
+        wave[r].w = bitcast<u32>(select(-1.0, -2.0, flags == SLOT_ENDED));
     }
     if next {
         // A shadow ray ending before it starts is still a ray (never occluded), not none.

@@ -22,6 +22,11 @@ const RAYS_AT: u64 = STATE_VEC4S;
 const HITS_AT: u64 = RAYS_AT + 3;
 const LIST_AT: u64 = HITS_AT + 1;
 
+/// The next ray's `t_near` the kernel writes for a slot with no ray out that is to be
+/// stepped all the same: its path ended at a surface, and the next step's `wave_misses`
+/// adds its sample and starts the next path.
+const FINISH_ME: f32 = -2.0;
+
 /// At most this many workgroups of 64 per step: each invocation steps every slot one
 /// `64 * STEP_GROUPS` apart (see `main` in the shader).
 const STEP_GROUPS: u32 = 64;
@@ -297,7 +302,8 @@ impl Lane {
         for shade in [false, true] {
             self.misses = self.list.len() - 1;
             for (j, (a, b)) in next.iter().zip(shadow).enumerate() {
-                let out = a.tfar >= 0.0 || b.tfar >= 0.0;
+                // A ray out, or none but a path that ended at a surface to finish.
+                let out = a.tfar >= 0.0 || b.tfar >= 0.0 || a.tnear == FINISH_ME;
                 if out && (a.tfar >= 0.0 && self.hits[j].is_hit()) == shade {
                     let mut hit = self.hits[j];
                     if self.occluded[j] != 0 {
