@@ -7,8 +7,9 @@
 #
 #   scripts/bench_vs_mitsuba.sh [SPP]
 #
-# It builds and runs target/release/lumagraph, or runs the binary LUMAGRAPH names (the GPU
-# work is Mesa's, so a dev build gives the same figures).
+# It builds and runs target/release/lumagraph, or runs the binary LUMAGRAPH names (use a
+# release build: with host intersection, Rust code runs on the host between the kernel's
+# steps, and a dev build compiles it at opt-level 1).
 # lumagraph's figure is `bench`'s "specialized" line (the shader the renderer uses). Mitsuba
 # 3.9.1 (variant llvm_ad_rgb) is taken from MITSUBA_PYTHON, by default
 # .venv-mitsuba/bin/python (python3 -m venv .venv-mitsuba && .venv-mitsuba/bin/pip install
