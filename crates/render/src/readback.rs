@@ -33,15 +33,34 @@ pub fn map_read_after<T>(
     size: u64,
     f: impl FnOnce(&[u8]) -> T,
 ) -> Result<T> {
-    map_read_when(buffer, size, f, || {
-        ctx.device
-            .poll(wgpu::PollType::Wait {
-                submission_index: Some(index),
-                timeout: Some(crate::context::GPU_TIMEOUT),
-            })
-            .map(|_| ())
-            .map_err(|e| ctx.error(e))
-    })
+    map_read_when(buffer, size, f, || wait_for(ctx, index))
+}
+
+/// Waits until submission `index` is done.
+fn wait_for(ctx: &GpuContext, index: wgpu::SubmissionIndex) -> Result<()> {
+    ctx.device
+        .poll(wgpu::PollType::Wait {
+            submission_index: Some(index),
+            timeout: Some(crate::context::GPU_TIMEOUT),
+        })
+        .map(|_| ())
+        .map_err(|e| ctx.error(e))
+}
+
+/// Maps `slice` in `mode`, `wait`s for the GPU, and checks that the mapping succeeded.
+fn map_slice(
+    slice: &wgpu::BufferSlice<'_>,
+    mode: wgpu::MapMode,
+    wait: impl FnOnce() -> Result<()>,
+) -> Result<()> {
+    let (tx, rx) = mpsc::channel();
+    slice.map_async(mode, move |r| {
+        let _ = tx.send(r);
+    });
+    wait()?;
+    rx.recv()
+        .map_err(|_| RenderError::Gpu("buffer map callback was dropped".into()))??;
+    Ok(())
 }
 
 /// Maps a whole `MAP_WRITE` buffer once submission `index` (its last use) is done, passes
@@ -59,18 +78,7 @@ pub fn map_write_after(
 ) -> Result<()> {
     let slice = buffer.slice(..);
     if let Some(index) = index {
-        let (tx, rx) = mpsc::channel();
-        slice.map_async(wgpu::MapMode::Write, move |r| {
-            let _ = tx.send(r);
-        });
-        ctx.device
-            .poll(wgpu::PollType::Wait {
-                submission_index: Some(index),
-                timeout: Some(crate::context::GPU_TIMEOUT),
-            })
-            .map_err(|e| ctx.error(e))?;
-        rx.recv()
-            .map_err(|_| RenderError::Gpu("buffer map callback was dropped".into()))??;
+        map_slice(&slice, wgpu::MapMode::Write, || wait_for(ctx, index))?;
     }
     {
         let mut view = slice
@@ -94,13 +102,7 @@ fn map_read_when<T>(
         return Ok(f(&[]));
     }
     let slice = buffer.slice(..size);
-    let (tx, rx) = mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    wait()?;
-    rx.recv()
-        .map_err(|_| RenderError::Gpu("buffer map callback was dropped".into()))??;
+    map_slice(&slice, wgpu::MapMode::Read, wait)?;
     let out = {
         let view = slice
             .get_mapped_range()
