@@ -151,6 +151,10 @@ enum Command {
         #[arg(long)]
         graph: Option<PathBuf>,
     },
+    /// List the GPU adapters wgpu finds (name, kind, backend, driver, ray queries,
+    /// timestamps, binding limits) and the one lumagraph would use.
+    #[command(after_help = "Example:\n  WGPU_BACKEND=vulkan lumagraph adapters")]
+    Adapters,
     /// Measure path tracing speed (paths/s) on the current adapter, specialized and general
     /// shaders side by side.
     #[command(after_help = "Example:\n  lumagraph bench --scene assets/cornell.ron --spp 64")]
@@ -585,6 +589,10 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
         Command::Gallery { out, kinds } => {
             let ctx = GpuContext::headless()?;
             gallery::run(&ctx, library, &out, &kinds)
+        }
+        Command::Adapters => {
+            print!("{}", GpuContext::describe_adapters()?);
+            Ok(())
         }
         Command::Bench {
             scene,

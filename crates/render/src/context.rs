@@ -63,6 +63,54 @@ impl GpuContext {
         pollster::block_on(Self::select_adapter(false)).map(|a| a.get_info())
     }
 
+    /// Every adapter the environment's backends offer, one line each, then the one
+    /// [`GpuContext::headless`] would choose: name, kind, backend and driver, and what
+    /// decides how lumagraph runs there (ray queries, timestamp queries, the largest storage
+    /// binding and buffer). `lumagraph adapters` prints it.
+    ///
+    /// # Errors
+    /// When no adapter is found at all.
+    pub fn describe_adapters() -> Result<String> {
+        use std::fmt::Write as _;
+        let desc = Self::instance_descriptor();
+        let backends = desc.backends;
+        let instance = wgpu::Instance::new(desc);
+        let adapters = pollster::block_on(instance.enumerate_adapters(backends));
+        if adapters.is_empty() {
+            return Err(RenderError::NoAdapter(String::new()));
+        }
+        let mib = |x: u64| x / (1024 * 1024);
+        let mut out = String::new();
+        for a in &adapters {
+            let info = a.get_info();
+            let features = a.features();
+            let limits = a.limits();
+            let has = |f: wgpu::Features| if features.contains(f) { "yes" } else { "no" };
+            let _ = writeln!(
+                out,
+                "{} ({:?}, {:?}, {} {})\n    ray queries: {}, ray-tracing pipelines: {}, timestamp queries: {}, \
+                 largest storage binding: {} MiB, largest buffer: {} MiB",
+                info.name,
+                info.device_type,
+                info.backend,
+                info.driver,
+                info.driver_info,
+                has(wgpu::Features::EXPERIMENTAL_RAY_QUERY),
+                has(wgpu::Features::EXPERIMENTAL_RAY_TRACING_PIPELINES),
+                has(wgpu::Features::TIMESTAMP_QUERY),
+                mib(u64::from(limits.max_storage_buffer_binding_size)),
+                mib(limits.max_buffer_size),
+            );
+        }
+        let chosen = pollster::block_on(Self::select_adapter(false))?.get_info();
+        let _ = writeln!(
+            out,
+            "chosen (WGPU_BACKEND, WGPU_ADAPTER_NAME, WGPU_POWER_PREF or the system's default): {} ({:?})",
+            chosen.name, chosen.backend
+        );
+        Ok(out)
+    }
+
     async fn select_adapter(prefer_cpu: bool) -> Result<wgpu::Adapter> {
         let desc = Self::instance_descriptor();
         let backends = desc.backends;
