@@ -431,8 +431,8 @@ fn print_features(plan: &crate::graph::Plan, scene: &GpuScene, library: &NodeLib
         println!("shader features of {} for this scene:", pass.node);
         for included in [true, false] {
             println!("  {}:", if included { "compiled in" } else { "left out" });
-            for f in features.iter().filter(|f| f.included == included) {
-                println!("    {:<28} {}", f.name, f.reason);
+            for (f, d) in features.iter().filter(|(_, d)| d.included == included) {
+                println!("    {:<28} {}", f.label(), d.reason);
             }
         }
     }
@@ -531,6 +531,15 @@ fn nodes(library: &NodeLibrary, markdown: bool, graph: Option<&Path>) -> Result<
             docs::text(&r)
         }
     );
+    Ok(())
+}
+
+/// `lumagraph export`: the resolved scene as JSON + OBJ.
+fn export(scene: &Path, out: &Path) -> Result<()> {
+    let loaded = load_scene(Some(scene))?.context("no scene")?;
+    for path in crate::scene::export::export(&loaded.scene, &loaded.gpu, out)? {
+        println!("wrote {}", path.display());
+    }
     Ok(())
 }
 
@@ -640,13 +649,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             variants: &variants,
             library,
         }),
-        Command::Export { scene, out } => {
-            let loaded = load_scene(Some(&scene))?.context("no scene")?;
-            for path in crate::scene::export::export(&loaded.scene, &loaded.gpu, &out)? {
-                println!("wrote {}", path.display());
-            }
-            Ok(())
-        }
+        Command::Export { scene, out } => export(&scene, &out),
         Command::TestChart { out } => {
             let chart = image_io::test_chart();
             let bytes = image_io::encode_exr(&chart, true)?;

@@ -16,6 +16,7 @@ use std::sync::Arc;
 
 use lumagraph::graph::{Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
+use lumagraph::render::specialize::{Feature, Features};
 use lumagraph::render::{Executor, Resources, compile, image_io, metrics};
 use lumagraph::scene::{GpuScene, Scene};
 
@@ -242,7 +243,9 @@ fn first_hit_aovs_see_the_back_wall() {
     let mut exec = Executor::new(ctx, plan, &resources).unwrap();
     exec.run_frame().unwrap();
     assert!(
-        !exec.notes()[0].1.contains("first-hit AOVs"),
+        exec.shader_features("pt")
+            .unwrap()
+            .on(Feature::FirstHitAovs),
         "{:?}",
         exec.notes()
     );
@@ -278,7 +281,12 @@ fn first_hit_aovs_see_the_back_wall() {
 /// `scene` rendered at 64×64 and `spp`, with its materials, lights and shading data
 /// written into the shader or read from their buffers, or with BVH traversal as GPU
 /// adapters run it: color, albedo, normal and depth, and how the shader was specialized.
-fn render_small(name: &str, spp: u32, in_buffers: bool, bvh: bool) -> Option<(Vec<Image>, String)> {
+fn render_small(
+    name: &str,
+    spp: u32,
+    in_buffers: bool,
+    bvh: bool,
+) -> Option<(Vec<Image>, Features)> {
     render_with(
         name,
         (64, 64),
@@ -298,7 +306,7 @@ fn render_with(
     size: (u32, u32),
     spp: u32,
     resources: Resources,
-) -> Option<(Vec<Image>, String)> {
+) -> Option<(Vec<Image>, Features)> {
     let ctx = common::gpu()?;
     let mut gpu =
         GpuScene::build(&Scene::load(&common::repo(&format!("assets/{name}"))).unwrap()).unwrap();
@@ -312,15 +320,11 @@ fn render_with(
         ..resources
     };
     let mut exec = Executor::new(ctx, plan, &resources).unwrap();
-    let how = exec
-        .notes()
-        .into_iter()
-        .map(|(_, n)| n)
-        .collect::<Vec<_>>()
-        .join("; ");
+    let features = exec.shader_features("pt").unwrap().clone();
+    println!("{name}: {}", features.summary());
     exec.run_frames(spp.div_ceil(4), true).unwrap();
     let images = ports.iter().map(|p| exec.read_port(p).unwrap()).collect();
-    Some((images, how))
+    Some((images, features))
 }
 
 /// Scenes small enough to be intersected inline with their data written into the shader:
@@ -376,14 +380,15 @@ fn inlined_scene_data_renders_bit_identical_images() {
             return;
         };
         let (buffers, how_buffers) = render_small(name, 8, true, false).unwrap();
-        println!("{name}: {how_inline}\n{name}: {how_buffers}");
         assert!(
-            how_inline.contains("materials and lights inlined"),
-            "{how_inline}"
+            how_inline.on(Feature::InlineData) && how_inline.on(Feature::InlineIntersection),
+            "{}",
+            how_inline.summary()
         );
         assert!(
-            !how_buffers.contains("materials and lights inlined"),
-            "{how_buffers}"
+            !how_buffers.on(Feature::InlineData),
+            "{}",
+            how_buffers.summary()
         );
         assert_bit_identical(name, &inline, &buffers);
         assert!(
@@ -417,9 +422,8 @@ fn spreading_workgroups_over_the_image_renders_bit_identical_images() {
             return;
         };
         let (in_order, how_in_order) = run(true).unwrap();
-        println!("{name}: {how_spread}\n{name}: {how_in_order}");
-        assert!(!how_spread.contains("spread workgroups"), "{how_spread}");
-        assert!(how_in_order.contains("spread workgroups"), "{how_in_order}");
+        assert!(how_spread.on(Feature::SpreadWorkgroups));
+        assert!(!how_in_order.on(Feature::SpreadWorkgroups));
         assert_bit_identical(name, &spread, &in_order);
         let black = spread[0]
             .pixels
@@ -441,8 +445,8 @@ fn spreading_workgroups_over_the_image_renders_bit_identical_images() {
 #[test]
 fn leaving_out_a_missing_primitive_kind_renders_bit_identical_images() {
     for (name, left_out) in [
-        ("boxtextured.ron", "sphere tests"),
-        ("furnace_materials.ron", "triangle tests"),
+        ("boxtextured.ron", Feature::Spheres),
+        ("furnace_materials.ron", Feature::Triangles),
     ] {
         let run = |general| {
             render_with(
@@ -461,8 +465,7 @@ fn leaving_out_a_missing_primitive_kind_renders_bit_identical_images() {
             return;
         };
         let (general, how_general) = run(true).unwrap();
-        println!("{name}: {how}\n{name}: {how_general}");
-        assert!(how.contains(left_out), "{how}");
+        assert!(!how.on(left_out) && how_general.on(left_out));
         assert_bit_identical(name, &specialized, &general);
         assert!(
             specialized[0].pixels.iter().any(|p| p[0] > 0.0),
@@ -493,8 +496,8 @@ fn bvh_traversal_renders_what_inline_intersection_renders() {
             return;
         };
         let (bvh, how_bvh) = render_small(name, 8, true, true).unwrap();
-        assert!(how_inline.contains("intersection inlined"), "{how_inline}");
-        assert!(!how_bvh.contains("intersection inlined"), "{how_bvh}");
+        assert!(how_inline.on(Feature::InlineIntersection));
+        assert!(!how_bvh.on(Feature::InlineIntersection));
         for (i, (a, b)) in inline.iter().zip(&bvh).enumerate() {
             let (differ, far) = (differing(a, b, None), differing(a, b, Some(1e-4)));
             println!(
@@ -531,12 +534,12 @@ fn host_against_wgsl(name: &str, size: (u32, u32), spp: u32) -> Option<HostAgain
         return None;
     }
     let (host, how_host) = render_with(name, size, spp, Resources::default()).unwrap();
-    println!("{how_host}");
-    if !how_host.contains("rays intersected on the host") {
+    if !how_host.on(Feature::HostRays) {
         assert!(
             std::env::var("LUMAGRAPH_ALLOW_NO_EMBREE").is_ok_and(|v| v == "1"),
-            "no host intersection on this CPU adapter ({how_host}): install Embree 3 \
-             (scripts/setup.sh), or set LUMAGRAPH_ALLOW_NO_EMBREE=1"
+            "no host intersection on this CPU adapter ({}): install Embree 3 \
+             (scripts/setup.sh), or set LUMAGRAPH_ALLOW_NO_EMBREE=1",
+            how_host.reason(Feature::HostRays)
         );
         return None;
     }
@@ -545,7 +548,7 @@ fn host_against_wgsl(name: &str, size: (u32, u32), spp: u32) -> Option<HostAgain
         ..Resources::default()
     };
     let (wgsl, how_wgsl) = render_with(name, size, spp, wgsl_only).unwrap();
-    assert!(!how_wgsl.contains("on the host"), "{how_wgsl}");
+    assert!(!how_wgsl.on(Feature::HostRays));
     assert_bit_identical(&format!("{name} AOVs"), &host[1..], &wgsl[1..]);
     let (a, b) = (&host[0], &wgsl[0]);
     assert!(a.pixels.iter().any(|p| p[0] > 0.0), "{name}: black");
@@ -685,12 +688,11 @@ fn inlined_materials_of_a_large_scene_render_what_the_buffers_render() {
         ..Resources::default()
     };
     let (buffers, how_buffers) = render_with("spheregrid.ron", (64, 64), 8, buffers).unwrap();
-    println!("{how_inline}\n{how_buffers}");
     if !common::gpu().is_some_and(lumagraph::render::GpuContext::is_cpu) {
         return;
     }
-    assert!(how_inline.contains("materials inlined"), "{how_inline}");
-    assert!(!how_buffers.contains("inlined"), "{how_buffers}");
+    assert!(how_inline.on(Feature::InlineData));
+    assert!(!how_buffers.on(Feature::InlineData) && !how_buffers.on(Feature::InlineIntersection));
     assert_bit_identical("spheregrid AOVs", &inline[1..], &buffers[1..]);
     let (differ, far) = (
         differing(&inline[0], &buffers[0], None),

@@ -611,7 +611,7 @@ fn missing_or_broken_images_name_the_material_and_image() {
 
 #[test]
 fn plan_lists_textures_for_textured_scenes_only() {
-    use lumagraph::render::specialize::{PathTraceOptions, features};
+    use lumagraph::render::specialize::{Feature, Features, PathTraceOptions};
     let opts = PathTraceOptions {
         specialize: true,
         cpu_adapter: true,
@@ -623,10 +623,10 @@ fn plan_lists_textures_for_textured_scenes_only() {
     };
     let on = |path: &Path| {
         let scene = GpuScene::build(&Scene::load(path).unwrap()).unwrap();
-        let f = features(&scene, opts);
-        let t = f.iter().find(|f| f.name == "material textures").unwrap();
-        println!("{}: {} ({})", path.display(), t.included, t.reason);
-        (t.included, scene.tri_texcoords.len(), scene.textures.len())
+        let f = Features::decide(&scene, opts);
+        let t = f.on(Feature::Textures);
+        println!("{}: {t} ({})", path.display(), f.reason(Feature::Textures));
+        (t, scene.tri_texcoords.len(), scene.textures.len())
     };
     let (inc, tc, words) = on(&common::repo("assets/boxtextured.ron"));
     assert!(inc && tc == 12 && words > 4, "{inc} {tc} {words}");
@@ -635,14 +635,11 @@ fn plan_lists_textures_for_textured_scenes_only() {
     // Textured scenes keep materials and lights in their buffers, however small.
     let scene =
         GpuScene::build(&Scene::load(&common::repo("assets/boxtextured.ron")).unwrap()).unwrap();
-    let f = features(&scene, opts);
-    let inline = f
-        .iter()
-        .find(|f| f.name == "inline materials and lights")
-        .unwrap();
+    let f = Features::decide(&scene, opts);
     assert!(
-        !inline.included && inline.reason.contains("textured"),
-        "{inline:?}"
+        !f.on(Feature::InlineData) && f.reason(Feature::InlineData).contains("textured"),
+        "{}",
+        f.reason(Feature::InlineData)
     );
 }
 
@@ -1319,7 +1316,7 @@ fn textured_emitter_selection_follows_the_texture() {
 /// which and why.
 #[test]
 fn small_scenes_are_inlined_on_cpu_adapters_only() {
-    use lumagraph::render::specialize::{PathTraceOptions, features};
+    use lumagraph::render::specialize::{Feature, Features, PathTraceOptions};
     let scene = GpuScene::build(&Scene::load(&common::repo("assets/cornell_spheres.ron")).unwrap())
         .unwrap();
     for cpu_adapter in [true, false] {
@@ -1332,14 +1329,13 @@ fn small_scenes_are_inlined_on_cpu_adapters_only() {
             in_image_order: false,
             host_rays: false,
         };
-        let f = features(&scene, opts);
-        let on = |name: &str| f.iter().find(|x| x.name == name).unwrap();
-        assert_eq!(on("inline intersection").included, cpu_adapter);
-        assert_eq!(on("inline materials and lights").included, cpu_adapter);
-        assert_eq!(on("BVH traversal").included, !cpu_adapter);
-        assert_eq!(on("spread workgroups").included, cpu_adapter);
+        let f = Features::decide(&scene, opts);
+        assert_eq!(f.on(Feature::InlineIntersection), cpu_adapter);
+        assert_eq!(f.on(Feature::InlineData), cpu_adapter);
+        assert_eq!(f.on(Feature::BvhTraversal), !cpu_adapter);
+        assert_eq!(f.on(Feature::SpreadWorkgroups), cpu_adapter);
         if !cpu_adapter {
-            let why = &on("BVH traversal").reason;
+            let why = f.reason(Feature::BvhTraversal);
             assert!(why.contains("a GPU adapter"), "{why}");
         }
     }

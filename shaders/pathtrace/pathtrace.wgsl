@@ -2,8 +2,9 @@
 // writes their mean radiance. Unidirectional path tracing with next-event estimation and
 // multiple importance sampling (power heuristic) for emissive triangles and spheres and the
 // environment map, next-event estimation alone for point, spot and directional lights,
-// Russian roulette from the fifth bounce, one-sided Lambertian materials and emitters
-// (Mitsuba 3's conventions, so the references match). With HAS_MEDIA, homogeneous media
+// Russian roulette from the fifth bounce, the layered material of bsdf.wgsl (diffuse or
+// rough diffuse base under GGX specular, metal, glass) and one-sided emitters (Mitsuba 3's
+// conventions, so the references match). With HAS_MEDIA, homogeneous media
 // inside closed shapes (medium.wgsl): Beer-Lambert absorption, or free-flight distance
 // sampling with Henyey-Greenstein scattering, next-event estimation from medium points with
 // MIS against phase sampling, and shadow rays through index-matched boundaries. Samples
@@ -15,6 +16,8 @@
 #import "pathtrace/bsdf.wgsl"
 #import "pathtrace/env.wgsl"
 #import "pathtrace/textures.wgsl"
+// Constants shared with the Rust side, generated from crates/render/src/shared.rs.
+#import "pathtrace/shared.wgsl"
 
 struct Frame {
     settings: Settings,
@@ -213,9 +216,8 @@ fn env_select_prob() -> f32 {
     return select(1.0, 0.5, HAS_LIGHTS && frame.header.num_lights > 0u);
 }
 
-// Probability that light sampling picks `l`: half by power, half uniformly (see
-// `light_selection` in crates/scene/src/flatten.rs, which builds the alias table).
-const LIGHT_UNIFORM_SHARE: f32 = 0.5;
+// Probability that light sampling picks `l`: LIGHT_UNIFORM_SHARE uniformly, the rest by
+// power (as `light_selection` in crates/scene/src/flatten.rs builds the alias table).
 
 fn light_select_pdf(l: Light) -> f32 {
     let total = frame.header.total_light_power;
@@ -900,10 +902,31 @@ fn wave_slots() -> u32 {
     return frame.wave_capacity;
 }
 
-// A slot's path state: 3 vec4 from `b` that every step moves (direction, BSDF pdf;
+// Host intersection's records in `wave`, declared once: their Rust twins
+// (`shared::WaveRays`, `embree::HostHit`) are checked field by field against these by the
+// param-block layout test. Per slot of a batch: `WAVE_HOT_VEC4S` + `WAVE_COLD_VEC4S` vec4 of
+// path state, then the sections (see crates/render/src/shared.rs) of `WaveRays` the kernel
+// writes, `WaveHit` the host writes, and the list of slots to step.
+struct WaveRays {
+    origin: vec3f,
+    next_near: f32,
+    next_dir: vec3f,
+    shadow_near: f32,
+    shadow_dir: vec3f,
+    shadow_far: f32,
+}
+
+struct WaveHit {
+    t: f32,
+    u: f32,
+    v: f32,
+    prim: u32,
+}
+
+// A slot's path state: `WAVE_HOT_VEC4S` (3) vec4 from `b` that every step moves (direction, BSDF pdf;
 // throughput, random state; radiance, bounce and slot flags in its top 8 bits), kept apart
-// from the rest so that a step's loads and stores stream through 48 bytes per slot; 4 vec4
-// from `c`: [0] the previous vertex and crossings, only for scenes with emitters or media
+// from the rest so that a step's loads and stores stream through 48 bytes per slot;
+// `WAVE_COLD_VEC4S` (4) vec4 from `c`: [0] the previous vertex and crossings, only for scenes with emitters or media
 // (no origin: host intersection hits only triangles, whose points come from the
 // barycentrics); [1] the shadow ray's contribution and the Sobol index, only while a shadow
 // ray is out or the first hit is next; [2] the pixel's sum and the Sobol seed, [3] the
@@ -934,7 +957,7 @@ fn wave_word(at: u32, i: u32) -> u32 {
 
 // Where the host's list of the slots to step starts: their count, then each one.
 fn wave_list_at() -> u32 {
-    return 11u * wave_slots();
+    return WAVE_LIST_AT * wave_slots();
 }
 
 // One step of the paths of window slot `slot`, the `j`-th of the step (see above).
@@ -956,8 +979,8 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
     shadow_pending = false;
     shadow_contribution = vec3f(0.0);
     // The slot's state: what every step moves, then the rest (see `save_slot`).
-    let b = 3u * (slot - frame.wave_base);
-    let c = 3u * slots + 4u * (slot - frame.wave_base);
+    let b = WAVE_HOT_VEC4S * (slot - frame.wave_base);
+    let c = WAVE_HOT_VEC4S * slots + WAVE_COLD_VEC4S * (slot - frame.wave_base);
     if kind == WAVE_KIND_START {
         sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler, n, frame.replicates);
         start_path(pixel);
@@ -980,7 +1003,8 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
             path_crossings = s3.w;
         }
         sampler_sobol = frame.sampler == SAMPLER_SOBOL;
-        let hv = wave[10u * slots + j];
+        // The `WaveHit` of this slot's ray; the sign bit of its `t` answers the shadow ray.
+        let hv = wave[WAVE_HITS_AT * slots + j];
         let shadow_out = (flags & SLOT_SHADOW) != 0u;
         if shadow_out || path_bounce == 0u {
             let s4 = wave[c + 1u];
@@ -1028,16 +1052,18 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
             }
         }
     }
-    // The rays leave from one point (`leave`): the next ray's origin is the shadow ray's.
-    let r = 7u * slots + 3u * j;
+    // The slot's `WaveRays`, written word by word (fewer stores where a ray is absent). The
+    // rays leave from one point (`leave`): the next ray's origin is the shadow ray's.
+    let r = WAVE_RAYS_AT * slots + WAVE_RAYS_VEC4S * j;
     let next = flags == 0u;
     if next || shadow_pending {
         let origin = select(shadow_ray.origin, path_ray.origin, next);
         // Within `origin_slab` of its origin a hit is the origin's own error (see `leave`).
-        wave[r] = vec4u(bitcast<vec3u>(origin), bitcast<u32>(select(-1.0, origin_slab, next)));
+        wave[r] = vec4u(bitcast<vec3u>(origin), bitcast<u32>(select(WAVE_NO_RAY, origin_slab, next)));
     } else {
-        // No ray: -2 asks the host to list the slot all the same (an ended path to finish).
-        wave[r].w = bitcast<u32>(select(-1.0, -2.0, flags == SLOT_ENDED));
+        // No ray; WAVE_FINISH_ME asks the host to list the slot all the same (an ended path
+        // to finish).
+        wave[r].w = bitcast<u32>(select(WAVE_NO_RAY, WAVE_FINISH_ME, flags == SLOT_ENDED));
     }
     if next {
         // A shadow ray ending before it starts is still a ray (never occluded), not none.
@@ -1049,7 +1075,7 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
         wave[r + 2u] = vec4u(bitcast<vec3u>(shadow_ray.dir), bitcast<u32>(max(shadow_far, 0.0)));
         flags |= SLOT_SHADOW;
     } else {
-        wave[r + 2u].w = bitcast<u32>(-1.0);
+        wave[r + 2u].w = bitcast<u32>(WAVE_NO_RAY);
     }
     save_slot(b, c, flags, moved, i, sum, dropped);
 }

@@ -98,7 +98,7 @@ impl GpuContext {
                 has(wgpu::Features::EXPERIMENTAL_RAY_QUERY),
                 has(wgpu::Features::EXPERIMENTAL_RAY_TRACING_PIPELINES),
                 has(wgpu::Features::TIMESTAMP_QUERY),
-                mib(u64::from(limits.max_storage_buffer_binding_size)),
+                mib(limits.max_storage_buffer_binding_size),
                 mib(limits.max_buffer_size),
             );
         }

@@ -80,6 +80,23 @@ pub struct HostHit {
     pub prim: u32,
 }
 
+/// Its WGSL twin is `WaveHit` (the hits section of host intersection's `wave` buffer, into
+/// which the host copies these as they are), checked field by field by the layout test.
+impl crate::params::ParamBlock for HostHit {
+    const LAYOUT: crate::params::BlockLayout = crate::params::BlockLayout {
+        name: "HostHit",
+        shader: "pathtrace/pathtrace.wgsl",
+        wgsl: "WaveHit",
+        size: std::mem::size_of::<Self>(),
+        fields: &[
+            ("t", std::mem::offset_of!(Self, t)),
+            ("u", std::mem::offset_of!(Self, u)),
+            ("v", std::mem::offset_of!(Self, v)),
+            ("prim", std::mem::offset_of!(Self, prim)),
+        ],
+    };
+}
+
 impl HostHit {
     /// No hit (what a "no ray" gets too).
     pub const MISS: HostHit = HostHit {

@@ -686,6 +686,16 @@ impl Executor {
             .collect()
     }
 
+    /// The shader features of node `id`, where its kind is specialized to the scene.
+    pub fn shader_features(&self, id: &str) -> Option<&crate::specialize::Features> {
+        self.plan
+            .passes
+            .iter()
+            .zip(&self.nodes)
+            .find(|(pass, _)| pass.node == id)
+            .and_then(|(_, node)| node.shader_features())
+    }
+
     /// Every node's counters since its last reset, as `(node id, counter)`.
     ///
     /// # Errors

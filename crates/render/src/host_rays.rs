@@ -12,20 +12,14 @@ use crate::context::GpuContext;
 use crate::embree::{Embree, HostHit, HostRay, HostScene};
 use crate::error::{RenderError, Result};
 use crate::readback::{map_read_after, map_write_after};
+use crate::shared::{WAVE_FINISH_ME, WaveRays};
 
-/// `wave` holds per pixel of the window: the path in flight (3 vec4 every step moves, 4 more
-/// it moves now and then), the rays of its step (3 vec4: they share their origin), the hit
-/// of its ray (1 vec4, its `t`'s sign bit the answer for its shadow ray), then the list of
-/// slots to step.
-const STATE_VEC4S: u64 = 7;
-const RAYS_AT: u64 = STATE_VEC4S;
-const HITS_AT: u64 = RAYS_AT + 3;
-const LIST_AT: u64 = HITS_AT + 1;
-
-/// The next ray's `t_near` the kernel writes for a slot with no ray out that is to be
-/// stepped all the same: its path ended at a surface, and the next step's `wave_misses`
-/// adds its sample and starts the next path.
-const FINISH_ME: f32 = -2.0;
+/// `wave`'s sections, in vec4 per slot of the batch (declared once in [`crate::shared`]).
+const RAYS_AT: u64 = crate::shared::WAVE_RAYS_AT as u64;
+const HITS_AT: u64 = crate::shared::WAVE_HITS_AT as u64;
+const LIST_AT: u64 = crate::shared::WAVE_LIST_AT as u64;
+/// Bytes of one slot's rays.
+const RAYS_BYTES: u64 = std::mem::size_of::<WaveRays>() as u64;
 
 /// At most this many workgroups of 64 per step: each invocation steps every slot one
 /// `64 * STEP_GROUPS` apart (see `main` in the shader).
@@ -156,7 +150,12 @@ impl Lane {
         let n = usize::try_from(slots).unwrap_or(usize::MAX);
         Self {
             wave: buffer(ctx, "pathtrace wave", 16 * vec4s, false),
-            rays_read: buffer(ctx, "pathtrace wave rays readback", 48 * slots, true),
+            rays_read: buffer(
+                ctx,
+                "pathtrace wave rays readback",
+                RAYS_BYTES * slots,
+                true,
+            ),
             upload: ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("pathtrace wave upload"),
                 size: 16 * slots + 4 * (slots + 1).next_multiple_of(4),
@@ -239,7 +238,7 @@ impl Lane {
         );
         step(what, &mut encoder, &self.wave)?;
         // The rays of its first `c` slots.
-        let bytes = 48 * c as u64;
+        let bytes = RAYS_BYTES * c as u64;
         encoder.copy_buffer_to_buffer(
             &self.wave,
             16 * RAYS_AT * capacity,
@@ -268,19 +267,19 @@ impl Lane {
         let mut wait = 0;
         map_read_after(ctx, &self.rays_read, index, bytes, |b| {
             wait = lap(&mut t);
-            let words: &[[f32; 12]] = bytemuck::cast_slice(b);
-            for ((w, n), s) in words.iter().zip(next.iter_mut()).zip(shadow.iter_mut()) {
+            let rays: &[WaveRays] = bytemuck::cast_slice(b);
+            for ((w, n), s) in rays.iter().zip(next.iter_mut()).zip(shadow.iter_mut()) {
                 *n = HostRay {
-                    origin: [w[0], w[1], w[2]],
-                    tnear: w[3],
-                    dir: [w[4], w[5], w[6]],
-                    tfar: if w[3] < 0.0 { -1.0 } else { f32::MAX },
+                    origin: w.origin,
+                    tnear: w.next_near,
+                    dir: w.next_dir,
+                    tfar: if w.next_near < 0.0 { -1.0 } else { f32::MAX },
                 };
                 *s = HostRay {
-                    origin: [w[0], w[1], w[2]],
-                    tnear: w[7],
-                    dir: [w[8], w[9], w[10]],
-                    tfar: w[11],
+                    origin: w.origin,
+                    tnear: w.shadow_near,
+                    dir: w.shadow_dir,
+                    tfar: w.shadow_far,
                 };
             }
         })?;
@@ -303,7 +302,7 @@ impl Lane {
             self.misses = self.list.len() - 1;
             for (j, (a, b)) in next.iter().zip(shadow).enumerate() {
                 // A ray out, or none but a path that ended at a surface to finish.
-                let out = a.tfar >= 0.0 || b.tfar >= 0.0 || a.tnear == FINISH_ME;
+                let out = a.tfar >= 0.0 || b.tfar >= 0.0 || a.tnear == WAVE_FINISH_ME;
                 if out && (a.tfar >= 0.0 && self.hits[j].is_hit()) == shade {
                     let mut hit = self.hits[j];
                     if self.occluded[j] != 0 {

@@ -38,6 +38,7 @@ pub mod readback;
 pub mod sampler;
 mod scene_gpu;
 pub mod shader;
+pub mod shared;
 pub mod specialize;
 pub mod tile_set;
 pub mod tiled;

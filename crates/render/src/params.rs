@@ -82,6 +82,8 @@ pub const BLOCKS: &[BlockLayout] = &[
     <crate::nodes::lut::LutParams as ParamBlock>::LAYOUT,
     <crate::nodes::difference::DifferenceParams as ParamBlock>::LAYOUT,
     <crate::nodes::auto_exposure::AutoExposureParams as ParamBlock>::LAYOUT,
+    <crate::shared::WaveRays as ParamBlock>::LAYOUT,
+    <crate::embree::HostHit as ParamBlock>::LAYOUT,
 ];
 
 /// Whether `layout` matches naga's layout of its WGSL twin in its shader file under

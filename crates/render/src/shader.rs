@@ -30,11 +30,15 @@ fn disk_dir() -> Option<PathBuf> {
     }
 }
 
-/// The raw text of one shader file.
+/// The raw text of one shader file (or of the one generated file,
+/// [`crate::shared::FILE`]).
 ///
 /// # Errors
 /// When there is no such file.
 pub fn raw(name: &str) -> Result<String> {
+    if name == crate::shared::FILE {
+        return Ok(crate::shared::wgsl());
+    }
     if let Some(dir) = disk_dir()
         && let Ok(text) = std::fs::read_to_string(dir.join(name))
     {

@@ -56,6 +56,9 @@ pub struct GpuScene {
     /// Every texture a material uses, packed by [`crate::texture::pack_textures`]; empty
     /// without textures (buffer `textures`).
     pub textures: Vec<u32>,
+    /// Each texture's channel ranges, in the order of `textures` (CPU side only: the shader
+    /// specializer leaves a lobe out only where no texel can produce it).
+    pub texture_ranges: Vec<crate::texture::TexelRange>,
     /// For each GPU triangle, its index in [`Scene::triangles`] (CPU side only).
     pub tri_source: Vec<u32>,
     /// For each GPU sphere, its index in [`Scene::spheres`] (CPU side only).
@@ -377,6 +380,11 @@ impl GpuScene {
         check_textures(scene)?;
         if textured {
             out.textures = crate::texture::pack_textures(&scene.textures);
+            out.texture_ranges = scene
+                .textures
+                .iter()
+                .map(crate::texture::Texture::range)
+                .collect();
         }
         let mut weights = Vec::new();
         out.push_triangles(scene, textured, &mut weights);

@@ -68,6 +68,33 @@ pub struct Texture {
     pub nearest: bool,
 }
 
+/// The smallest and largest texel byte of each channel (RGBA) of a texture: what the
+/// shader specializer reads to know which values a textured factor can take.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TexelRange {
+    /// The smallest byte of each channel.
+    pub min: [u8; 4],
+    /// The largest byte of each channel.
+    pub max: [u8; 4],
+}
+
+impl Texture {
+    /// The range of each channel over every texel (bilinear filtering stays within it).
+    pub fn range(&self) -> TexelRange {
+        let mut r = TexelRange {
+            min: [u8::MAX; 4],
+            max: [0; 4],
+        };
+        for t in &self.texels {
+            for c in 0..4 {
+                r.min[c] = r.min[c].min(t[c]);
+                r.max[c] = r.max[c].max(t[c]);
+            }
+        }
+        r
+    }
+}
+
 /// Words of descriptor per texture in the packed buffer: texel offset (in words), width,
 /// height, flags (bits 0–1 wrap S, bits 2–3 wrap T, bit 4 nearest).
 pub const TEXTURE_DESC_WORDS: usize = 4;

@@ -210,6 +210,12 @@ pub trait NodeExec {
         Vec::new()
     }
 
+    /// What the node's shader compiles in and leaves out, for kinds specialized to the
+    /// scene (tests and tools read the choices here, never from the notes' words).
+    fn shader_features(&self) -> Option<&crate::specialize::Features> {
+        None
+    }
+
     /// The node's counters since its last reset (may read back from the GPU).
     ///
     /// # Errors
@@ -280,7 +286,8 @@ pub trait NodeExec {
 
 /// What a pass of a kind specialized to the scene compiles in and leaves out, for a CPU
 /// adapter (`true`) or a GPU.
-pub type Features = fn(&Pass, &lumagraph_scene::GpuScene, bool) -> Vec<crate::specialize::Feature>;
+pub type ShaderFeatures =
+    fn(&Pass, &lumagraph_scene::GpuScene, bool) -> crate::specialize::Features;
 
 /// The size of the image a source produces from its params (paths relative to the folder
 /// given), or why it cannot tell.
@@ -306,7 +313,7 @@ pub struct NodeImpl {
     /// For a kind whose shader is specialized to the scene: what a pass of it compiles in
     /// and leaves out for `scene` (with the default resources), for `lumagraph plan`.
     /// The `bool` says whether the adapter is a CPU one (lavapipe), where other choices pay.
-    pub features: Option<Features>,
+    pub features: Option<ShaderFeatures>,
 }
 
 impl std::fmt::Debug for NodeImpl {
@@ -349,7 +356,7 @@ impl NodeImpl {
 
     /// With shader features to list for a scene.
     #[must_use]
-    pub const fn with_features(mut self, features: Features) -> Self {
+    pub const fn with_features(mut self, features: ShaderFeatures) -> Self {
         self.features = Some(features);
         self
     }

@@ -16,6 +16,7 @@ use crate::nodes::{Counter, FrameIo, NodeExec, NodeImpl, Recording, Resources, b
 use crate::pool::{PooledTexture, create};
 use crate::readback::map_read;
 use crate::scene_gpu::SceneBuffers;
+use crate::specialize::{Feature, Features};
 
 /// `stats` slots: dropped (non-finite) samples, rays traced (low, high 32 bits), samples
 /// adaptive sampling took (since the last read).
@@ -26,7 +27,7 @@ pub(crate) const IMPL: NodeImpl = NodeImpl::new("PathTrace", |ctx, pass, resourc
     boxed(PathTrace::new(ctx, pass, resources))
 })
 .with_features(|pass, scene, cpu_adapter| {
-    crate::specialize::features(scene, options(pass, &Resources::default(), cpu_adapter))
+    crate::specialize::Features::decide(scene, options(pass, &Resources::default(), cpu_adapter))
 })
 .owning(|pass| {
     adaptive_on(pass).then(|| {
@@ -264,8 +265,8 @@ pub(crate) struct PathTrace {
     /// Dropped samples and rays since the last reset, read back so far.
     dropped: u64,
     rays: u64,
-    /// How the shader was specialized, for reports.
-    how: String,
+    /// What the shader compiles in and leaves out, and why.
+    features: Features,
     /// Stand-ins for outputs nothing reads (color, albedo, normal, depth, samples).
     unused: [PooledTexture; 5],
     /// GGX albedo tables of the material model.
@@ -305,21 +306,17 @@ impl PathTrace {
             RenderError::Gpu("PathTrace needs a scene (lumagraph render --scene FILE)".into())
         })?;
         let opts = options(pass, resources, ctx.is_cpu() && !resources.traverse_bvh);
-        let (source, how) = crate::specialize::pathtrace_source(&scene, opts)?;
+        let specialization = crate::specialize::Specialization::new(&scene, opts);
+        let source = specialization.source()?;
+        let features = specialization.features;
         let samples_per_dispatch = if !ctx.is_cpu() {
             u32::MAX
-        } else if crate::specialize::features(&scene, opts)
-            .iter()
-            .any(|f| f.name == "inline intersection" && f.included)
-        {
+        } else if features.on(Feature::InlineIntersection) {
             CPU_SAMPLES_PER_DISPATCH[1]
         } else {
             CPU_SAMPLES_PER_DISPATCH[0]
         };
-        let host = if crate::specialize::features(&scene, opts)
-            .iter()
-            .any(|f| f.name == "host intersection" && f.included)
-        {
+        let host = if features.on(Feature::HostRays) {
             Some(HostRays::new(ctx, &scene)?)
         } else {
             None
@@ -376,7 +373,7 @@ impl PathTrace {
             samples: 0,
             dropped: 0,
             rays: 0,
-            how,
+            features,
             unused,
             ggx_table,
             env,
@@ -686,8 +683,12 @@ impl NodeExec for PathTrace {
         Ok(())
     }
 
+    fn shader_features(&self) -> Option<&Features> {
+        Some(&self.features)
+    }
+
     fn notes(&self) -> Vec<String> {
-        let mut notes = vec![format!("shader: {}", self.how)];
+        let mut notes = vec![format!("shader: {}", self.features.summary())];
         if let Some(host) = &self.host {
             notes.push(host.note.clone());
         }

@@ -1,0 +1,502 @@
+//! The path tracer's shader features, typed: each [`Feature`] is decided once for a scene,
+//! an adapter and a graph ([`Features::decide`]), with the reason for its choice. The WGSL
+//! options (`pathtrace/options.wgsl`), the plan's explanation and the node's own choices
+//! (host intersection, dispatch sizes) all derive from the one [`Features`] value; no
+//! choice is found by its label, which is only what `plan` prints.
+//!
+//! Leaving a feature out is an optimization and must never change an image: a lobe is left
+//! out only where no material can produce it, counting what its textures can do (a
+//! metallic-roughness texture can lower a metallic factor of 1 to 0 per texel), from the
+//! range of the texels each texture holds.
+
+use lumagraph_scene::{
+    ENV_MAP, ENV_NONE, FEATURE_TEXTURES, GpuMaterial, GpuScene, MATERIAL_INDEX_MATCHED,
+    MATERIAL_MEDIUM,
+};
+
+use super::{INLINE_MAX_MATERIALS, INLINE_MAX_PRIMITIVES, PathTraceOptions, codegen};
+
+/// One part of the path tracer that a shader compiles in or leaves out.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Feature {
+    /// Intersection through the BVH (WGSL traversal, or the host's).
+    BvhTraversal,
+    /// Every primitive tested with its coordinates written into the code.
+    InlineIntersection,
+    /// Materials and lights (and, with inline intersection, the primitives' shading data)
+    /// written into the code.
+    InlineData,
+    /// Next-event estimation with multiple importance sampling.
+    LightSampling,
+    /// A non-black environment.
+    Environment,
+    /// The environment map's importance sampling.
+    EnvMapSampling,
+    /// Triangle leaves and surfaces.
+    Triangles,
+    /// Sphere leaves and surfaces.
+    Spheres,
+    /// The dielectric specular (GGX) lobe over the diffuse base.
+    SpecularLobe,
+    /// The metal lobe.
+    MetalLobe,
+    /// The glass (rough dielectric transmission) lobe.
+    GlassLobe,
+    /// The energy-preserving Oren–Nayar diffuse base.
+    RoughDiffuse,
+    /// Media inside shapes and index-matched boundaries.
+    Media,
+    /// First-hit albedo, normal and depth.
+    FirstHitAovs,
+    /// Adaptive sampling's statistics and skipping.
+    Adaptive,
+    /// UVs, tangents and texture sampling.
+    Textures,
+    /// Workgroups spread over the image (CPU adapters).
+    SpreadWorkgroups,
+    /// A lane whose path ended starts its next sample at once (CPU adapters).
+    PathRegeneration,
+    /// The host (Embree) intersects the rays; the WGSL shades them step by step.
+    HostRays,
+}
+
+impl Feature {
+    /// Every feature, in the order `plan` lists them.
+    pub const ALL: [Self; 19] = [
+        Self::BvhTraversal,
+        Self::InlineIntersection,
+        Self::InlineData,
+        Self::LightSampling,
+        Self::Environment,
+        Self::EnvMapSampling,
+        Self::Triangles,
+        Self::Spheres,
+        Self::SpecularLobe,
+        Self::MetalLobe,
+        Self::GlassLobe,
+        Self::RoughDiffuse,
+        Self::Media,
+        Self::FirstHitAovs,
+        Self::Adaptive,
+        Self::Textures,
+        Self::SpreadWorkgroups,
+        Self::PathRegeneration,
+        Self::HostRays,
+    ];
+
+    /// What `plan` and the render's shader line call it: words for people, never looked up.
+    pub const fn label(self) -> &'static str {
+        match self {
+            Self::BvhTraversal => "BVH traversal",
+            Self::InlineIntersection => "inline intersection",
+            Self::InlineData => "inline materials and lights",
+            Self::LightSampling => "light sampling (NEE + MIS)",
+            Self::Environment => "environment",
+            Self::EnvMapSampling => "environment map sampling",
+            Self::Triangles => "triangle tests",
+            Self::Spheres => "sphere tests",
+            Self::SpecularLobe => "dielectric specular lobe",
+            Self::MetalLobe => "metal lobe",
+            Self::GlassLobe => "glass lobe",
+            Self::RoughDiffuse => "rough diffuse (EON)",
+            Self::Media => "participating media",
+            Self::FirstHitAovs => "first-hit AOVs",
+            Self::Adaptive => "adaptive sampling",
+            Self::Textures => "material textures",
+            Self::SpreadWorkgroups => "spread workgroups",
+            Self::PathRegeneration => "path regeneration",
+            Self::HostRays => "host intersection",
+        }
+    }
+
+    /// The `bool` constant of `pathtrace/options.wgsl` that compiles it in or out; `None`
+    /// for the features that choose which files are imported instead (intersection and
+    /// scene data, see [`super::Specialization::source`]).
+    pub const fn wgsl_const(self) -> Option<&'static str> {
+        Some(match self {
+            Self::BvhTraversal | Self::InlineIntersection | Self::InlineData => return None,
+            Self::LightSampling => "HAS_LIGHTS",
+            Self::Environment => "HAS_ENVIRONMENT",
+            Self::EnvMapSampling => "HAS_ENV_MAP",
+            Self::Triangles => "HAS_TRIANGLES",
+            Self::Spheres => "HAS_SPHERES",
+            Self::SpecularLobe => "HAS_SPECULAR",
+            Self::MetalLobe => "HAS_METAL",
+            Self::GlassLobe => "HAS_GLASS",
+            Self::RoughDiffuse => "HAS_ROUGH_DIFFUSE",
+            Self::Media => "HAS_MEDIA",
+            Self::FirstHitAovs => "WRITE_AOVS",
+            Self::Adaptive => "ADAPTIVE",
+            Self::Textures => "HAS_TEXTURES",
+            Self::SpreadWorkgroups => "SPREAD_WORKGROUPS",
+            Self::PathRegeneration => "REGENERATE_PATHS",
+            Self::HostRays => "HOST_RAYS",
+        })
+    }
+}
+
+/// Whether a feature is compiled in, and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Decision {
+    /// Whether its code is compiled in.
+    pub included: bool,
+    /// Why, for people.
+    pub reason: String,
+}
+
+fn decision(included: bool, reason: impl Into<String>) -> Decision {
+    Decision {
+        included,
+        reason: reason.into(),
+    }
+}
+
+/// Every [`Feature`]'s decision for one shader.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Features {
+    /// In [`Feature::ALL`]'s order.
+    decisions: Vec<Decision>,
+}
+
+impl Features {
+    /// Decides every feature for `scene` and `options`.
+    pub fn decide(scene: &GpuScene, options: PathTraceOptions) -> Self {
+        let facts = Facts::new(scene, options);
+        Self {
+            decisions: Feature::ALL.iter().map(|&f| facts.decide(f)).collect(),
+        }
+    }
+
+    /// Whether `f` is compiled in.
+    pub fn on(&self, f: Feature) -> bool {
+        self.decisions[f as usize].included
+    }
+
+    /// Why `f` is compiled in or left out.
+    pub fn reason(&self, f: Feature) -> &str {
+        &self.decisions[f as usize].reason
+    }
+
+    /// Every feature with its decision, in [`Feature::ALL`]'s order.
+    pub fn iter(&self) -> impl Iterator<Item = (Feature, &Decision)> {
+        Feature::ALL.into_iter().zip(&self.decisions)
+    }
+
+    /// The same features with `f` set to `included` (tests compare shaders that differ in
+    /// one feature).
+    #[must_use]
+    pub fn with(mut self, f: Feature, included: bool) -> Self {
+        self.decisions[f as usize] = decision(included, "forced");
+        self
+    }
+
+    /// `pathtrace/options.wgsl` for these features: one `const NAME: bool` for each feature
+    /// that has one.
+    pub fn wgsl_options(&self) -> String {
+        use std::fmt::Write as _;
+        let mut out = String::from(
+            "// Generated from the shader's features (crates/render/src/specialize/features.rs).\n",
+        );
+        for (f, d) in self.iter() {
+            if let Some(name) = f.wgsl_const() {
+                let _ = writeln!(out, "const {name}: bool = {};", d.included);
+            }
+        }
+        out
+    }
+
+    /// One line for the render's output: how the scene is intersected and where its data
+    /// lives, then what is left out.
+    pub fn summary(&self) -> String {
+        let how = match (
+            self.on(Feature::InlineIntersection),
+            self.on(Feature::HostRays),
+            self.on(Feature::InlineData),
+        ) {
+            (true, _, true) => "intersection inlined, materials and lights inlined",
+            (true, _, false) => "intersection inlined",
+            (false, true, true) => "rays intersected on the host, materials inlined",
+            (false, true, false) => "rays intersected on the host",
+            (false, false, true) => "BVH traversal, materials inlined",
+            (false, false, false) => "BVH traversal",
+        };
+        let left_out: Vec<&str> = self
+            .iter()
+            .filter(|(_, d)| !d.included)
+            .map(|(f, _)| f.label())
+            .collect();
+        format!(
+            "{how}; left out: {}",
+            if left_out.is_empty() {
+                "nothing".to_owned()
+            } else {
+                left_out.join(", ")
+            }
+        )
+    }
+}
+
+/// The range of values a material's factor can take once its texture is applied: the
+/// factor times the texture channel's smallest and largest texel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Range {
+    min: f32,
+    max: f32,
+}
+
+impl Range {
+    fn of(factor: f32) -> Self {
+        Self {
+            min: factor,
+            max: factor,
+        }
+    }
+
+    /// `self` times a texture channel whose texels span `[lo, hi]` (texel bytes over 255).
+    fn times(self, lo: f32, hi: f32) -> Self {
+        let (a, b) = (self.min * lo, self.max * hi);
+        Self {
+            min: a.min(b).min(self.min * hi).min(self.max * lo),
+            max: a.max(b).max(self.min * hi).max(self.max * lo),
+        }
+    }
+}
+
+/// What a material can do, over every texel of its textures.
+#[derive(Clone, Copy, Debug)]
+struct MaterialRanges {
+    metallic: Range,
+    transmission: Range,
+    specular: Range,
+}
+
+/// The smallest and largest value of each channel (RGBA, over 255) of texture `id` in the
+/// scene's packed textures; the full range [0, 1] where it is unknown.
+fn channel_range(scene: &GpuScene, id: u32, channel: usize) -> (f32, f32) {
+    match scene.texture_ranges.get(id as usize) {
+        Some(r) if id != 0xFFFF => (
+            f32::from(r.min[channel]) / 255.0,
+            f32::from(r.max[channel]) / 255.0,
+        ),
+        _ => (0.0, 1.0),
+    }
+}
+
+fn material_ranges(scene: &GpuScene, m: &GpuMaterial) -> MaterialRanges {
+    let lo = |packed: u32| packed & 0xFFFF;
+    let hi = |packed: u32| packed >> 16;
+    let textured = |factor: f32, id: u32, channel: usize| {
+        if id == 0xFFFF {
+            Range::of(factor)
+        } else {
+            let (a, b) = channel_range(scene, id, channel);
+            Range::of(factor).times(a, b)
+        }
+    };
+    let mut specular = textured(m.specular, hi(m.tex_transmission_specular), 3);
+    let color = lo(m.tex_specular_color);
+    if color != 0xFFFF {
+        // The specular color texture multiplies by its largest channel (sRGB decoded, which
+        // keeps 0 and 1 and is monotonic): within [0, largest channel's largest texel].
+        let top = (0..3)
+            .map(|c| channel_range(scene, color, c).1)
+            .fold(0.0f32, f32::max);
+        specular = specular.times(0.0, top);
+    }
+    MaterialRanges {
+        metallic: textured(m.metallic, hi(m.tex_base_mr), 2),
+        transmission: textured(m.transmission, lo(m.tex_transmission_specular), 0),
+        specular,
+    }
+}
+
+/// What the decisions are made from, worked out once.
+struct Facts<'a> {
+    scene: &'a GpuScene,
+    options: PathTraceOptions,
+    /// The general shader: everything compiled in.
+    all: bool,
+    prims: usize,
+    inline: bool,
+    inline_data: bool,
+    textured: bool,
+    materials: Vec<MaterialRanges>,
+}
+
+impl<'a> Facts<'a> {
+    fn new(scene: &'a GpuScene, options: PathTraceOptions) -> Self {
+        let prims = scene.tri_positions.len() + scene.spheres.len();
+        let inline = options.specialize && options.cpu_adapter && prims <= INLINE_MAX_PRIMITIVES;
+        let textured = scene.header.features & FEATURE_TEXTURES != 0;
+        // Small scenes have all their data written into the code; larger ones on a CPU
+        // adapter their materials (and few lights), the primitives' data staying in buffers.
+        let inline_data = options.specialize
+            && options.cpu_adapter
+            && !options.data_in_buffers
+            && !textured
+            && scene.materials.len() <= INLINE_MAX_MATERIALS
+            && codegen::inlinable(scene, inline);
+        Self {
+            scene,
+            options,
+            all: !options.specialize,
+            prims,
+            inline,
+            inline_data,
+            textured,
+            materials: scene
+                .materials
+                .iter()
+                .map(|m| material_ranges(scene, m))
+                .collect(),
+        }
+    }
+
+    /// How many materials can do what `f` says (over all their texels).
+    fn count(&self, f: impl Fn(&MaterialRanges, &GpuMaterial) -> bool) -> usize {
+        self.materials
+            .iter()
+            .zip(&self.scene.materials)
+            .filter(|(r, m)| f(r, m))
+            .count()
+    }
+
+    /// `n` things that need a feature, or the general shader's reason.
+    fn needed(&self, n: usize, what: &str) -> Decision {
+        if self.all {
+            decision(true, "general shader (specialization off)")
+        } else if n > 0 {
+            decision(true, format!("{n} {what}"))
+        } else {
+            decision(false, format!("no {what}"))
+        }
+    }
+
+    fn decide(&self, f: Feature) -> Decision {
+        let s = self.scene;
+        match f {
+            Feature::BvhTraversal => self.bvh(),
+            Feature::InlineIntersection => decision(
+                self.inline,
+                super::inline_intersection_reason(s, self.inline),
+            ),
+            Feature::InlineData => decision(
+                self.inline_data,
+                super::inline_data_reason(s, self.options, self.inline_data, self.inline),
+            ),
+            Feature::LightSampling => self.needed(s.lights.len(), "emissive primitives"),
+            Feature::Environment => {
+                let env = self.all || s.settings.env_kind != ENV_NONE;
+                decision(
+                    env,
+                    if env {
+                        "environment not black"
+                    } else {
+                        "black environment"
+                    },
+                )
+            }
+            Feature::EnvMapSampling => {
+                let map = self.all || s.settings.env_kind == ENV_MAP;
+                decision(
+                    map,
+                    if map {
+                        "equirectangular map, importance sampled"
+                    } else {
+                        "no environment map"
+                    },
+                )
+            }
+            Feature::Triangles => self.needed(s.tri_positions.len(), "triangles"),
+            Feature::Spheres => self.needed(s.spheres.len(), "spheres"),
+            Feature::SpecularLobe => self.needed(
+                self.count(|r, _| {
+                    r.specular.max > 0.0 && r.metallic.min < 1.0 && r.transmission.min < 1.0
+                }),
+                "materials with specular > 0",
+            ),
+            Feature::MetalLobe => self.needed(
+                self.count(|r, _| r.metallic.max > 0.0),
+                "materials with metallic > 0",
+            ),
+            Feature::GlassLobe => self.needed(
+                self.count(|r, _| r.transmission.max > 0.0 && r.metallic.min < 1.0),
+                "materials with transmission > 0",
+            ),
+            Feature::RoughDiffuse => self.needed(
+                self.count(|r, m| {
+                    m.diffuse_roughness > 0.0 && r.metallic.min < 1.0 && r.transmission.min < 1.0
+                }),
+                "materials with diffuse_roughness > 0",
+            ),
+            Feature::Media => self.needed(
+                self.count(|_, m| m.flags & (MATERIAL_MEDIUM | MATERIAL_INDEX_MATCHED) != 0),
+                "materials with a medium inside or an index-matched boundary",
+            ),
+            Feature::FirstHitAovs => decision(
+                self.options.aovs,
+                if self.options.aovs {
+                    "albedo, normal or depth is read"
+                } else {
+                    "nothing reads albedo, normal or depth"
+                },
+            ),
+            Feature::Adaptive => decision(
+                self.options.adaptive,
+                if self.options.adaptive {
+                    "adaptive_error > 0"
+                } else {
+                    "adaptive_error is 0"
+                },
+            ),
+            Feature::Textures => decision(
+                self.all || self.textured,
+                super::textures_reason(s, self.all),
+            ),
+            Feature::SpreadWorkgroups => {
+                let o = self.options;
+                decision(
+                    o.cpu_adapter && !o.in_image_order,
+                    if !o.cpu_adapter {
+                        "a GPU adapter: workgroups in image order"
+                    } else if o.in_image_order {
+                        "image order asked for"
+                    } else {
+                        "a CPU adapter: each driver thread takes one contiguous range of workgroups"
+                    },
+                )
+            }
+            Feature::PathRegeneration => decision(
+                self.options.cpu_adapter && self.inline,
+                if !self.options.cpu_adapter {
+                    "a GPU adapter: one bounce loop per sample"
+                } else if self.inline {
+                    "a CPU adapter: a SIMD lane whose path ended starts its next sample at once"
+                } else {
+                    "BVH traversal: no gain measured on a CPU adapter"
+                },
+            ),
+            Feature::HostRays => super::host_rays_decision(s, self.options, self.inline),
+        }
+    }
+
+    fn bvh(&self) -> Decision {
+        let (prims, s) = (self.prims, self.scene);
+        decision(
+            !self.inline,
+            if self.inline {
+                format!("{prims} primitives <= {INLINE_MAX_PRIMITIVES}: tested inline")
+            } else if self.options.specialize
+                && !self.options.cpu_adapter
+                && prims <= INLINE_MAX_PRIMITIVES
+            {
+                format!(
+                    "{} nodes (a GPU adapter: faster than testing the {prims} primitives inline)",
+                    s.bvh_nodes.len()
+                )
+            } else {
+                format!("{} nodes", s.bvh_nodes.len())
+            },
+        )
+    }
+}

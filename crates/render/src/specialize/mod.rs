@@ -1,0 +1,250 @@
+//! Shaders specialized to the scene: code the scene does not need is not compiled.
+//!
+//! On CPU drivers (lavapipe), every memory load inside the traversal loop is costly, while
+//! constants written into the shader are nearly free; on GPUs, tiny scenes gain too. So a
+//! scene with few primitives gets an intersection routine that tests every primitive with
+//! its coordinates written into the code, replacing `pathtrace/intersect.wgsl` (the BVH
+//! traversal over storage buffers) through the import resolver's overrides. Such a scene,
+//! unless textured, also gets its materials, lights, light alias table and per-primitive
+//! shading data written into the code (`pathtrace/scene_data.wgsl` replaced), so no bounce
+//! reads them from memory; the images are bit-identical to reading the buffers.
+//!
+//! What is compiled in is decided once per shader as typed [`Feature`]s
+//! ([`features`]); the generated code is in [`codegen`]. [`Specialization`] holds both and
+//! assembles the source.
+
+mod codegen;
+mod features;
+
+pub use codegen::{inline_intersection, inline_materials_data, inline_scene_data, parallelograms};
+pub use features::{Decision, Feature, Features};
+
+use lumagraph_scene::GpuScene;
+
+/// Scenes with at most this many primitives get inline intersection code.
+pub const INLINE_MAX_PRIMITIVES: usize = 64;
+
+/// Scenes with at most this many materials (and [`INLINE_MAX_PRIMITIVES`] primitives) get
+/// their materials, lights and per-primitive shading data written into the shader.
+pub const INLINE_MAX_MATERIALS: usize = 64;
+
+/// What the graph needs of the path tracer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PathTraceOptions {
+    /// Specialize to the scene where it pays (off: the general shader, for benchmarks).
+    pub specialize: bool,
+    /// Whether the shader runs on a CPU adapter (lavapipe): there, small scenes are
+    /// intersected inline, with their data written into the code (loads in loops are what
+    /// llvmpipe pays most for); on a GPU the BVH is faster than testing every primitive
+    /// (2.6-3.6× on 64 spheres on an H100, `docs/benchmarks.md`), so it always traverses it.
+    pub cpu_adapter: bool,
+    /// Write the first-hit AOVs (albedo, normal, depth): something reads them.
+    pub aovs: bool,
+    /// Adaptive sampling (`adaptive_error` > 0): per-pixel statistics and skipping.
+    pub adaptive: bool,
+    /// With `specialize`, keep materials, lights and shading data in their storage buffers
+    /// even where the scene is small enough to write them into the shader (tests and
+    /// benchmarks compare the two; images are bit-identical).
+    pub data_in_buffers: bool,
+    /// On a CPU adapter, trace workgroups in image order instead of spreading them over the
+    /// image (the images are bit-identical; a test compares the two).
+    pub in_image_order: bool,
+    /// On a CPU adapter, whether the host can intersect the path tracer's rays (Embree was
+    /// found, [`crate::embree`]) and may: the scene's rays are then traced there when the
+    /// BVH would be traversed, and the scene allows (see [`features`]).
+    pub host_rays: bool,
+}
+
+/// A path tracer shader specialized to one scene, adapter and graph: its features, decided
+/// once, and the code written for the scene where the features ask for it.
+#[derive(Clone, Debug)]
+pub struct Specialization {
+    /// What is compiled in and left out, and why.
+    pub features: Features,
+    /// Replaces `pathtrace/intersect.wgsl` ([`Feature::InlineIntersection`]).
+    intersection: Option<String>,
+    /// Replaces `pathtrace/scene_data.wgsl` ([`Feature::InlineData`]).
+    scene_data: Option<String>,
+}
+
+impl Specialization {
+    /// Decides the features for `scene` and `options` and writes the code they ask for.
+    pub fn new(scene: &GpuScene, options: PathTraceOptions) -> Self {
+        let features = Features::decide(scene, options);
+        let inline = features.on(Feature::InlineIntersection);
+        let intersection = if inline {
+            inline_intersection(scene)
+        } else {
+            None
+        };
+        let scene_data = if !features.on(Feature::InlineData) {
+            None
+        } else if inline {
+            inline_scene_data(scene)
+        } else {
+            inline_materials_data(scene)
+        };
+        Self {
+            features,
+            intersection,
+            scene_data,
+        }
+    }
+
+    /// The path tracer's source: `pathtrace/pathtrace.wgsl` with the options file written
+    /// from the features and the generated files in place of the ones they replace.
+    ///
+    /// # Errors
+    /// When a shader file is missing.
+    pub fn source(&self) -> crate::Result<String> {
+        let mut overrides = vec![("pathtrace/options.wgsl", self.features.wgsl_options())];
+        if let Some(code) = &self.intersection {
+            overrides.push(("pathtrace/intersect.wgsl", code.clone()));
+        }
+        if let Some(code) = &self.scene_data {
+            overrides.push(("pathtrace/scene_data.wgsl", code.clone()));
+        }
+        crate::shader::resolve_with("pathtrace/pathtrace.wgsl", &overrides)
+    }
+}
+
+/// Why materials, lights and shading data are (or are not) written into the shader.
+fn inline_intersection_reason(scene: &GpuScene, inline: bool) -> String {
+    let prims = scene.tri_positions.len() + scene.spheres.len();
+    let pairs = if inline {
+        parallelograms(&scene.tri_positions)
+            .iter()
+            .filter(|(_, b)| b.is_some())
+            .count()
+    } else {
+        0
+    };
+    if pairs > 0 {
+        format!("{prims} primitives, {pairs} parallelograms of 2 triangles tested as one")
+    } else {
+        format!("{prims} primitives")
+    }
+}
+
+fn inline_data_reason(
+    scene: &GpuScene,
+    options: PathTraceOptions,
+    included: bool,
+    all: bool,
+) -> String {
+    let m = scene.materials.len();
+    let lights = scene.lights.len();
+    let prims = scene.tri_positions.len() + scene.spheres.len();
+    let textured = scene.header.features & lumagraph_scene::FEATURE_TEXTURES != 0;
+    if included && all {
+        format!("{m} materials, {lights} lights, {prims} primitives' shading data")
+    } else if included && lights <= INLINE_MAX_MATERIALS {
+        format!(
+            "{m} materials, {lights} lights ({prims} primitives > {INLINE_MAX_PRIMITIVES}: \
+             their data read from buffers)"
+        )
+    } else if included {
+        format!("{m} materials ({lights} lights and {prims} primitives: read from buffers)")
+    } else if !options.specialize {
+        "general shader (specialization off)".to_owned()
+    } else if !options.cpu_adapter {
+        "a GPU adapter: read from buffers, with BVH traversal".to_owned()
+    } else if options.data_in_buffers {
+        "forced off: read from buffers".to_owned()
+    } else if textured {
+        "textured materials: read from buffers".to_owned()
+    } else if m > INLINE_MAX_MATERIALS {
+        format!("{m} materials > {INLINE_MAX_MATERIALS}: read from buffers")
+    } else {
+        "a value is not finite: read from buffers".to_owned()
+    }
+}
+
+/// Why texture sampling is (or is not) compiled in.
+fn textures_reason(scene: &GpuScene, all: bool) -> String {
+    let textured_materials = scene
+        .materials
+        .iter()
+        .filter(|x| {
+            [
+                x.tex_base_mr,
+                x.tex_emissive_normal,
+                x.tex_transmission_specular,
+                x.tex_specular_color,
+            ]
+            .iter()
+            .any(|&t| t & 0xFFFF != 0xFFFF || t >> 16 != 0xFFFF)
+        })
+        .count();
+    if all {
+        "general shader (specialization off)".to_owned()
+    } else if textured_materials > 0 {
+        format!(
+            "{textured_materials} textured materials, {} KiB of texels",
+            scene.textures.len() * 4 / 1024
+        )
+    } else {
+        "no material has a texture".to_owned()
+    }
+}
+
+/// Whether the host intersects the rays (`HOST_RAYS`), and why (not).
+fn host_rays_decision(scene: &GpuScene, options: PathTraceOptions, inline: bool) -> Decision {
+    let media = scene.materials.iter().any(|x| {
+        x.flags & (lumagraph_scene::MATERIAL_MEDIUM | lumagraph_scene::MATERIAL_INDEX_MATCHED) != 0
+    });
+    let (included, reason) = if !options.cpu_adapter || !options.specialize {
+        (
+            false,
+            "a GPU adapter or the general shader: traced in WGSL".to_owned(),
+        )
+    } else if inline {
+        (false, "intersected inline".to_owned())
+    } else if !options.host_rays {
+        (
+            false,
+            format!("no host intersector: {}", host_rays_unavailable()),
+        )
+    } else if scene.tri_positions.is_empty() || !scene.spheres.is_empty() {
+        (
+            false,
+            "spheres or no triangles: the host intersects triangles only".to_owned(),
+        )
+    } else if media {
+        (
+            false,
+            "participating media: shadow rays cross boundaries in WGSL".to_owned(),
+        )
+    } else if options.adaptive {
+        (false, "adaptive sampling: traced in WGSL".to_owned())
+    } else if scene.settings.max_bounces >= HOST_RAYS_MAX_BOUNCES {
+        (
+            false,
+            format!(
+                "{} bounces: a step keeps at most {HOST_RAYS_MAX_BOUNCES}",
+                scene.settings.max_bounces
+            ),
+        )
+    } else {
+        (
+            true,
+            format!(
+                "a CPU adapter: {} intersects the {} triangles on the host's threads, the WGSL shades",
+                crate::embree::Embree::load().map_or_else(|e| e, |e| e.version()),
+                scene.tri_positions.len()
+            ),
+        )
+    };
+    Decision { included, reason }
+}
+
+/// Why the host intersector is not used, for the plan.
+/// Host intersection's steps keep the bounce in 24 bits of a word (`save_slot` in the shader).
+const HOST_RAYS_MAX_BOUNCES: u32 = 1 << 24;
+
+fn host_rays_unavailable() -> String {
+    match crate::embree::Embree::load() {
+        Ok(_) => "WGSL intersection asked for".to_owned(),
+        Err(e) => e,
+    }
+}
