@@ -91,7 +91,7 @@ fn gpu_and_cpu_traversals_agree_on_100k_rays() {
         "{} triangles",
         gpu_scene.tri_positions.len()
     );
-    let buffers = SceneBuffers::upload(ctx, &gpu_scene);
+    let buffers = SceneBuffers::upload(ctx, &gpu_scene).unwrap();
     let rays = random_rays(100_000);
     let start = std::time::Instant::now();
     let gpu = Raycaster::new(ctx)

@@ -626,7 +626,7 @@ fn plan_lists_textures_for_textured_scenes_only() {
         let f = Features::decide(&scene, opts);
         let t = f.on(Feature::Textures);
         println!("{}: {t} ({})", path.display(), f.reason(Feature::Textures));
-        (t, scene.tri_texcoords.len(), scene.textures.len())
+        (t, scene.tri_texcoords.len(), scene.atlas.texels.len())
     };
     let (inc, tc, words) = on(&common::repo("assets/boxtextured.ron"));
     assert!(inc && tc == 12 && words > 4, "{inc} {tc} {words}");
@@ -736,7 +736,7 @@ fn material_override_drops_the_files_textures() {
     );
     assert!(scene.materials.iter().all(|m| !m.textures.any()));
     let g = GpuScene::build(&scene).unwrap();
-    assert!(g.textures.is_empty() && g.tri_texcoords.is_empty() && g.lights.is_empty());
+    assert!(g.atlas.texels.is_empty() && g.tri_texcoords.is_empty() && g.lights.is_empty());
 }
 
 // ---------------------------------------------------------------- GPU tests

@@ -37,9 +37,11 @@ struct RasterCamera {
 const NEAR: f32 = 1e-4;
 
 @group(0) @binding(0) var<uniform> cam: RasterCamera;
-// Materials and every texture (one zeroed stand-in each without textures).
+// Materials, where every texture is in the atlas, and the atlas (zeroed stand-ins, and a
+// 1x1 atlas, without textures).
 @group(0) @binding(1) var<storage, read> materials: array<Material>;
-@group(0) @binding(2) var<storage, read> textures: array<u32>;
+@group(0) @binding(2) var<storage, read> texture_descs: array<vec4u>;
+@group(0) @binding(3) var textures: texture_2d_array<f32>;
 
 struct VertexIn {
     @location(0) position: vec3f,

@@ -97,10 +97,11 @@ fn light_weight(light_pdf: f32, bsdf_pdf: f32) -> f32 {
 // Environment map texels (rgb radiance, a = pixel probability) and their alias table.
 @group(0) @binding(14) var<storage, read> env_texels: array<vec4f>;
 @group(0) @binding(15) var<storage, read> env_alias: array<AliasEntry>;
-// Texture coordinates and tangents per triangle, and every texture (see textures.wgsl); one
-// zeroed entry each when no material has a texture (HAS_TEXTURES off).
+// Texture coordinates and tangents per triangle, and where every texture is in the atlas
+// (`textures`, binding 23; see textures.wgsl); one zeroed entry each (and a 1x1 atlas) when no
+// material has a texture (HAS_TEXTURES off).
 @group(0) @binding(16) var<storage, read> tri_texcoords: array<TriTexcoords>;
-@group(0) @binding(17) var<storage, read> textures: array<u32>;
+@group(0) @binding(17) var<storage, read> texture_descs: array<vec4u>;
 // Adaptive sampling (ADAPTIVE), per pixel of the window: the sums (rgb) and frame counts (a)
 // of the even and of the odd frames, in that order, and whether `pathtrace/adaptive.wgsl`
 // stopped the pixel (16-byte stand-ins otherwise).
@@ -113,6 +114,8 @@ fn light_weight(light_pdf: f32, bsdf_pdf: f32) -> f32 {
 // With HOST_RAYS, the paths in flight and the rays the host intersects (a 16-byte stand-in
 // otherwise): see `wave_step`.
 @group(0) @binding(22) var<storage, read_write> wave: array<vec4<u32>>;
+// The texture atlas: every texture of the scene in the RGBA8 pages of one array texture.
+@group(0) @binding(23) var textures: texture_2d_array<f32>;
 
 #import "pathtrace/intersect.wgsl"
 #import "pathtrace/scene_data.wgsl"

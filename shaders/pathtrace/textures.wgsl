@@ -1,11 +1,14 @@
 // Texture sampling and textured materials, mirrored exactly by crates/scene/src/texture.rs.
-// The includer declares `textures: array<u32>` (every texture of the scene: 4 descriptor
-// words per texture, offset / width / height / flags, then RGBA8 texels, one word each) and
-// calls these only when HAS_TEXTURES.
+// The includer declares `textures: texture_2d_array<f32>` (the atlas: every texture of the
+// scene placed whole in one of its RGBA8 pages, crates/scene/src/texture.rs `pack_atlas`) and
+// `texture_descs: array<vec4u>` (per texture: x | y << 16 of its corner in its page, the
+// page, width | height << 16, flags), and calls these only when HAS_TEXTURES.
 //
 // Sampling is bilinear between the four texels around the point (texel centers at
 // (i + 0.5) / size), each decoded from sRGB first when asked; or the nearest texel when the
-// glTF sampler says NEAREST. UV (0, 0) is the image's top-left corner.
+// glTF sampler says NEAREST. UV (0, 0) is the image's top-left corner. Wrapping and
+// filtering are done here, texel by texel (`textureLoad`), so no texel of a neighbour in the
+// atlas is ever read.
 #import "pathtrace/scene_types.wgsl"
 #import "common/color.wgsl"
 
@@ -26,10 +29,11 @@ fn tex_wrap(i: i32, n: i32, mode: u32) -> i32 {
     return ((i % n) + n) % n;
 }
 
-fn tex_fetch(offset: u32, w: i32, h: i32, flags: u32, x: i32, y: i32, srgb: bool) -> vec4f {
-    let xi = tex_wrap(x, w, flags & 3u);
-    let yi = tex_wrap(y, h, (flags >> 2u) & 3u);
-    let c = unpack4x8unorm(textures[offset + u32(yi * w + xi)]);
+fn tex_fetch(d: vec4u, x: i32, y: i32, srgb: bool) -> vec4f {
+    let xi = tex_wrap(x, i32(d.z & 0xffffu), d.w & 3u);
+    let yi = tex_wrap(y, i32(d.z >> 16u), (d.w >> 2u) & 3u);
+    let at = vec2i(i32(d.x & 0xffffu) + xi, i32(d.x >> 16u) + yi);
+    let c = textureLoad(textures, at, i32(d.y), 0);
     if srgb {
         return vec4f(srgb_decode(c.rgb), c.a);
     }
@@ -38,24 +42,18 @@ fn tex_fetch(offset: u32, w: i32, h: i32, flags: u32, x: i32, y: i32, srgb: bool
 
 // The filtered texel of texture `id` at `uv`.
 fn tex_sample(id: u32, uv: vec2f, srgb: bool) -> vec4f {
-    let d = 4u * id;
-    let offset = textures[d];
-    let w = i32(textures[d + 1u]);
-    let h = i32(textures[d + 2u]);
-    let flags = textures[d + 3u];
-    let p = uv * vec2f(f32(w), f32(h));
-    if (flags & TEX_NEAREST) != 0u {
+    let d = texture_descs[id];
+    let p = uv * vec2f(f32(d.z & 0xffffu), f32(d.z >> 16u));
+    if (d.w & TEX_NEAREST) != 0u {
         let f = vec2i(floor(p));
-        return tex_fetch(offset, w, h, flags, f.x, f.y, srgb);
+        return tex_fetch(d, f.x, f.y, srgb);
     }
     let q = p - 0.5;
     let f = floor(q);
     let t = q - f;
     let i = vec2i(f);
-    let a = mix(tex_fetch(offset, w, h, flags, i.x, i.y, srgb),
-        tex_fetch(offset, w, h, flags, i.x + 1, i.y, srgb), t.x);
-    let b = mix(tex_fetch(offset, w, h, flags, i.x, i.y + 1, srgb),
-        tex_fetch(offset, w, h, flags, i.x + 1, i.y + 1, srgb), t.x);
+    let a = mix(tex_fetch(d, i.x, i.y, srgb), tex_fetch(d, i.x + 1, i.y, srgb), t.x);
+    let b = mix(tex_fetch(d, i.x, i.y + 1, srgb), tex_fetch(d, i.x + 1, i.y + 1, srgb), t.x);
     return mix(a, b, t.y);
 }
 

@@ -26,6 +26,8 @@ use crate::timing::GpuTimer;
 pub enum Binding {
     /// `texture_2d<f32>`, read with `textureLoad`.
     Texture,
+    /// `texture_2d_array<f32>`, read with `textureLoad`.
+    TextureArray,
     /// `texture_2d<f32>` or `texture_3d<f32>` in a shader that declares a filtering
     /// `sampler`: bound as filterable float (`rgba32float` needs the adapter's
     /// `FLOAT32_FILTERABLE`, which [`GpuContext`] asks for).
@@ -66,6 +68,11 @@ impl Binding {
                 view_dimension: dim,
                 multisampled: false,
             },
+            Self::TextureArray => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
             Self::Sampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
             Self::Texture3d => wgpu::BindingType::Texture {
                 sample_type: wgpu::TextureSampleType::Float { filterable: false },
@@ -94,6 +101,7 @@ impl Binding {
     fn builder_method(self) -> &'static str {
         match self {
             Self::Texture
+            | Self::TextureArray
             | Self::Texture3d
             | Self::FilteredTexture { .. }
             | Self::StorageTexture {
@@ -119,6 +127,54 @@ fn storage_format(format: naga::StorageFormat) -> Option<wgpu::TextureFormat> {
         S::Rgba8Unorm => T::Rgba8Unorm,
         S::R32Uint => T::R32Uint,
         _ => return None,
+    })
+}
+
+/// The binding of a texture of dimension `dim` (`arrayed` or not) and `class`, bound
+/// filterable where the shader has a sampler (`filtering`).
+fn image_binding(
+    dim: naga::ImageDimension,
+    arrayed: bool,
+    class: naga::ImageClass,
+    filtering: bool,
+) -> std::result::Result<Binding, String> {
+    let float = matches!(
+        class,
+        naga::ImageClass::Sampled {
+            kind: naga::ScalarKind::Float,
+            multi: false,
+        }
+    );
+    Ok(match (dim, arrayed, class) {
+        (naga::ImageDimension::D3, false, _) if float => {
+            if filtering {
+                Binding::FilteredTexture {
+                    dim: wgpu::TextureViewDimension::D3,
+                }
+            } else {
+                Binding::Texture3d
+            }
+        }
+        (naga::ImageDimension::D2, true, _) if float && !filtering => Binding::TextureArray,
+        (naga::ImageDimension::D2, false, _) if float && filtering => Binding::FilteredTexture {
+            dim: wgpu::TextureViewDimension::D2,
+        },
+        (naga::ImageDimension::D2, false, _) if float => Binding::Texture,
+        (naga::ImageDimension::D2, false, naga::ImageClass::Storage { format, access }) => {
+            Binding::StorageTexture {
+                format: storage_format(format)
+                    .ok_or_else(|| format!("storage format {format:?} is not supported"))?,
+                access: match (
+                    access.contains(naga::StorageAccess::LOAD),
+                    access.contains(naga::StorageAccess::STORE),
+                ) {
+                    (true, true) => wgpu::StorageTextureAccess::ReadWrite,
+                    (true, false) => wgpu::StorageTextureAccess::ReadOnly,
+                    _ => wgpu::StorageTextureAccess::WriteOnly,
+                },
+            }
+        }
+        _ => return Err("this kind of texture is not supported".to_owned()),
     })
 }
 
@@ -167,63 +223,13 @@ pub fn reflect(label: &str, source: &str) -> Result<(Vec<Binding>, [u32; 3])> {
             }
             (
                 naga::AddressSpace::Handle,
-                naga::TypeInner::Image {
-                    dim: naga::ImageDimension::D3,
-                    arrayed: false,
-                    class:
-                        naga::ImageClass::Sampled {
-                            kind: naga::ScalarKind::Float,
-                            multi: false,
-                        },
-                },
-            ) => {
-                if filtering {
-                    Binding::FilteredTexture {
-                        dim: wgpu::TextureViewDimension::D3,
-                    }
-                } else {
-                    Binding::Texture3d
-                }
-            }
-            (
-                naga::AddressSpace::Handle,
-                naga::TypeInner::Image {
-                    dim: naga::ImageDimension::D2,
-                    arrayed: false,
+                &naga::TypeInner::Image {
+                    dim,
+                    arrayed,
                     class,
                 },
-            ) => match *class {
-                naga::ImageClass::Sampled {
-                    kind: naga::ScalarKind::Float,
-                    multi: false,
-                } if filtering => Binding::FilteredTexture {
-                    dim: wgpu::TextureViewDimension::D2,
-                },
-                naga::ImageClass::Sampled {
-                    kind: naga::ScalarKind::Float,
-                    multi: false,
-                } => Binding::Texture,
-                naga::ImageClass::Storage { format, access } => Binding::StorageTexture {
-                    format: storage_format(format).ok_or_else(|| {
-                        err(format!(
-                            "`{name}`: storage format {format:?} is not supported"
-                        ))
-                    })?,
-                    access: match (
-                        access.contains(naga::StorageAccess::LOAD),
-                        access.contains(naga::StorageAccess::STORE),
-                    ) {
-                        (true, true) => wgpu::StorageTextureAccess::ReadWrite,
-                        (true, false) => wgpu::StorageTextureAccess::ReadOnly,
-                        _ => wgpu::StorageTextureAccess::WriteOnly,
-                    },
-                },
-                _ => {
-                    return Err(err(format!(
-                        "`{name}`: this kind of texture is not supported"
-                    )));
-                }
-            },
+            ) => image_binding(dim, arrayed, class, filtering)
+                .map_err(|message| err(format!("`{name}`: {message}")))?,
             (_, inner) => {
                 return Err(err(format!(
                     "`{name}` (binding {}): {inner:?} is not a supported binding",

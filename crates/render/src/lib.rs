@@ -54,7 +54,7 @@ pub use nodes::output::write_image as write_output;
 pub use nodes::{Counter, Measurement, Resources};
 pub use partial::Partial;
 pub use pool::{PooledTexture, TexturePool, create as create_texture, wgpu_format};
-pub use scene_gpu::SceneBuffers;
+pub use scene_gpu::{SceneBuffers, check_limits as check_scene_limits};
 pub use timing::GpuTimer;
 /// The wgpu this crate is built on (its types appear in [`Binding`] and [`GpuContext`]).
 pub use wgpu;

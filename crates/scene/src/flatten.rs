@@ -53,9 +53,9 @@ pub struct GpuScene {
     /// Texture coordinates and tangents per triangle, same order as `tri_positions`; empty
     /// when no material has a texture (buffer `tri_texcoords`).
     pub tri_texcoords: Vec<GpuTriTexcoords>,
-    /// Every texture a material uses, packed by [`crate::texture::pack_textures`]; empty
-    /// without textures (buffer `textures`).
-    pub textures: Vec<u32>,
+    /// Every texture a material uses, in one atlas ([`crate::texture::pack_atlas`]); empty
+    /// without textures (the array texture `textures` and buffer `texture_descs`).
+    pub atlas: crate::texture::TextureAtlas,
     /// Each texture's channel ranges, in the order of `textures` (CPU side only: the shader
     /// specializer leaves a lobe out only where no texel can produce it).
     pub texture_ranges: Vec<crate::texture::TexelRange>,
@@ -379,7 +379,7 @@ impl GpuScene {
         let textured = scene.materials.iter().any(|m| m.textures.any());
         check_textures(scene)?;
         if textured {
-            out.textures = crate::texture::pack_textures(&scene.textures);
+            out.atlas = crate::texture::pack_atlas(&scene.textures);
             out.texture_ranges = scene
                 .textures
                 .iter()

@@ -159,7 +159,7 @@ pub struct GpuSphere {
 }
 
 /// A material, 160 bytes (ten vec4s). Texture ids index the scene's textures (see
-/// [`crate::texture::pack_textures`]), 16 bits each, 0xFFFF = none; each texture multiplies
+/// [`crate::texture::pack_atlas`]), 16 bits each, 0xFFFF = none; each texture multiplies
 /// its factor.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]

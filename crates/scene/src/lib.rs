@@ -45,5 +45,5 @@ pub use scene::{
     Camera, LoadReport, Material, MaterialTextures, NO_TEXTURE, PunctualLight, Scene, Sphere,
     Triangle, cube_quads, push_triangle, quad_triangles, rectangle_quad, transform_triangle,
 };
-pub use texture::{TexelRange, Texture, Wrap};
+pub use texture::{TexelRange, Texture, TextureAtlas, Wrap, pack_atlas};
 pub use traverse::{Hit, Ray, intersect, intersect_within, occluded};

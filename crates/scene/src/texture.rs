@@ -8,9 +8,13 @@
 //! sampler's `magFilter` is `NEAREST`. There are no mipmaps: the path tracer averages many
 //! jittered samples per pixel, which filters minified textures.
 //!
-//! On the GPU all textures of a scene live in one storage buffer of `u32`s
-//! ([`pack_textures`]): [`TEXTURE_DESC_WORDS`] words of descriptor per texture, then the
-//! texels, one RGBA8 word each (R in the low byte, as `unpack4x8unorm` reads it).
+//! On the GPU all textures of a scene live in one 2D array texture of RGBA8 texels, an atlas
+//! ([`TextureAtlas`], [`pack_atlas`]): square pages of one size, each texture placed whole
+//! in one page, and one descriptor per texture saying where. The shader wraps and filters
+//! itself, reading texels with `textureLoad`, so no texel of one texture bleeds into
+//! another. An atlas holds what a device's 2D array textures can (pages up to its largest
+//! 2D texture side, as many as its array layers): far more than one storage buffer binding
+//! (128 MiB on many devices).
 
 use glam::{Vec2, Vec3, Vec4};
 
@@ -95,9 +99,6 @@ impl Texture {
     }
 }
 
-/// Words of descriptor per texture in the packed buffer: texel offset (in words), width,
-/// height, flags (bits 0–1 wrap S, bits 2–3 wrap T, bit 4 nearest).
-pub const TEXTURE_DESC_WORDS: usize = 4;
 /// Descriptor flag: nearest-texel lookup.
 pub const TEX_NEAREST: u32 = 16;
 /// The finest subdivision [`Texture::triangle_mean`] uses: at most 64² = 4096 samples.
@@ -183,20 +184,88 @@ impl Texture {
     }
 }
 
-/// All textures in one `u32` array: descriptors first, then the texels of each texture.
-pub fn pack_textures(textures: &[Texture]) -> Vec<u32> {
-    let head = textures.len() * TEXTURE_DESC_WORDS;
-    let total = head + textures.iter().map(|t| t.texels.len()).sum::<usize>();
-    let mut out = Vec::with_capacity(total);
-    let mut offset = head as u32;
-    for t in textures {
-        out.extend_from_slice(&[offset, t.width, t.height, t.flags()]);
-        offset += t.texels.len() as u32;
+/// Every texture of a scene placed in the pages of one 2D array texture.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct TextureAtlas {
+    /// The side of every page, in texels (a power of two at least as large as the largest
+    /// side of any texture); 0 without textures.
+    pub page_size: u32,
+    /// Pages (array layers).
+    pub pages: u32,
+    /// Per texture: where it is (x | y << 16 in its page), its page, its size
+    /// (width | height << 16) and its flags ([`Texture::flags`]).
+    pub descriptors: Vec<[u32; 4]>,
+    /// The pages' RGBA8 texels (R in the low byte), page after page, row by row from the
+    /// top; texels no texture covers are 0.
+    pub texels: Vec<u32>,
+}
+
+impl TextureAtlas {
+    /// Bytes of texels.
+    pub fn bytes(&self) -> u64 {
+        4 * self.texels.len() as u64
     }
-    for t in textures {
-        out.extend(t.texels.iter().map(|&c| u32::from_le_bytes(c)));
+}
+
+/// The smallest page side: pages of tiny textures are not made smaller than this.
+pub const ATLAS_MIN_PAGE: u32 = 256;
+
+/// Places `textures` in pages of one size (shelf packing, tallest first: textures whose sides
+/// are powers of two fill pages without gaps) and copies their texels there.
+pub fn pack_atlas(textures: &[Texture]) -> TextureAtlas {
+    if textures.is_empty() {
+        return TextureAtlas::default();
     }
-    out
+    let side = textures
+        .iter()
+        .map(|t| t.width.max(t.height))
+        .max()
+        .unwrap_or(1);
+    let page = side.next_power_of_two().max(ATLAS_MIN_PAGE);
+    let mut order: Vec<usize> = (0..textures.len()).collect();
+    order.sort_by_key(|&i| {
+        (
+            std::cmp::Reverse(textures[i].height),
+            std::cmp::Reverse(textures[i].width),
+            i,
+        )
+    });
+    // Shelves: rows of textures left to right; a new shelf under the last, a new page when
+    // the page is full.
+    let (mut p, mut x, mut y, mut shelf) = (0u32, 0u32, 0u32, 0u32);
+    let mut place = vec![(0u32, 0u32, 0u32); textures.len()];
+    for &i in &order {
+        let t = &textures[i];
+        if x + t.width > page {
+            (x, y, shelf) = (0, y + shelf, 0);
+        }
+        if y + t.height > page {
+            (p, x, y, shelf) = (p + 1, 0, 0, 0);
+        }
+        place[i] = (x, y, p);
+        x += t.width;
+        shelf = shelf.max(t.height);
+    }
+    let pages = p + 1;
+    let page_texels = page as usize * page as usize;
+    let mut texels = vec![0u32; page_texels * pages as usize];
+    let mut descriptors = Vec::with_capacity(textures.len());
+    for (t, &(x, y, p)) in textures.iter().zip(&place) {
+        descriptors.push([x | (y << 16), p, t.width | (t.height << 16), t.flags()]);
+        for row in 0..t.height as usize {
+            let src = &t.texels[row * t.width as usize..(row + 1) * t.width as usize];
+            let at = p as usize * page_texels + (y as usize + row) * page as usize + x as usize;
+            for (d, s) in texels[at..at + src.len()].iter_mut().zip(src) {
+                *d = u32::from_le_bytes(*s);
+            }
+        }
+    }
+    TextureAtlas {
+        page_size: page,
+        pages,
+        descriptors,
+        texels,
+    }
 }
 
 /// The tangents of a triangle at its corners (xyz unit and orthogonal to the corner's

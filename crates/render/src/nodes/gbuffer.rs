@@ -98,11 +98,15 @@ impl GBuffer {
             bytemuck::cast_slice(&scene.materials),
             true,
         );
-        let textures = storage(
-            "gbuffer textures",
-            bytemuck::cast_slice(&scene.textures),
+        let texture_descs = storage(
+            "gbuffer texture descriptors",
+            bytemuck::cast_slice(&scene.atlas.descriptors),
             textured,
         );
+        if textured {
+            crate::scene_gpu::check_limits(&scene, &ctx.device.limits(), &ctx.info.name)?;
+        }
+        let textures = crate::scene_gpu::atlas_texture(ctx, &scene);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer"),
             layout: &layout,
@@ -117,7 +121,11 @@ impl GBuffer {
                 },
                 wgpu::BindGroupEntry {
                     binding: 2,
-                    resource: textures.as_entire_binding(),
+                    resource: texture_descs.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&textures),
                 },
             ],
         });
@@ -139,7 +147,7 @@ impl GBuffer {
 }
 
 /// The raster pipeline of `source` (the resolved G-buffer shader) and its bind group layout
-/// (camera uniform, materials, textures).
+/// (camera uniform, materials, texture descriptors, the texture atlas).
 fn pipeline(
     ctx: &GpuContext,
     source: String,
@@ -165,6 +173,16 @@ fn pipeline(
             },
             storage_entry(1),
             storage_entry(2),
+            wgpu::BindGroupLayoutEntry {
+                binding: 3,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                    multisampled: false,
+                },
+                count: None,
+            },
         ],
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

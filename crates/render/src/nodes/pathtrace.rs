@@ -341,7 +341,7 @@ impl PathTrace {
             create(ctx, "unused depth", TexFormat::R32Float, one),
             create(ctx, "unused samples", TexFormat::Rgba32Float, one),
         ];
-        let buffers = SceneBuffers::upload(ctx, &scene);
+        let buffers = SceneBuffers::upload(ctx, &scene)?;
         let frame = uniform_buffer(
             ctx,
             "pathtrace frame",
@@ -470,12 +470,13 @@ impl PathTrace {
             .buffer(&self.env.texels)
             .buffer(&self.env.alias)
             .buffer(&b.tri_texcoords)
-            .buffer(&b.textures)
+            .buffer(&b.texture_descs)
             .buffer(&self.adaptive.halves)
             .buffer(&self.adaptive.stopped)
             .buffer(&self.adaptive.active)
             .buffer(sums)
             .buffer(wave)
+            .read(&b.textures)
     }
 
     /// Records a frame traced with host intersection: the steps of its paths are

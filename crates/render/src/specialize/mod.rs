@@ -180,8 +180,11 @@ fn textures_reason(scene: &GpuScene, all: bool) -> String {
         "general shader (specialization off)".to_owned()
     } else if textured_materials > 0 {
         format!(
-            "{textured_materials} textured materials, {} KiB of texels",
-            scene.textures.len() * 4 / 1024
+            "{textured_materials} textured materials, {} KiB of texels in {} atlas pages of {}x{}",
+            scene.atlas.bytes() / 1024,
+            scene.atlas.pages,
+            scene.atlas.page_size,
+            scene.atlas.page_size
         )
     } else {
         "no material has a texture".to_owned()

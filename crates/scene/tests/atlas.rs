@@ -1,0 +1,93 @@
+//! The texture atlas: every texture placed whole in a page, none overlapping, its texels
+//! copied where its descriptor says (GPU-free).
+
+use lumagraph_scene::{Texture, Wrap, pack_atlas};
+
+fn texture(i: usize, width: u32, height: u32) -> Texture {
+    Texture {
+        name: format!("t{i}"),
+        width,
+        height,
+        texels: (0..width * height)
+            .map(|k| (k + 977 * i as u32).to_le_bytes())
+            .collect(),
+        wrap: [Wrap::Repeat, Wrap::ClampToEdge],
+        nearest: i.is_multiple_of(3),
+    }
+}
+
+/// Textures of 61 sizes (1×1 to 700×300, powers of two and not), in the order given.
+#[test]
+fn every_texture_lands_whole_in_one_page_and_none_overlap() {
+    let textures: Vec<Texture> = (0..61)
+        .map(|i| {
+            let (w, h) = match i % 4 {
+                0 => (1 << (i % 10), 1 << ((i / 2) % 10)),
+                1 => (1 + (i as u32 * 37) % 700, 1 + (i as u32 * 13) % 300),
+                2 => (64, 64),
+                _ => (3, 250),
+            };
+            texture(i, w, h)
+        })
+        .collect();
+    let atlas = pack_atlas(&textures);
+    let page = atlas.page_size;
+    assert!(page.is_power_of_two() && page >= 700, "page {page}");
+    assert_eq!(atlas.descriptors.len(), textures.len());
+    assert_eq!(
+        atlas.texels.len(),
+        (page * page * atlas.pages) as usize,
+        "texels"
+    );
+    let rect = |d: &[u32; 4]| (d[0] & 0xFFFF, d[0] >> 16, d[1], d[2] & 0xFFFF, d[2] >> 16);
+    for (i, (t, d)) in textures.iter().zip(&atlas.descriptors).enumerate() {
+        let (x, y, p, w, h) = rect(d);
+        assert_eq!((w, h), (t.width, t.height), "texture {i}'s size");
+        assert!(
+            x + w <= page && y + h <= page && p < atlas.pages,
+            "texture {i} out of its page"
+        );
+        assert_eq!(d[3], t.flags(), "texture {i}'s flags");
+        for (k, texel) in t.texels.iter().enumerate() {
+            let (tx, ty) = (k as u32 % w, k as u32 / w);
+            let at = (p * page * page + (y + ty) * page + x + tx) as usize;
+            assert_eq!(
+                atlas.texels[at],
+                u32::from_le_bytes(*texel),
+                "texture {i} texel {k}"
+            );
+        }
+        for (j, e) in atlas.descriptors.iter().enumerate().skip(i + 1) {
+            let (x2, y2, p2, w2, h2) = rect(e);
+            let apart = p != p2 || x + w <= x2 || x2 + w2 <= x || y + h <= y2 || y2 + h2 <= y;
+            assert!(apart, "textures {i} and {j} overlap");
+        }
+    }
+    // Shelf packing keeps pages reasonably full: at most twice the texels in pages.
+    let used: u64 = textures.iter().map(|t| u64::from(t.width * t.height)).sum();
+    assert!(
+        atlas.texels.len() as u64 <= 2 * used + u64::from(page * page),
+        "{} texels in pages for {used}",
+        atlas.texels.len()
+    );
+}
+
+/// Powers of two fill pages without gaps: one texture of 2048², 20 of 1024² and 8 of 512²
+/// take 7 pages of 2048² (one for the largest, 5 full of 1024² ones, one holding the 512²
+/// ones).
+#[test]
+fn power_of_two_textures_fill_their_pages() {
+    let mut textures: Vec<Texture> = (0..20).map(|i| texture(i, 1024, 1024)).collect();
+    textures.extend((20..28).map(|i| texture(i, 512, 512)));
+    textures.push(texture(28, 2048, 2048));
+    let atlas = pack_atlas(&textures);
+    assert_eq!(atlas.page_size, 2048);
+    // 2048² + 20 × 1024² + 8 × 512² = 1 + 5 + 0.5 pages.
+    assert_eq!(atlas.pages, 7);
+}
+
+#[test]
+fn no_textures_no_pages() {
+    let atlas = pack_atlas(&[]);
+    assert_eq!((atlas.pages, atlas.texels.len()), (0, 0));
+}
