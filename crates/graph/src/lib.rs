@@ -5,6 +5,7 @@
 //! - [`group`]: graph files used as nodes, flattened before compiling.
 //! - [`compile`]: validation, topological order, pruning and texture assignment,
 //!   giving a [`Plan`] that the render crate executes.
+//! - [`outputs`]: where the files a plan writes go (inside the output folder).
 //!
 //! Everything here runs anywhere in microseconds, so it is tested without a GPU.
 
@@ -15,6 +16,7 @@ mod error;
 mod graph;
 pub mod group;
 pub mod layout;
+pub mod outputs;
 mod plan;
 pub mod registry;
 pub mod tile;
