@@ -2,7 +2,9 @@
 //! `--out`: an Output path that is absolute, climbs out with `..` or leaves through a
 //! symbolic link is refused before anything is rendered, with one error naming the node,
 //! the path and the folder, and nothing is written anywhere; `--allow-outputs-outside`
-//! lets it. `render`, `merge` of partial renders and `merge` of tile sets alike.
+//! lets it. `render`, `merge` of partial renders and `merge` of tile sets alike. The
+//! files it names are read only when they are regular files (a device would be read
+//! without end).
 //!
 //! Each test renders into a folder a few levels inside a temporary parent, so that an
 //! escaping path lands inside the parent and the test can see it.
@@ -210,4 +212,62 @@ fn merges_refuse_escaping_paths_unless_allowed() {
         std::fs::remove_file(written).unwrap();
         let _ = std::fs::remove_dir_all(&merged);
     }
+}
+
+/// A device named where a graph names a file (a declared kind's `.wgsl`, a group file, a
+/// LUT) is refused at once, not read without end.
+#[cfg(unix)]
+#[test]
+fn a_device_named_as_a_file_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let wgsl = dir.path().join("wgsl.ron");
+    std::fs::write(
+        &wgsl,
+        r#"(
+    version: 2,
+    kinds: [(name: "Z", inputs: [(name: "color")], outputs: [(name: "color")], wgsl: "/dev/zero")],
+    nodes: [],
+)"#,
+    )
+    .unwrap();
+    let group = dir.path().join("group.ron");
+    std::fs::write(
+        &group,
+        r#"(version: 3, groups: [(name: "Z", file: "/dev/zero")], nodes: [])"#,
+    )
+    .unwrap();
+    for g in [&wgsl, &group] {
+        let stderr = fails(&["validate", s(g)]);
+        assert!(
+            stderr.contains("/dev/zero") && stderr.contains("not a regular file"),
+            "{stderr}"
+        );
+    }
+    if common::gpu().is_none() {
+        return;
+    }
+    let graph = dir.path().join("lut.ron");
+    let chart = common::repo("assets/test_chart.exr");
+    std::fs::write(
+        &graph,
+        format!(
+            r#"(
+    version: 1,
+    nodes: [
+        (id: "input", kind: "ImageInput", params: {{"path": {:?}}}),
+        (id: "lut", kind: "LUT", params: {{"path": "/dev/zero"}}),
+        (id: "out", kind: "Output", params: {{"path": "x.exr"}}),
+    ],
+    edges: [(from: "input.color", to: "lut.color"), (from: "lut.color", to: "out.color")],
+)"#,
+            chart.display().to_string()
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let stderr = fails(&["render", s(&graph), "--out", s(&out)]);
+    assert!(
+        stderr.contains("node \"lut\"") && stderr.contains("not a regular file"),
+        "{stderr}"
+    );
 }
