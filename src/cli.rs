@@ -94,6 +94,10 @@ enum Command {
         #[arg(long, value_name = "START..END", value_parser = split::parse_range,
               conflicts_with_all = ["spp", "resume", "checkpoint", "checkpoint_every", "tile"])]
         samples: Option<split::SampleRange>,
+        /// Let the graph's Output paths be absolute or climb out of `--out` (by default
+        /// they are refused: docs/security.md).
+        #[arg(long)]
+        allow_outputs_outside: bool,
     },
     /// Merge partial renders (`render --samples`) of one graph and scene into what a single
     /// render of all their samples writes: checks that they belong together, sums them
@@ -117,6 +121,10 @@ enum Command {
         /// Merge ranges that leave samples out (by default a gap is an error).
         #[arg(long)]
         allow_gaps: bool,
+        /// Let the graph's Output paths be absolute or climb out of `--out` (by default
+        /// they are refused: docs/security.md).
+        #[arg(long)]
+        allow_outputs_outside: bool,
     },
     /// Print the compiled plan: passes in order, textures and shared memory, what is left out.
     #[command(after_help = "Example:\n  lumagraph plan graphs/post_tonemap.ron")]
@@ -321,6 +329,7 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
     let plan = args
         .library
         .compile(&graph, &[], scene.as_ref().map(|s| &*s.gpu))?;
+    crate::graph::outputs::output_files(&plan, &graph, args.out, args.outputs_anywhere)?;
     let progressive = uses_scene(&plan);
     if scene.is_some() && !progressive {
         println!("scene not used: no node of this graph renders a scene");
@@ -330,6 +339,7 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
     let resources = Resources {
         base_dir: graph.base_dir(),
         out_dir: args.out.to_owned(),
+        outputs_anywhere: args.outputs_anywhere,
         scene: scene.as_ref().map(|s| Arc::clone(&s.gpu)),
         ..Resources::default()
     };
@@ -452,6 +462,8 @@ struct RenderArgs<'a> {
     samples: Option<split::SampleRange>,
     /// `--tiles`.
     tiles: Option<split::SampleRange>,
+    /// `--allow-outputs-outside`.
+    outputs_anywhere: bool,
 }
 
 /// `lumagraph plan`: the plan, node-owned memory, and the shader features per pass.
@@ -557,6 +569,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             tile,
             tiles,
             samples,
+            allow_outputs_outside,
         } => render(&RenderArgs {
             library,
             graph: &graph,
@@ -573,6 +586,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             tile,
             tiles,
             samples,
+            outputs_anywhere: allow_outputs_outside,
         }),
         Command::Merge {
             partials,
@@ -580,6 +594,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             graph,
             scene,
             allow_gaps,
+            allow_outputs_outside,
         } => split::merge(&split::MergeArgs {
             library,
             partials: &partials,
@@ -587,6 +602,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             graph: graph.as_deref(),
             scene: scene.as_deref(),
             allow_gaps,
+            outputs_anywhere: allow_outputs_outside,
         }),
         Command::Plan {
             graph,
@@ -650,15 +666,18 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             library,
         }),
         Command::Export { scene, out } => export(&scene, &out),
-        Command::TestChart { out } => {
-            let chart = image_io::test_chart();
-            let bytes = image_io::encode_exr(&chart, true)?;
-            crate::graph::write_atomic(&out, &bytes)
-                .with_context(|| format!("cannot write {}", out.display()))?;
-            println!("wrote {}", out.display());
-            Ok(())
-        }
+        Command::TestChart { out } => test_chart(&out),
     }
+}
+
+/// `lumagraph test-chart`: the generated HDR test chart written to `out`.
+fn test_chart(out: &Path) -> Result<()> {
+    let chart = image_io::test_chart();
+    let bytes = image_io::encode_exr(&chart, true)?;
+    crate::graph::write_atomic(out, &bytes)
+        .with_context(|| format!("cannot write {}", out.display()))?;
+    println!("wrote {}", out.display());
+    Ok(())
 }
 
 /// Mesa's Vulkan device-select layer, loaded with every Vulkan instance, asks Wayland for

@@ -146,6 +146,68 @@ fn several_outputs_and_an_optional_input() {
     assert_eq!(out[3], want_flipped, "one.shifted");
 }
 
+/// A declared kind's WGSL runs with the runtime bounds checks wgpu compiles into every
+/// shader (naga's `Restrict` policy for arrays, and for image loads where the driver has
+/// no robust image access of its own): a table indexed far past its end and before its
+/// start, an input read a million pixels outside the image (directly, not through the
+/// clamping `load_<input>`) and a store far outside the output neither crash the device
+/// nor read or write outside their memory. Each index is clamped to the table's last
+/// element (4.0, where memory past the table would hold anything); the far read gives
+/// zero (robust image access) or the clamped edge texel, and the stray store is dropped
+/// (every pixel is what `node` returned).
+#[test]
+fn out_of_bounds_indices_in_a_declared_kind_stay_in_bounds() {
+    let kinds = r#"        (
+            name: "Peek",
+            inputs: [(name: "color")],
+            outputs: [(name: "color")],
+            code: r"
+fn node(pixel: vec2u, size: vec2u) -> vec4f {
+    var table = array<f32, 4>(1.0, 2.0, 3.0, 4.0);
+    let past = table[pixel.x * 1000u + pixel.y + 4u];
+    let before = table[i32(pixel.y) - 1000000];
+    let far = textureLoad(color, vec2i(pixel) + vec2i(1000000, -1000000), 0);
+    textureStore(out_color, vec2i(-5, 1000000) - vec2i(pixel), vec4f(99.0));
+    return vec4f(past, before, far.x, far.w);
+}
+",
+        ),"#;
+    let dir = tempfile::tempdir().unwrap();
+    let chart = repo(CHART).display().to_string();
+    let body = format!(
+        r#"    nodes: [
+        (id: "in", kind: "ImageInput", params: {{"path": "{chart}"}}),
+        (id: "peek", kind: "Peek"),
+    ],
+    edges: [(from: "in.color", to: "peek.color")],"#
+    );
+    let path = write(dir.path(), "g.ron", &graph_text(kinds, &body));
+    let Some(out) = run(&path, &["peek.color"]) else {
+        return;
+    };
+    let image = image_io::load(&repo(CHART)).unwrap();
+    assert_eq!(out[0].pixels.len(), image.pixels.len());
+    // Restrict clamps (x + 1e6, y - 1e6) to the top right texel.
+    let edge = image.pixels[image.width as usize - 1];
+    let allowed = [[0.0, 0.0], [0.0, 1.0], [edge[0], edge[3]]];
+    let mut far_kinds = std::collections::BTreeSet::new();
+    for (i, p) in out[0].pixels.iter().enumerate() {
+        assert_eq!(
+            [p[0], p[1]],
+            [4.0, 4.0],
+            "pixel {i}: a table read out of bounds"
+        );
+        let far = [p[2], p[3]];
+        let k = allowed.iter().position(|a| *a == far);
+        assert!(
+            k.is_some(),
+            "pixel {i}: far read gave {far:?}, not one of {allowed:?}"
+        );
+        far_kinds.extend(k);
+    }
+    eprintln!("far reads gave {far_kinds:?} of {allowed:?}");
+}
+
 #[test]
 fn the_shipped_example_renders() {
     if common::gpu().is_none() {

@@ -11,6 +11,9 @@
 //! otherwise takes a new one, printed). A failure writes the smallest input found under
 //! `target/fuzz-failures/`.
 //!
+//! Generated graphs (random kinds, edges and params, declared kinds, groups, escaping
+//! output paths) go through compile and render in `tests/fuzz_graphs.rs`.
+//!
 //! `tests/corpus/` holds broken files (and every input that once made a loader panic); each
 //! goes through its loader in [`corpus_files_load_without_panicking`], and the ones the CLI
 //! takes through `lumagraph render` in [`render_refuses_the_corpus_with_an_error`].

@@ -123,6 +123,8 @@ pub(super) struct MergeArgs<'a> {
     pub graph: Option<&'a Path>,
     pub scene: Option<&'a Path>,
     pub allow_gaps: bool,
+    /// `--allow-outputs-outside`.
+    pub outputs_anywhere: bool,
 }
 
 /// `merge`: the partial renders checked, merged and run through the rest of the graph.
@@ -133,7 +135,7 @@ pub(super) fn merge(args: &MergeArgs<'_>) -> Result<()> {
         .filter(|p| crate::render::tile_set::TileSet::is_tile_set(p))
         .count();
     if sets == args.partials.len() {
-        return super::tiled::merge_tiles(args.partials, args.out);
+        return super::tiled::merge_tiles(args.partials, args.out, args.outputs_anywhere);
     }
     if sets > 0 {
         bail!(
@@ -170,6 +172,7 @@ pub(super) fn merge(args: &MergeArgs<'_>) -> Result<()> {
     let plan = args
         .library
         .compile(&graph, &[], scene.as_ref().map(|s| &*s.gpu))?;
+    crate::graph::outputs::output_files(&plan, &graph, args.out, args.outputs_anywhere)?;
     let ctx = GpuContext::headless()?;
     println!("adapter: {}", ctx.describe());
     for (path, p) in &parts {
@@ -186,6 +189,7 @@ pub(super) fn merge(args: &MergeArgs<'_>) -> Result<()> {
     let resources = Resources {
         base_dir: graph.base_dir(),
         out_dir: args.out.to_owned(),
+        outputs_anywhere: args.outputs_anywhere,
         scene: scene.as_ref().map(|s| Arc::clone(&s.gpu)),
         ..Resources::default()
     };

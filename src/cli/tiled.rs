@@ -250,8 +250,8 @@ fn report(exec: &Executor, tiling: &Tiling, image: Extent, frames: u32, wall: Du
 }
 
 /// `merge` of tile sets (`render --tiles`): checked, assembled, each output written as the
-/// whole tiled render writes it.
-pub(super) fn merge_tiles(paths: &[PathBuf], out: &Path) -> Result<()> {
+/// whole tiled render writes it (inside `out` unless `anywhere`).
+pub(super) fn merge_tiles(paths: &[PathBuf], out: &Path, anywhere: bool) -> Result<()> {
     let start = Instant::now();
     let mut sets = Vec::new();
     for path in paths {
@@ -265,15 +265,24 @@ pub(super) fn merge_tiles(paths: &[PathBuf], out: &Path) -> Result<()> {
         )
     })?;
     let whole = sets[0].1.image;
-    std::fs::create_dir_all(out)
-        .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", out.display()))?;
     let resources = Resources {
         out_dir: out.to_owned(),
+        outputs_anywhere: anywhere,
         ..Resources::default()
     };
+    // Every path checked before anything is written (the tile sets name them).
+    let files = images
+        .iter()
+        .map(|image| {
+            resources
+                .output(&image.path)
+                .map_err(|e| anyhow::anyhow!("node \"{}\": {e}", image.node))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    std::fs::create_dir_all(out)
+        .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", out.display()))?;
     let mut written = Vec::new();
-    for image in images {
-        let file = resources.output(&image.path);
+    for (image, file) in images.into_iter().zip(files) {
         crate::render::write_output(&file, image.bytes, image.format, image.ty, whole)
             .map_err(|e| anyhow::anyhow!("node \"{}\": {e}", image.node))?;
         written.push(file);

@@ -60,6 +60,8 @@ pub struct Progress {
     pub spp: u32,
     /// Time since the start (frozen when it ends).
     pub elapsed: Duration,
+    /// The files it writes (each Output path resolved in the folder), once compiled.
+    pub files: Vec<PathBuf>,
     /// How it ended: the files written, or why not.
     pub finished: Option<Result<Vec<PathBuf>, String>>,
 }
@@ -191,11 +193,15 @@ fn run(
             dir.clone()
         }
         Target::Port { port, file } => {
+            // The file the user chose: its folder is the output folder.
+            let name = file
+                .file_name()
+                .ok_or_else(|| format!("{} names no file", file.display()))?;
             graph.remove_sinks(&registry);
             let mut out = Node::new(PORT_OUTPUT, "Output");
             out.params.insert(
                 "path".into(),
-                ParamValue::Str(file.to_string_lossy().into_owned()),
+                ParamValue::Str(name.to_string_lossy().into_owned()),
             );
             graph.nodes.push(out);
             graph
@@ -210,6 +216,11 @@ fn run(
     if !plan.passes.iter().any(|p| p.kind.sink) {
         return Err("the graph has no Output node: nothing to write".into());
     }
+    // The graph's Output paths stay in the folder, as `lumagraph render` keeps them; the
+    // files are shown before anything is written.
+    let files = lumagraph_graph::outputs::output_files(&plan, &graph, &out_dir, false)
+        .map_err(|e| e.to_string())?;
+    set(&|s| s.files = files.iter().map(|f| f.path.clone()).collect());
     let resources = Resources {
         base_dir: base,
         out_dir,

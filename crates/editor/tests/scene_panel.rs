@@ -266,6 +266,12 @@ fn render_to_file_writes_the_full_resolution_image() {
     }
     let p = h.state().render_job.as_ref().unwrap().progress();
     let files = p.finished.clone().unwrap().expect("written");
+    // The files shown while it rendered are those written.
+    let mut shown = p.files.clone();
+    shown.sort();
+    let mut sorted = files.clone();
+    sorted.sort();
+    assert_eq!(shown, sorted);
     assert_eq!(p.done, p.frames);
     // pathtrace.ron: 4 samples per frame.
     assert_eq!((p.frames, p.spp), (2, 8));
@@ -326,6 +332,49 @@ fn a_render_without_outputs_says_why() {
     assert!(job.wait(Duration::from_secs(120)));
     let err = job.progress().finished.unwrap().unwrap_err();
     assert!(err.contains("no output node"), "{err}");
+}
+
+/// An Output path that climbs out of the folder Render to file writes into is refused,
+/// naming the node, the path and the folder, and nothing is written (as `lumagraph
+/// render` refuses it).
+#[test]
+fn an_output_outside_the_folder_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some((mut ed, _)) = cornell_editor(dir.path()) else {
+        return;
+    };
+    let id = ed
+        .doc
+        .graph
+        .nodes
+        .iter()
+        .find(|n| n.kind == "Output")
+        .map(|n| n.id.clone())
+        .unwrap();
+    ed.doc.set_param(
+        &id,
+        "path",
+        lumagraph_graph::ParamValue::Str("../escaped.png".into()),
+    );
+    let out = dir.path().join("out");
+    ed.render_form.dir = out.display().to_string();
+    ed.render_form.spp = 1;
+    assert!(ed.start_render());
+    let job = ed.render_job.as_ref().unwrap();
+    assert!(job.wait(Duration::from_secs(120)));
+    let err = job.progress().finished.unwrap().unwrap_err();
+    assert!(
+        err.contains(&format!("node \"{id}\""))
+            && err.contains("\"../escaped.png\" is outside the output folder")
+            && err.contains(&out.display().to_string()),
+        "{err}"
+    );
+    assert!(!dir.path().join("escaped.png").exists());
+    assert!(is_empty_dir(&out), "nothing written in the folder");
+}
+
+fn is_empty_dir(dir: &Path) -> bool {
+    std::fs::read_dir(dir).map_or(true, |mut d| d.next().is_none())
 }
 
 /// A lost GPU device (here destroyed, as a driver reset would lose it) does not end the

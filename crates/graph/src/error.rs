@@ -139,6 +139,9 @@ pub enum ErrorKind {
     /// A source node could not tell its image size.
     #[error("{0}")]
     Source(String),
+    /// An output path leaves the output folder.
+    #[error("{0}")]
+    OutsideOutput(crate::outputs::OutsideOutput),
 }
 
 /// One error with its location.

@@ -228,7 +228,7 @@ impl Graph {
     /// When the file cannot be read or is not a valid graph file; the error names the file
     /// and the line and column.
     pub fn load(path: &Path) -> Result<Self, GraphError> {
-        let text = std::fs::read_to_string(path).map_err(|source| GraphError {
+        let text = read_text(path).map_err(|source| GraphError {
             file: Some(path.to_owned()),
             ..GraphError::new(ErrorKind::Io {
                 action: "cannot read graph file",
@@ -387,6 +387,22 @@ impl Graph {
         }
         e
     }
+}
+
+/// The text of the regular file at `path`. A path a file names (a group file, a kind's
+/// `.wgsl`, a LUT) may be a device or a pipe, which would be read without end: only
+/// regular files (or links to them) are read.
+///
+/// # Errors
+/// When `path` is not a regular file, or cannot be read as UTF-8 text.
+pub fn read_text(path: &Path) -> std::io::Result<String> {
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() {
+        return Err(std::io::Error::other(
+            "not a regular file (a folder, a device or a pipe)",
+        ));
+    }
+    std::fs::read_to_string(path)
 }
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename,

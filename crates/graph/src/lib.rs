@@ -5,6 +5,7 @@
 //! - [`group`]: graph files used as nodes, flattened before compiling.
 //! - [`compile`]: validation, topological order, pruning and texture assignment,
 //!   giving a [`Plan`] that the render crate executes.
+//! - [`outputs`]: where the files a plan writes go (inside the output folder).
 //!
 //! Everything here runs anywhere in microseconds, so it is tested without a GPU.
 
@@ -15,6 +16,7 @@ mod error;
 mod graph;
 pub mod group;
 pub mod layout;
+pub mod outputs;
 mod plan;
 pub mod registry;
 pub mod tile;
@@ -22,7 +24,7 @@ mod types;
 
 pub use compile::{CompileOptions, Params, compile, resolve_params};
 pub use error::{ErrorKind, GraphError, GraphErrors, Pos};
-pub use graph::{Edge, Graph, Node, Origin, VERSION, split_port_ref, write_atomic};
+pub use graph::{Edge, Graph, Node, Origin, VERSION, read_text, split_port_ref, write_atomic};
 pub use plan::{LeftOut, Pass, Plan, Slot, TextureDesc, TextureId};
 pub use registry::{Category, NodeKind, Registry};
 pub use types::{Extent, ParamType, ParamValue, PortType, TexFormat};

@@ -167,7 +167,8 @@ pub enum ParamType {
         options: &'static [(&'static str, &'static str)],
     },
     /// A file path; relative paths are resolved against the graph file's folder
-    /// (inputs) or the output folder (outputs).
+    /// (inputs) or the output folder (outputs, which must stay inside it:
+    /// [`crate::outputs`]).
     Path {
         /// Value when the file does not set one.
         default: &'static str,

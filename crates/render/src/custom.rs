@@ -163,7 +163,7 @@ fn declared_kind(graph: &Graph, decl: &KindDecl) -> Result<NodeKind, GraphError>
     let code = if decl.code.trim().is_empty() {
         {
             let file = graph.base_dir().join(&decl.wgsl);
-            let text = std::fs::read_to_string(&file).map_err(|e| {
+            let text = lumagraph_graph::read_text(&file).map_err(|e| {
                 at_decl(graph, decl, format!("cannot read {}: {e}", file.display()))
             })?;
             Code {

@@ -71,6 +71,9 @@ pub enum RenderError {
     /// A node kind has no GPU implementation in this build.
     #[error("node kind {0} has no implementation")]
     Unimplemented(String),
+    /// An output path leaves the output folder (a path from a graph or tile set file).
+    #[error("{0}")]
+    OutsideOutput(#[from] lumagraph_graph::outputs::OutsideOutput),
     /// A node kind could not be added to a [`NodeLibrary`](crate::NodeLibrary); the
     /// message names it.
     #[error("{0}")]

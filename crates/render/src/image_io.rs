@@ -18,10 +18,16 @@ fn extension(path: &Path) -> String {
         .to_ascii_lowercase()
 }
 
+/// The file is there and is a regular file (a device or a pipe would be read without end).
 fn check_exists(path: &Path) -> Result<()> {
-    std::fs::metadata(path)
-        .map(|_| ())
-        .map_err(|e| RenderError::image(path, format!("cannot open image: {e}")))
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => Ok(()),
+        Ok(_) => Err(RenderError::image(
+            path,
+            "cannot open image: not a regular file (a folder, a device or a pipe)",
+        )),
+        Err(e) => Err(RenderError::image(path, format!("cannot open image: {e}"))),
+    }
 }
 
 /// The size of an image file, read from its header only.

@@ -39,7 +39,13 @@ pub fn raw(name: &str) -> Result<String> {
     if name == crate::shared::FILE {
         return Ok(crate::shared::wgsl());
     }
-    if let Some(dir) = disk_dir()
+    // Only names inside the folder: an `#import` of a kind declared in a graph file names
+    // a shader, never another file on disk.
+    let inside = std::path::Path::new(name)
+        .components()
+        .all(|c| matches!(c, std::path::Component::Normal(_)));
+    if inside
+        && let Some(dir) = disk_dir()
         && let Ok(text) = std::fs::read_to_string(dir.join(name))
     {
         return Ok(text);
@@ -95,5 +101,25 @@ fn shader_error(e: lumagraph_wgsl::ImportError) -> RenderError {
     RenderError::Shader {
         name: e.file,
         message: e.message,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// A name that leaves `shaders/` is no shader, in debug builds (which read the folder
+    /// on disk) as in release builds: a declared kind's `#import "../Cargo.toml"` reads
+    /// nothing.
+    #[test]
+    fn only_files_inside_the_shader_folder_are_read() {
+        assert!(super::raw("common/color.wgsl").is_ok());
+        for name in [
+            "../Cargo.toml",
+            "../../Cargo.toml",
+            "common/../../Cargo.toml",
+        ] {
+            assert!(super::raw(name).is_err(), "{name} was read");
+        }
+        let abs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("Cargo.toml");
+        assert!(super::raw(abs.to_str().unwrap()).is_err());
     }
 }

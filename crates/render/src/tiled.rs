@@ -186,7 +186,8 @@ pub fn render(
             Canvas {
                 node: pass.node.clone(),
                 param: pass.params.str("path").to_owned(),
-                path: crate::nodes::output::output_path(pass, resources),
+                path: crate::nodes::output::output_path(pass, resources)
+                    .map_err(|e| e.in_node(&pass.node))?,
                 bytes: Vec::new(),
                 image: None,
             },

@@ -157,3 +157,28 @@ fn mirrored_transform_keeps_front_side() {
         assert!(close(t.normal(), Vec3::NEG_Y, 1e-6), "{}", t.normal());
     }
 }
+
+/// An OBJ whose `mtllib` names a device (which would be read without end) loads without
+/// materials, saying why.
+#[cfg(unix)]
+#[test]
+fn an_mtllib_naming_a_device_is_not_read() {
+    let obj = std::env::temp_dir().join(format!("lumagraph-mtllib-{}.obj", std::process::id()));
+    std::fs::write(
+        &obj,
+        "mtllib /dev/zero\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let m = import_mesh(&obj, Mat4::IDENTITY);
+    let _ = std::fs::remove_file(&obj);
+    let m = m.unwrap();
+    assert_eq!(m.triangles.len(), 1);
+    assert!(
+        m.report
+            .warnings
+            .iter()
+            .any(|w| w.contains("/dev/zero is not a file")),
+        "{:?}",
+        m.report.warnings
+    );
+}

@@ -262,7 +262,11 @@ impl Editor {
             Some(Err(e)) => {
                 ui.colored_label(RED, e);
             }
-            None => {}
+            None => {
+                for f in &p.files {
+                    ui.label(format!("writing {}", f.display()));
+                }
+            }
         }
     }
 

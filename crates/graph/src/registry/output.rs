@@ -22,7 +22,7 @@ fn output() -> NodeKind {
                 default: "out.png",
                 extensions: &["png", "exr"],
             },
-            doc: "file to write, relative to the output folder (`--out`)",
+            doc: "file to write, relative to the output folder (`--out`) and inside it",
         }],
         sink: true,
         history: false,

@@ -129,7 +129,7 @@ impl Lut {
     /// # Errors
     /// When it cannot be read, or as [`Lut::parse`].
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| RenderError::image(path, e))?;
+        let text = lumagraph_graph::read_text(path).map_err(|e| RenderError::image(path, e))?;
         Self::parse(&text, path)
     }
 

@@ -32,8 +32,12 @@ use crate::timing::GpuTimer;
 pub struct Resources {
     /// Folder input paths are relative to (the graph file's folder).
     pub base_dir: PathBuf,
-    /// Folder output paths are relative to.
+    /// Folder output paths are relative to; they must stay inside it (see
+    /// [`lumagraph_graph::outputs`]) unless `outputs_anywhere` is set.
     pub out_dir: PathBuf,
+    /// Write output paths that are absolute or leave `out_dir` as they are, instead of
+    /// refusing them (`lumagraph render --allow-outputs-outside`).
+    pub outputs_anywhere: bool,
     /// The scene, flattened, for nodes that render one.
     pub scene: Option<Arc<lumagraph_scene::GpuScene>>,
     /// Use the general shaders even where a scene-specialized one exists (benchmarks).
@@ -105,9 +109,17 @@ impl Resources {
         self.base_dir.join(p)
     }
 
-    /// An output path resolved against the output folder.
-    pub fn output(&self, p: &str) -> PathBuf {
-        self.out_dir.join(p)
+    /// An output path resolved against the output folder, inside it unless
+    /// `outputs_anywhere` is set ([`lumagraph_graph::outputs::resolve_output`]).
+    ///
+    /// # Errors
+    /// [`RenderError::OutsideOutput`] for a path that leaves the output folder.
+    pub fn output(&self, p: &str) -> Result<PathBuf> {
+        Ok(lumagraph_graph::outputs::resolve_output(
+            &self.out_dir,
+            p,
+            self.outputs_anywhere,
+        )?)
     }
 }
 

@@ -37,14 +37,14 @@ impl Output {
         Ok(node)
     }
 
-    fn path(&self, pass: &Pass) -> PathBuf {
+    fn path(&self, pass: &Pass) -> Result<PathBuf> {
         output_path(pass, &self.paths)
     }
 }
 
 impl NodeExec for Output {
     fn update(&mut self, _ctx: &GpuContext, pass: &Pass) -> Result<()> {
-        check_writable(&self.path(pass))
+        check_writable(&self.path(pass)?)
     }
 
     fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
@@ -112,14 +112,17 @@ impl NodeExec for Output {
         let Some(image) = self.held_image(ctx)? else {
             return Ok(Vec::new());
         };
-        let path = self.path(pass);
+        let path = self.path(pass)?;
         write_image(&path, image.bytes, image.format, image.ty, image.extent)?;
         Ok(vec![path])
     }
 }
 
 /// The file an `Output` node writes of `pass` (its `path` param, relative to `out_dir`).
-pub(crate) fn output_path(pass: &Pass, resources: &Resources) -> PathBuf {
+///
+/// # Errors
+/// A path that leaves the output folder ([`Resources::output`]).
+pub(crate) fn output_path(pass: &Pass, resources: &Resources) -> Result<PathBuf> {
     resources.output(pass.params.str("path"))
 }
 

@@ -32,6 +32,11 @@ pub fn import_obj(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneErr
     let mtl_problem = RefCell::new(None);
     let (models, materials) = tobj::load_obj_buf(&mut text.as_slice(), &options, |mtl: &Path| {
         let mtl_path = base.join(mtl);
+        // `mtllib` may name a device or a pipe, which would be read without end.
+        if std::fs::metadata(&mtl_path).is_ok_and(|m| !m.is_file()) {
+            *mtl_problem.borrow_mut() = Some(format!("{} is not a file", mtl_path.display()));
+            return Err(tobj::LoadError::OpenFileFailed);
+        }
         let text = std::fs::read(&mtl_path).map_err(|_| tobj::LoadError::OpenFileFailed)?;
         if let Some(problem) = check_mtl(&text) {
             *mtl_problem.borrow_mut() = Some(format!("{}: {problem}", mtl_path.display()));
