@@ -422,37 +422,7 @@ type Check<T> = Arc<dyn Fn(T) -> Result<(), String> + Send + Sync>;
 /// is left behind: the test fails anyway).
 fn guarded<T: Send + 'static>(check: &Check<T>, input: T) -> Result<Result<(), String>, String> {
     let check = Arc::clone(check);
-    let (tx, rx) = std::sync::mpsc::channel();
-    let handle = std::thread::Builder::new()
-        .name("fuzz case".into())
-        .stack_size(32 << 20)
-        .spawn(move || {
-            let result = check(input);
-            let _ = tx.send(result);
-        })
-        .unwrap();
-    match rx.recv_timeout(CASE_LIMIT) {
-        Ok(result) => {
-            let _ = handle.join();
-            Ok(result)
-        }
-        Err(std::sync::mpsc::RecvTimeoutError::Timeout) => Err(format!(
-            "hang: the case did not finish within {} s",
-            CASE_LIMIT.as_secs()
-        )),
-        Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
-            let payload = handle.join().err();
-            let message = payload
-                .as_ref()
-                .and_then(|p| {
-                    p.downcast_ref::<&str>()
-                        .map(|s| (*s).to_owned())
-                        .or_else(|| p.downcast_ref::<String>().cloned())
-                })
-                .unwrap_or_default();
-            Err(format!("panic: {message}"))
-        }
-    }
+    common::guarded(CASE_LIMIT, move || check(input))
 }
 
 /// Where a failing input is written.

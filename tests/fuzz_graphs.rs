@@ -207,36 +207,7 @@ fn render(graph: &Path, out: &Path, scene: bool) -> Result<Outcome, String> {
 
 /// Runs `case` on a thread of its own: `Err` for a panic, a hang or a violated property.
 fn guarded(case: Case) -> Result<Outcome, String> {
-    let (tx, rx) = std::sync::mpsc::channel();
-    let handle = std::thread::Builder::new()
-        .name("fuzz case".into())
-        .stack_size(32 << 20)
-        .spawn(move || {
-            let _ = tx.send(run_case(&case));
-        })
-        .unwrap();
-    match rx.recv_timeout(CASE_LIMIT) {
-        Ok(result) => {
-            let _ = handle.join();
-            result
-        }
-        Err(std::sync::mpsc::RecvTimeoutError::Timeout) => Err(format!(
-            "hang: the case did not finish within {} s",
-            CASE_LIMIT.as_secs()
-        )),
-        Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
-            let payload = handle.join().err();
-            let message = payload
-                .as_ref()
-                .and_then(|p| {
-                    p.downcast_ref::<&str>()
-                        .map(|s| (*s).to_owned())
-                        .or_else(|| p.downcast_ref::<String>().cloned())
-                })
-                .unwrap_or_default();
-            Err(format!("panic: {message}"))
-        }
-    }
+    common::guarded(CASE_LIMIT, move || run_case(&case))?
 }
 
 /// `LUMAGRAPH_FUZZ_GRAPH_CASES`, else [`DEFAULT_CASES`]; the seed: `LUMAGRAPH_FUZZ_SEED`,

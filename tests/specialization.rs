@@ -4,7 +4,8 @@
 //!
 //! Each scene is the Cornell box or the sphere furnace with every material drawn at random
 //! (metallic, transmission, specular and diffuse roughness each 0, 1 or between; roughness,
-//! IOR and colours between) and random textures given to some of them: metallic-roughness,
+//! IOR and colours between; opaque, alpha-masked or blended) and random textures given to
+//! some of them: metallic-roughness,
 //! transmission, specular and specular-colour textures whose channels are constant (0 or 255)
 //! or spread, so a factor of 1 or 0 can be lowered per texel, or not. The first scene holds
 //! the case that once rendered black: glass (transmission 1) with a metallic factor of 1
@@ -21,7 +22,7 @@ use lumagraph::graph::{Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
 use lumagraph::render::specialize::{Feature, Features};
 use lumagraph::render::{Executor, Resources, compile};
-use lumagraph::scene::{GpuScene, NO_TEXTURE, Scene, Texture, Wrap};
+use lumagraph::scene::{AlphaMode, GpuScene, NO_TEXTURE, Scene, Texture, Wrap};
 
 /// A small deterministic generator (`SplitMix64`), so a failing case can be rerun by its seed.
 struct Rng(u64);
@@ -73,23 +74,46 @@ fn random_texture(rng: &mut Rng, name: String) -> Texture {
         texels,
         wrap: [Wrap::Repeat; 2],
         nearest: false,
+        uv_set: 0,
+        transform: lumagraph::scene::UvTransform::IDENTITY,
     }
 }
 
-/// `scene` with its materials drawn at random and textures given to some; the triangles get
-/// UVs from their positions. Each of metallic, transmission, specular and diffuse
+/// `scene` with its materials drawn at random and textures given to some (reading either UV
+/// set, some through a transform); the triangles get two UV sets from their positions, and
+/// in half the scenes half of them random vertex colours. Each of metallic, transmission, specular and diffuse
 /// roughness is allowed in a scene with probability 0.6, else 0 in all its materials. `glass_case`: the first material is metallic 1, transmission 1
 /// with a metallic-roughness texture whose metallic (blue) channel spreads over [0, 255].
 fn randomize(scene: &mut Scene, rng: &mut Rng, glass_case: bool) {
+    let colored = rng.chance(0.5);
     for t in &mut scene.triangles {
         t.uvs = Some(
             t.positions
                 .map(|p| Vec2::new(p.x + 0.37 * p.z, p.y - 0.21 * p.z)),
         );
+        t.uvs1 = Some(t.positions.map(|p| Vec2::new(0.5 * p.z - p.y, p.x)));
+        // Vertex colours on some triangles, their alpha cutting or blending too.
+        if colored && rng.chance(0.5) {
+            t.colors = Some(std::array::from_fn(|_| {
+                std::array::from_fn(|_| (rng.next() % 256) as u8)
+            }));
+        }
     }
     let textures = 3 + (rng.next() % 3) as usize;
     scene.textures = (0..textures)
-        .map(|i| random_texture(rng, format!("random {i}")))
+        .map(|i| {
+            let mut t = random_texture(rng, format!("random {i}"));
+            // Some read the second UV set, some through a transform.
+            t.uv_set = u32::from(rng.chance(0.3));
+            if rng.chance(0.3) {
+                t.transform = lumagraph::scene::UvTransform::khr(
+                    [rng.f(), rng.f()],
+                    6.0 * rng.f(),
+                    [0.5 + 2.0 * rng.f(), 0.5 + 2.0 * rng.f()],
+                );
+            }
+            t
+        })
         .collect();
     let pick = |rng: &mut Rng, p: f32| {
         if rng.chance(p) {
@@ -121,6 +145,14 @@ fn randomize(scene: &mut Scene, rng: &mut Rng, glass_case: bool) {
         m.textures.transmission = pick(rng, 0.3);
         m.textures.specular = pick(rng, 0.25);
         m.textures.specular_color = pick(rng, 0.2);
+        // Alpha: masked or blended, by a factor and the base colour texture's alpha.
+        m.alpha_mode = match rng.next() % 4 {
+            0 => AlphaMode::Mask { cutoff: rng.f() },
+            1 => AlphaMode::Blend,
+            _ => AlphaMode::Opaque,
+        };
+        m.opacity = if rng.chance(0.5) { 1.0 } else { rng.f() };
+        m.textures.base_color = pick(rng, 0.4);
     }
     if glass_case && let Some(m) = scene.materials.first_mut() {
         m.metallic = 1.0;
@@ -128,16 +160,18 @@ fn randomize(scene: &mut Scene, rng: &mut Rng, glass_case: bool) {
         m.roughness = 0.3;
         m.textures.transmission = NO_TEXTURE;
         let mut mr = random_texture(rng, "metallic 0 to 1".into());
-        for (i, t) in mr.texels.iter_mut().enumerate() {
+        let mut texels = mr.texels.to_vec();
+        for (i, t) in texels.iter_mut().enumerate() {
             t[2] = (i * 17) as u8;
         }
+        mr.texels = texels.into();
         scene.textures.push(mr);
         m.textures.metallic_roughness = scene.textures.len() as u32 - 1;
     }
 }
 
 /// Frames of each shader, and the significance of the comparison of their block means.
-const FRAMES: u32 = 24;
+const FRAMES: u32 = 16;
 const SPP_PER_FRAME: i64 = 4;
 const ALPHA: f64 = 1e-3;
 
@@ -183,11 +217,12 @@ fn frames(scene: &GpuScene, general: bool, seed: u32) -> Option<(Vec<Image>, Fea
 /// tenth of the bounces off a material with `specular: 0`, whose value is 0, where the
 /// specialized one samples the diffuse base alone), a second general render with another
 /// seed must have the same 8×8-block means: Welch's t-test on every block and channel over
-/// 24 independent frames of 4 spp each, at overall significance 1e-3 (Bonferroni). Also
+/// 16 independent frames of 4 spp each, at overall significance 1e-3 (Bonferroni). Also
 /// asserted: each lobe is left out in some scene, and the first scene keeps the glass lobe.
 #[test]
 fn specialized_shaders_render_what_the_general_shader_renders() {
     let mut left_out_somewhere = std::collections::BTreeSet::new();
+    let mut alpha_somewhere = false;
     let mut identical = 0;
     for seed in 0..16u32 {
         let base = if seed % 2 == 0 {
@@ -209,6 +244,7 @@ fn specialized_shaders_render_what_the_general_shader_renders() {
                 left_out_somewhere.insert(f.label());
             }
         }
+        alpha_somewhere |= features.on(Feature::Alpha);
         if seed == 0 {
             assert!(
                 features.on(Feature::GlassLobe),
@@ -245,11 +281,13 @@ fn specialized_shaders_render_what_the_general_shader_renders() {
     println!(
         "{identical} of 16 scenes bit-identical; left out in some scene: {left_out_somewhere:?}"
     );
+    assert!(alpha_somewhere, "no scene needs the alpha test");
     for f in [
         Feature::SpecularLobe,
         Feature::GlassLobe,
         Feature::MetalLobe,
         Feature::RoughDiffuse,
+        Feature::Alpha,
     ] {
         assert!(
             left_out_somewhere.contains(f.label()),

@@ -49,9 +49,11 @@ fn constant(i: usize, side: u32, c: [u8; 4]) -> Texture {
         name: format!("constant {i}"),
         width: side,
         height: side,
-        texels: vec![c; (side * side) as usize],
+        texels: vec![c; (side * side) as usize].into(),
         wrap: [Wrap::Repeat; 2],
         nearest: false,
+        uv_set: 0,
+        transform: lumagraph::scene::UvTransform::IDENTITY,
     }
 }
 

@@ -13,12 +13,17 @@
 // exact normal and depth, so silhouettes and normals match the ray tracer's.
 // With textures (HAS_TEXTURES), fragments of textured materials take their albedo and normal
 // through the path tracer's own functions (pathtrace/textures.wgsl) at the interpolated UV.
+// With HAS_ALPHA, fragments of alpha-masked materials whose opacity (times the base colour
+// texture's alpha) is below the cutoff are discarded, as the path tracer's any-hit test cuts
+// them out (pathtrace/alpha.wgsl); blended ones are discarded with probability 1 - opacity,
+// drawn per pixel and material (the path tracer draws per ray and primitive).
 // Outputs: albedo (base color; alpha 2 on emissive materials, 1 on others, which Denoise uses
 // to keep lights and lit surfaces apart), shading normal, distance along the ray; 0 where
 // nothing is hit.
 #import "pathtrace/scene_types.wgsl"
 #import "pathtrace/textures.wgsl"
 #import "gbuffer/options.wgsl"
+#import "common/rng.wgsl"
 
 struct RasterCamera {
     position: vec3f,
@@ -40,7 +45,7 @@ const NEAR: f32 = 1e-4;
 // Materials, where every texture is in the atlas, and the atlas (zeroed stand-ins, and a
 // 1x1 atlas, without textures).
 @group(0) @binding(1) var<storage, read> materials: array<Material>;
-@group(0) @binding(2) var<storage, read> texture_descs: array<vec4u>;
+@group(0) @binding(2) var<storage, read> texture_descs: array<TexDesc>;
 @group(0) @binding(3) var textures: texture_2d_array<f32>;
 
 struct VertexIn {
@@ -49,10 +54,13 @@ struct VertexIn {
     @location(2) albedo: vec3f,
     // Sphere center and radius; for a triangle, its unit geometric normal and 0.
     @location(3) sphere: vec4f,
-    @location(4) uv: vec2f,
+    // Both UV sets (set 0 in xy).
+    @location(4) uv: vec4f,
     // Tangent (xyz) and handedness (w, corner 0's on every corner).
     @location(5) tangent: vec4f,
     @location(6) material: u32,
+    // Vertex colour, decoded (white without).
+    @location(7) color: vec4f,
 }
 
 struct VertexOut {
@@ -61,9 +69,10 @@ struct VertexOut {
     @location(1) normal: vec3f,
     @location(2) @interpolate(flat) albedo: vec3f,
     @location(3) @interpolate(flat) sphere: vec4f,
-    @location(4) uv: vec2f,
+    @location(4) uv: vec4f,
     @location(5) tangent: vec4f,
     @location(6) @interpolate(flat) material: u32,
+    @location(7) color: vec4f,
 }
 
 @vertex
@@ -91,6 +100,7 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.uv = v.uv;
     out.tangent = v.tangent;
     out.material = v.material;
+    out.color = v.color;
     return out;
 }
 
@@ -109,9 +119,34 @@ fn pixel_ray(xy: vec2f) -> vec3f {
         - (2.0 * u.y - 1.0) * cam.tan_half_fov * cam.up);
 }
 
+// Whether the fragment's surface stops the pixel's ray (see HAS_ALPHA above).
+fn opaque_here(f: VertexOut) -> bool {
+    let m = materials[f.material];
+    if (m.flags & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) == 0u {
+        return true;
+    }
+    var alpha = m.opacity;
+    let tex = tex_lo(m.tex_base_mr);
+    if HAS_TEXTURES && f.sphere.w <= 0.0 {
+        alpha *= f.color.a;
+        if tex != NO_TEX {
+            alpha *= tex_sample(tex, f.uv, false).a;
+        }
+    }
+    if (m.flags & MATERIAL_ALPHA_MASK) != 0u {
+        return alpha >= m.alpha_cutoff;
+    }
+    let px = vec2u(f.clip.xy + cam.window.xy);
+    let h = pcg_hash(px.x ^ pcg_hash(px.y ^ pcg_hash(f.material)));
+    return f32(h >> 8u) * INV_2_24 < alpha;
+}
+
 @fragment
 fn fs_main(f: VertexOut) -> FragmentOut {
     let dir = pixel_ray(f.clip.xy);
+    if HAS_ALPHA && !opaque_here(f) {
+        discard;
+    }
     var out: FragmentOut;
     let flag = select(1.0, 2.0, any(materials[f.material].emission > vec3f(0.0)));
     out.albedo = vec4f(f.albedo, flag);
@@ -141,7 +176,7 @@ fn fs_main(f: VertexOut) -> FragmentOut {
         // A zero interpolated normal falls back to the geometric one, as in the path tracer.
         var ns = select(f.sphere.xyz, normalize(n), dot(n, n) > 0.0);
         if HAS_TEXTURES {
-            let m = textured_material(materials[f.material], f.uv);
+            let m = textured_material(materials[f.material], f.uv, f.color);
             out.albedo = vec4f(m.base_color, flag);
             ns = normal_mapped(m, ns, f.sphere.xyz, f.uv, f.tangent);
         }

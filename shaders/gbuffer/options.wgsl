@@ -4,3 +4,6 @@
 
 // Some material has a texture: textured albedo and normal maps compiled in.
 const HAS_TEXTURES: bool = true;
+
+// Some material is alpha-masked or blended: its cut-out fragments are discarded.
+const HAS_ALPHA: bool = true;

@@ -6,7 +6,8 @@
 //   var<storage, read> tri_positions: array<TriPositions>;
 //   var<storage, read> spheres: array<Sphere>;
 // and the constants HAS_TRIANGLES and HAS_SPHERES (false where the scene has none of them:
-// that leaf test is left out).
+// that leaf test is left out), and HAS_ALPHA with the any-hit tests `triangle_hit_counts` and
+// `sphere_hit_counts` (alpha.wgsl; always true where HAS_ALPHA is false).
 // Hits count for 0 < t < t_max; callers offset ray origins off surfaces.
 //
 // `bvh_nodes` holds one 64-byte record per node (4 vec4s): the BvhNode (aabb_min, index;
@@ -45,7 +46,9 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                 for (var i = first; i < first + count; i = i + 1u) {
                     let tri = tri_positions[i];
                     let r = intersect_triangle(ray.origin, ray.dir, tri.v0, tri.e1, tri.e2, hit.t);
-                    if (r.x != 0.0 && i != skip_prim) {
+                    // The any-hit test only for triangles whose material needs it (the
+                    // flag rides in the record just read).
+                    if (r.x != 0.0 && i != skip_prim && (!HAS_ALPHA || (tri.flags & TRI_ALPHA) == 0u || triangle_hit_counts(i, r.z, r.w, ray))) {
                         hit = Hit(i, r.y, r.z, r.w);
                         if (any_hit) {
                             return hit;
@@ -56,7 +59,7 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                 for (var i = first; i < first + count; i = i + 1u) {
                     let s = spheres[i];
                     let t = intersect_sphere_from(i | PRIM_SPHERE, ray.origin, ray.dir, s.center, s.radius, hit.t);
-                    if (t > 0.0) {
+                    if (t > 0.0 && (!HAS_ALPHA || sphere_hit_counts(i, ray))) {
                         hit = Hit(i | PRIM_SPHERE, t, 0.0, 0.0);
                         if (any_hit) {
                             return hit;

@@ -41,6 +41,10 @@ const HAS_ROUGH_DIFFUSE: bool = true;
 // compiled in.
 const HAS_MEDIA: bool = true;
 
+// Some material is alpha-masked or blended (and can be seen through): every intersector
+// runs the any-hit test of alpha.wgsl.
+const HAS_ALPHA: bool = true;
+
 // The host intersects the rays (CPU adapters with Embree, scenes of triangles without
 // media): each dispatch takes every path one step, between the host's answers (`wave_step`
 // in pathtrace.wgsl), instead of tracing whole paths.

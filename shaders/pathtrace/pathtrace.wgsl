@@ -101,7 +101,7 @@ fn light_weight(light_pdf: f32, bsdf_pdf: f32) -> f32 {
 // (`textures`, binding 23; see textures.wgsl); one zeroed entry each (and a 1x1 atlas) when no
 // material has a texture (HAS_TEXTURES off).
 @group(0) @binding(16) var<storage, read> tri_texcoords: array<TriTexcoords>;
-@group(0) @binding(17) var<storage, read> texture_descs: array<vec4u>;
+@group(0) @binding(17) var<storage, read> texture_descs: array<TexDesc>;
 // Adaptive sampling (ADAPTIVE), per pixel of the window: the sums (rgb) and frame counts (a)
 // of the even and of the odd frames, in that order, and whether `pathtrace/adaptive.wgsl`
 // stopped the pixel (16-byte stand-ins otherwise).
@@ -119,6 +119,7 @@ fn light_weight(light_pdf: f32, bsdf_pdf: f32) -> f32 {
 
 #import "pathtrace/intersect.wgsl"
 #import "pathtrace/scene_data.wgsl"
+#import "pathtrace/alpha.wgsl"
 #import "pathtrace/medium.wgsl"
 
 const RR_START: u32 = 5u;
@@ -136,8 +137,10 @@ struct Surface {
     light: u32,
     // Componentwise bound on the rounding error of `p` (triangles; 0 on spheres).
     err: vec3f,
-    // Texture coordinates (HAS_TEXTURES; 0 on spheres).
-    uv: vec2f,
+    // Texture coordinates, set 0 in xy and set 1 in zw (HAS_TEXTURES; 0 on spheres).
+    uv: vec4f,
+    // Vertex colour (HAS_TEXTURES; white on spheres).
+    color: vec4f,
 }
 
 // Rounding error bounds of a point computed as v0 + u e1 + v e2 in f32: a float step of each
@@ -160,7 +163,8 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
     var s: Surface;
     s.p = ray.origin + hit.t * ray.dir;
     s.err = vec3f(0.0);
-    s.uv = vec2f(0.0);
+    s.uv = vec4f(0.0);
+    s.color = vec4f(1.0);
     if is_sphere(hit.prim) {
         let sph = scene_sphere(hit.prim & ~PRIM_SPHERE);
         s.ng = normalize(s.p - sph.center);
@@ -185,6 +189,7 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
         if HAS_TEXTURES {
             let tc = tri_texcoords[hit.prim];
             s.uv = tri_uv(tc, hit.u, hit.v);
+            s.color = tri_color(tc, hit.u, hit.v);
             s.ns = normal_mapped(scene_material(sh.material), s.ns, s.ng, s.uv, tri_tangent(tc, hit.u, hit.v));
         }
     }
@@ -549,7 +554,7 @@ fn path_step_from(first_hit: Hit, may_miss: bool) -> bool {
         skip_prim = hit.prim;
         var mat = scene_material(s.material);
         if HAS_TEXTURES {
-            mat = textured_material(mat, s.uv);
+            mat = textured_material(mat, s.uv, s.color);
         }
         if HAS_MEDIA && (mat.flags & MATERIAL_INDEX_MATCHED) != 0u {
             // No surface: the ray goes on into or out of the medium, and this is no
@@ -856,7 +861,7 @@ fn first_hit_aovs(at: vec2u) {
             var m = scene_material(s.material);
             flag = select(1.0, 2.0, any(m.emission > vec3f(0.0)));
             if HAS_TEXTURES {
-                m = textured_material(m, s.uv);
+                m = textured_material(m, s.uv, s.color);
             }
             albedo = m.base_color;
             normal = s.ns;

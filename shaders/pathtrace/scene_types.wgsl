@@ -15,6 +15,12 @@ const MATERIAL_CONDUCTOR: u32 = 2u;
 const MATERIAL_SINGLE_SCATTER: u32 = 4u;
 const MATERIAL_MEDIUM: u32 = 8u;
 const MATERIAL_INDEX_MATCHED: u32 = 16u;
+// The surface is cut out where its opacity is below `alpha_cutoff` (alpha.wgsl); a ray passes
+// through it with probability 1 - opacity.
+const MATERIAL_ALPHA_MASK: u32 = 32u;
+const MATERIAL_ALPHA_BLEND: u32 = 64u;
+// TriPositions::flags: the triangle's material is alpha-masked or blended.
+const TRI_ALPHA: u32 = 1u;
 const LIGHT_SPHERE: u32 = 1u;
 const LIGHT_TWO_SIDED: u32 = 2u;
 const LIGHT_POINT: u32 = 4u;
@@ -34,6 +40,7 @@ const FEATURE_ENVIRONMENT: u32 = 8u;
 const FEATURE_LIGHTS: u32 = 16u;
 const FEATURE_METAL: u32 = 32u;
 const FEATURE_MEDIA: u32 = 64u;
+const FEATURE_ALPHA: u32 = 128u;
 
 // BVH node, 32 bytes. Depth-first order: an inner node's first child is the next node.
 //   bits 0-1: split axis (inner); bit 2: leaf kind (1 = spheres, 0 = triangles);
@@ -52,7 +59,8 @@ const NODE_COUNT_SHIFT: u32 = 3u;
 // Triangle intersection data, 48 bytes: corner 0 and the edges to corners 1 and 2.
 struct TriPositions {
     v0: vec3<f32>,
-    pad0: u32,
+    // TRI_ALPHA: the triangle's material takes the any-hit test (alpha.wgsl).
+    flags: u32,
     e1: vec3<f32>,
     pad1: u32,
     e2: vec3<f32>,
@@ -98,11 +106,13 @@ struct Material {
     tex_specular_color: u32,
     // Roughness of the diffuse base: 0 Lambertian, else energy-preserving Oren-Nayar (EON).
     diffuse_roughness: f32,
-    pad1: u32,
+    // Opacity, times the base colour texture's alpha (MATERIAL_ALPHA_MASK, _BLEND).
+    opacity: f32,
     // Complex index of refraction of a conductor (MATERIAL_CONDUCTOR), and its metal
     // lobe's cosine-weighted average Fresnel reflectance.
     eta: vec3<f32>,
-    pad2: u32,
+    // MATERIAL_ALPHA_MASK's cutoff.
+    alpha_cutoff: f32,
     k: vec3<f32>,
     pad3: u32,
     f_avg: vec3<f32>,
@@ -115,16 +125,30 @@ struct Material {
     pad5: u32,
 }
 
-// A triangle's tangents (xyz, w = handedness) and UVs at its corners, 80 bytes, same index as
-// TriPositions; only present when some material has a texture.
+// A triangle's tangents (xyz, w = handedness), UVs (two sets) and vertex colours (RGBA8, R in
+// the low byte, RGB sRGB-encoded; white without) at its corners, 112 bytes, same index as
+// TriPositions; only present when some material has a texture or some triangle a colour.
 struct TriTexcoords {
     t0: vec4<f32>,
     t1: vec4<f32>,
     t2: vec4<f32>,
     uv01: vec4<f32>,
     uv2: vec2<f32>,
+    uv1_2: vec2<f32>,
+    uv1_01: vec4<f32>,
+    colors: vec3<u32>,
     pad0: u32,
-    pad1: u32,
+}
+
+// Where a texture's texels are in the atlas (x | y << 16 of its corner in its page, the page,
+// width | height << 16, flags) and how a material reads it: coordinate set `uv_set` through
+// uv' = u * m.xy + v * m.zw + offset (KHR_texture_transform), 48 bytes.
+struct TexDesc {
+    place: vec4<u32>,
+    m: vec4<f32>,
+    offset: vec2<f32>,
+    uv_set: u32,
+    pad: u32,
 }
 
 // Emissive triangle (p0, e1, e2) or sphere (center p0, radius e1.x), 64 bytes, or a light

@@ -1,14 +1,16 @@
 // Texture sampling and textured materials, mirrored exactly by crates/scene/src/texture.rs.
-// The includer declares `textures: texture_2d_array<f32>` (the atlas: every texture of the
+// The includer declares `textures: texture_2d_array<f32>` (the atlas: every image of the
 // scene placed whole in one of its RGBA8 pages, crates/scene/src/texture.rs `pack_atlas`) and
-// `texture_descs: array<vec4u>` (per texture: x | y << 16 of its corner in its page, the
-// page, width | height << 16, flags), and calls these only when HAS_TEXTURES.
+// `texture_descs: array<TexDesc>` (per texture: where its image is, its wrap and filter, and
+// which coordinates it reads through which transform), and calls these only when
+// HAS_TEXTURES.
 //
-// Sampling is bilinear between the four texels around the point (texel centers at
-// (i + 0.5) / size), each decoded from sRGB first when asked; or the nearest texel when the
-// glTF sampler says NEAREST. UV (0, 0) is the image's top-left corner. Wrapping and
-// filtering are done here, texel by texel (`textureLoad`), so no texel of a neighbour in the
-// atlas is ever read.
+// A point's coordinates come as one vec4f: set 0 (TEXCOORD_0) in xy, set 1 in zw. Each
+// texture picks its set and maps it (KHR_texture_transform) before the lookup. Sampling is
+// bilinear between the four texels around the point (texel centers at (i + 0.5) / size),
+// each decoded from sRGB first when asked; or the nearest texel when the glTF sampler says
+// NEAREST. UV (0, 0) is the image's top-left corner. Wrapping and filtering are done here,
+// texel by texel (`textureLoad`), so no texel of a neighbour in the atlas is ever read.
 #import "pathtrace/scene_types.wgsl"
 #import "common/color.wgsl"
 
@@ -40,9 +42,8 @@ fn tex_fetch(d: vec4u, x: i32, y: i32, srgb: bool) -> vec4f {
     return c;
 }
 
-// The filtered texel of texture `id` at `uv`.
-fn tex_sample(id: u32, uv: vec2f, srgb: bool) -> vec4f {
-    let d = texture_descs[id];
+// The filtered texel of the image placed at `d` at `uv` in its own coordinates.
+fn tex_filter(d: vec4u, uv: vec2f, srgb: bool) -> vec4f {
     let p = uv * vec2f(f32(d.z & 0xffffu), f32(d.z >> 16u));
     if (d.w & TEX_NEAREST) != 0u {
         let f = vec2i(floor(p));
@@ -57,6 +58,18 @@ fn tex_sample(id: u32, uv: vec2f, srgb: bool) -> vec4f {
     return mix(a, b, t.y);
 }
 
+// Where texture `d` is looked up for a point with coordinates `uvs`: its set, transformed.
+fn tex_uv(d: TexDesc, uvs: vec4f) -> vec2f {
+    let uv = select(uvs.xy, uvs.zw, d.uv_set != 0u);
+    return vec2f(d.m.x * uv.x + d.m.z * uv.y + d.offset.x, d.m.y * uv.x + d.m.w * uv.y + d.offset.y);
+}
+
+// The filtered texel of texture `id` for a point with coordinates `uvs`.
+fn tex_sample(id: u32, uvs: vec4f, srgb: bool) -> vec4f {
+    let d = texture_descs[id];
+    return tex_filter(d.place, tex_uv(d, uvs), srgb);
+}
+
 fn tex_lo(packed: u32) -> u32 {
     return packed & 0xffffu;
 }
@@ -65,13 +78,32 @@ fn tex_hi(packed: u32) -> u32 {
     return packed >> 16u;
 }
 
-// The UV at barycentrics (u, v) of a triangle.
-fn tri_uv(tc: TriTexcoords, u: f32, v: f32) -> vec2f {
-    return (1.0 - u - v) * tc.uv01.xy + u * tc.uv01.zw + v * tc.uv2;
+// Both UV sets at barycentrics (u, v) of a triangle (set 0 in xy, set 1 in zw).
+fn tri_uv(tc: TriTexcoords, u: f32, v: f32) -> vec4f {
+    let w = 1.0 - u - v;
+    return vec4f(
+        w * tc.uv01.xy + u * tc.uv01.zw + v * tc.uv2,
+        w * tc.uv1_01.xy + u * tc.uv1_01.zw + v * tc.uv1_2,
+    );
+}
+
+// A vertex colour (RGBA8, RGB sRGB-encoded) decoded as a texel is.
+fn vertex_color(c: u32) -> vec4f {
+    let v = vec4f(f32(c & 0xffu), f32((c >> 8u) & 0xffu), f32((c >> 16u) & 0xffu), f32(c >> 24u)) / 255.0;
+    return vec4f(srgb_decode(v.rgb), v.a);
+}
+
+// The vertex colour at barycentrics (u, v) of a triangle (white where the mesh has none).
+// Exactly white where all three corners are (the weights need not sum to 1 exactly).
+fn tri_color(tc: TriTexcoords, u: f32, v: f32) -> vec4f {
+    if all(tc.colors == vec3u(0xffffffffu)) {
+        return vec4f(1.0);
+    }
+    return (1.0 - u - v) * vertex_color(tc.colors.x) + u * vertex_color(tc.colors.y) + v * vertex_color(tc.colors.z);
 }
 
 // Emission of `m` at `uv`: factor x texture (sRGB).
-fn textured_emission(m: Material, uv: vec2f) -> vec3f {
+fn textured_emission(m: Material, uv: vec4f) -> vec3f {
     let id = tex_lo(m.tex_emissive_normal);
     if id == NO_TEX {
         return m.emission;
@@ -79,12 +111,14 @@ fn textured_emission(m: Material, uv: vec2f) -> vec3f {
     return m.emission * tex_sample(id, uv, true).rgb;
 }
 
-// `m` with its textures applied at `uv`: base color x texture (sRGB; alpha ignored),
-// roughness x G and metallic x B of the metallic-roughness texture, emission x texture
-// (sRGB), transmission x R of the transmission texture, specular x A of the specular texture
-// x max channel of the specular color texture (sRGB).
-fn textured_material(m_in: Material, uv: vec2f) -> Material {
+// `m` with its textures and the vertex colour `color` applied at `uv`: base color x texture
+// (sRGB; alpha is the any-hit test's) x vertex colour, roughness x G and metallic x B of the
+// metallic-roughness texture, emission x texture (sRGB), transmission x R of the
+// transmission texture, specular x A of the specular texture x max channel of the specular
+// color texture (sRGB).
+fn textured_material(m_in: Material, uv: vec4f, color: vec4f) -> Material {
     var m = m_in;
+    m.base_color *= color.rgb;
     let base = tex_lo(m.tex_base_mr);
     if base != NO_TEX {
         m.base_color *= tex_sample(base, uv, true).rgb;
@@ -116,7 +150,7 @@ fn textured_material(m_in: Material, uv: vec2f) -> Material {
 // x and y scaled by `normal_scale`, in the frame (tangent, bitangent, ns) where the tangent
 // is made orthogonal to ns and the bitangent is w * ns x tangent. Falls back to `ns` when the
 // result is degenerate or faces away from the geometric normal `ng` (front side).
-fn normal_mapped(m: Material, ns: vec3f, ng: vec3f, uv: vec2f, tangent: vec4f) -> vec3f {
+fn normal_mapped(m: Material, ns: vec3f, ng: vec3f, uv: vec4f, tangent: vec4f) -> vec3f {
     let id = tex_hi(m.tex_emissive_normal);
     if id == NO_TEX {
         return ns;

@@ -393,3 +393,59 @@ pub fn mesh_env_scene(size: Option<u32>) -> std::sync::Arc<lumagraph::scene::Gpu
     }
     gpu_scene("assets/bench/mesh_env.ron", size)
 }
+
+/// Runs `f` on a thread of its own (32 MiB of stack) and returns what it returned; `Err`
+/// naming a panic, or a run longer than `limit` (a hung thread is left behind: the caller
+/// fails anyway). The fuzz tests run each case so.
+pub fn guarded<T: Send + 'static>(
+    limit: std::time::Duration,
+    f: impl FnOnce() -> T + Send + 'static,
+) -> Result<T, String> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let handle = std::thread::Builder::new()
+        .name("fuzz case".into())
+        .stack_size(32 << 20)
+        .spawn(move || {
+            let _ = tx.send(f());
+        })
+        .unwrap();
+    match rx.recv_timeout(limit) {
+        Ok(result) => {
+            let _ = handle.join();
+            Ok(result)
+        }
+        Err(std::sync::mpsc::RecvTimeoutError::Timeout) => Err(format!(
+            "hang: the case did not finish within {} s",
+            limit.as_secs()
+        )),
+        Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+            let payload = handle.join().err();
+            let message = payload
+                .as_ref()
+                .and_then(|p| {
+                    p.downcast_ref::<&str>()
+                        .map(|s| (*s).to_owned())
+                        .or_else(|| p.downcast_ref::<String>().cloned())
+                })
+                .unwrap_or_default();
+            Err(format!("panic: {message}"))
+        }
+    }
+}
+
+/// The pinhole ray through image position `p` (in pixels from the top-left corner), as
+/// the shader makes it: through the pixel centre at `(x + 0.5, y + 0.5)`.
+pub fn image_ray(g: &lumagraph::scene::GpuScene, p: glam::Vec2) -> lumagraph::scene::Ray {
+    use glam::Vec3;
+    let c = &g.camera;
+    let (w, h) = (g.settings.width as f32, g.settings.height as f32);
+    let u = p.x / w;
+    let v = p.y / h;
+    let dir = Vec3::from(c.forward)
+        + (2.0 * u - 1.0) * c.tan_half_fov * c.aspect * Vec3::from(c.right)
+        - (2.0 * v - 1.0) * c.tan_half_fov * Vec3::from(c.up);
+    lumagraph::scene::Ray {
+        origin: Vec3::from(c.position),
+        dir: dir.normalize(),
+    }
+}

@@ -121,6 +121,56 @@ type RtcGeometry = *mut c_void;
 /// `RTCErrorFunction`.
 type RtcErrorFunction = unsafe extern "C" fn(user: *mut c_void, code: u32, message: *const c_char);
 
+/// `struct RTCFilterFunctionNArguments`: the candidate hits of `n` rays, `ray` and `hit`
+/// laid out as `RTCRayN` and `RTCHitN` (field `k` of ray `i` at `[k·n + i]`); setting
+/// `valid[i]` to 0 rejects ray `i`'s candidate.
+#[repr(C)]
+struct RtcFilterArgs {
+    valid: *mut i32,
+    geometry_user_ptr: *mut c_void,
+    context: *mut c_void,
+    ray: *mut f32,
+    hit: *mut f32,
+    n: u32,
+}
+
+/// `RTCFilterFunctionN`.
+type RtcFilterFunction = unsafe extern "C" fn(args: *const RtcFilterArgs);
+
+/// The any-hit test of host intersection (Embree's intersect and occluded filter of the
+/// triangle geometry): a candidate counts where
+/// [`lumagraph_scene::traverse::triangle_hit_counts`] says so, the CPU mirror of the WGSL
+/// intersectors' `triangle_hit_counts` (alpha masks and blending).
+///
+/// # Safety
+/// Called by Embree with `args` as its headers describe, the geometry's user pointer a live
+/// `GpuScene` (`HostScene` keeps it) whose triangles are the geometry's, in order.
+unsafe extern "C" fn any_hit_filter(args: *const RtcFilterArgs) {
+    // SAFETY: see the function's contract.
+    let a = unsafe { &*args };
+    // SAFETY: the user pointer is the `GpuScene` the `HostScene` holds.
+    let scene = unsafe { &*a.geometry_user_ptr.cast::<lumagraph_scene::GpuScene>() };
+    let n = a.n as usize;
+    for i in 0..n {
+        // SAFETY: `valid`, `ray` and `hit` hold `n` entries per field.
+        unsafe {
+            if *a.valid.add(i) == 0 {
+                continue;
+            }
+            let ray = |k: usize| *a.ray.add(k * n + i);
+            let hit = |k: usize| *a.hit.add(k * n + i);
+            let r = lumagraph_scene::traverse::Ray {
+                origin: glam::Vec3::new(ray(0), ray(1), ray(2)),
+                dir: glam::Vec3::new(ray(4), ray(5), ray(6)),
+            };
+            let prim = *a.hit.cast::<u32>().add(5 * n + i);
+            if !lumagraph_scene::traverse::triangle_hit_counts(scene, prim, hit(3), hit(4), &r) {
+                *a.valid.add(i) = 0;
+            }
+        }
+    }
+}
+
 /// `RTC_INVALID_GEOMETRY_ID`.
 const RTC_INVALID_GEOMETRY_ID: u32 = u32::MAX;
 /// `RTCFormat`: `RTC_FORMAT_UINT3` (`RTC_FORMAT_UINT = 0x5001`, then 2, 3).
@@ -286,6 +336,11 @@ struct Api {
     release_geometry: unsafe extern "C" fn(geometry: RtcGeometry),
     commit_geometry: unsafe extern "C" fn(geometry: RtcGeometry),
     set_geometry_build_quality: unsafe extern "C" fn(geometry: RtcGeometry, quality: u32),
+    set_geometry_user_data: unsafe extern "C" fn(geometry: RtcGeometry, user: *mut c_void),
+    set_geometry_intersect_filter:
+        unsafe extern "C" fn(geometry: RtcGeometry, f: Option<RtcFilterFunction>),
+    set_geometry_occluded_filter:
+        unsafe extern "C" fn(geometry: RtcGeometry, f: Option<RtcFilterFunction>),
     set_new_geometry_buffer: unsafe extern "C" fn(
         geometry: RtcGeometry,
         kind: u32,
@@ -355,6 +410,9 @@ impl Api {
             release_geometry: sym!("rtcReleaseGeometry"),
             commit_geometry: sym!("rtcCommitGeometry"),
             set_geometry_build_quality: sym!("rtcSetGeometryBuildQuality"),
+            set_geometry_user_data: sym!("rtcSetGeometryUserData"),
+            set_geometry_intersect_filter: sym!("rtcSetGeometryIntersectFilterFunction"),
+            set_geometry_occluded_filter: sym!("rtcSetGeometryOccludedFilterFunction"),
             set_new_geometry_buffer: sym!("rtcSetNewGeometryBuffer"),
             intersect1: sym!("rtcIntersect1"),
             occluded1: sym!("rtcOccluded1"),
@@ -600,6 +658,9 @@ pub struct HostScene {
     scene: Option<NonNull<c_void>>,
     triangles: usize,
     tuning: Tuning,
+    /// The scene whose materials the any-hit filter reads (alpha), kept alive as long as
+    /// Embree may call the filter with it.
+    any_hit: Option<Arc<lumagraph_scene::GpuScene>>,
 }
 
 // SAFETY: a committed Embree scene is immutable; Embree allows ray queries on it from any
@@ -637,12 +698,37 @@ impl HostScene {
         Self::with_tuning(embree, corners, Tuning::default())
     }
 
+    /// [`HostScene::new`] over `scene`'s triangles (`tri_corners`), whose candidate hits
+    /// take the any-hit test of every intersector
+    /// ([`lumagraph_scene::traverse::triangle_hit_counts`]: alpha masks and blending),
+    /// where its materials need it ([`lumagraph_scene::FEATURE_ALPHA`]).
+    ///
+    /// # Errors
+    /// As [`HostScene::new`].
+    pub fn of_scene(
+        embree: Arc<Embree>,
+        scene: &Arc<lumagraph_scene::GpuScene>,
+    ) -> Result<Self, String> {
+        let any_hit = (scene.header.features & lumagraph_scene::FEATURE_ALPHA != 0)
+            .then(|| Arc::clone(scene));
+        Self::build(embree, &scene.tri_corners, Tuning::default(), any_hit)
+    }
+
     /// [`HostScene::new`] with other build and trace settings (for measurements).
     #[doc(hidden)]
     pub fn with_tuning(
         embree: Arc<Embree>,
         corners: &[[[f32; 3]; 3]],
         tuning: Tuning,
+    ) -> Result<Self, String> {
+        Self::build(embree, corners, tuning, None)
+    }
+
+    fn build(
+        embree: Arc<Embree>,
+        corners: &[[[f32; 3]; 3]],
+        tuning: Tuning,
+        any_hit: Option<Arc<lumagraph_scene::GpuScene>>,
     ) -> Result<Self, String> {
         let mut out = Self {
             embree,
@@ -652,6 +738,7 @@ impl HostScene {
                 chunk: tuning.chunk.max(16),
                 ..tuning
             },
+            any_hit,
         };
         if corners.is_empty() {
             return Ok(out);
@@ -693,6 +780,19 @@ impl HostScene {
                 flags |= RTC_SCENE_FLAG_COMPACT;
             }
             let quality = tuning.quality.min(RTC_BUILD_QUALITY_HIGH);
+            if let Some(g) = &out.any_hit {
+                // SAFETY: `geometry` is live; the user pointer is the `GpuScene` that
+                // `out.any_hit` keeps alive as long as the Embree scene, and
+                // `any_hit_filter` reads it as one.
+                unsafe {
+                    (api.set_geometry_user_data)(
+                        geometry,
+                        Arc::as_ptr(g).cast::<c_void>().cast_mut(),
+                    );
+                    (api.set_geometry_intersect_filter)(geometry, Some(any_hit_filter));
+                    (api.set_geometry_occluded_filter)(geometry, Some(any_hit_filter));
+                }
+            }
             // SAFETY: `geometry` and `scene` are live and belong to `device`; the geometry
             // has both buffers set. Attaching takes a reference, so releasing ours below
             // leaves the scene owning it.

@@ -328,12 +328,15 @@ impl HostRays {
     ///
     /// # Errors
     /// When Embree cannot be loaded or refuses the scene.
-    pub(crate) fn new(ctx: &GpuContext, scene: &lumagraph_scene::GpuScene) -> Result<Self> {
+    pub(crate) fn new(
+        ctx: &GpuContext,
+        scene: &std::sync::Arc<lumagraph_scene::GpuScene>,
+    ) -> Result<Self> {
         let fail = |e: String| RenderError::Gpu(format!("host intersection: {e}"));
         let embree = Embree::load().map_err(fail)?;
         let version = embree.version();
         let start = std::time::Instant::now();
-        let scene = HostScene::new(embree, &scene.tri_corners).map_err(fail)?;
+        let scene = HostScene::of_scene(embree, scene).map_err(fail)?;
         let note = format!(
             "host intersection: {version}, {} triangles built in {:.0} ms",
             scene.len(),

@@ -233,8 +233,12 @@ impl SceneBuffers {
     /// [`RenderError::TooLarge`] where a part does not fit ([`check_limits`]).
     pub fn upload(ctx: &GpuContext, scene: &GpuScene) -> Result<Self> {
         check_limits(scene, &ctx.device.limits(), &ctx.info.name)?;
-        // A runtime-sized array binding holds at least one element.
-        let one = [lumagraph_scene::GpuTriTexcoords::default()];
+        // A runtime-sized array binding holds at least one element: white, for the general
+        // shader, which reads the vertex colour of every triangle.
+        let one = [lumagraph_scene::GpuTriTexcoords {
+            colors: [lumagraph_scene::VERTEX_WHITE; 3],
+            ..Default::default()
+        }];
         let texcoords = if scene.tri_texcoords.is_empty() {
             &one[..]
         } else {

@@ -166,6 +166,28 @@ pub struct MaterialDesc {
     /// No surface: rays cross the shape's boundary unchanged, into or out of its `medium`
     /// (an index-matched boundary, Mitsuba's `null` BSDF). Default false.
     pub index_matched: bool,
+    /// How the surface's opacity (`opacity` × the base colour texture's alpha) is used:
+    /// `Opaque` ignores it (default), `Mask` cuts the surface out where it is below
+    /// `alpha_cutoff`, `Blend` lets rays through with probability 1 − opacity (stochastic
+    /// transparency). glTF's `alphaMode`.
+    pub alpha_mode: AlphaModeDesc,
+    /// `Mask`'s cutoff in [0, 1]. Default 0.5 (glTF's `alphaCutoff`).
+    pub alpha_cutoff: f32,
+    /// The surface's opacity in [0, 1] (glTF's base colour factor alpha, OBJ's `d`).
+    /// Default 1.
+    pub opacity: f32,
+}
+
+/// How a material's opacity is used (glTF `alphaMode`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+pub enum AlphaModeDesc {
+    /// Opacity is ignored.
+    #[default]
+    Opaque,
+    /// The surface is cut out where its opacity is below the cutoff.
+    Mask,
+    /// Rays pass through with probability 1 − opacity.
+    Blend,
 }
 
 /// A homogeneous participating medium: coefficients per unit length of the scene
@@ -213,6 +235,9 @@ impl Default for MaterialDesc {
             attenuation_distance: None,
             medium: None,
             index_matched: false,
+            alpha_mode: AlphaModeDesc::Opaque,
+            alpha_cutoff: 0.5,
+            opacity: 1.0,
         }
     }
 }

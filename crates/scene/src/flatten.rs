@@ -59,6 +59,10 @@ pub struct GpuScene {
     /// Each texture's channel ranges, in the order of `textures` (CPU side only: the shader
     /// specializer leaves a lobe out only where no texel can produce it).
     pub texture_ranges: Vec<crate::texture::TexelRange>,
+    /// Per material, the smallest vertex colour alpha (over 255) of its triangles; 255 where
+    /// none has vertex colours (CPU side only: the specializer keeps alpha where it can
+    /// cut).
+    pub vertex_alpha_min: Vec<u8>,
     /// For each GPU triangle, its index in [`Scene::triangles`] (CPU side only).
     pub tri_source: Vec<u32>,
     /// For each GPU sphere, its index in [`Scene::spheres`] (CPU side only).
@@ -97,6 +101,17 @@ impl From<&Material> for GpuMaterial {
         if m.index_matched {
             flags |= MATERIAL_INDEX_MATCHED;
         }
+        let alpha_cutoff = match m.alpha_mode {
+            crate::scene::AlphaMode::Opaque => 0.0,
+            crate::scene::AlphaMode::Mask { cutoff } => {
+                flags |= crate::gpu::MATERIAL_ALPHA_MASK;
+                cutoff
+            }
+            crate::scene::AlphaMode::Blend => {
+                flags |= crate::gpu::MATERIAL_ALPHA_BLEND;
+                0.0
+            }
+        };
         let medium = m.medium.unwrap_or(crate::scene::Medium {
             sigma_a: Vec3::ZERO,
             sigma_s: Vec3::ZERO,
@@ -119,6 +134,8 @@ impl From<&Material> for GpuMaterial {
             transmission: m.transmission,
             ior: m.ior,
             diffuse_roughness: m.diffuse_roughness,
+            opacity: m.opacity,
+            alpha_cutoff,
             tex_base_mr: tex16(m.textures.base_color)
                 | (tex16(m.textures.metallic_roughness) << 16),
             tex_emissive_normal: tex16(m.textures.emissive) | (tex16(m.textures.normal) << 16),
@@ -220,12 +237,12 @@ pub fn light_selection(powers: &[f32]) -> Vec<f32> {
 pub const MIN_TEXTURED_POWER_SCALE: f32 = 1e-2;
 
 /// How much of the emissive factor's luminance the emissive texture of `m` leaves over a
-/// triangle with texture coordinates `uv`: the mean of the textured emission over the
-/// triangle ([`crate::texture::Texture::triangle_mean`]) over the factor's luminance, at
-/// least [`MIN_TEXTURED_POWER_SCALE`]. Only the selection probability uses it; the light's
-/// radiance is still read from the texture at the sampled point, so the estimate stays
-/// unbiased whatever the scale.
-fn textured_emission_scale(scene: &Scene, m: &Material, uv: [glam::Vec2; 3]) -> f32 {
+/// triangle with texture coordinates `uvs` (both sets): the mean of the textured emission
+/// over the triangle ([`crate::texture::Texture::triangle_mean`], at the texture's own
+/// coordinates) over the factor's luminance, at least [`MIN_TEXTURED_POWER_SCALE`]. Only
+/// the selection probability uses it; the light's radiance is still read from the texture
+/// at the sampled point, so the estimate stays unbiased whatever the scale.
+fn textured_emission_scale(scene: &Scene, m: &Material, uvs: [[glam::Vec2; 3]; 2]) -> f32 {
     let factor = luminance(m.emission);
     let Some(tex) = scene.textures.get(m.textures.emissive as usize) else {
         return 1.0;
@@ -233,6 +250,7 @@ fn textured_emission_scale(scene: &Scene, m: &Material, uv: [glam::Vec2; 3]) -> 
     if factor <= 0.0 {
         return 1.0;
     }
+    let uv = [0, 1, 2].map(|k| tex.uv([uvs[0][k], uvs[1][k]]));
     let mean = tex.triangle_mean(uv, true).truncate();
     let scale = luminance(m.emission * mean) / factor;
     if scale.is_finite() {
@@ -376,7 +394,7 @@ impl GpuScene {
             },
             ..Self::default()
         };
-        let textured = scene.materials.iter().any(|m| m.textures.any());
+        let textured = surface_attributes(scene);
         check_textures(scene)?;
         if textured {
             out.atlas = crate::texture::pack_atlas(&scene.textures);
@@ -385,6 +403,14 @@ impl GpuScene {
                 .iter()
                 .map(crate::texture::Texture::range)
                 .collect();
+        }
+        out.vertex_alpha_min = vec![u8::MAX; scene.materials.len()];
+        for t in &scene.triangles {
+            if let (Some(c), Some(min)) =
+                (t.colors, out.vertex_alpha_min.get_mut(t.material as usize))
+            {
+                *min = c.iter().fold(*min, |m, c| m.min(c[3]));
+            }
         }
         let mut weights = Vec::new();
         out.push_triangles(scene, textured, &mut weights);
@@ -412,8 +438,11 @@ impl GpuScene {
             let t = &scene.triangles[src as usize];
             let [p0, p1, p2] = t.positions;
             let (e1, e2) = (p1 - p0, p2 - p0);
+            let alpha =
+                scene.materials[t.material as usize].alpha_mode != crate::scene::AlphaMode::Opaque;
             self.tri_positions.push(GpuTriangle {
                 v0: p0.to_array(),
+                flags: if alpha { crate::gpu::TRI_ALPHA } else { 0 },
                 e1: e1.to_array(),
                 e2: e2.to_array(),
                 ..GpuTriangle::default()
@@ -422,21 +451,34 @@ impl GpuScene {
                 .push([p0.to_array(), p1.to_array(), p2.to_array()]);
             let flat_n = e1.cross(e2).normalize();
             let ns = t.normals.unwrap_or([flat_n; 3]);
+            let m = &scene.materials[t.material as usize];
             if textured {
                 let uv = t.uvs.unwrap_or([glam::Vec2::ZERO; 3]);
-                let tan = t
-                    .tangents
-                    .unwrap_or_else(|| crate::texture::triangle_tangents(t.positions, ns, uv));
+                let uv1 = t.uvs1.unwrap_or([glam::Vec2::ZERO; 3]);
+                // Generated tangents follow the normal map's own coordinates: its set,
+                // through its transform.
+                let tan = t.tangents.unwrap_or_else(|| {
+                    let normal_uv = scene
+                        .textures
+                        .get(m.textures.normal as usize)
+                        .map_or(uv, |tex| [0, 1, 2].map(|k| tex.uv([uv[k], uv1[k]])));
+                    crate::texture::triangle_tangents(t.positions, ns, normal_uv)
+                });
+                let colors = t
+                    .colors
+                    .map_or([crate::gpu::VERTEX_WHITE; 3], |c| c.map(u32::from_le_bytes));
                 self.tri_texcoords.push(GpuTriTexcoords {
                     t0: tan[0].to_array(),
                     t1: tan[1].to_array(),
                     t2: tan[2].to_array(),
                     uv01: [uv[0].x, uv[0].y, uv[1].x, uv[1].y],
                     uv2: uv[2].to_array(),
-                    ..GpuTriTexcoords::default()
+                    uv1_2: uv1[2].to_array(),
+                    uv1_01: [uv1[0].x, uv1[0].y, uv1[1].x, uv1[1].y],
+                    colors,
+                    pad0: 0,
                 });
             }
-            let m = &scene.materials[t.material as usize];
             let mut light = NO_LIGHT;
             if m.is_emissive() {
                 light = self.lights.len() as u32;
@@ -445,7 +487,8 @@ impl GpuScene {
                 let mut power = luminance(m.emission) * area * std::f32::consts::PI * sides;
                 if textured && m.textures.emissive != NO_TEXTURE {
                     let uv = t.uvs.unwrap_or([glam::Vec2::ZERO; 3]);
-                    power *= textured_emission_scale(scene, m, uv);
+                    let uv1 = t.uvs1.unwrap_or([glam::Vec2::ZERO; 3]);
+                    power *= textured_emission_scale(scene, m, [uv, uv1]);
                 }
                 weights.push(power);
                 self.lights.push(GpuLight {
@@ -510,6 +553,14 @@ impl GpuScene {
 
 /// Refuses more textures than the GPU layout can index and materials that use a texture
 /// the scene does not have.
+/// Whether the shader reads per-triangle attributes beyond normals: some material has a
+/// texture or some triangle has vertex colours ([`GpuScene::tri_texcoords`],
+/// [`FEATURE_TEXTURES`]).
+fn surface_attributes(scene: &Scene) -> bool {
+    scene.materials.iter().any(|m| m.textures.any())
+        || scene.triangles.iter().any(|t| t.colors.is_some())
+}
+
 fn check_textures(scene: &Scene) -> Result<(), SceneError> {
     if scene.textures.len() >= 0xFFFF {
         return Err(SceneError::new(ErrorKind::BadValue {
@@ -551,8 +602,15 @@ fn header(scene: &Scene, g: &GpuScene, depth: usize, total_power: f32) -> GpuHea
     if scene.materials.iter().any(|m| m.metallic > 0.0) {
         features |= FEATURE_METAL;
     }
-    if scene.materials.iter().any(|m| m.textures.any()) {
+    if surface_attributes(scene) {
         features |= FEATURE_TEXTURES;
+    }
+    if scene
+        .materials
+        .iter()
+        .any(|m| m.alpha_mode != crate::scene::AlphaMode::Opaque)
+    {
+        features |= crate::gpu::FEATURE_ALPHA;
     }
     if scene
         .materials

@@ -38,6 +38,13 @@ pub const MATERIAL_MEDIUM: u32 = 8;
 /// [`GpuMaterial::flags`]: no surface: rays cross it unchanged (an index-matched medium
 /// boundary).
 pub const MATERIAL_INDEX_MATCHED: u32 = 16;
+/// [`GpuTriangle::flags`]: the triangle's material is alpha-masked or blended, so its hits
+/// take the any-hit test ([`crate::traverse::triangle_hit_counts`]).
+pub const TRI_ALPHA: u32 = 1;
+/// Material flag: the surface is cut out where its opacity is below `alpha_cutoff`.
+pub const MATERIAL_ALPHA_MASK: u32 = 32;
+/// Material flag: a ray passes through the surface with probability 1 − opacity.
+pub const MATERIAL_ALPHA_BLEND: u32 = 64;
 /// [`GpuLight::flags`]: the light is a sphere (else a triangle).
 pub const LIGHT_SPHERE: u32 = 1;
 /// [`GpuLight::flags`]: emission leaves both sides of the triangle.
@@ -75,6 +82,9 @@ pub const FEATURE_LIGHTS: u32 = 16;
 pub const FEATURE_METAL: u32 = 32;
 /// [`GpuHeader::features`]: some material has a medium inside or is index-matched.
 pub const FEATURE_MEDIA: u32 = 64;
+/// [`GpuHeader::features`]: some material's alpha mode is `Mask` or `Blend`: every
+/// intersector applies its any-hit test ([`crate::traverse::triangle_hit_counts`]).
+pub const FEATURE_ALPHA: u32 = 128;
 
 /// A BVH node, 32 bytes. See [`crate::bvh`] for the encoding.
 #[repr(C)]
@@ -110,8 +120,9 @@ pub struct GpuBvhRecord {
 pub struct GpuTriangle {
     /// Corner 0 (offset 0).
     pub v0: [f32; 3],
-    /// Padding (offset 12).
-    pub pad0: u32,
+    /// [`TRI_ALPHA`] (offset 12): read with the corners, so the traversal knows without
+    /// another load whether a hit takes the any-hit test.
+    pub flags: u32,
     /// Corner 1 − corner 0 (offset 16).
     pub e1: [f32; 3],
     /// Padding (offset 28).
@@ -199,12 +210,13 @@ pub struct GpuMaterial {
     /// Roughness of the diffuse base: 0 Lambertian, else energy-preserving Oren–Nayar
     /// (offset 72).
     pub diffuse_roughness: f32,
-    /// Padding (offset 76).
-    pub pad1: u32,
+    /// Opacity, times the base colour texture's alpha ([`MATERIAL_ALPHA_MASK`],
+    /// [`MATERIAL_ALPHA_BLEND`]; offset 76).
+    pub opacity: f32,
     /// A conductor's index of refraction, real part ([`MATERIAL_CONDUCTOR`]; offset 80).
     pub eta: [f32; 3],
-    /// Padding (offset 92).
-    pub pad2: u32,
+    /// [`MATERIAL_ALPHA_MASK`]'s cutoff (offset 92).
+    pub alpha_cutoff: f32,
     /// A conductor's extinction coefficient (offset 96).
     pub k: [f32; 3],
     /// Padding (offset 108).
@@ -224,9 +236,9 @@ pub struct GpuMaterial {
     pub pad5: u32,
 }
 
-/// A triangle's texture coordinates and tangents, 80 bytes, same index as its
-/// [`GpuTriangle`]; only filled when some material has a texture (else the buffer holds
-/// one zeroed entry).
+/// A triangle's texture coordinates, tangents and vertex colours, 112 bytes, same index as
+/// its [`GpuTriangle`]; only filled when some material has a texture or some triangle has
+/// vertex colours (else the buffer holds one zeroed entry).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuTriTexcoords {
@@ -236,14 +248,72 @@ pub struct GpuTriTexcoords {
     pub t1: [f32; 4],
     /// Tangent at corner 2 (offset 32).
     pub t2: [f32; 4],
-    /// UV at corner 0 (xy) and corner 1 (zw) (offset 48).
+    /// UV (set 0) at corner 0 (xy) and corner 1 (zw) (offset 48).
     pub uv01: [f32; 4],
-    /// UV at corner 2 (offset 64).
+    /// UV (set 0) at corner 2 (offset 64).
     pub uv2: [f32; 2],
-    /// Padding (offset 72).
+    /// The second UV set (glTF `TEXCOORD_1`) at corner 2 (offset 72).
+    pub uv1_2: [f32; 2],
+    /// The second UV set at corners 0 (xy) and 1 (zw) (offset 80).
+    pub uv1_01: [f32; 4],
+    /// Vertex colours at the corners, RGBA8 (R in the low byte; RGB sRGB-encoded), white
+    /// where the mesh has none (offset 96).
+    pub colors: [u32; 3],
+    /// Padding (offset 108).
     pub pad0: u32,
-    /// Padding (offset 76).
-    pub pad1: u32,
+}
+
+/// Where a texture's texels are in the atlas and how a material reads them, 48 bytes: the
+/// atlas place (x | y << 16 in its page, the page, width | height << 16, flags:
+/// [`crate::Texture::flags`]), then the coordinate transform (`uv' = u · m.xy + v · m.zw +
+/// offset`) and the coordinate set.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuTexDesc {
+    /// Place, page, size and flags (offset 0).
+    pub place: [u32; 4],
+    /// The transform's matrix by columns (offset 16).
+    pub m: [f32; 4],
+    /// The transform's offset (offset 32).
+    pub offset: [f32; 2],
+    /// 0: `TEXCOORD_0`, 1: `TEXCOORD_1` (offset 40).
+    pub uv_set: u32,
+    /// Padding (offset 44).
+    pub pad: u32,
+}
+
+/// White in [`GpuTriTexcoords::colors`]: the vertex colour of meshes without one.
+pub const VERTEX_WHITE: u32 = 0xFFFF_FFFF;
+
+impl GpuTriTexcoords {
+    /// Both UV sets at barycentrics (`u`, `v`), set 0 in xy and set 1 in zw: `tri_uv` in
+    /// `pathtrace/textures.wgsl`.
+    pub fn uv(&self, u: f32, v: f32) -> glam::Vec4 {
+        use glam::Vec2;
+        let w = 1.0 - u - v;
+        let set0 = w * Vec2::new(self.uv01[0], self.uv01[1])
+            + u * Vec2::new(self.uv01[2], self.uv01[3])
+            + v * Vec2::from(self.uv2);
+        let set1 = w * Vec2::new(self.uv1_01[0], self.uv1_01[1])
+            + u * Vec2::new(self.uv1_01[2], self.uv1_01[3])
+            + v * Vec2::from(self.uv1_2);
+        set0.extend(set1.x).extend(set1.y)
+    }
+
+    /// The vertex colour at barycentrics (`u`, `v`), each corner decoded as a texel is, and
+    /// exactly white where all three are: `tri_color` in `pathtrace/textures.wgsl`.
+    pub fn color(&self, u: f32, v: f32) -> glam::Vec4 {
+        if self.colors == [VERTEX_WHITE; 3] {
+            return glam::Vec4::ONE;
+        }
+        let decode = |c: u32| {
+            let [r, g, b, a] = c.to_le_bytes().map(|x| f32::from(x) / 255.0);
+            let d = crate::texture::srgb_decode;
+            glam::Vec4::new(d(r), d(g), d(b), a)
+        };
+        let [c0, c1, c2] = self.colors.map(decode);
+        (1.0 - u - v) * c0 + u * c1 + v * c2
+    }
 }
 
 /// An emitter, 64 bytes: an emissive triangle or sphere, or a point, spot or directional

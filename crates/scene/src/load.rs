@@ -329,6 +329,14 @@ fn material_from_desc(name: &str, d: &MaterialDesc) -> Result<Material, SceneErr
         multiscatter: d.multiscatter,
         medium,
         index_matched: d.index_matched,
+        opacity: unit_range("opacity", d.opacity)?,
+        alpha_mode: match d.alpha_mode {
+            crate::file::AlphaModeDesc::Opaque => crate::scene::AlphaMode::Opaque,
+            crate::file::AlphaModeDesc::Mask => crate::scene::AlphaMode::Mask {
+                cutoff: unit_range("alpha_cutoff", d.alpha_cutoff)?,
+            },
+            crate::file::AlphaModeDesc::Blend => crate::scene::AlphaMode::Blend,
+        },
         ..Material::named(name)
     })
 }
@@ -822,6 +830,10 @@ impl<'a> Builder<'a> {
                 self.scene_triangles
                     .extend(mesh.triangles.into_iter().map(|mut t| {
                         t.material = ids[t.material as usize];
+                        // An override material replaces the file's look, vertex colours too.
+                        if over.is_some() {
+                            t.colors = None;
+                        }
                         t
                     }));
                 self.report.merge(mesh.report);

@@ -322,6 +322,13 @@ fn material_value(m: &MaterialDesc) -> Val {
                 m.index_matched.to_string(),
                 &d.index_matched.to_string(),
             ),
+            given(
+                "alpha_mode",
+                format!("{:?}", m.alpha_mode),
+                &format!("{:?}", d.alpha_mode),
+            ),
+            given("alpha_cutoff", num(m.alpha_cutoff), &num(d.alpha_cutoff)),
+            given("opacity", num(m.opacity), &num(d.opacity)),
         ],
     }
 }

@@ -119,6 +119,26 @@ pub struct Material {
     /// No surface: rays cross it unchanged (the index-matched boundary of a `medium`,
     /// Mitsuba's `null` BSDF).
     pub index_matched: bool,
+    /// Opacity in [0, 1], times the base colour texture's alpha; used as `alpha_mode` says.
+    pub opacity: f32,
+    /// How the opacity is used.
+    pub alpha_mode: AlphaMode,
+}
+
+/// How a material's opacity is used (glTF `alphaMode`): every intersector (and the G-buffer
+/// raster) applies it to the rays that reach the surface, camera and shadow rays alike.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum AlphaMode {
+    /// Opacity is ignored: the surface is solid.
+    #[default]
+    Opaque,
+    /// The surface is cut out where its opacity is below `cutoff`.
+    Mask {
+        /// In [0, 1].
+        cutoff: f32,
+    },
+    /// Stochastic transparency: a ray passes through with probability 1 − opacity.
+    Blend,
 }
 
 /// A homogeneous participating medium: coefficients per unit length of the scene, linear RGB.
@@ -176,6 +196,8 @@ impl Material {
             multiscatter: true,
             medium: None,
             index_matched: false,
+            opacity: 1.0,
+            alpha_mode: AlphaMode::Opaque,
         }
     }
 
@@ -225,6 +247,13 @@ pub struct Triangle {
     pub normals: Option<[Vec3; 3]>,
     /// Texture coordinates (glTF `TEXCOORD_0`) at the corners, when the source had them.
     pub uvs: Option<[Vec2; 3]>,
+    /// The second set of texture coordinates (glTF `TEXCOORD_1`), read by textures whose
+    /// `uv_set` is 1 ([`crate::texture::Texture::uv_set`]).
+    pub uvs1: Option<[Vec2; 3]>,
+    /// Vertex colours (glTF `COLOR_0`), multiplying the base colour and the opacity: RGB
+    /// sRGB-encoded and alpha linear, 8 bits a channel, as texels are (decoded as a texel
+    /// is, then interpolated across the triangle).
+    pub colors: Option<[[u8; 4]; 3]>,
     /// Tangents at the corners (glTF `TANGENT`: xyz along +U, w = ±1 the handedness of the
     /// bitangent `w · normal × tangent`), when the source had them; else they are generated
     /// when the scene is flattened (see [`crate::texture::triangle_tangents`]).
@@ -402,6 +431,12 @@ pub fn push_triangle(out: &mut Vec<Triangle>, report: &mut LoadReport, mut tri: 
     {
         tri.uvs = None;
     }
+    if tri
+        .uvs1
+        .is_some_and(|uvs| !uvs.iter().all(|uv| uv.is_finite()))
+    {
+        tri.uvs1 = None;
+    }
     if tri.tangents.is_some_and(|ts| {
         !ts.iter()
             .all(|t| t.is_finite() && t.truncate().length_squared() > 1e-20)
@@ -423,6 +458,8 @@ pub fn transform_triangle(m: &Mat4, tri: &Triangle) -> Triangle {
         .normals
         .map(|ns| ns.map(|n| normal_m.transform_vector3(n)));
     let mut uvs = tri.uvs;
+    let mut uvs1 = tri.uvs1;
+    let mut colors = tri.colors;
     let mut tangents = tri.tangents.map(|ts| {
         ts.map(|t| {
             let w = if mirror { -t.w } else { t.w };
@@ -437,6 +474,12 @@ pub fn transform_triangle(m: &Mat4, tri: &Triangle) -> Triangle {
         if let Some(uv) = uvs.as_mut() {
             uv.swap(1, 2);
         }
+        if let Some(uv) = uvs1.as_mut() {
+            uv.swap(1, 2);
+        }
+        if let Some(c) = colors.as_mut() {
+            c.swap(1, 2);
+        }
         if let Some(ts) = tangents.as_mut() {
             ts.swap(1, 2);
         }
@@ -445,6 +488,8 @@ pub fn transform_triangle(m: &Mat4, tri: &Triangle) -> Triangle {
         positions,
         normals,
         uvs,
+        uvs1,
+        colors,
         tangents,
         material: tri.material,
     }
@@ -458,6 +503,8 @@ pub fn quad_triangles(corners: [Vec3; 4], material: u32) -> [Triangle; 2] {
             positions: [a, b, c],
             normals: None,
             uvs: None,
+            uvs1: None,
+            colors: None,
             tangents: None,
             material,
         },
@@ -465,6 +512,8 @@ pub fn quad_triangles(corners: [Vec3; 4], material: u32) -> [Triangle; 2] {
             positions: [a, c, d],
             normals: None,
             uvs: None,
+            uvs1: None,
+            colors: None,
             tangents: None,
             material,
         },

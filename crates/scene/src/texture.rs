@@ -2,7 +2,8 @@
 //! `shaders/pathtrace/textures.wgsl`.
 //!
 //! A texture is RGBA8 texels (row 0 at the top: glTF's UV (0, 0) is the image's top-left
-//! corner), a wrap mode per axis and a filter. Sampling is bilinear between the four texels
+//! corner), a wrap mode per axis and a filter, and the coordinates it reads: a UV set and
+//! a transform ([`UvTransform`], glTF's `KHR_texture_transform`). Sampling is bilinear between the four texels
 //! around the point (texel centers at `(i + 0.5) / width`), after decoding each texel from
 //! sRGB when asked (as a GPU filters an sRGB texture), or the nearest texel when the glTF
 //! sampler's `magFilter` is `NEAREST`. There are no mipmaps: the path tracer averages many
@@ -16,7 +17,11 @@
 //! 2D texture side, as many as its array layers): far more than one storage buffer binding
 //! (128 MiB on many devices).
 
+use std::sync::Arc;
+
 use glam::{Vec2, Vec3, Vec4};
+
+use crate::gpu::GpuTexDesc;
 
 /// How coordinates outside [0, 1] map into the texture (glTF sampler `wrapS` / `wrapT`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -55,7 +60,58 @@ impl Wrap {
     }
 }
 
-/// A decoded texture.
+/// An affine map of texture coordinates, `uv' = u · m[0..2] + v · m[2..4] + offset`: glTF's
+/// `KHR_texture_transform` (see [`UvTransform::khr`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvTransform {
+    /// The 2×2 matrix by columns: the image of U's axis (`m[0]`, `m[1]`), then V's.
+    pub m: [f32; 4],
+    /// Added after the matrix.
+    pub offset: [f32; 2],
+}
+
+impl Default for UvTransform {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
+}
+
+impl UvTransform {
+    /// Coordinates unchanged (exactly: `u · 1 + v · 0 + 0 = u` in floating point).
+    pub const IDENTITY: Self = Self {
+        m: [1.0, 0.0, 0.0, 1.0],
+        offset: [0.0, 0.0],
+    };
+
+    /// `KHR_texture_transform`'s matrix `T · R · S`: scale first, then rotate by `rotation`
+    /// radians (counter-clockwise in UV space, so clockwise on the image, whose V goes down),
+    /// then translate by `offset`.
+    pub fn khr(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> Self {
+        let (sin, cos) = rotation.sin_cos();
+        Self {
+            m: [
+                cos * scale[0],
+                -sin * scale[0],
+                sin * scale[1],
+                cos * scale[1],
+            ],
+            offset,
+        }
+    }
+
+    /// `uv` mapped: the shader's `tex_uv`, operation for operation.
+    pub fn apply(&self, uv: Vec2) -> Vec2 {
+        let m = self.m;
+        Vec2::new(
+            m[0] * uv.x + m[2] * uv.y + self.offset[0],
+            m[1] * uv.x + m[3] * uv.y + self.offset[1],
+        )
+    }
+}
+
+/// A decoded texture as a material reads it: an image, how it is wrapped and filtered, and
+/// which texture coordinates it reads through which transform. Textures that share an
+/// image share its texels ([`Arc`]), in memory and in the atlas.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
     /// Where it came from, for messages (`"BoxTextured.gltf image 0 (CesiumLogoFlat.png)"`).
@@ -65,11 +121,16 @@ pub struct Texture {
     /// Height in texels (≥ 1).
     pub height: u32,
     /// RGBA8 texels, row by row from the top.
-    pub texels: Vec<[u8; 4]>,
+    pub texels: Arc<[[u8; 4]]>,
     /// Wrap along U (glTF `wrapS`) and V (`wrapT`).
     pub wrap: [Wrap; 2],
     /// Nearest-texel lookup (glTF `magFilter: NEAREST`) instead of bilinear.
     pub nearest: bool,
+    /// Which texture coordinates it reads: 0 ([`crate::Triangle::uvs`], glTF `TEXCOORD_0`)
+    /// or 1 ([`crate::Triangle::uvs1`]).
+    pub uv_set: u32,
+    /// Applied to the coordinates before the lookup (glTF `KHR_texture_transform`).
+    pub transform: UvTransform,
 }
 
 /// The smallest and largest texel byte of each channel (RGBA) of a texture: what the
@@ -89,7 +150,7 @@ impl Texture {
             min: [u8::MAX; 4],
             max: [0; 4],
         };
-        for t in &self.texels {
+        for t in self.texels.iter() {
             for c in 0..4 {
                 r.min[c] = r.min[c].min(t[c]);
                 r.max[c] = r.max[c].max(t[c]);
@@ -103,6 +164,16 @@ impl Texture {
 pub const TEX_NEAREST: u32 = 16;
 /// The finest subdivision [`Texture::triangle_mean`] uses: at most 64² = 4096 samples.
 pub const TRIANGLE_MEAN_MAX_SPLIT: u32 = 64;
+
+/// Linear → sRGB, one channel in [0, 1] (how vertex colours are stored).
+pub fn srgb_encode(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
 
 /// sRGB → linear, one channel in [0, 1] (the WGSL `srgb_decode`).
 pub fn srgb_decode(c: f32) -> f32 {
@@ -182,19 +253,25 @@ impl Texture {
             | (self.wrap[1].code() << 2)
             | if self.nearest { TEX_NEAREST } else { 0 }
     }
+
+    /// Where this texture is looked up for a point whose coordinates are `uvs` (set 0, set
+    /// 1): its set, transformed.
+    pub fn uv(&self, uvs: [Vec2; 2]) -> Vec2 {
+        self.transform.apply(uvs[(self.uv_set as usize).min(1)])
+    }
 }
 
 /// Every texture of a scene placed in the pages of one 2D array texture.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct TextureAtlas {
     /// The side of every page, in texels (a power of two at least as large as the largest
     /// side of any texture); 0 without textures.
     pub page_size: u32,
     /// Pages (array layers).
     pub pages: u32,
-    /// Per texture: where it is (x | y << 16 in its page), its page, its size
-    /// (width | height << 16) and its flags ([`Texture::flags`]).
-    pub descriptors: Vec<[u32; 4]>,
+    /// Per texture: where its image is, how it is wrapped and filtered, and which
+    /// coordinates it reads through which transform.
+    pub descriptors: Vec<GpuTexDesc>,
     /// The pages' RGBA8 texels (R in the low byte), page after page, row by row from the
     /// top; texels no texture covers are 0.
     pub texels: Vec<u32>,
@@ -205,16 +282,92 @@ impl TextureAtlas {
     pub fn bytes(&self) -> u64 {
         4 * self.texels.len() as u64
     }
+
+    /// The texel of texture `id` at integer coordinates, wrapped: `tex_fetch` in
+    /// `pathtrace/textures.wgsl`, line for line.
+    pub fn fetch(&self, id: u32, x: i64, y: i64, srgb: bool) -> Vec4 {
+        let d = self.descriptors[id as usize].place;
+        let wrap = |code: u32| match code {
+            1 => Wrap::ClampToEdge,
+            2 => Wrap::MirroredRepeat,
+            _ => Wrap::Repeat,
+        };
+        let xi = wrap(d[3] & 3).index(x, d[2] & 0xFFFF);
+        let yi = wrap((d[3] >> 2) & 3).index(y, d[2] >> 16);
+        let page = self.page_size as usize;
+        let at = d[1] as usize * page * page
+            + ((d[0] >> 16) + yi) as usize * page
+            + ((d[0] & 0xFFFF) + xi) as usize;
+        let v = Vec4::from_array(self.texels[at].to_le_bytes().map(|c| f32::from(c) / 255.0));
+        if srgb {
+            Vec4::new(srgb_decode(v.x), srgb_decode(v.y), srgb_decode(v.z), v.w)
+        } else {
+            v
+        }
+    }
+
+    /// The filtered value of texture `id` for a point whose coordinates are `uvs` (set 0 in
+    /// xy, set 1 in zw): `tex_sample` in `pathtrace/textures.wgsl`, and
+    /// [`Texture::sample`] at [`Texture::uv`] of the texture placed there.
+    pub fn sample(&self, id: u32, uvs: Vec4, srgb: bool) -> Vec4 {
+        let d = &self.descriptors[id as usize];
+        let uv = if d.uv_set == 0 {
+            uvs.truncate().truncate()
+        } else {
+            Vec2::new(uvs.z, uvs.w)
+        };
+        let uv = UvTransform {
+            m: d.m,
+            offset: d.offset,
+        }
+        .apply(uv);
+        self.filter(id, uv, srgb)
+    }
+
+    /// The filtered value of texture `id` at `uv` in its own coordinates (after its
+    /// transform): `tex_filter` in `pathtrace/textures.wgsl`.
+    pub fn filter(&self, id: u32, uv: Vec2, srgb: bool) -> Vec4 {
+        let d = self.descriptors[id as usize].place;
+        let p = uv * Vec2::new((d[2] & 0xFFFF) as f32, (d[2] >> 16) as f32);
+        if d[3] & TEX_NEAREST != 0 {
+            let f = p.floor();
+            return self.fetch(id, f.x as i64, f.y as i64, srgb);
+        }
+        let p = p - 0.5;
+        let f = p.floor();
+        let t = p - f;
+        let (x, y) = (f.x as i64, f.y as i64);
+        let a = self
+            .fetch(id, x, y, srgb)
+            .lerp(self.fetch(id, x + 1, y, srgb), t.x);
+        let b = self
+            .fetch(id, x, y + 1, srgb)
+            .lerp(self.fetch(id, x + 1, y + 1, srgb), t.x);
+        a.lerp(b, t.y)
+    }
 }
 
 /// The smallest page side: pages of tiny textures are not made smaller than this.
 pub const ATLAS_MIN_PAGE: u32 = 256;
 
-/// Places `textures` in pages of one size (shelf packing, tallest first: textures whose sides
-/// are powers of two fill pages without gaps) and copies their texels there.
-pub fn pack_atlas(textures: &[Texture]) -> TextureAtlas {
-    if textures.is_empty() {
+/// Places the images of `textures` in pages of one size (shelf packing, tallest first:
+/// images whose sides are powers of two fill pages without gaps) and copies their texels
+/// there; textures sharing an image ([`Texture::texels`], the same [`Arc`]) share its place.
+pub fn pack_atlas(all: &[Texture]) -> TextureAtlas {
+    if all.is_empty() {
         return TextureAtlas::default();
+    }
+    // One entry per image: the first texture showing it.
+    let mut image_of = Vec::with_capacity(all.len());
+    let mut first: std::collections::HashMap<*const [u8; 4], usize> =
+        std::collections::HashMap::new();
+    let mut textures: Vec<&Texture> = Vec::new();
+    for t in all {
+        let at = *first.entry(t.texels.as_ptr()).or_insert_with(|| {
+            textures.push(t);
+            textures.len() - 1
+        });
+        image_of.push(at);
     }
     let side = textures
         .iter()
@@ -249,9 +402,7 @@ pub fn pack_atlas(textures: &[Texture]) -> TextureAtlas {
     let pages = p + 1;
     let page_texels = page as usize * page as usize;
     let mut texels = vec![0u32; page_texels * pages as usize];
-    let mut descriptors = Vec::with_capacity(textures.len());
     for (t, &(x, y, p)) in textures.iter().zip(&place) {
-        descriptors.push([x | (y << 16), p, t.width | (t.height << 16), t.flags()]);
         for row in 0..t.height as usize {
             let src = &t.texels[row * t.width as usize..(row + 1) * t.width as usize];
             let at = p as usize * page_texels + (y as usize + row) * page as usize + x as usize;
@@ -260,6 +411,20 @@ pub fn pack_atlas(textures: &[Texture]) -> TextureAtlas {
             }
         }
     }
+    let descriptors = all
+        .iter()
+        .zip(&image_of)
+        .map(|(t, &i)| {
+            let (x, y, p) = place[i];
+            GpuTexDesc {
+                place: [x | (y << 16), p, t.width | (t.height << 16), t.flags()],
+                m: t.transform.m,
+                offset: t.transform.offset,
+                uv_set: t.uv_set.min(1),
+                pad: 0,
+            }
+        })
+        .collect();
     TextureAtlas {
         page_size: page,
         pages,

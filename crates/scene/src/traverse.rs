@@ -9,7 +9,7 @@ use glam::Vec3;
 
 use crate::bvh::{BVH_END, NODE_COUNT_SHIFT, NODE_SPHERES};
 use crate::flatten::GpuScene;
-use crate::gpu::{NO_HIT, PRIM_SPHERE};
+use crate::gpu::{MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, NO_HIT, PRIM_SPHERE};
 
 /// A ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -142,6 +142,71 @@ fn v3(a: [f32; 3]) -> Vec3 {
     Vec3::from_array(a)
 }
 
+/// The PCG hash of `common/rng.wgsl`.
+fn pcg_hash(v: u32) -> u32 {
+    let state = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
+    (word >> 22) ^ word
+}
+
+/// A number in [0, 1) that is a function of the ray and the triangle only: stochastic
+/// transparency's choice, the same for the ray wherever it is traced (`alpha_hash` in
+/// `pathtrace/alpha.wgsl`, line for line).
+pub fn alpha_hash(prim: u32, ray: &Ray) -> f32 {
+    let bits = |x: f32| x.to_bits();
+    let mut h = pcg_hash(bits(ray.dir.z));
+    for w in [
+        bits(ray.dir.y),
+        bits(ray.dir.x),
+        bits(ray.origin.z),
+        bits(ray.origin.y),
+        bits(ray.origin.x),
+        prim,
+    ] {
+        h = pcg_hash(w ^ h);
+    }
+    (h >> 8) as f32 * 5.960_464_5e-8
+}
+
+/// The any-hit test every intersector applies to a candidate hit on triangle `prim` at
+/// barycentrics (`u`, `v`): whether it counts, by its material's alpha mode — `Mask`
+/// where its opacity (× the vertex colour's alpha and the base colour texture's alpha at the
+/// hit) reaches the cutoff,
+/// `Blend` where [`alpha_hash`] falls below it, always otherwise (`triangle_hit_counts` in
+/// `pathtrace/alpha.wgsl`, line for line).
+pub fn triangle_hit_counts(scene: &GpuScene, prim: u32, u: f32, v: f32, ray: &Ray) -> bool {
+    let m = &scene.materials[scene.tri_shading[prim as usize].material as usize];
+    if m.flags & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND) == 0 {
+        return true;
+    }
+    let mut alpha = m.opacity;
+    if let Some(tc) = scene.tri_texcoords.get(prim as usize) {
+        alpha *= tc.color(u, v).w;
+        let tex = m.tex_base_mr & 0xFFFF;
+        if tex != 0xFFFF {
+            alpha *= scene.atlas.sample(tex, tc.uv(u, v), false).w;
+        }
+    }
+    alpha_stops(m, alpha, prim, ray)
+}
+
+/// Whether `alpha` lets the surface of `m` stop `ray` (`prim` draws the blend).
+fn alpha_stops(m: &crate::gpu::GpuMaterial, alpha: f32, prim: u32, ray: &Ray) -> bool {
+    if m.flags & MATERIAL_ALPHA_MASK != 0 {
+        return alpha >= m.alpha_cutoff;
+    }
+    alpha_hash(prim, ray) < alpha
+}
+
+/// [`triangle_hit_counts`] for sphere `i` (no texture: the opacity alone).
+pub fn sphere_hit_counts(scene: &GpuScene, i: u32, ray: &Ray) -> bool {
+    let m = &scene.materials[scene.spheres[i as usize].material as usize];
+    if m.flags & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND) == 0 {
+        return true;
+    }
+    alpha_stops(m, m.opacity, i | PRIM_SPHERE, ray)
+}
+
 /// The closest hit with `0 < t < t_max`, walking the BVH.
 pub fn intersect_within(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
     traverse::<false>(scene, ray, t_max)
@@ -167,6 +232,7 @@ fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
     if scene.bvh_nodes.is_empty() {
         return None;
     }
+    let alpha = scene.header.features & crate::gpu::FEATURE_ALPHA != 0;
     let inv_dir = safe_inverse(ray.dir);
     // Bit `a` set where the direction's component on axis `a` is negative: such rays visit
     // the second child of a node split on `a` first.
@@ -206,7 +272,10 @@ fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
                         v3(tri.e1),
                         v3(tri.e2),
                         hit.t,
-                    ) {
+                    ) && (!alpha
+                        || tri.flags & crate::gpu::TRI_ALPHA == 0
+                        || triangle_hit_counts(scene, i, u, v, ray))
+                    {
                         hit = Hit { prim: i, t, u, v };
                         if ANY {
                             return Some(hit);
@@ -218,6 +287,7 @@ fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
                     let s = scene.spheres[i as usize];
                     if let Some(t) =
                         intersect_sphere(ray.origin, ray.dir, v3(s.center), s.radius, hit.t)
+                        && (!alpha || sphere_hit_counts(scene, i, ray))
                     {
                         hit = Hit {
                             prim: i | PRIM_SPHERE,

@@ -1,7 +1,7 @@
 //! The texture atlas: every texture placed whole in a page, none overlapping, its texels
 //! copied where its descriptor says (GPU-free).
 
-use lumagraph_scene::{Texture, Wrap, pack_atlas};
+use lumagraph_scene::{GpuTexDesc, Texture, UvTransform, Wrap, pack_atlas};
 
 fn texture(i: usize, width: u32, height: u32) -> Texture {
     Texture {
@@ -13,6 +13,8 @@ fn texture(i: usize, width: u32, height: u32) -> Texture {
             .collect(),
         wrap: [Wrap::Repeat, Wrap::ClampToEdge],
         nearest: i.is_multiple_of(3),
+        uv_set: 0,
+        transform: UvTransform::IDENTITY,
     }
 }
 
@@ -39,7 +41,10 @@ fn every_texture_lands_whole_in_one_page_and_none_overlap() {
         (page * page * atlas.pages) as usize,
         "texels"
     );
-    let rect = |d: &[u32; 4]| (d[0] & 0xFFFF, d[0] >> 16, d[1], d[2] & 0xFFFF, d[2] >> 16);
+    let rect = |d: &GpuTexDesc| {
+        let d = d.place;
+        (d[0] & 0xFFFF, d[0] >> 16, d[1], d[2] & 0xFFFF, d[2] >> 16)
+    };
     for (i, (t, d)) in textures.iter().zip(&atlas.descriptors).enumerate() {
         let (x, y, p, w, h) = rect(d);
         assert_eq!((w, h), (t.width, t.height), "texture {i}'s size");
@@ -47,7 +52,7 @@ fn every_texture_lands_whole_in_one_page_and_none_overlap() {
             x + w <= page && y + h <= page && p < atlas.pages,
             "texture {i} out of its page"
         );
-        assert_eq!(d[3], t.flags(), "texture {i}'s flags");
+        assert_eq!(d.place[3], t.flags(), "texture {i}'s flags");
         for (k, texel) in t.texels.iter().enumerate() {
             let (tx, ty) = (k as u32 % w, k as u32 / w);
             let at = (p * page * page + (y + ty) * page + x + tx) as usize;
@@ -90,4 +95,38 @@ fn power_of_two_textures_fill_their_pages() {
 fn no_textures_no_pages() {
     let atlas = pack_atlas(&[]);
     assert_eq!((atlas.pages, atlas.texels.len()), (0, 0));
+}
+
+/// Textures that share an image (glTF textures read through different transforms or UV
+/// sets) share its place in the atlas: the image is stored once, and each descriptor keeps
+/// its own transform and set.
+#[test]
+fn textures_sharing_an_image_share_its_place() {
+    let a = texture(1, 64, 32);
+    let turned = Texture {
+        uv_set: 1,
+        transform: UvTransform::khr([0.25, -0.5], 1.0, [2.0, 3.0]),
+        ..a.clone()
+    };
+    let other = texture(2, 64, 32);
+    let atlas = pack_atlas(&[a.clone(), turned.clone(), other]);
+    let d = &atlas.descriptors;
+    assert_eq!(d[0].place, d[1].place, "shared image, one place");
+    assert_ne!(d[0].place, d[2].place, "another image, another place");
+    assert_eq!(
+        (d[0].uv_set, d[0].m, d[0].offset),
+        (0, [1.0, 0.0, 0.0, 1.0], [0.0, 0.0])
+    );
+    assert_eq!(
+        (d[1].uv_set, d[1].m, d[1].offset),
+        (1, turned.transform.m, turned.transform.offset)
+    );
+    // Two images of 64×32 fit one page: the shared one is not stored twice.
+    let single = pack_atlas(&[a.clone(), texture(2, 64, 32)]);
+    assert_eq!(atlas.texels.len(), single.texels.len());
+    // KHR_texture_transform: scale, then rotate, then offset.
+    let t = UvTransform::khr([0.5, 0.25], std::f32::consts::FRAC_PI_2, [2.0, 4.0]);
+    let p = t.apply(glam::Vec2::new(1.0, 1.0));
+    // Scaled (2, 4); rotated by 90° with the spec's matrix [cos sin; -sin cos]: (4, -2).
+    assert!((p - glam::Vec2::new(4.5, -1.75)).length() < 1e-6, "{p}");
 }

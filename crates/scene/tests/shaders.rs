@@ -7,7 +7,7 @@ use std::mem::{offset_of, size_of};
 
 use lumagraph_scene::{
     GpuAliasEntry, GpuBvhNode, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere,
-    GpuTriShading, GpuTriTexcoords, GpuTriangle,
+    GpuTexDesc, GpuTriShading, GpuTriTexcoords, GpuTriangle,
 };
 
 /// `name` with its imports resolved as the renderer resolves them (`lumagraph-wgsl`), read
@@ -32,6 +32,9 @@ fn validate(source: &str, what: &str) -> naga::Module {
 const STUB: &str = r#"
 const HAS_TRIANGLES: bool = true;
 const HAS_SPHERES: bool = true;
+const HAS_ALPHA: bool = false;
+fn triangle_hit_counts(prim: u32, u: f32, v: f32, ray: Ray) -> bool { return true; }
+fn sphere_hit_counts(i: u32, ray: Ray) -> bool { return true; }
 @group(0) @binding(0) var<storage, read> bvh_nodes: array<vec4<u32>>;
 @group(0) @binding(1) var<storage, read> tri_positions: array<TriPositions>;
 @group(0) @binding(2) var<storage, read> spheres: array<Sphere>;
@@ -99,9 +102,9 @@ fn material_layout() -> (&'static str, usize, Vec<(&'static str, usize)>) {
             tex_transmission_specular,
             tex_specular_color,
             diffuse_roughness,
-            pad1,
+            opacity,
             eta,
-            pad2,
+            alpha_cutoff,
             k,
             pad3,
             f_avg,
@@ -118,7 +121,7 @@ fn material_layout() -> (&'static str, usize, Vec<(&'static str, usize)>) {
 fn wgsl_layouts_match_rust() {
     let expected = [
         layout!(GpuBvhNode, "BvhNode", [aabb_min, index, aabb_max, bits]),
-        layout!(GpuTriangle, "TriPositions", [v0, pad0, e1, pad1, e2, pad2]),
+        layout!(GpuTriangle, "TriPositions", [v0, flags, e1, pad1, e2, pad2]),
         layout!(
             GpuTriShading,
             "TriShading",
@@ -133,8 +136,9 @@ fn wgsl_layouts_match_rust() {
         layout!(
             GpuTriTexcoords,
             "TriTexcoords",
-            [t0, t1, t2, uv01, uv2, pad0, pad1]
+            [t0, t1, t2, uv01, uv2, uv1_2, uv1_01, colors, pad0]
         ),
+        layout!(GpuTexDesc, "TexDesc", [place, m, offset, uv_set, pad]),
         layout!(
             GpuLight,
             "Light",
@@ -242,6 +246,19 @@ fn wgsl_constants_match_rust() {
         ("FEATURE_ENVIRONMENT", lumagraph_scene::FEATURE_ENVIRONMENT),
         ("FEATURE_LIGHTS", lumagraph_scene::FEATURE_LIGHTS),
         ("FEATURE_METAL", lumagraph_scene::FEATURE_METAL),
+        ("FEATURE_MEDIA", lumagraph_scene::FEATURE_MEDIA),
+        ("FEATURE_ALPHA", lumagraph_scene::FEATURE_ALPHA),
+        ("MATERIAL_CONDUCTOR", lumagraph_scene::MATERIAL_CONDUCTOR),
+        ("MATERIAL_MEDIUM", lumagraph_scene::MATERIAL_MEDIUM),
+        (
+            "MATERIAL_INDEX_MATCHED",
+            lumagraph_scene::MATERIAL_INDEX_MATCHED,
+        ),
+        ("MATERIAL_ALPHA_MASK", lumagraph_scene::MATERIAL_ALPHA_MASK),
+        (
+            "MATERIAL_ALPHA_BLEND",
+            lumagraph_scene::MATERIAL_ALPHA_BLEND,
+        ),
     ] {
         let dec = format!("const {name}: u32 = {value}u;");
         let hex = format!("const {name}: u32 = {value:#x}u;");

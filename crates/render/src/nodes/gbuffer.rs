@@ -21,9 +21,9 @@ use crate::kernel::uniform_buffer;
 use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed};
 use crate::pool::{PooledTexture, create, wgpu_format};
 
-/// Floats per vertex: position, normal, albedo (3 each), sphere (4), uv (2), tangent (4),
-/// material id (the bits of a `u32`).
-const VERTEX_FLOATS: usize = 20;
+/// Floats per vertex: position, normal, albedo (3 each), sphere (4), uv (both sets: 4),
+/// tangent (4), material id (the bits of a `u32`), vertex colour (4, decoded).
+const VERTEX_FLOATS: usize = 26;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const PORTS: [(&str, TexFormat); 3] = [
     ("albedo", TexFormat::Rgba32Float),
@@ -70,7 +70,10 @@ impl GBuffer {
             "gbuffer/gbuffer.wgsl",
             &[(
                 "gbuffer/options.wgsl",
-                format!("const HAS_TEXTURES: bool = {textured};\n"),
+                format!(
+                    "const HAS_TEXTURES: bool = {textured};\nconst HAS_ALPHA: bool = {};\n",
+                    scene.header.features & lumagraph_scene::FEATURE_ALPHA != 0
+                ),
             )],
         )?;
         let (pipeline, layout) = pipeline(ctx, source)?;
@@ -192,7 +195,7 @@ fn pipeline(
     });
     let attributes = wgpu::vertex_attr_array![
         0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x4,
-        4 => Float32x2, 5 => Float32x4, 6 => Uint32
+        4 => Float32x4, 5 => Float32x4, 6 => Uint32, 7 => Float32x4
     ];
     let target = |format| {
         Some(wgpu::ColorTargetState {
@@ -320,12 +323,20 @@ fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     ]
 }
 
+/// A vertex colour (RGBA8, RGB sRGB-encoded) decoded as the path tracer's `vertex_color`.
+fn vertex_color(c: u32) -> [f32; 4] {
+    let [r, g, b, a] = c.to_le_bytes().map(|v| f32::from(v) / 255.0);
+    let d = lumagraph_scene::texture::srgb_decode;
+    [d(r), d(g), d(b), a]
+}
+
 /// Texture attributes of a vertex.
 #[derive(Clone, Copy)]
 struct Tex {
-    uv: [f32; 2],
+    uv: [f32; 4],
     tangent: [f32; 4],
     material: u32,
+    color: [f32; 4],
 }
 
 /// The vertex data of every triangle and tessellated sphere, `VERTEX_FLOATS` per vertex.
@@ -345,11 +356,13 @@ pub(crate) fn vertices(scene: &GpuScene, segments: u32) -> Vec<f32> {
         out.extend_from_slice(&tex.uv);
         out.extend_from_slice(&tex.tangent);
         out.push(f32::from_bits(tex.material));
+        out.extend_from_slice(&tex.color);
     };
     let no_tex = |material: u32| Tex {
-        uv: [0.0; 2],
+        uv: [0.0; 4],
         tangent: [0.0; 4],
         material,
+        color: [1.0; 4],
     };
     for (i, (t, sh)) in scene
         .tri_positions
@@ -370,10 +383,17 @@ pub(crate) fn vertices(scene: &GpuScene, segments: u32) -> Vec<f32> {
             let tex = tc.map_or(no_tex(sh.material), |tc| {
                 let [t0, t1, t2] = [tc.t0, tc.t1, tc.t2];
                 let tan = [t0, t1, t2][k];
+                let uv = [[tc.uv01[0], tc.uv01[1]], [tc.uv01[2], tc.uv01[3]], tc.uv2][k];
+                let uv1 = [
+                    [tc.uv1_01[0], tc.uv1_01[1]],
+                    [tc.uv1_01[2], tc.uv1_01[3]],
+                    tc.uv1_2,
+                ][k];
                 Tex {
-                    uv: [[tc.uv01[0], tc.uv01[1]], [tc.uv01[2], tc.uv01[3]], tc.uv2][k],
+                    uv: [uv[0], uv[1], uv1[0], uv1[1]],
                     tangent: [tan[0], tan[1], tan[2], t0[3]],
                     material: sh.material,
+                    color: vertex_color(tc.colors[k]),
                 }
             });
             push(corners[k], normals[k], a, [ng[0], ng[1], ng[2], 0.0], tex);

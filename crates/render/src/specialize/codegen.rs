@@ -59,29 +59,47 @@ pub fn parallelograms(tris: &[lumagraph_scene::GpuTriangle]) -> Vec<(usize, Opti
 }
 
 /// Generated replacement for `pathtrace/intersect.wgsl`, or `None` when the scene is too
-/// large to inline.
-pub fn inline_intersection(scene: &GpuScene) -> Option<String> {
+/// large to inline. With `alpha` ([`super::Feature::Alpha`]), the primitives of alpha-masked
+/// or blended materials take the any-hit test.
+pub fn inline_intersection(scene: &GpuScene, alpha: bool) -> Option<String> {
     let (tris, spheres) = (&scene.tri_positions, &scene.spheres);
     if tris.len() + spheres.len() > INLINE_MAX_PRIMITIVES {
         return None;
     }
+    // Primitives of alpha-masked or blended materials take the any-hit test
+    // (`triangle_hit_counts`, `sphere_hit_counts` in pathtrace/alpha.wgsl), each triangle
+    // on its own.
+    let alpha_material = |m: u32| {
+        alpha
+            && scene.materials[m as usize].flags
+                & (lumagraph_scene::MATERIAL_ALPHA_MASK | lumagraph_scene::MATERIAL_ALPHA_BLEND)
+                != 0
+    };
+    let alpha_tri = |i: usize| alpha_material(scene.tri_shading[i].material);
     let mut closest = String::new();
     let mut any = String::new();
+    let single = |a: usize, closest: &mut String, any: &mut String| {
+        let t = &tris[a];
+        let args = format!("{}, {}, {}", v3(t.v0), v3(t.e1), v3(t.e2));
+        let test = if alpha_tri(a) {
+            format!(" && triangle_hit_counts({a}u, r.z, r.w, ray)")
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            closest,
+            "    r = intersect_triangle(ray.origin, ray.dir, {args}, hit.t);\n    if (r.x != 0.0 && skip_prim != {a}u{test}) {{ hit = Hit({a}u, r.y, r.z, r.w); }}"
+        );
+        let _ = writeln!(
+            any,
+            "    r = intersect_triangle(ray.origin, ray.dir, {args}, t_max);\n    if (skip_prim != {a}u && r.x != 0.0{test}) {{ return true; }}"
+        );
+    };
     for (a, b) in parallelograms(tris) {
         let t = &tris[a];
         let args = format!("{}, {}, {}", v3(t.v0), v3(t.e1), v3(t.e2));
         match b {
-            None => {
-                let _ = writeln!(
-                    closest,
-                    "    r = intersect_triangle(ray.origin, ray.dir, {args}, hit.t);\n    if (r.x != 0.0 && skip_prim != {a}u) {{ hit = Hit({a}u, r.y, r.z, r.w); }}"
-                );
-                let _ = writeln!(
-                    any,
-                    "    if (skip_prim != {a}u && intersect_triangle(ray.origin, ray.dir, {args}, t_max).x != 0.0) {{ return true; }}"
-                );
-            }
-            Some(b) => {
+            Some(b) if !alpha_tri(a) && !alpha_tri(b) => {
                 // Hits with u < 0 are on the second triangle, (v0, v0 + e2, v0 + e2 - e1):
                 // its barycentrics are (u + v, -u).
                 let _ = writeln!(
@@ -93,17 +111,27 @@ pub fn inline_intersection(scene: &GpuScene) -> Option<String> {
                     "    if (skip_prim != {a}u && skip_prim != {b}u && intersect_parallelogram(ray.origin, ray.dir, {args}, t_max).x != 0.0) {{ return true; }}"
                 );
             }
+            Some(b) => {
+                single(a, &mut closest, &mut any);
+                single(b, &mut closest, &mut any);
+            }
+            None => single(a, &mut closest, &mut any),
         }
     }
     for (i, s) in spheres.iter().enumerate() {
         let args = format!("{}, {:?}", v3(s.center), s.radius);
+        let test = if alpha_material(s.material) {
+            format!(" && sphere_hit_counts({i}u, ray)")
+        } else {
+            String::new()
+        };
         let _ = writeln!(
             closest,
-            "    t = intersect_sphere_from({i}u | PRIM_SPHERE, ray.origin, ray.dir, {args}, hit.t);\n    if (t > 0.0) {{ hit = Hit({i}u | PRIM_SPHERE, t, 0.0, 0.0); }}"
+            "    t = intersect_sphere_from({i}u | PRIM_SPHERE, ray.origin, ray.dir, {args}, hit.t);\n    if (t > 0.0{test}) {{ hit = Hit({i}u | PRIM_SPHERE, t, 0.0, 0.0); }}"
         );
         let _ = writeln!(
             any,
-            "    if (intersect_sphere_from({i}u | PRIM_SPHERE, ray.origin, ray.dir, {args}, t_max) > 0.0) {{ return true; }}"
+            "    if (intersect_sphere_from({i}u | PRIM_SPHERE, ray.origin, ray.dir, {args}, t_max) > 0.0{test}) {{ return true; }}"
         );
     }
     Some(format!(
@@ -123,6 +151,7 @@ fn intersect_scene(ray: Ray) -> Hit {{
 }}
 
 fn occluded(ray: Ray, t_max: f32) -> bool {{
+    var r: vec4<f32>;
 {any}    return false;
 }}
 ",
@@ -196,6 +225,14 @@ fn table_fns(name: &str, ty: &str, types: &[&str], rows: &[Vec<String>]) -> Stri
     out
 }
 
+/// The WGSL types of [`materials_rows`]'s fields, in order (`Material` in
+/// `pathtrace/scene_types.wgsl`).
+const MATERIAL_TYPES: [&str; 26] = [
+    "vec3f", "f32", "vec3f", "f32", "f32", "f32", "f32", "f32", "u32", "u32", "u32", "f32", "u32",
+    "u32", "f32", "f32", "vec3f", "f32", "vec3f", "u32", "vec3f", "u32", "vec3f", "f32", "vec3f",
+    "u32",
+];
+
 /// Every material as WGSL literals, field by field.
 fn materials_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
     scene
@@ -218,9 +255,9 @@ fn materials_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
                 u(m.tex_transmission_specular),
                 u(m.tex_specular_color),
                 l.f(m.diffuse_roughness),
-                u(0),
+                l.f(m.opacity),
                 l.v3(m.eta),
-                u(0),
+                l.f(m.alpha_cutoff),
                 l.v3(m.k),
                 u(0),
                 l.v3(m.f_avg),
@@ -268,7 +305,7 @@ fn positions_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
     scene
         .tri_positions
         .iter()
-        .map(|t| vec![l.v3(t.v0), u(0), l.v3(t.e1), u(0), l.v3(t.e2), u(0)])
+        .map(|t| vec![l.v3(t.v0), u(t.flags), l.v3(t.e1), u(0), l.v3(t.e2), u(0)])
         .collect()
 }
 
@@ -340,10 +377,6 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
     if l.not_finite.get() {
         return None;
     }
-    let material_types = [
-        f3, f1, f3, f1, f1, f1, f1, f1, u1, u1, u1, f1, u1, u1, f1, u1, f3, u1, f3, u1, f3, u1, f3,
-        f1, f3, u1,
-    ];
     Some(format!(
         "// Generated for this scene: {} materials, {} lights, {} triangles and {} spheres,
 // returned by id with their values in the code (no material, light or shading buffer read).
@@ -354,7 +387,7 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
         lights.len(),
         positions.len(),
         spheres.len(),
-        table_fns("scene_material", "Material", &material_types, &materials),
+        table_fns("scene_material", "Material", &MATERIAL_TYPES, &materials),
         table_fns(
             "scene_light",
             "Light",
@@ -407,10 +440,6 @@ pub fn inline_materials_data(scene: &GpuScene) -> Option<String> {
     if l.not_finite.get() {
         return None;
     }
-    let material_types = [
-        f3, f1, f3, f1, f1, f1, f1, f1, u1, u1, u1, f1, u1, u1, f1, u1, f3, u1, f3, u1, f3, u1, f3,
-        f1, f3, u1,
-    ];
     let light_fns = if few_lights {
         format!(
             "{}{}",
@@ -452,7 +481,7 @@ fn scene_sphere(i: u32) -> Sphere {{
         },
         scene.tri_positions.len(),
         scene.spheres.len(),
-        table_fns("scene_material", "Material", &material_types, &materials),
+        table_fns("scene_material", "Material", &MATERIAL_TYPES, &materials),
     ))
 }
 

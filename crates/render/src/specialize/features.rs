@@ -10,8 +10,8 @@
 //! range of the texels each texture holds.
 
 use lumagraph_scene::{
-    ENV_MAP, ENV_NONE, FEATURE_TEXTURES, GpuMaterial, GpuScene, MATERIAL_INDEX_MATCHED,
-    MATERIAL_MEDIUM,
+    ENV_MAP, ENV_NONE, FEATURE_TEXTURES, GpuMaterial, GpuScene, MATERIAL_ALPHA_BLEND,
+    MATERIAL_ALPHA_MASK, MATERIAL_INDEX_MATCHED, MATERIAL_MEDIUM,
 };
 
 use super::{INLINE_MAX_MATERIALS, INLINE_MAX_PRIMITIVES, PathTraceOptions, codegen};
@@ -46,6 +46,8 @@ pub enum Feature {
     RoughDiffuse,
     /// Media inside shapes and index-matched boundaries.
     Media,
+    /// The any-hit test of alpha-masked and blended materials, in every intersector.
+    Alpha,
     /// First-hit albedo, normal and depth.
     FirstHitAovs,
     /// Adaptive sampling's statistics and skipping.
@@ -62,7 +64,7 @@ pub enum Feature {
 
 impl Feature {
     /// Every feature, in the order `plan` lists them.
-    pub const ALL: [Self; 19] = [
+    pub const ALL: [Self; 20] = [
         Self::BvhTraversal,
         Self::InlineIntersection,
         Self::InlineData,
@@ -76,6 +78,7 @@ impl Feature {
         Self::GlassLobe,
         Self::RoughDiffuse,
         Self::Media,
+        Self::Alpha,
         Self::FirstHitAovs,
         Self::Adaptive,
         Self::Textures,
@@ -100,6 +103,7 @@ impl Feature {
             Self::GlassLobe => "glass lobe",
             Self::RoughDiffuse => "rough diffuse (EON)",
             Self::Media => "participating media",
+            Self::Alpha => "alpha (mask, blend)",
             Self::FirstHitAovs => "first-hit AOVs",
             Self::Adaptive => "adaptive sampling",
             Self::Textures => "material textures",
@@ -125,6 +129,7 @@ impl Feature {
             Self::GlassLobe => "HAS_GLASS",
             Self::RoughDiffuse => "HAS_ROUGH_DIFFUSE",
             Self::Media => "HAS_MEDIA",
+            Self::Alpha => "HAS_ALPHA",
             Self::FirstHitAovs => "WRITE_AOVS",
             Self::Adaptive => "ADAPTIVE",
             Self::Textures => "HAS_TEXTURES",
@@ -268,6 +273,8 @@ struct MaterialRanges {
     metallic: Range,
     transmission: Range,
     specular: Range,
+    /// Opacity times the base colour texture's alpha.
+    opacity: Range,
 }
 
 /// The smallest and largest value of each channel (RGBA, over 255) of texture `id` in the
@@ -282,7 +289,7 @@ fn channel_range(scene: &GpuScene, id: u32, channel: usize) -> (f32, f32) {
     }
 }
 
-fn material_ranges(scene: &GpuScene, m: &GpuMaterial) -> MaterialRanges {
+fn material_ranges(scene: &GpuScene, index: usize, m: &GpuMaterial) -> MaterialRanges {
     let lo = |packed: u32| packed & 0xFFFF;
     let hi = |packed: u32| packed >> 16;
     let textured = |factor: f32, id: u32, channel: usize| {
@@ -303,7 +310,10 @@ fn material_ranges(scene: &GpuScene, m: &GpuMaterial) -> MaterialRanges {
             .fold(0.0f32, f32::max);
         specular = specular.times(0.0, top);
     }
+    let vertex_alpha =
+        |i: usize| f32::from(scene.vertex_alpha_min.get(i).copied().unwrap_or(0)) / 255.0;
     MaterialRanges {
+        opacity: textured(m.opacity, lo(m.tex_base_mr), 3).times(vertex_alpha(index), 1.0),
         metallic: textured(m.metallic, hi(m.tex_base_mr), 2),
         transmission: textured(m.transmission, lo(m.tex_transmission_specular), 0),
         specular,
@@ -347,7 +357,8 @@ impl<'a> Facts<'a> {
             materials: scene
                 .materials
                 .iter()
-                .map(|m| material_ranges(scene, m))
+                .enumerate()
+                .map(|(i, m)| material_ranges(scene, i, m))
                 .collect(),
         }
     }
@@ -428,6 +439,13 @@ impl<'a> Facts<'a> {
                     m.diffuse_roughness > 0.0 && r.metallic.min < 1.0 && r.transmission.min < 1.0
                 }),
                 "materials with diffuse_roughness > 0",
+            ),
+            Feature::Alpha => self.needed(
+                self.count(|r, m| {
+                    (m.flags & MATERIAL_ALPHA_MASK != 0 && r.opacity.min < m.alpha_cutoff)
+                        || (m.flags & MATERIAL_ALPHA_BLEND != 0 && r.opacity.min < 1.0)
+                }),
+                "materials that can be cut out (alpha mask) or seen through (alpha blend)",
             ),
             Feature::Media => self.needed(
                 self.count(|_, m| m.flags & (MATERIAL_MEDIUM | MATERIAL_INDEX_MATCHED) != 0),

@@ -73,7 +73,7 @@ impl Specialization {
         let features = Features::decide(scene, options);
         let inline = features.on(Feature::InlineIntersection);
         let intersection = if inline {
-            inline_intersection(scene)
+            inline_intersection(scene, features.on(Feature::Alpha))
         } else {
             None
         };

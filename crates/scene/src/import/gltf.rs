@@ -2,8 +2,17 @@
 //! perspective cameras, metallic-roughness materials with their base color,
 //! metallic-roughness, normal and emissive textures, `KHR_materials_emissive_strength`,
 //! `KHR_materials_ior`, `KHR_materials_transmission` and `KHR_materials_specular` (factors
-//! and textures), `KHR_materials_diffuse_roughness` (its factor). Texture coordinates are `TEXCOORD_0`; tangents are the file's `TANGENT`
-//! when present (else generated when the scene is flattened).
+//! and textures), `KHR_materials_diffuse_roughness` (its factor), `alphaMode`, `alphaCutoff`
+//! and the base colour factor's alpha (with the base colour texture's alpha: masks and
+//! blending, [`crate::scene::AlphaMode`]). Textures read `TEXCOORD_0` or `TEXCOORD_1` (their
+//! `texCoord`), through their `KHR_texture_transform` (offset, rotation, scale, `texCoord`
+//! override); `COLOR_0` multiplies the base colour and the opacity. Tangents are the file's
+//! `TANGENT` when present (else generated when the scene is flattened, along the normal
+//! texture's own coordinates).
+//!
+//! `EXT_mesh_gpu_instancing` places a node's mesh at each of its instances (translation,
+//! rotation, scale from float accessors): the instances are copies of the mesh, each
+//! instance's triangles stored ([`MAX_INSTANCED_TRIANGLES`] at most).
 //!
 //! `KHR_lights_punctual` lights become [`PunctualLight`]s, converted as Blender's importer
 //! does in its default ("Standard") mode: a point or spot light's intensity in candela
@@ -27,14 +36,14 @@ use crate::scene::{
     Camera, Material, MaterialTextures, NO_TEXTURE, PunctualLight, Triangle, push_triangle,
     transform_triangle,
 };
-use crate::texture::{Texture, Wrap};
+use crate::texture::{Texture, UvTransform, Wrap};
 
 /// Imports a `.gltf` (with embedded or external buffers) or `.glb` file.
 ///
 /// # Errors
 /// When the file or its buffers cannot be read or are not valid glTF.
 pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneError> {
-    let file = open(path)?;
+    let (file, unread) = open(path)?;
     check_images(&file.document)?;
     check_uris(&file.document, path.parent())?;
     let buffers = ::gltf::import_buffers(&file.document, path.parent(), file.blob.clone())?;
@@ -42,12 +51,14 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
     check_views(doc, &buffers)?;
     check_tree(doc)?;
     let mut out = ImportedMesh::default();
+    out.report.warnings.extend(unread);
     let mut decoder = Decoder {
         base: path.parent(),
         file: path
             .file_name()
             .map_or_else(String::new, |f| f.to_string_lossy().into_owned()),
         buffers: &buffers,
+        decoded: HashMap::new(),
         used: HashMap::new(),
         textures: Vec::new(),
     };
@@ -98,6 +109,10 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
             }
         }
         if let Some(mesh) = node.mesh() {
+            let worlds: Vec<Mat4> = match instances(doc, &node, &buffers)? {
+                Some(locals) => locals.iter().map(|l| world * *l).collect(),
+                None => vec![world],
+            };
             for prim in mesh.primitives() {
                 if prim.mode() != ::gltf::mesh::Mode::Triangles {
                     out.report.warnings.push(format!(
@@ -123,7 +138,7 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
                         prim.index()
                     )))
                 })?;
-                read_primitive(&prim, &buffers, &world, material as u32, &mut out);
+                read_primitive(&prim, &buffers, &worlds, material as u32, &mut out);
             }
         }
         let children: Vec<_> = node.children().collect();
@@ -133,10 +148,15 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
 }
 
 /// Reads and validates a `.gltf` or `.glb` file, as `gltf::Gltf::open` does, checking first
-/// what the gltf crate's validation indexes unchecked: each primitive's `POSITION`
-/// accessor.
-fn open(path: &Path) -> Result<::gltf::Gltf, SceneError> {
+/// what the gltf crate's validation indexes unchecked (each primitive's `POSITION`
+/// accessor) and what lumagraph does not read ([`super::gltf_extensions::check`]: an error
+/// for a required extension, the warnings returned for the rest).
+fn open(path: &Path) -> Result<(::gltf::Gltf, Vec<String>), SceneError> {
     let bytes = std::fs::read(path).map_err(::gltf::Error::Io)?;
+    let file = path
+        .file_name()
+        .map_or_else(String::new, |f| f.to_string_lossy().into_owned());
+    let unread = super::gltf_extensions::check(&bytes, &file)?;
     if bytes.starts_with(b"glTF") {
         // gltf subtracts the header's 12 bytes from this length unchecked.
         let length = bytes
@@ -165,11 +185,19 @@ fn open(path: &Path) -> Result<::gltf::Gltf, SceneError> {
             }
         }
     }
-    let document = ::gltf::Document::from_json(unchecked.document.into_json())?;
-    Ok(::gltf::Gltf {
-        document,
-        blob: unchecked.blob,
-    })
+    let mut root = unchecked.document.into_json();
+    // Every extension the file requires is one lumagraph reads (checked above), some of
+    // them from the raw JSON where the gltf crate does not know them: its validation would
+    // refuse those.
+    root.extensions_required.clear();
+    let document = ::gltf::Document::from_json(root)?;
+    Ok((
+        ::gltf::Gltf {
+            document,
+            blob: unchecked.blob,
+        },
+        unread,
+    ))
 }
 
 /// Every buffer view within its buffer's data (the gltf crate slices them unchecked, for
@@ -460,10 +488,112 @@ fn punctual_light(
     })
 }
 
+/// The most triangles instancing may make: instances are copies (each instance's
+/// triangles are stored), so a file instancing a large mesh many times gets an error naming
+/// the node rather than exhausting memory.
+pub const MAX_INSTANCED_TRIANGLES: u64 = 50_000_000;
+
+/// The instance transforms of a node with `EXT_mesh_gpu_instancing` (relative to the
+/// node): translation, rotation (a unit quaternion) and scale per instance, from float
+/// accessors; `None` without the extension.
+///
+/// # Errors
+/// [`ErrorKind::GltfData`] naming the node, where an accessor is missing, not of floats, or
+/// of another count than the others, or where the copies would exceed
+/// [`MAX_INSTANCED_TRIANGLES`].
+fn instances(
+    doc: &::gltf::Document,
+    node: &::gltf::Node<'_>,
+    buffers: &[::gltf::buffer::Data],
+) -> Result<Option<Vec<Mat4>>, SceneError> {
+    use ::gltf::accessor::{DataType, Dimensions};
+    let Some(ext) = node.extension_value("EXT_mesh_gpu_instancing") else {
+        return Ok(None);
+    };
+    let fail = |why: String| {
+        SceneError::new(ErrorKind::GltfData(format!(
+            "node {} ({}): EXT_mesh_gpu_instancing: {why}",
+            node.index(),
+            node.name().unwrap_or("unnamed")
+        )))
+    };
+    let data = |b: ::gltf::Buffer<'_>| buffers.get(b.index()).map(|d| &d.0[..]);
+    // The values of attribute `name` (`dims` floats each), or `None` where it is absent.
+    let read = |name: &str, dims: Dimensions| -> Result<Option<Vec<Vec4>>, SceneError> {
+        let Some(i) = ext.pointer(&format!("/attributes/{name}")) else {
+            return Ok(None);
+        };
+        let a = i
+            .as_u64()
+            .and_then(|i| doc.accessors().nth(usize::try_from(i).ok()?))
+            .ok_or_else(|| fail(format!("{name} names no accessor ({i})")))?;
+        if a.data_type() != DataType::F32 || a.dimensions() != dims {
+            return Err(fail(format!(
+                "{name} is {:?} of {:?}; lumagraph reads {dims:?} of floats",
+                a.dimensions(),
+                a.data_type()
+            )));
+        }
+        let values: Option<Vec<Vec4>> = match dims {
+            Dimensions::Vec4 => ::gltf::accessor::Iter::<[f32; 4]>::new(a, data)
+                .map(|it| it.map(Vec4::from).collect()),
+            _ => ::gltf::accessor::Iter::<[f32; 3]>::new(a, data)
+                .map(|it| it.map(|v| Vec3::from(v).extend(0.0)).collect()),
+        };
+        values
+            .ok_or_else(|| fail(format!("{name}: its buffer data cannot be read")))
+            .map(Some)
+    };
+    let translation = read("TRANSLATION", Dimensions::Vec3)?;
+    let rotation = read("ROTATION", Dimensions::Vec4)?;
+    let scale = read("SCALE", Dimensions::Vec3)?;
+    let counts: Vec<usize> = [&translation, &rotation, &scale]
+        .iter()
+        .filter_map(|v| v.as_ref().map(Vec::len))
+        .collect();
+    let n = counts.first().copied().unwrap_or(0);
+    if counts.iter().any(|&c| c != n) {
+        return Err(fail(format!(
+            "its attributes have different counts {counts:?}"
+        )));
+    }
+    let triangles: u64 = node
+        .mesh()
+        .map(|m| {
+            m.primitives()
+                .map(|p| {
+                    p.indices()
+                        .or_else(|| p.get(&::gltf::Semantic::Positions))
+                        .map_or(0, |a| a.count() as u64 / 3)
+                })
+                .sum()
+        })
+        .unwrap_or(0);
+    if triangles.saturating_mul(n as u64) > MAX_INSTANCED_TRIANGLES {
+        return Err(fail(format!(
+            "{n} instances of {triangles} triangles would be stored as {} triangles, over \
+             lumagraph's {MAX_INSTANCED_TRIANGLES} (instances are copies)",
+            triangles.saturating_mul(n as u64)
+        )));
+    }
+    Ok(Some(
+        (0..n)
+            .map(|k| {
+                let t = translation.as_ref().map_or(Vec3::ZERO, |v| v[k].truncate());
+                let r = rotation.as_ref().map_or(glam::Quat::IDENTITY, |v| {
+                    glam::Quat::from_vec4(v[k]).normalize()
+                });
+                let s = scale.as_ref().map_or(Vec3::ONE, |v| v[k].truncate());
+                Mat4::from_scale_rotation_translation(s, r, t)
+            })
+            .collect(),
+    ))
+}
+
 fn read_primitive(
     prim: &::gltf::Primitive<'_>,
     buffers: &[::gltf::buffer::Data],
-    world: &Mat4,
+    worlds: &[Mat4],
     material: u32,
     out: &mut ImportedMesh,
 ) {
@@ -479,10 +609,26 @@ fn read_primitive(
         .read_normals()
         .map(|n| n.map(Vec3::from).collect())
         .filter(|n: &Vec<Vec3>| n.len() == positions.len());
-    let uvs: Option<Vec<Vec2>> = reader
-        .read_tex_coords(0)
-        .map(|t| t.into_f32().map(Vec2::from).collect())
-        .filter(|t: &Vec<Vec2>| t.len() == positions.len());
+    let uv_set = |set: u32| -> Option<Vec<Vec2>> {
+        reader
+            .read_tex_coords(set)
+            .map(|t| t.into_f32().map(Vec2::from).collect())
+            .filter(|t: &Vec<Vec2>| t.len() == positions.len())
+    };
+    let (uvs, uvs1) = (uv_set(0), uv_set(1));
+    // Vertex colours as texels are stored: RGB sRGB-encoded, alpha linear, 8 bits each.
+    let colors: Option<Vec<[u8; 4]>> = reader
+        .read_colors(0)
+        .map(|c| {
+            c.into_rgba_f32()
+                .map(|[r, g, b, a]| {
+                    let byte = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+                    let e = crate::texture::srgb_encode;
+                    [byte(e(r)), byte(e(g)), byte(e(b)), byte(a)]
+                })
+                .collect()
+        })
+        .filter(|c: &Vec<[u8; 4]>| c.len() == positions.len());
     // Tangents only mean something with the normals they were made for.
     let tangents: Option<Vec<Vec4>> = reader
         .read_tangents()
@@ -503,6 +649,8 @@ fn read_primitive(
             positions: idx.map(|i| positions[i]),
             normals: normals.as_ref().map(|n| idx.map(|i| n[i])),
             uvs: uvs.as_ref().map(|t| idx.map(|i| t[i])),
+            uvs1: uvs1.as_ref().map(|t| idx.map(|i| t[i])),
+            colors: colors.as_ref().map(|c| idx.map(|i| c[i])),
             tangents: tangents.as_ref().map(|t| {
                 idx.map(|i| {
                     let w = if t[i].w < 0.0 { -1.0 } else { 1.0 };
@@ -511,11 +659,13 @@ fn read_primitive(
             }),
             material,
         };
-        push_triangle(
-            &mut out.triangles,
-            &mut out.report,
-            transform_triangle(world, &tri),
-        );
+        for world in worlds {
+            push_triangle(
+                &mut out.triangles,
+                &mut out.report,
+                transform_triangle(world, &tri),
+            );
+        }
     }
     if bad_indices > 0 {
         out.report.warnings.push(format!(
@@ -538,9 +688,52 @@ struct Decoder<'a> {
     /// The glTF file's name, for texture names.
     file: String,
     buffers: &'a [::gltf::buffer::Data],
-    /// glTF texture index → index in `textures`.
-    used: HashMap<usize, u32>,
+    /// glTF texture index → index in `textures` of its first use (its image decoded).
+    decoded: HashMap<usize, u32>,
+    /// (glTF texture, coordinate set, transform's bits) → index in `textures`.
+    used: HashMap<(usize, u32, [u32; 6]), u32>,
     textures: Vec<Texture>,
+}
+
+/// How a texture reference reads its texture: the coordinate set (`texCoord`, or the
+/// transform's override) and the `KHR_texture_transform`, from the extension's JSON.
+fn texture_transform(ext: Option<&::gltf::json::Value>, tex_coord: u32) -> (u32, UvTransform) {
+    let Some(t) = ext else {
+        return (tex_coord, UvTransform::IDENTITY);
+    };
+    let pair = |key: &str, default: [f32; 2]| {
+        t.get(key)
+            .and_then(::gltf::json::Value::as_array)
+            .and_then(|a| Some([a.first()?.as_f64()? as f32, a.get(1)?.as_f64()? as f32]))
+            .unwrap_or(default)
+    };
+    let rotation = t
+        .get("rotation")
+        .and_then(::gltf::json::Value::as_f64)
+        .unwrap_or(0.0) as f32;
+    let set = t
+        .get("texCoord")
+        .and_then(::gltf::json::Value::as_u64)
+        .map_or(tex_coord, |c| u32::try_from(c).unwrap_or(u32::MAX));
+    (
+        set,
+        UvTransform::khr(pair("offset", [0.0; 2]), rotation, pair("scale", [1.0; 2])),
+    )
+}
+
+/// The `KHR_texture_transform` of a texture info, as JSON (the gltf crate's typed view,
+/// back to the extension's fields).
+fn info_transform(i: &::gltf::texture::Info<'_>) -> Option<::gltf::json::Value> {
+    i.texture_transform().map(|t| {
+        let mut v = ::gltf::json::Value::Object(Default::default());
+        v["offset"] = t.offset().iter().map(|&x| f64::from(x)).collect();
+        v["rotation"] = f64::from(t.rotation()).into();
+        v["scale"] = t.scale().iter().map(|&x| f64::from(x)).collect();
+        if let Some(c) = t.tex_coord() {
+            v["texCoord"] = c.into();
+        }
+        v
+    })
 }
 
 fn wrap(mode: ::gltf::texture::WrappingMode) -> Wrap {
@@ -609,25 +802,58 @@ fn rgba8(data: &::gltf::image::Data) -> Option<Vec<[u8; 4]>> {
 }
 
 impl Decoder<'_> {
-    /// The index of `info`'s texture among the decoded ones, decoding it on first use.
+    /// The index of the texture `info` reads with coordinate set `tex_coord` through
+    /// `transform`, among the decoded ones: each image decoded on first use, each way of
+    /// reading it one [`Texture`] sharing its texels.
     fn texture(
         &mut self,
         info: Option<::gltf::texture::Texture<'_>>,
-        tex_coord: u32,
+        (tex_coord, transform): (u32, UvTransform),
         warnings: &mut Vec<String>,
     ) -> Result<u32, SceneError> {
         let Some(t) = info else {
             return Ok(NO_TEXTURE);
         };
-        if tex_coord != 0 {
+        let uv_set = if tex_coord > 1 {
             warnings.push(format!(
-                "texture {} uses TEXCOORD_{tex_coord}; TEXCOORD_0 is used instead",
+                "texture {} uses TEXCOORD_{tex_coord}; lumagraph reads TEXCOORD_0 and \
+                 TEXCOORD_1, so TEXCOORD_0 is used instead",
                 t.index()
             ));
-        }
-        if let Some(&i) = self.used.get(&t.index()) {
+            0
+        } else {
+            tex_coord
+        };
+        let bits = [
+            transform.m[0],
+            transform.m[1],
+            transform.m[2],
+            transform.m[3],
+            transform.offset[0],
+            transform.offset[1],
+        ]
+        .map(f32::to_bits);
+        let key = (t.index(), uv_set, bits);
+        if let Some(&i) = self.used.get(&key) {
             return Ok(i);
         }
+        let image = match self.decoded.get(&t.index()) {
+            Some(&i) => self.textures[i as usize].clone(),
+            None => self.decode(&t)?,
+        };
+        let index = self.textures.len() as u32;
+        self.textures.push(Texture {
+            uv_set,
+            transform,
+            ..image
+        });
+        self.decoded.entry(t.index()).or_insert(index);
+        self.used.insert(key, index);
+        Ok(index)
+    }
+
+    /// Decodes the image of `t` with its sampler.
+    fn decode(&self, t: &::gltf::texture::Texture<'_>) -> Result<Texture, SceneError> {
         let image = t.source();
         let what = match image.source() {
             ::gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => {
@@ -648,17 +874,16 @@ impl Decoder<'_> {
             rgba8(&data).ok_or_else(|| fail("the image has fewer pixels than its size".into()))?;
         let sampler = t.sampler();
         let nearest = sampler.mag_filter() == Some(::gltf::texture::MagFilter::Nearest);
-        let index = self.textures.len() as u32;
-        self.textures.push(Texture {
+        Ok(Texture {
             name: format!("{} image {} ({what})", self.file, image.index()),
             width: data.width,
             height: data.height,
-            texels,
+            texels: texels.into(),
             wrap: [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())],
             nearest,
-        });
-        self.used.insert(t.index(), index);
-        Ok(index)
+            uv_set: 0,
+            transform: UvTransform::IDENTITY,
+        })
     }
 }
 
@@ -708,11 +933,13 @@ fn material(
     warnings: &mut Vec<String>,
 ) -> Result<Material, SceneError> {
     let pbr = m.pbr_metallic_roughness();
-    let [r, g, b, _] = pbr.base_color_factor();
+    let [r, g, b, a] = pbr.base_color_factor();
     let strength = m.emissive_strength().unwrap_or(1.0);
     let mut tex = |i: Option<::gltf::texture::Info<'_>>| {
-        let coord = i.as_ref().map_or(0, ::gltf::texture::Info::tex_coord);
-        dec.texture(i.map(|i| i.texture()), coord, warnings)
+        let read = i.as_ref().map_or((0, UvTransform::IDENTITY), |i| {
+            texture_transform(info_transform(i).as_ref(), i.tex_coord())
+        });
+        dec.texture(i.map(|i| i.texture()), read, warnings)
     };
     let base_color = tex(pbr.base_color_texture())?;
     let metallic_roughness = tex(pbr.metallic_roughness_texture())?;
@@ -730,7 +957,14 @@ fn material(
         .and_then(::gltf::material::Specular::specular_color_texture))?;
     let normal_info = m.normal_texture();
     let normal = match &normal_info {
-        Some(n) => dec.texture(Some(n.texture()), n.tex_coord(), warnings)?,
+        Some(n) => {
+            let ext = n.extensions().and_then(|e| e.get("KHR_texture_transform"));
+            dec.texture(
+                Some(n.texture()),
+                texture_transform(ext, n.tex_coord()),
+                warnings,
+            )?
+        }
         None => NO_TEXTURE,
     };
     let ior = m.ior().unwrap_or(1.5);
@@ -774,5 +1008,13 @@ fn material(
                 )
             }),
         index_matched: false,
+        opacity: a.clamp(0.0, 1.0),
+        alpha_mode: match m.alpha_mode() {
+            ::gltf::material::AlphaMode::Opaque => crate::scene::AlphaMode::Opaque,
+            ::gltf::material::AlphaMode::Mask => crate::scene::AlphaMode::Mask {
+                cutoff: m.alpha_cutoff().unwrap_or(0.5).clamp(0.0, 1.0),
+            },
+            ::gltf::material::AlphaMode::Blend => crate::scene::AlphaMode::Blend,
+        },
     })
 }

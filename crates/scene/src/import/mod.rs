@@ -7,6 +7,7 @@
 //! [`LoadReport`], never a panic.
 
 pub mod gltf;
+mod gltf_extensions;
 pub mod obj;
 
 use std::path::Path;

@@ -89,6 +89,8 @@ pub fn import_obj(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneErr
                 positions: [p0, p1, p2],
                 normals,
                 uvs: None,
+                uvs1: None,
+                colors: None,
                 tangents: None,
                 material,
             };
