@@ -29,6 +29,9 @@ pub struct GpuContext {
     errors: std::sync::Arc<std::sync::Mutex<Option<String>>>,
     /// Why the device was lost, once it is (see [`GpuContext::lost`]).
     lost: std::sync::Arc<std::sync::Mutex<Option<String>>>,
+    /// Kernels compiled on this device, reused when the same shader is built again
+    /// ([`crate::kernel::KernelCache`]).
+    pub(crate) kernels: std::sync::Arc<crate::kernel::KernelCache>,
 }
 
 impl GpuContext {
@@ -234,6 +237,7 @@ impl GpuContext {
             timestamps,
             errors,
             lost,
+            kernels: std::sync::Arc::default(),
         }
     }
 

@@ -267,9 +267,55 @@ pub fn linear_sampler(ctx: &GpuContext) -> wgpu::Sampler {
     })
 }
 
+/// The kernels compiled on a device, by their WGSL and entry points: a shader built again
+/// with the same text (the same node in a new executor, a specialized shader of an
+/// unchanged scene, a test's many renders) takes the pipelines already compiled instead
+/// of compiling them again, which on a CPU adapter takes most of a second to several
+/// seconds each. Holds the last [`KERNEL_CACHE_SIZE`] kernels built.
+#[derive(Debug, Default)]
+pub struct KernelCache {
+    kernels: std::sync::Mutex<std::collections::VecDeque<(String, Vec<String>, Kernel)>>,
+}
+
+/// How many kernels a [`KernelCache`] keeps (the oldest goes first).
+pub const KERNEL_CACHE_SIZE: usize = 48;
+
+impl KernelCache {
+    fn get(&self, source: &str, entry_points: &[&str]) -> Option<Kernel> {
+        let kernels = self
+            .kernels
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        kernels
+            .iter()
+            .find(|(s, e, _)| {
+                s == source
+                    && e.iter()
+                        .map(String::as_str)
+                        .eq(entry_points.iter().copied())
+            })
+            .map(|(_, _, k)| k.clone())
+    }
+
+    fn put(&self, source: &str, entry_points: &[&str], kernel: &Kernel) {
+        let mut kernels = self
+            .kernels
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if kernels.len() >= KERNEL_CACHE_SIZE {
+            kernels.pop_front();
+        }
+        kernels.push_back((
+            source.to_owned(),
+            entry_points.iter().map(|e| (*e).to_owned()).collect(),
+            kernel.clone(),
+        ));
+    }
+}
+
 /// A compute pipeline with the bindings its shader declares (and, where asked for, one per
 /// further entry point of the same shader, bound alike).
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct Kernel {
     label: String,
     pipeline: wgpu::ComputePipeline,
@@ -312,6 +358,18 @@ impl Kernel {
         source: &str,
         entry_points: &[&str],
     ) -> Result<Self> {
+        if let Some(kernel) = ctx.kernels.get(source, entry_points) {
+            return Ok(Self {
+                label: label.to_owned(),
+                ..kernel
+            });
+        }
+        let kernel = Self::compile(ctx, label, source, entry_points)?;
+        ctx.kernels.put(source, entry_points, &kernel);
+        Ok(kernel)
+    }
+
+    fn compile(ctx: &GpuContext, label: &str, source: &str, entry_points: &[&str]) -> Result<Self> {
         let (bindings, workgroup) = reflect(label, source)?;
         let device = &ctx.device;
         if bindings
