@@ -275,6 +275,15 @@ fn load(path: &Path, overrides: &[String]) -> Result<Graph> {
     Ok(graph)
 }
 
+/// The process's peak resident memory in bytes (Linux: `VmHWM` of `/proc/self/status`);
+/// `None` elsewhere.
+fn peak_memory() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
 /// A scene loaded and flattened for the GPU.
 struct LoadedScene {
     scene: Scene,
@@ -295,7 +304,10 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
     for w in &r.warnings {
         println!("scene warning: {w}");
     }
+    let built = Instant::now();
     let gpu = GpuScene::build(&scene)?;
+    let layout = built.elapsed();
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     println!(
         "scene {}: {} triangles, {} spheres, {} lights, {} textures, {} BVH nodes ({:.0} ms)",
         path.display(),
@@ -304,7 +316,30 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
         gpu.lights.len(),
         scene.textures.len(),
         gpu.bvh_nodes.len(),
-        start.elapsed().as_secs_f64() * 1e3
+        ms(start.elapsed())
+    );
+    let d = scene.stats.decode;
+    let textures = if d.images > 0 {
+        format!(
+            " (of which decoding {} images, {:.1} MiB of texels, on {} thread{}: {:.0} ms)",
+            d.images,
+            d.bytes as f64 / f64::from(1 << 20),
+            d.threads,
+            if d.threads == 1 { "" } else { "s" },
+            ms(d.time)
+        )
+    } else {
+        String::new()
+    };
+    println!(
+        "  loading {:.0} ms{textures}; GPU layout {:.0} ms (of which BVH {:.0} ms){}",
+        ms(scene.stats.total),
+        ms(layout),
+        ms(gpu.bvh_time),
+        peak_memory().map_or_else(String::new, |m| format!(
+            "; peak memory so far {:.2} GiB",
+            m as f64 / f64::from(1 << 30)
+        ))
     );
     Ok(Some(LoadedScene {
         scene,

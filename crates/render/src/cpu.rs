@@ -52,25 +52,9 @@ pub fn luminance(c: V3) -> f32 {
     c[0] * 0.2126 + c[1] * 0.7152 + c[2] * 0.0722
 }
 
-/// Linear → sRGB transfer, clamped to \[0, 1\].
-pub fn srgb_encode(x: f32) -> f32 {
-    let c = x.clamp(0.0, 1.0);
-    if c <= 0.003_130_8 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
-}
-
-/// sRGB → linear transfer.
-pub fn srgb_decode(x: f32) -> f32 {
-    let c = x.clamp(0.0, 1.0);
-    if c <= 0.040_45 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
+/// Linear → sRGB and sRGB → linear transfers, clamped to \[0, 1\] (the scene crate's:
+/// textures and vertex colours are decoded with them).
+pub use lumagraph_scene::texture::{srgb_decode, srgb_encode};
 
 /// Quantizes a value in \[0, 1\] to 8 bits, rounding to nearest.
 #[expect(

@@ -70,6 +70,8 @@ pub struct GpuScene {
     /// The environment map's file, when the environment is a map (CPU side only: the
     /// renderer loads it and builds its sampling tables).
     pub environment_map: Option<std::path::PathBuf>,
+    /// How long building the BVH took (CPU side only: `render` prints it).
+    pub bvh_time: std::time::Duration,
 }
 
 /// Rec. 709 luminance of linear RGB.
@@ -380,7 +382,9 @@ impl GpuScene {
                 Aabb::new(c - s.radius, c + s.radius)
             })
             .collect();
+        let bvh_started = std::time::Instant::now();
         let flat = bvh::build(&tri_boxes, &sphere_boxes, options)?;
+        let bvh_time = bvh_started.elapsed();
 
         let mut out = Self {
             materials: scene.materials.iter().map(GpuMaterial::from).collect(),
@@ -392,6 +396,7 @@ impl GpuScene {
                 Environment::Map { path, .. } => Some(path.into()),
                 _ => None,
             },
+            bvh_time,
             ..Self::default()
         };
         let textured = surface_attributes(scene);

@@ -42,9 +42,9 @@ pub use flatten::{GpuScene, LIGHT_UNIFORM_SHARE, alias_table, light_selection, l
 pub use gpu::*;
 pub use load::transform_matrix;
 pub use scene::{
-    AlphaMode, Camera, LoadReport, Material, MaterialTextures, NO_TEXTURE, PunctualLight, Scene,
-    Sphere, Triangle, cube_quads, push_triangle, quad_triangles, rectangle_quad,
-    transform_triangle,
+    AlphaMode, Camera, LoadReport, LoadStats, Material, MaterialTextures, NO_TEXTURE,
+    PunctualLight, Scene, Sphere, Triangle, cube_quads, push_triangle, quad_triangles,
+    rectangle_quad, transform_triangle,
 };
 pub use texture::{TexelRange, Texture, TextureAtlas, UvTransform, Wrap, pack_atlas};
 pub use traverse::{Hit, Ray, intersect, intersect_within, occluded};

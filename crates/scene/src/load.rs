@@ -467,12 +467,16 @@ impl Scene {
     }
 
     fn build(file: &SceneFile, text: &str, base_dir: &Path) -> Result<Self, SceneError> {
-        if file.version == 1 {
+        let started = std::time::Instant::now();
+        let mut scene = if file.version == 1 {
             let mut file = file.clone();
             file.environment = environment_from_v1(file.environment);
-            return Builder::new(text, base_dir).build(&file);
-        }
-        Builder::new(text, base_dir).build(file)
+            Builder::new(text, base_dir).build(&file)?
+        } else {
+            Builder::new(text, base_dir).build(file)?
+        };
+        scene.stats.total = started.elapsed();
+        Ok(scene)
     }
 }
 
@@ -515,6 +519,7 @@ struct Builder<'a> {
     lights: Vec<PunctualLight>,
     textures: Vec<crate::texture::Texture>,
     report: LoadReport,
+    decode: crate::import::DecodeStats,
     /// Cameras of each named `Mesh` shape.
     mesh_cameras: BTreeMap<String, Vec<Camera>>,
     /// The shapes with a medium inside so far: their label and bounds.
@@ -554,6 +559,7 @@ impl<'a> Builder<'a> {
             lights: Vec::new(),
             textures: Vec::new(),
             report: LoadReport::default(),
+            decode: crate::import::DecodeStats::default(),
             mesh_cameras: BTreeMap::new(),
             media: Vec::new(),
         }
@@ -684,6 +690,10 @@ impl<'a> Builder<'a> {
             environment,
             settings: s,
             report: self.report,
+            stats: crate::scene::LoadStats {
+                decode: self.decode,
+                ..Default::default()
+            },
         })
     }
 
@@ -837,6 +847,7 @@ impl<'a> Builder<'a> {
                         t
                     }));
                 self.report.merge(mesh.report);
+                self.decode.add(&mesh.decode);
                 self.lights.extend(mesh.lights);
                 if let Some(n) = name {
                     self.mesh_cameras.insert(n.clone(), mesh.cameras);

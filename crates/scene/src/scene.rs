@@ -373,6 +373,18 @@ pub struct Scene {
     pub settings: RenderSettings,
     /// What loading dropped or changed.
     pub report: LoadReport,
+    /// How long loading took.
+    pub stats: LoadStats,
+}
+
+/// How long loading a scene took, and its texture decoding within that (what `render`
+/// prints).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LoadStats {
+    /// Reading the scene file, its meshes and their textures.
+    pub total: std::time::Duration,
+    /// Decoding the texture images (part of `total`).
+    pub decode: crate::import::DecodeStats,
 }
 
 impl Scene {

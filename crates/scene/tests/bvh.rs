@@ -60,6 +60,7 @@ fn sphere_grid_scene() -> Scene {
             seed: 0,
         },
         report: mesh.report,
+        stats: lumagraph_scene::LoadStats::default(),
     }
 }
 

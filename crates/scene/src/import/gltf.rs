@@ -58,16 +58,28 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
             .file_name()
             .map_or_else(String::new, |f| f.to_string_lossy().into_owned()),
         buffers: &buffers,
+        material: String::new(),
         decoded: HashMap::new(),
         used: HashMap::new(),
         textures: Vec::new(),
+        users: Vec::new(),
     };
     for m in doc.materials() {
+        decoder.material = material_name(&m);
         let mat = material(&m, &mut decoder, &mut out.report.warnings)
             .map_err(|e| e.about(format!("material \"{}\"", material_name(&m))))?;
         out.materials.push(mat);
     }
-    out.textures = decoder.textures;
+    let started = std::time::Instant::now();
+    let threads = decoder.threads();
+    out.textures = decoder.decode_all()?;
+    let (images, bytes) = image_stats(&out.textures);
+    out.decode = super::DecodeStats {
+        time: started.elapsed(),
+        images,
+        bytes,
+        threads,
+    };
     let mut default_material = None;
 
     let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
@@ -682,17 +694,34 @@ fn material_name(m: &::gltf::Material<'_>) -> String {
     )
 }
 
-/// Decodes the textures materials use, each once.
+/// Decodes the textures materials use, each image once, after the materials are read
+/// and on several threads ([`Decoder::decode_all`]).
 struct Decoder<'a> {
     base: Option<&'a Path>,
     /// The glTF file's name, for texture names.
     file: String,
     buffers: &'a [::gltf::buffer::Data],
-    /// glTF texture index → index in `textures` of its first use (its image decoded).
-    decoded: HashMap<usize, u32>,
+    /// The material being read, for errors about its textures.
+    material: String,
+    /// glTF texture index → index in `users` of its image.
+    decoded: HashMap<usize, usize>,
     /// (glTF texture, coordinate set, transform's bits) → index in `textures`.
     used: HashMap<(usize, u32, [u32; 6]), u32>,
-    textures: Vec<Texture>,
+    /// The textures as materials read them, their images still to decode (empty texels):
+    /// with each, the index in `users` of its image.
+    textures: Vec<(Texture, usize)>,
+    /// Each glTF texture to decode, with the first material using it.
+    users: Vec<(::gltf::texture::Texture<'a>, String)>,
+}
+
+/// The distinct images of `textures` (textures read through different transforms or sets
+/// share one) and their texels' bytes.
+fn image_stats(textures: &[Texture]) -> (usize, u64) {
+    let mut seen = HashMap::new();
+    for t in textures {
+        seen.insert(t.texels.as_ptr(), 4 * t.texels.len() as u64);
+    }
+    (seen.len(), seen.values().sum())
 }
 
 /// How a texture reference reads its texture: the coordinate set (`texCoord`, or the
@@ -801,13 +830,13 @@ fn rgba8(data: &::gltf::image::Data) -> Option<Vec<[u8; 4]>> {
     )
 }
 
-impl Decoder<'_> {
+impl<'a> Decoder<'a> {
     /// The index of the texture `info` reads with coordinate set `tex_coord` through
-    /// `transform`, among the decoded ones: each image decoded on first use, each way of
-    /// reading it one [`Texture`] sharing its texels.
+    /// `transform`: each way of reading an image one [`Texture`], sharing the image's
+    /// texels once decoded.
     fn texture(
         &mut self,
-        info: Option<::gltf::texture::Texture<'_>>,
+        info: Option<::gltf::texture::Texture<'a>>,
         (tex_coord, transform): (u32, UvTransform),
         warnings: &mut Vec<String>,
     ) -> Result<u32, SceneError> {
@@ -837,19 +866,87 @@ impl Decoder<'_> {
         if let Some(&i) = self.used.get(&key) {
             return Ok(i);
         }
-        let image = match self.decoded.get(&t.index()) {
-            Some(&i) => self.textures[i as usize].clone(),
-            None => self.decode(&t)?,
-        };
-        let index = self.textures.len() as u32;
-        self.textures.push(Texture {
-            uv_set,
-            transform,
-            ..image
+        let image = *self.decoded.entry(t.index()).or_insert_with(|| {
+            self.users.push((t.clone(), self.material.clone()));
+            self.users.len() - 1
         });
-        self.decoded.entry(t.index()).or_insert(index);
+        let index = self.textures.len() as u32;
+        self.textures.push((
+            Texture {
+                name: String::new(),
+                width: 0,
+                height: 0,
+                texels: Vec::new().into(),
+                wrap: [Wrap::Repeat; 2],
+                nearest: false,
+                uv_set,
+                transform,
+            },
+            image,
+        ));
         self.used.insert(key, index);
         Ok(index)
+    }
+
+    /// Threads [`Decoder::decode_all`] uses: `LUMAGRAPH_DECODE_THREADS` where set, else
+    /// the machine's, at most 16; at most one per image.
+    fn threads(&self) -> usize {
+        std::env::var("LUMAGRAPH_DECODE_THREADS")
+            .ok()
+            .and_then(|v| v.parse::<usize>().ok())
+            .unwrap_or_else(|| {
+                std::thread::available_parallelism()
+                    .map_or(1, std::num::NonZero::get)
+                    .min(16)
+            })
+            .clamp(1, self.users.len().max(1))
+    }
+
+    /// Decodes every image the materials use, on [`Decoder::threads`] threads, and returns
+    /// the textures with their texels. The first image (in the order materials use them)
+    /// that cannot be decoded is the error, naming its material.
+    fn decode_all(self) -> Result<Vec<Texture>, SceneError> {
+        let n = self.users.len();
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let results: Vec<std::sync::Mutex<Option<Result<Texture, SceneError>>>> =
+            (0..n).map(|_| std::sync::Mutex::new(None)).collect();
+        std::thread::scope(|scope| {
+            for _ in 0..self.threads() {
+                scope.spawn(|| {
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some((t, _)) = self.users.get(i) else {
+                            break;
+                        };
+                        let decoded = self.decode(t);
+                        *results[i]
+                            .lock()
+                            .unwrap_or_else(std::sync::PoisonError::into_inner) = Some(decoded);
+                    }
+                });
+            }
+        });
+        let mut images = Vec::with_capacity(n);
+        for (slot, (_, material)) in results.into_iter().zip(&self.users) {
+            let decoded = slot
+                .into_inner()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .unwrap_or_else(|| {
+                    Err(SceneError::new(ErrorKind::Texture(
+                        "an image was not decoded (a decoding thread stopped)".to_owned(),
+                    )))
+                });
+            images.push(decoded.map_err(|e| e.about(format!("material \"{material}\"")))?);
+        }
+        Ok(self
+            .textures
+            .into_iter()
+            .map(|(t, i)| Texture {
+                uv_set: t.uv_set,
+                transform: t.transform,
+                ..images[i].clone()
+            })
+            .collect())
     }
 
     /// Decodes the image of `t` with its sampler.
@@ -927,15 +1024,15 @@ fn diffuse_roughness(m: &::gltf::Material<'_>, warnings: &mut Vec<String>) -> f3
         .map_or(0.0, |f| f.clamp(0.0, 1.0) as f32)
 }
 
-fn material(
-    m: &::gltf::Material<'_>,
-    dec: &mut Decoder<'_>,
+fn material<'a>(
+    m: &::gltf::Material<'a>,
+    dec: &mut Decoder<'a>,
     warnings: &mut Vec<String>,
 ) -> Result<Material, SceneError> {
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, a] = pbr.base_color_factor();
     let strength = m.emissive_strength().unwrap_or(1.0);
-    let mut tex = |i: Option<::gltf::texture::Info<'_>>| {
+    let mut tex = |i: Option<::gltf::texture::Info<'a>>| {
         let read = i.as_ref().map_or((0, UvTransform::IDENTITY), |i| {
             texture_transform(info_transform(i).as_ref(), i.tex_coord())
         });

@@ -32,6 +32,31 @@ pub struct ImportedMesh {
     pub lights: Vec<PunctualLight>,
     /// What was dropped or changed.
     pub report: LoadReport,
+    /// How its textures' images were decoded.
+    pub decode: DecodeStats,
+}
+
+/// How long decoding a file's texture images took, how many and how large they are.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DecodeStats {
+    /// Wall time of the decoding.
+    pub time: std::time::Duration,
+    /// Distinct images decoded.
+    pub images: usize,
+    /// Their texels' bytes (RGBA8).
+    pub bytes: u64,
+    /// Threads that decoded them.
+    pub threads: usize,
+}
+
+impl DecodeStats {
+    /// Adds `other`'s images and time (files are decoded one after another).
+    pub fn add(&mut self, other: &Self) {
+        self.time += other.time;
+        self.images += other.images;
+        self.bytes += other.bytes;
+        self.threads = self.threads.max(other.threads);
+    }
 }
 
 /// Imports a `.gltf`, `.glb` or `.obj` file, placed by `transform`.
