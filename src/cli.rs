@@ -14,6 +14,7 @@
 mod bench;
 mod converge;
 mod gallery;
+mod gltf_gallery;
 mod plot;
 mod progressive;
 mod split;
@@ -193,6 +194,27 @@ enum Command {
         #[arg(long = "kind")]
         kinds: Vec<String>,
     },
+    /// Render every glTF model under some folders (default: assets/gltf-conformance) into
+    /// OUT/gltf-gallery/ and a contact sheet, OUT/gltf-gallery.md, with what each model
+    /// tests and what loading it said.
+    #[command(
+        name = "gltf-gallery",
+        after_help = "Examples:\n  lumagraph gltf-gallery --out docs\n  lumagraph gltf-gallery ~/glTF-Sample-Assets/Models --out /tmp/g --size 256x256 --spp 16"
+    )]
+    GltfGallery {
+        /// Folders searched for .gltf and .glb files (recursively).
+        #[arg(default_value = "assets/gltf-conformance")]
+        dirs: Vec<PathBuf>,
+        /// Folder for gltf-gallery.md and the gltf-gallery/ images.
+        #[arg(long, default_value = "docs")]
+        out: PathBuf,
+        /// Image size in pixels, width then height, as in 320x240.
+        #[arg(long, default_value = "320x240")]
+        size: String,
+        /// Samples per pixel.
+        #[arg(long, default_value_t = 64)]
+        spp: u32,
+    },
     /// Open the node editor, optionally on a graph file and a scene.
     #[command(
         after_help = "Examples:\n  lumagraph edit graphs/post_tonemap.ron\n  lumagraph edit graphs/pathtrace_denoise.ron --scene assets/cornell.ron"
@@ -305,7 +327,7 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
         println!("scene warning: {w}");
     }
     let built = Instant::now();
-    let gpu = GpuScene::build(&scene)?;
+    let (gpu, bvh_time) = GpuScene::build_timed(&scene)?;
     let layout = built.elapsed();
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     println!(
@@ -335,7 +357,7 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
         "  loading {:.0} ms{textures}; GPU layout {:.0} ms (of which BVH {:.0} ms){}",
         ms(scene.stats.total),
         ms(layout),
-        ms(gpu.bvh_time),
+        ms(bvh_time),
         peak_memory().map_or_else(String::new, |m| format!(
             "; peak memory so far {:.2} GiB",
             m as f64 / f64::from(1 << 30)
@@ -650,6 +672,12 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             let ctx = GpuContext::headless()?;
             gallery::run(&ctx, library, &out, &kinds)
         }
+        Command::GltfGallery {
+            dirs,
+            out,
+            size,
+            spp,
+        } => gltf_gallery::run(library, &dirs, &out, &size, spp.max(1)),
         Command::Adapters => {
             print!("{}", GpuContext::describe_adapters()?);
             Ok(())

@@ -663,6 +663,94 @@ fn gallery_renders_the_kinds_asked_for() {
     );
 }
 
+/// `gltf-gallery` renders each model of the folders given into a PNG of the size asked for
+/// and lists it on the contact sheet with what it tests and what loading said; a model that
+/// does not load is listed with its error, and the rest still render.
+#[test]
+fn gltf_gallery_lists_each_model_with_what_it_tests() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let models = dir.path().join("models");
+    let vc = models.join("VertexColorTest");
+    std::fs::create_dir_all(&vc).unwrap();
+    for f in ["VertexColorTest.glb", "metadata.json"] {
+        std::fs::copy(
+            common::repo("assets/gltf-conformance/VertexColorTest").join(f),
+            vc.join(f),
+        )
+        .unwrap();
+    }
+    std::fs::write(
+        models.join("Coated.gltf"),
+        r#"{"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_materials_clearcoat"],
+  "extensionsRequired": ["KHR_materials_clearcoat"]}"#,
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = lumagraph(&[
+        "gltf-gallery",
+        models.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--size",
+        "40x30",
+        "--spp",
+        "1",
+    ]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    let img =
+        lumagraph::render::image_io::load(&out.join("gltf-gallery/VertexColorTest.png")).unwrap();
+    assert_eq!((img.width, img.height), (40, 30));
+    let page = std::fs::read_to_string(out.join("gltf-gallery.md")).unwrap();
+    for want in [
+        "## VertexColorTest\n\nTests if vertex colors are supported.",
+        "![VertexColorTest](gltf-gallery/VertexColorTest.png)",
+        "## Coated",
+        "Does not load: `",
+        "requires the extension KHR_materials_clearcoat",
+    ] {
+        assert!(page.contains(want), "missing «{want}» in:\n{page}");
+    }
+    let o = lumagraph(&[
+        "gltf-gallery",
+        "--size",
+        "40by30",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o).1.contains("--size 40by30: expected WIDTHxHEIGHT"),
+        "{:?}",
+        text(&o)
+    );
+}
+
+/// The docs' glTF gallery shows every model of `assets/gltf-conformance/`: a model added
+/// without running `lumagraph gltf-gallery --out docs` fails here.
+#[test]
+fn docs_gltf_gallery_shows_every_model() {
+    let page = std::fs::read_to_string(common::repo("docs/gltf-gallery.md")).unwrap();
+    for entry in std::fs::read_dir(common::repo("assets/gltf-conformance")).unwrap() {
+        let path = entry.unwrap().path();
+        if !path.is_dir() {
+            continue;
+        }
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let image = format!("gltf-gallery/{name}.png");
+        assert!(
+            page.contains(&format!("![{name}]({image})")),
+            "docs/gltf-gallery.md does not show {name}: run `lumagraph gltf-gallery --out docs`"
+        );
+        assert!(
+            common::repo("docs").join(&image).is_file(),
+            "docs/{image} is missing"
+        );
+    }
+}
+
 /// Every graph shipped under `graphs/` validates (with the Cornell box for those that
 /// render a scene).
 #[test]

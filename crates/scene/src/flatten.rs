@@ -70,8 +70,6 @@ pub struct GpuScene {
     /// The environment map's file, when the environment is a map (CPU side only: the
     /// renderer loads it and builds its sampling tables).
     pub environment_map: Option<std::path::PathBuf>,
-    /// How long building the BVH took (CPU side only: `render` prints it).
-    pub bvh_time: std::time::Duration,
 }
 
 /// Rec. 709 luminance of linear RGB.
@@ -354,11 +352,30 @@ impl GpuScene {
         Self::build_with(scene, &BvhOptions::default())
     }
 
+    /// [`GpuScene::build`], and how long building its BVH took (what `render` prints).
+    ///
+    /// # Errors
+    /// As [`GpuScene::build`].
+    pub fn build_timed(scene: &Scene) -> Result<(Self, std::time::Duration), SceneError> {
+        let mut bvh = std::time::Duration::ZERO;
+        let built = Self::build_inner(scene, &BvhOptions::default(), &mut bvh)?;
+        Ok((built, bvh))
+    }
+
     /// Flattens `scene`.
     ///
     /// # Errors
     /// As [`GpuScene::build`].
     pub fn build_with(scene: &Scene, options: &BvhOptions) -> Result<Self, SceneError> {
+        let mut bvh = std::time::Duration::ZERO;
+        Self::build_inner(scene, options, &mut bvh)
+    }
+
+    fn build_inner(
+        scene: &Scene,
+        options: &BvhOptions,
+        bvh_time: &mut std::time::Duration,
+    ) -> Result<Self, SceneError> {
         let total = scene.triangles.len() + scene.spheres.len();
         if total >= 1 << 28 {
             return Err(SceneError::new(ErrorKind::TooManyPrimitives(total)));
@@ -384,7 +401,7 @@ impl GpuScene {
             .collect();
         let bvh_started = std::time::Instant::now();
         let flat = bvh::build(&tri_boxes, &sphere_boxes, options)?;
-        let bvh_time = bvh_started.elapsed();
+        *bvh_time = bvh_started.elapsed();
 
         let mut out = Self {
             materials: scene.materials.iter().map(GpuMaterial::from).collect(),
@@ -396,7 +413,6 @@ impl GpuScene {
                 Environment::Map { path, .. } => Some(path.into()),
                 _ => None,
             },
-            bvh_time,
             ..Self::default()
         };
         let textured = surface_attributes(scene);

@@ -26,6 +26,9 @@ const READ: &[&str] = &[
     "EXT_mesh_gpu_instancing",
 ];
 
+/// Extensions that carry nothing a render shows (metadata): neither read nor warned about.
+const NOTHING_TO_RENDER: &[&str] = &["KHR_xmp", "KHR_xmp_json_ld"];
+
 /// Extensions read in part, with what is not read.
 const PARTLY_READ: &[(&str, &str)] = &[
     (
@@ -183,7 +186,7 @@ pub fn check(bytes: &[u8], file: &str) -> Result<Vec<String>, SceneError> {
         } else {
             format!(" (used by {})", some(who))
         };
-        if READ.contains(&ext.as_str()) {
+        if READ.contains(&ext.as_str()) || NOTHING_TO_RENDER.contains(&ext.as_str()) {
             continue;
         }
         if let Some((_, lost)) = PARTLY_READ.iter().find(|(n, _)| n == ext) {
@@ -215,7 +218,11 @@ pub fn check(bytes: &[u8], file: &str) -> Result<Vec<String>, SceneError> {
 
 /// Every extension the file requires and lumagraph does not read is an error.
 fn check_required(root: &Value, text: &[u8], file: &str) -> Result<(), SceneError> {
-    let known = |name: &str| READ.contains(&name) || PARTLY_READ.iter().any(|(n, _)| *n == name);
+    let known = |name: &str| {
+        READ.contains(&name)
+            || NOTHING_TO_RENDER.contains(&name)
+            || PARTLY_READ.iter().any(|(n, _)| *n == name)
+    };
     if let Some(required) = root.get("extensionsRequired").and_then(Value::as_array) {
         for (i, ext) in required.iter().enumerate() {
             let name = ext.as_str().unwrap_or("?");
