@@ -36,8 +36,39 @@ pub(super) fn key(graph: &Graph, scene: Option<&GpuScene>) -> u64 {
     for n in &mut g.nodes {
         n.pos = None;
     }
-    let scene = scene.map_or_else(String::new, |s| format!("{s:?}"));
+    let scene = scene.map_or_else(String::new, scene_digest);
     crate::render::checkpoint::render_key(&g.to_ron(), &scene)
+}
+
+/// Every number of the flattened scene, hashed: what the GPU gets and the CPU data that
+/// shapes the render (the host intersector's corners, the orders, the environment map's
+/// file). Hashing the bytes rather than the scene's `Debug` text keeps a large scene's key
+/// cheap (the Crytek Sponza's text was over a gigabyte and took most of a minute).
+fn scene_digest(s: &GpuScene) -> String {
+    use bytemuck::{bytes_of, cast_slice};
+    let h = crate::render::checkpoint::Fnv::default()
+        .write(bytes_of(&s.header))
+        .write(bytes_of(&s.camera))
+        .write(bytes_of(&s.settings))
+        .write(cast_slice(&s.bvh_nodes))
+        .write(cast_slice(&s.bvh_skips))
+        .write(cast_slice(&s.tri_positions))
+        .write(cast_slice(&s.tri_corners))
+        .write(cast_slice(&s.tri_shading))
+        .write(cast_slice(&s.spheres))
+        .write(cast_slice(&s.materials))
+        .write(cast_slice(&s.lights))
+        .write(cast_slice(&s.light_alias))
+        .write(cast_slice(&s.tri_texcoords))
+        .write(cast_slice(&s.atlas.descriptors))
+        .write(cast_slice(&s.atlas.texels))
+        .write(&s.atlas.page_size.to_le_bytes())
+        .write(&s.atlas.pages.to_le_bytes())
+        .write(&s.vertex_alpha_min)
+        .write(cast_slice(&s.tri_source))
+        .write(cast_slice(&s.sphere_source))
+        .write(format!("{:?}", s.environment_map).as_bytes());
+    format!("{:016x}", h.finish())
 }
 
 /// The first Ctrl-C or SIGTERM asks the render to stop after its current batch of frames

@@ -63,7 +63,7 @@ impl Fnv {
 
 /// The key of a render: the lumagraph version, the graph as compiled (`graph_text`, e.g.
 /// its RON with overrides applied and without layout) and the scene as flattened
-/// (`scene_text`, e.g. its `Debug` form: every number the GPU gets). The sample count is
+/// (`scene_text`, e.g. a digest of every number the GPU gets). The sample count is
 /// not part of it: a render may go on to more samples.
 pub fn render_key(graph_text: &str, scene_text: &str) -> u64 {
     Fnv::default()
