@@ -344,12 +344,11 @@ fn image_ray(g: &GpuScene, p: Vec2) -> Ray {
 /// The material and UV the CPU ray cast finds along `ray`.
 fn hit_uv(g: &GpuScene, ray: &Ray) -> Option<(u32, Vec2)> {
     let hit = lumagraph::scene::intersect(g, ray)?;
-    let tc = g.tri_texcoords[hit.prim as usize];
-    let (a, b) = (hit.u, hit.v);
-    let uv = (1.0 - a - b) * Vec2::new(tc.uv01[0], tc.uv01[1])
-        + a * Vec2::new(tc.uv01[2], tc.uv01[3])
-        + b * Vec2::from(tc.uv2);
-    Some((g.tri_shading[hit.prim as usize].material, uv))
+    let uv = g.tri_texcoords[hit.prim as usize].uv(hit.u, hit.v);
+    Some((
+        g.tri_shading[hit.prim as usize].material,
+        Vec2::new(uv.x, uv.y),
+    ))
 }
 
 /// Per pixel: the material and UV the CPU ray cast finds through its center.

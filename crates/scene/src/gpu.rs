@@ -285,6 +285,14 @@ pub struct GpuTexDesc {
 /// White in [`GpuTriTexcoords::colors`]: the vertex colour of meshes without one.
 pub const VERTEX_WHITE: u32 = 0xFFFF_FFFF;
 
+/// A vertex colour as stored (RGBA8, R in the low byte, RGB sRGB-encoded) decoded as a
+/// texel is: `vertex_color` in `pathtrace/textures.wgsl`.
+pub fn vertex_color(c: u32) -> glam::Vec4 {
+    let [r, g, b, a] = c.to_le_bytes().map(|x| f32::from(x) / 255.0);
+    let d = crate::texture::srgb_decode;
+    glam::Vec4::new(d(r), d(g), d(b), a)
+}
+
 impl GpuTriTexcoords {
     /// Both UV sets at barycentrics (`u`, `v`), set 0 in xy and set 1 in zw: `tri_uv` in
     /// `pathtrace/textures.wgsl`.
@@ -306,12 +314,7 @@ impl GpuTriTexcoords {
         if self.colors == [VERTEX_WHITE; 3] {
             return glam::Vec4::ONE;
         }
-        let decode = |c: u32| {
-            let [r, g, b, a] = c.to_le_bytes().map(|x| f32::from(x) / 255.0);
-            let d = crate::texture::srgb_decode;
-            glam::Vec4::new(d(r), d(g), d(b), a)
-        };
-        let [c0, c1, c2] = self.colors.map(decode);
+        let [c0, c1, c2] = self.colors.map(vertex_color);
         (1.0 - u - v) * c0 + u * c1 + v * c2
     }
 }

@@ -323,13 +323,6 @@ fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     ]
 }
 
-/// A vertex colour (RGBA8, RGB sRGB-encoded) decoded as the path tracer's `vertex_color`.
-fn vertex_color(c: u32) -> [f32; 4] {
-    let [r, g, b, a] = c.to_le_bytes().map(|v| f32::from(v) / 255.0);
-    let d = lumagraph_scene::texture::srgb_decode;
-    [d(r), d(g), d(b), a]
-}
-
 /// Texture attributes of a vertex.
 #[derive(Clone, Copy)]
 struct Tex {
@@ -393,7 +386,7 @@ pub(crate) fn vertices(scene: &GpuScene, segments: u32) -> Vec<f32> {
                     uv: [uv[0], uv[1], uv1[0], uv1[1]],
                     tangent: [tan[0], tan[1], tan[2], t0[3]],
                     material: sh.material,
-                    color: vertex_color(tc.colors[k]),
+                    color: lumagraph_scene::vertex_color(tc.colors[k]).to_array(),
                 }
             });
             push(corners[k], normals[k], a, [ng[0], ng[1], ng[2], 0.0], tex);

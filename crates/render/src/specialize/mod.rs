@@ -160,7 +160,7 @@ fn inline_data_reason(
     }
 }
 
-/// Why texture sampling is (or is not) compiled in.
+/// Why texture sampling and vertex colours are (or are not) compiled in.
 fn textures_reason(scene: &GpuScene, all: bool) -> String {
     let textured_materials = scene
         .materials
@@ -186,8 +186,10 @@ fn textures_reason(scene: &GpuScene, all: bool) -> String {
             scene.atlas.page_size,
             scene.atlas.page_size
         )
+    } else if scene.header.features & lumagraph_scene::FEATURE_TEXTURES != 0 {
+        "vertex colours (no material has a texture)".to_owned()
     } else {
-        "no material has a texture".to_owned()
+        "no material has a texture or vertex colours".to_owned()
     }
 }
 

@@ -724,8 +724,9 @@ fn image_stats(textures: &[Texture]) -> (usize, u64) {
     (seen.len(), seen.values().sum())
 }
 
-/// How a texture reference reads its texture: the coordinate set (`texCoord`, or the
-/// transform's override) and the `KHR_texture_transform`, from the extension's JSON.
+/// How a normal texture reads its texture (the gltf crate has no typed transform for it):
+/// the coordinate set (`texCoord`, or the transform's override) and the
+/// `KHR_texture_transform`, from the extension's JSON.
 fn texture_transform(ext: Option<&::gltf::json::Value>, tex_coord: u32) -> (u32, UvTransform) {
     let Some(t) = ext else {
         return (tex_coord, UvTransform::IDENTITY);
@@ -750,19 +751,16 @@ fn texture_transform(ext: Option<&::gltf::json::Value>, tex_coord: u32) -> (u32,
     )
 }
 
-/// The `KHR_texture_transform` of a texture info, as JSON (the gltf crate's typed view,
-/// back to the extension's fields).
-fn info_transform(i: &::gltf::texture::Info<'_>) -> Option<::gltf::json::Value> {
-    i.texture_transform().map(|t| {
-        let mut v = ::gltf::json::Value::Object(Default::default());
-        v["offset"] = t.offset().iter().map(|&x| f64::from(x)).collect();
-        v["rotation"] = f64::from(t.rotation()).into();
-        v["scale"] = t.scale().iter().map(|&x| f64::from(x)).collect();
-        if let Some(c) = t.tex_coord() {
-            v["texCoord"] = c.into();
-        }
-        v
-    })
+/// How a texture info reads its texture: its coordinate set (the transform's override
+/// where it has one) and its `KHR_texture_transform`, from the gltf crate's typed view.
+fn info_read(i: &::gltf::texture::Info<'_>) -> (u32, UvTransform) {
+    i.texture_transform()
+        .map_or((i.tex_coord(), UvTransform::IDENTITY), |t| {
+            (
+                t.tex_coord().unwrap_or_else(|| i.tex_coord()),
+                UvTransform::khr(t.offset(), t.rotation(), t.scale()),
+            )
+        })
 }
 
 fn wrap(mode: ::gltf::texture::WrappingMode) -> Wrap {
@@ -1033,9 +1031,7 @@ fn material<'a>(
     let [r, g, b, a] = pbr.base_color_factor();
     let strength = m.emissive_strength().unwrap_or(1.0);
     let mut tex = |i: Option<::gltf::texture::Info<'a>>| {
-        let read = i.as_ref().map_or((0, UvTransform::IDENTITY), |i| {
-            texture_transform(info_transform(i).as_ref(), i.tex_coord())
-        });
+        let read = i.as_ref().map_or((0, UvTransform::IDENTITY), info_read);
         dec.texture(i.map(|i| i.texture()), read, warnings)
     };
     let base_color = tex(pbr.base_color_texture())?;
