@@ -12,10 +12,10 @@ missing=()
 for p in "${packages[@]}"; do
     dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
 done
+sudo=""
+[ "$(id -u)" -ne 0 ] && sudo="sudo"
 if [ ${#missing[@]} -gt 0 ]; then
     echo "setup: installing ${missing[*]}"
-    sudo=""
-    [ "$(id -u)" -ne 0 ] && sudo="sudo"
     $sudo apt-get update -qq
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
@@ -27,4 +27,36 @@ if ! command -v cargo >/dev/null 2>&1; then
         echo "setup: installing Rust with rustup"
         curl --proto '=https' --tlsv1.2 -sSf https://sh.rustup.rs | sh -s -- -y --profile minimal -c rustfmt,clippy
     fi
+fi
+
+# Mesa 25's lavapipe, beside the system's Vulkan drivers (not instead of them): it has ray
+# queries, which the path tracer uses where a device offers them and whose tests need them
+# (tests/ray_query.rs runs them on it). Debian bookworm's own Mesa (22.3) has none, and
+# compiles shaders 2-3x faster, which the rest of the tests depend on. On bookworm, the
+# bookworm-backports suite is added to apt's sources and the driver unpacked from its
+# mesa-vulkan-drivers package into $ray_query_dir; scripts/env.sh points
+# LUMAGRAPH_RAY_QUERY_ICD at it. Elsewhere: set LUMAGRAPH_RAY_QUERY_ICD to the ICD file of a
+# Mesa 25 or later lavapipe, or LUMAGRAPH_ALLOW_NO_RAY_QUERY=1 to skip those tests.
+ray_query_dir="${XDG_CACHE_HOME:-$HOME/.cache}/lumagraph/lavapipe-ray-query"
+if [ ! -f "$ray_query_dir/lvp_icd.json" ] && grep -q '^VERSION_CODENAME=bookworm' /etc/os-release 2>/dev/null; then
+    if ! grep -rqs 'bookworm-backports' /etc/apt/sources.list /etc/apt/sources.list.d/; then
+        echo "setup: adding Debian's bookworm-backports suite to apt's sources, for Mesa 25's lavapipe"
+        printf '%s\n' 'Types: deb' 'URIs: http://deb.debian.org/debian' 'Suites: bookworm-backports' \
+            'Components: main' 'Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg' |
+            $sudo tee /etc/apt/sources.list.d/bookworm-backports.sources >/dev/null
+        $sudo apt-get update -qq
+    fi
+    echo "setup: unpacking Mesa 25's lavapipe (ray queries) from bookworm-backports into $ray_query_dir"
+    work=$(mktemp -d)
+    chmod 777 "$work"
+    (cd "$work" && apt-get download -qq -t bookworm-backports mesa-vulkan-drivers 2>/dev/null)
+    mkdir -p "$ray_query_dir"
+    dpkg-deb -x "$work"/mesa-vulkan-drivers_*.deb "$work/root"
+    lib=$(find "$work/root" -name libvulkan_lvp.so | head -n 1)
+    cp "$lib" "$ray_query_dir/libvulkan_lvp.so"
+    api=$(sed -n 's/.*"api_version": *"\([^"]*\)".*/\1/p' "$work"/root/usr/share/vulkan/icd.d/lvp_icd*.json | head -n 1)
+    printf '{\n  "file_format_version": "1.0.0",\n  "ICD": {\n    "library_path": "%s",\n    "api_version": "%s"\n  }\n}\n' \
+        "$ray_query_dir/libvulkan_lvp.so" "$api" >"$ray_query_dir/lvp_icd.json.tmp"
+    mv "$ray_query_dir/lvp_icd.json.tmp" "$ray_query_dir/lvp_icd.json"
+    rm -rf "$work"
 fi

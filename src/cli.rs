@@ -480,21 +480,30 @@ fn print_features(plan: &crate::graph::Plan, scene: &GpuScene, library: &NodeLib
     if specialized.is_empty() {
         return;
     }
-    let cpu = match GpuContext::default_adapter_info() {
-        Ok(info) => {
+    let traits = match GpuContext::default_adapter_traits() {
+        Ok((info, traits)) => {
             println!(
-                "adapter: {} ({:?}); the shader choices below are made for it",
-                info.name, info.device_type
+                "adapter: {} ({:?}{}); the shader choices below are made for it",
+                info.name,
+                info.device_type,
+                if traits.ray_query_limit.is_some() {
+                    ", ray queries"
+                } else {
+                    ""
+                }
             );
-            info.device_type == crate::render::wgpu::DeviceType::Cpu
+            traits
         }
         Err(e) => {
             println!("adapter: none found ({e}); shader choices shown for a CPU one");
-            true
+            crate::render::specialize::AdapterTraits {
+                cpu: true,
+                ray_query_limit: None,
+            }
         }
     };
     for (pass, features) in specialized {
-        let features = features(pass, scene, cpu);
+        let features = features(pass, scene, traits);
         println!("shader features of {} for this scene:", pass.node);
         for included in [true, false] {
             println!("  {}:", if included { "compiled in" } else { "left out" });

@@ -144,6 +144,22 @@ fn masked_checkerboard_shows_the_wall_through_its_holes() {
     check_checkerboard(8, &[("host", Resources::default()), ("WGSL BVH", wgsl)]);
 }
 
+/// [`masked_checkerboard_shows_the_wall_through_its_holes`] through ray queries: each
+/// candidate the device finds takes the same any-hit test (on a driver with ray queries,
+/// `common::ray_queries_here`).
+#[test]
+fn masked_checkerboard_shows_the_wall_through_ray_queries() {
+    if !common::ray_queries_here("masked_checkerboard_shows_the_wall_through_ray_queries") {
+        return;
+    }
+    let ray_queries = Resources {
+        ray_queries: true,
+        ..Resources::default()
+    };
+    check_checkerboard(1, &[("ray queries", ray_queries.clone())]);
+    check_checkerboard(8, &[("ray queries", ray_queries)]);
+}
+
 /// [`masked_checkerboard_shows_the_wall_through_its_holes`] with the wall in `tiles`²
 /// quads, through each of `intersectors`.
 fn check_checkerboard(tiles: u32, intersectors: &[(&str, Resources)]) {
@@ -197,6 +213,12 @@ fn check_checkerboard(tiles: u32, intersectors: &[(&str, Resources)]) {
             continue;
         }
         assert_eq!(host, *name == "host", "{name}: {}", features.summary());
+        assert_eq!(
+            features.on(Feature::RayQueries),
+            *name == "ray queries",
+            "{name}: {}",
+            features.summary()
+        );
         for (what, image) in [("path tracer", &pt), ("G-buffer", &gb)] {
             let differ = image
                 .pixels

@@ -287,7 +287,7 @@ fn render_small(
     in_buffers: bool,
     bvh: bool,
 ) -> Option<(Vec<Image>, Features)> {
-    render_with(
+    common::render_with(
         name,
         (64, 64),
         spp,
@@ -297,34 +297,6 @@ fn render_small(
             ..Resources::default()
         },
     )
-}
-
-/// `scene` rendered at `size` and `spp` with `resources` (the scene set here): color,
-/// albedo, normal and depth, and how the shader was specialized.
-fn render_with(
-    name: &str,
-    size: (u32, u32),
-    spp: u32,
-    resources: Resources,
-) -> Option<(Vec<Image>, Features)> {
-    let ctx = common::gpu()?;
-    let mut gpu =
-        GpuScene::build(&Scene::load(&common::repo(&format!("assets/{name}"))).unwrap()).unwrap();
-    (gpu.settings.width, gpu.settings.height) = size;
-    let gpu = Arc::new(gpu);
-    let ports = ["acc.color", "pt.albedo", "pt.normal", "pt.depth"];
-    let outputs: Vec<String> = ports.iter().map(|p| (*p).to_owned()).collect();
-    let plan = compile(&progressive_graph(4), &outputs, Some(&gpu)).unwrap();
-    let resources = Resources {
-        scene: Some(Arc::clone(&gpu)),
-        ..resources
-    };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
-    let features = exec.shader_features("pt").unwrap().clone();
-    println!("{name}: {}", features.summary());
-    exec.run_frames(spp.div_ceil(4), true).unwrap();
-    let images = ports.iter().map(|p| exec.read_port(p).unwrap()).collect();
-    Some((images, features))
 }
 
 /// Scenes small enough to be intersected inline with their data written into the shader:
@@ -337,33 +309,10 @@ const SMALL_SCENES: [&str; 3] = [
     "cornell_spheres.ron",
 ];
 
-/// Pixels of `a` and `b` that differ: in any bit (`None`), or by more than `rel` relative in
-/// a color channel.
-fn differing(a: &Image, b: &Image, rel: Option<f32>) -> usize {
-    a.pixels
-        .iter()
-        .zip(&b.pixels)
-        .filter(|(x, y)| match rel {
-            None => x.map(f32::to_bits) != y.map(f32::to_bits),
-            Some(r) => (0..3).any(|c| (x[c] - y[c]).abs() > r * (x[c].abs() + 1e-3)),
-        })
-        .count()
-}
-
-/// The largest relative difference of a color channel between `a` and `b` (against
-/// |a| + 1e-3, as `differing` measures).
-fn worst_relative(a: &Image, b: &Image) -> f32 {
-    a.pixels
-        .iter()
-        .zip(&b.pixels)
-        .flat_map(|(x, y)| (0..3).map(|c| (x[c] - y[c]).abs() / (x[c].abs() + 1e-3)))
-        .fold(0.0f32, f32::max)
-}
-
 /// Each output of `a` equal to `b`'s bit for bit (the pixels that differ are printed).
 fn assert_bit_identical(name: &str, a: &[Image], b: &[Image]) {
     for (i, (a, b)) in a.iter().zip(b).enumerate() {
-        let differ = differing(a, b, None);
+        let differ = common::differing(a, b, None);
         println!(
             "{name}: output {i}: {differ} of {} pixels differ",
             a.pixels.len()
@@ -408,7 +357,7 @@ fn inlined_scene_data_renders_bit_identical_images() {
 fn spreading_workgroups_over_the_image_renders_bit_identical_images() {
     for (name, size) in [("cornell.ron", (60, 84)), ("spheregrid.ron", (90, 50))] {
         let run = |in_order| {
-            render_with(
+            common::render_with(
                 name,
                 size,
                 8,
@@ -449,7 +398,7 @@ fn leaving_out_a_missing_primitive_kind_renders_bit_identical_images() {
         ("furnace_materials.ron", Feature::Triangles),
     ] {
         let run = |general| {
-            render_with(
+            common::render_with(
                 name,
                 (48, 40),
                 8,
@@ -499,7 +448,10 @@ fn bvh_traversal_renders_what_inline_intersection_renders() {
         assert!(how_inline.on(Feature::InlineIntersection));
         assert!(!how_bvh.on(Feature::InlineIntersection));
         for (i, (a, b)) in inline.iter().zip(&bvh).enumerate() {
-            let (differ, far) = (differing(a, b, None), differing(a, b, Some(1e-4)));
+            let (differ, far) = (
+                common::differing(a, b, None),
+                common::differing(a, b, Some(1e-4)),
+            );
             println!(
                 "{name}: output {i}: {differ} of {} pixels differ, {far} by more than 1e-4",
                 a.pixels.len()
@@ -514,7 +466,7 @@ fn bvh_traversal_renders_what_inline_intersection_renders() {
                 "{name}: output {i}: {far} pixels differ by more than 1e-4"
             );
             if i == 0 {
-                let worst = worst_relative(a, b);
+                let worst = common::worst_relative(a, b);
                 println!("{name}: color differs by at most {worst:.2e} relative");
                 assert!(worst <= 1e-2, "{name}: color differs by {worst} relative");
             }
@@ -533,7 +485,7 @@ fn host_against_wgsl(name: &str, size: (u32, u32), spp: u32) -> Option<HostAgain
         println!("a GPU adapter: no host intersection to compare");
         return None;
     }
-    let (host, how_host) = render_with(name, size, spp, Resources::default()).unwrap();
+    let (host, how_host) = common::render_with(name, size, spp, Resources::default()).unwrap();
     if !how_host.on(Feature::HostRays) {
         assert!(
             std::env::var("LUMAGRAPH_ALLOW_NO_EMBREE").is_ok_and(|v| v == "1"),
@@ -547,7 +499,7 @@ fn host_against_wgsl(name: &str, size: (u32, u32), spp: u32) -> Option<HostAgain
         wgsl_intersection: true,
         ..Resources::default()
     };
-    let (wgsl, how_wgsl) = render_with(name, size, spp, wgsl_only).unwrap();
+    let (wgsl, how_wgsl) = common::render_with(name, size, spp, wgsl_only).unwrap();
     assert!(!how_wgsl.on(Feature::HostRays));
     assert_bit_identical(&format!("{name} AOVs"), &host[1..], &wgsl[1..]);
     let (a, b) = (&host[0], &wgsl[0]);
@@ -559,9 +511,9 @@ fn host_against_wgsl(name: &str, size: (u32, u32), spp: u32) -> Option<HostAgain
             .sum::<f64>()
     };
     let found = HostAgainstWgsl {
-        far: differing(a, b, Some(1e-4)),
+        far: common::differing(a, b, Some(1e-4)),
         pixels: a.pixels.len(),
-        worst: worst_relative(a, b),
+        worst: common::worst_relative(a, b),
         mean: (sum(a) - sum(b)) / sum(b),
     };
     println!(
@@ -569,7 +521,7 @@ fn host_against_wgsl(name: &str, size: (u32, u32), spp: u32) -> Option<HostAgain
          {:.2e}; the image means differ by {:.2e} relative",
         size.0,
         size.1,
-        differing(a, b, None),
+        common::differing(a, b, None),
         found.pixels,
         found.far,
         found.worst,
@@ -679,7 +631,7 @@ fn host_intersection_renders_glass_as_wgsl_traversal_does() {
 #[test]
 fn inlined_materials_of_a_large_scene_render_what_the_buffers_render() {
     let Some((inline, how_inline)) =
-        render_with("spheregrid.ron", (64, 64), 8, Resources::default())
+        common::render_with("spheregrid.ron", (64, 64), 8, Resources::default())
     else {
         return;
     };
@@ -687,7 +639,8 @@ fn inlined_materials_of_a_large_scene_render_what_the_buffers_render() {
         scene_data_in_buffers: true,
         ..Resources::default()
     };
-    let (buffers, how_buffers) = render_with("spheregrid.ron", (64, 64), 8, buffers).unwrap();
+    let (buffers, how_buffers) =
+        common::render_with("spheregrid.ron", (64, 64), 8, buffers).unwrap();
     if !common::gpu().is_some_and(lumagraph::render::GpuContext::is_cpu) {
         return;
     }
@@ -695,8 +648,8 @@ fn inlined_materials_of_a_large_scene_render_what_the_buffers_render() {
     assert!(!how_buffers.on(Feature::InlineData) && !how_buffers.on(Feature::InlineIntersection));
     assert_bit_identical("spheregrid AOVs", &inline[1..], &buffers[1..]);
     let (differ, far) = (
-        differing(&inline[0], &buffers[0], None),
-        differing(&inline[0], &buffers[0], Some(1e-5)),
+        common::differing(&inline[0], &buffers[0], None),
+        common::differing(&inline[0], &buffers[0], Some(1e-5)),
     );
     println!("spheregrid color: {differ} of 4096 pixels differ, {far} by more than 1e-5");
     assert_eq!(far, 0, "{far} pixels differ by more than 1e-5 relative");

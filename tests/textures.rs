@@ -633,6 +633,7 @@ fn plan_lists_textures_for_textured_scenes_only() {
         data_in_buffers: false,
         in_image_order: false,
         host_rays: false,
+        ..PathTraceOptions::default()
     };
     let on = |path: &Path| {
         let scene = GpuScene::build(&Scene::load(path).unwrap()).unwrap();
@@ -1589,6 +1590,7 @@ fn small_scenes_are_inlined_on_cpu_adapters_only() {
             data_in_buffers: false,
             in_image_order: false,
             host_rays: false,
+            ..PathTraceOptions::default()
         };
         let f = Features::decide(&scene, opts);
         assert_eq!(f.on(Feature::InlineIntersection), cpu_adapter);

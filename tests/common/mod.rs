@@ -449,3 +449,111 @@ pub fn image_ray(g: &lumagraph::scene::GpuScene, p: glam::Vec2) -> lumagraph::sc
         dir: dir.normalize(),
     }
 }
+
+/// `scene` rendered at `size` and `spp` with `resources` (the scene set here): color,
+/// albedo, normal and depth, and how the shader was specialized.
+pub fn render_with(
+    name: &str,
+    size: (u32, u32),
+    spp: u32,
+    resources: lumagraph::render::Resources,
+) -> Option<(
+    Vec<lumagraph::render::cpu::Image>,
+    lumagraph::render::specialize::Features,
+)> {
+    use lumagraph::graph::ParamValue;
+    use lumagraph::render::{Executor, compile};
+    use lumagraph::scene::{GpuScene, Scene};
+    let ctx = gpu()?;
+    let mut scene =
+        GpuScene::build(&Scene::load(&repo(&format!("assets/{name}"))).unwrap()).unwrap();
+    (scene.settings.width, scene.settings.height) = size;
+    let scene = std::sync::Arc::new(scene);
+    let ports = ["acc.color", "pt.albedo", "pt.normal", "pt.depth"];
+    let outputs: Vec<String> = ports.iter().map(|p| (*p).to_owned()).collect();
+    let graph = progressive_graph(&[("samples_per_frame", ParamValue::Int(4))]);
+    let plan = compile(&graph, &outputs, Some(&scene)).unwrap();
+    let resources = lumagraph::render::Resources {
+        scene: Some(scene),
+        ..resources
+    };
+    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let features = exec.shader_features("pt").unwrap().clone();
+    println!("{name}: {}", features.summary());
+    exec.run_frames(spp.div_ceil(4), true).unwrap();
+    let images = ports.iter().map(|p| exec.read_port(p).unwrap()).collect();
+    Some((images, features))
+}
+
+/// Pixels of `a` and `b` that differ: in any bit (`None`), or by more than `rel` relative in
+/// a color channel.
+pub fn differing(
+    a: &lumagraph::render::cpu::Image,
+    b: &lumagraph::render::cpu::Image,
+    rel: Option<f32>,
+) -> usize {
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .filter(|(x, y)| match rel {
+            None => x.map(f32::to_bits) != y.map(f32::to_bits),
+            Some(r) => (0..3).any(|c| (x[c] - y[c]).abs() > r * (x[c].abs() + 1e-3)),
+        })
+        .count()
+}
+
+/// The largest relative difference of a color channel between `a` and `b` (against
+/// |a| + 1e-3, as `differing` measures).
+pub fn worst_relative(a: &lumagraph::render::cpu::Image, b: &lumagraph::render::cpu::Image) -> f32 {
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .flat_map(|(x, y)| (0..3).map(|c| (x[c] - y[c]).abs() / (x[c].abs() + 1e-3)))
+        .fold(0.0f32, f32::max)
+}
+
+/// For a test that needs ray queries: `true` where this process's device has them (the
+/// test runs here). Otherwise the test `name` runs again in a child process on the driver
+/// that `LUMAGRAPH_RAY_QUERY_ICD` names (Mesa 25's lavapipe, which `scripts/setup.sh`
+/// unpacks beside the system's drivers and `scripts/env.sh` names), its output is shown
+/// and its success asserted, and the caller returns (`false`). Without such a driver, a
+/// failure, unless `LUMAGRAPH_ALLOW_NO_RAY_QUERY=1`.
+pub fn ray_queries_here(name: &str) -> bool {
+    let Some(ctx) = gpu() else {
+        return false;
+    };
+    if ctx.ray_queries() {
+        return true;
+    }
+    let child = std::env::var_os("LUMAGRAPH_RAY_QUERY_CHILD").is_some();
+    let icd = std::env::var("LUMAGRAPH_RAY_QUERY_ICD")
+        .ok()
+        .filter(|p| Path::new(p).is_file());
+    if let (Some(icd), false) = (&icd, child) {
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([name, "--exact", "--nocapture", "--test-threads=1"])
+            .env("VK_ICD_FILENAMES", icd)
+            .env("LUMAGRAPH_RAY_QUERY_CHILD", "1")
+            .output()
+            .unwrap();
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        println!("{name}, run again on the driver of {icd}:\n{text}");
+        assert!(out.status.success(), "{name} failed on {icd}");
+        assert!(text.contains("1 passed"), "{name} did not run on {icd}");
+        return false;
+    }
+    assert!(
+        std::env::var("LUMAGRAPH_ALLOW_NO_RAY_QUERY").is_ok_and(|v| v == "1"),
+        "{}: no ray queries{}; run scripts/setup.sh (it unpacks Mesa 25's lavapipe) or set \
+         LUMAGRAPH_RAY_QUERY_ICD to the ICD file of a driver with them, or set \
+         LUMAGRAPH_ALLOW_NO_RAY_QUERY=1",
+        ctx.describe(),
+        if child { " on the driver named" } else { "" }
+    );
+    println!("{}: no ray queries, {name} not run", ctx.describe());
+    false
+}

@@ -58,12 +58,8 @@ pub enum EditorError {
 /// (timestamp queries for per-node GPU times).
 pub fn wgpu_setup() -> egui_wgpu::WgpuSetup {
     let mut setup = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
-    setup.device_descriptor = Arc::new(|adapter| wgpu::DeviceDescriptor {
-        label: Some("lumagraph editor"),
-        required_features: adapter.features() & GpuContext::optional_features(),
-        required_limits: GpuContext::limits(adapter),
-        ..Default::default()
-    });
+    setup.device_descriptor =
+        Arc::new(|adapter| GpuContext::device_descriptor(adapter, "lumagraph editor"));
     egui_wgpu::WgpuSetup::CreateNew(setup)
 }
 

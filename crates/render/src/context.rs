@@ -66,6 +66,25 @@ impl GpuContext {
         pollster::block_on(Self::select_adapter(false)).map(|a| a.get_info())
     }
 
+    /// The adapter [`GpuContext::headless`] would choose and what the path tracer's choices
+    /// depend on in it, without opening a device.
+    ///
+    /// # Errors
+    /// When no adapter matches.
+    pub fn default_adapter_traits() -> Result<(wgpu::AdapterInfo, crate::specialize::AdapterTraits)>
+    {
+        let adapter = pollster::block_on(Self::select_adapter(false))?;
+        let info = adapter.get_info();
+        let rq = adapter.features() & Self::optional_features();
+        let traits = crate::specialize::AdapterTraits {
+            cpu: info.device_type == wgpu::DeviceType::Cpu,
+            ray_query_limit: rq
+                .contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY)
+                .then(|| adapter.limits().max_blas_primitive_count),
+        };
+        Ok((info, traits))
+    }
+
     /// Every adapter the environment's backends offer, one line each, then the one
     /// [`GpuContext::headless`] would choose: name, kind, backend and driver, and what
     /// decides how lumagraph runs there (ray queries, timestamp queries, the largest storage
@@ -168,15 +187,8 @@ impl GpuContext {
     /// When the device cannot be opened.
     pub async fn from_adapter(adapter: wgpu::Adapter) -> Result<Self> {
         let info = adapter.get_info();
-        let wanted = Self::optional_features();
-        let features = adapter.features() & wanted;
         let (device, queue) = adapter
-            .request_device(&wgpu::DeviceDescriptor {
-                label: Some("lumagraph"),
-                required_features: features,
-                required_limits: Self::limits(&adapter),
-                ..Default::default()
-            })
+            .request_device(&Self::device_descriptor(&adapter, "lumagraph"))
             .await
             .map_err(|e| RenderError::Device {
                 adapter: info.name.clone(),
@@ -185,11 +197,61 @@ impl GpuContext {
         Ok(Self::from_parts(adapter, device, queue))
     }
 
+    /// The device lumagraph asks `adapter` for: the features of
+    /// [`Self::optional_features`] it has, and its own limits.
+    pub fn device_descriptor(
+        adapter: &wgpu::Adapter,
+        label: &'static str,
+    ) -> wgpu::DeviceDescriptor<'static> {
+        let features = adapter.features() & Self::optional_features();
+        #[expect(unsafe_code, reason = "wgpu's token for experimental features")]
+        let experimental_features = if features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
+            // SAFETY: wgpu marks ray queries experimental (its API may change, and bugs in
+            // it may be undefined behaviour). lumagraph uses them only through
+            // `crate::accel` and `pathtrace/ray_query.wgsl`, whose images the tests compare
+            // with the WGSL BVH's; LUMAGRAPH_RAY_QUERY=off leaves them out.
+            unsafe { wgpu::ExperimentalFeatures::enabled() }
+        } else {
+            wgpu::ExperimentalFeatures::disabled()
+        };
+        wgpu::DeviceDescriptor {
+            label: Some(label),
+            required_features: features,
+            required_limits: Self::limits(adapter),
+            experimental_features,
+            ..Default::default()
+        }
+    }
+
     /// Features lumagraph enables when the adapter has them.
     pub fn optional_features() -> wgpu::Features {
         // Filtering rgba32float images (bilinear taps in blur, bloom, resize and LUT
         // nodes): every desktop GPU and lavapipe have it; a shader that samples needs it.
-        wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::FLOAT32_FILTERABLE
+        let mut f = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::FLOAT32_FILTERABLE;
+        // Ray queries: the path tracer's intersector where the device has them
+        // (`crate::accel`), unless LUMAGRAPH_RAY_QUERY=off.
+        if !ray_queries_turned_off() {
+            f |= wgpu::Features::EXPERIMENTAL_RAY_QUERY;
+        }
+        f
+    }
+
+    /// What the path tracer's choices depend on in this device.
+    pub fn traits(&self) -> crate::specialize::AdapterTraits {
+        crate::specialize::AdapterTraits {
+            cpu: self.is_cpu(),
+            ray_query_limit: self
+                .ray_queries()
+                .then(|| self.device.limits().max_blas_primitive_count),
+        }
+    }
+
+    /// Whether the device can trace the path tracer's rays through ray queries
+    /// (`wgpu::Features::EXPERIMENTAL_RAY_QUERY`, asked for where the adapter has it).
+    pub fn ray_queries(&self) -> bool {
+        self.device
+            .features()
+            .contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY)
     }
 
     /// Limits lumagraph asks for: the adapter's own (large images, big scene buffers).
@@ -385,4 +447,15 @@ pub fn human_bytes(bytes: u64) -> String {
         1_048_576..1_073_741_824 => format!("{:.1} MiB", b / 1_048_576.0),
         _ => format!("{:.1} GiB", b / 1_073_741_824.0),
     }
+}
+
+/// Whether `LUMAGRAPH_RAY_QUERY=off` asks lumagraph not to use the device's ray queries.
+pub fn ray_queries_turned_off() -> bool {
+    std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "off" || v == "0")
+}
+
+/// Whether `LUMAGRAPH_RAY_QUERY=on` asks the path tracer to trace through the device's ray
+/// queries wherever they can trace the scene, even on a CPU adapter (benchmarks).
+pub fn ray_queries_asked_for() -> bool {
+    std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "on" || v == "1")
 }

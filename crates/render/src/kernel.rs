@@ -53,6 +53,8 @@ pub enum Binding {
         /// Whether the shader only reads it.
         read_only: bool,
     },
+    /// `acceleration_structure` (ray queries, [`crate::accel`]).
+    AccelerationStructure,
 }
 
 impl Binding {
@@ -94,6 +96,9 @@ impl Binding {
                 has_dynamic_offset: false,
                 min_binding_size: None,
             },
+            Self::AccelerationStructure => wgpu::BindingType::AccelerationStructure {
+                vertex_return: false,
+            },
         }
     }
 
@@ -112,6 +117,7 @@ impl Binding {
             Self::Uniform => "uniform",
             Self::Storage { .. } => "buffer",
             Self::Sampler => "sampler",
+            Self::AccelerationStructure => "accel",
         }
     }
 }
@@ -221,6 +227,12 @@ pub fn reflect(label: &str, source: &str) -> Result<(Vec<Binding>, [u32; 3])> {
             (naga::AddressSpace::Handle, naga::TypeInner::Sampler { comparison: false }) => {
                 Binding::Sampler
             }
+            (
+                naga::AddressSpace::Handle,
+                naga::TypeInner::AccelerationStructure {
+                    vertex_return: false,
+                },
+            ) => Binding::AccelerationStructure,
             (
                 naga::AddressSpace::Handle,
                 &naga::TypeInner::Image {
@@ -516,6 +528,12 @@ impl<'a> PassBuilder<'a> {
     #[must_use]
     pub fn uniform(self, buffer: &'a wgpu::Buffer) -> Self {
         self.push("uniform", buffer.as_entire_binding())
+    }
+
+    /// An acceleration structure (ray queries).
+    #[must_use]
+    pub fn accel(self, tlas: &'a wgpu::Tlas) -> Self {
+        self.push("accel", tlas.as_binding())
     }
 
     /// Whether the resources given match the shader's bindings, one by one.

@@ -14,6 +14,7 @@
 //! - [`embree`]: the path tracer's rays traced on the host with Embree 3, loaded at run
 //!   time (for CPU adapters, where the WGSL BVH traversal is slow).
 
+pub mod accel;
 pub mod bsdf_check;
 pub mod bsdf_tables;
 pub mod checkpoint;

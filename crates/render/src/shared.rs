@@ -40,6 +40,12 @@ pub const WAVE_NO_RAY: f32 = -1.0;
 /// light must use the same, or MIS is biased.
 pub const LIGHT_UNIFORM_SHARE: f32 = lumagraph_scene::LIGHT_UNIFORM_SHARE;
 
+/// The custom data of the ray queries' instance of the triangles' boxes
+/// ([`crate::accel`], `pathtrace/ray_query.wgsl`).
+pub const ACCEL_TRIANGLES: u32 = 0;
+/// The custom data of the ray queries' instance of the spheres' boxes.
+pub const ACCEL_SPHERES: u32 = 1;
+
 crate::param_block! {
     /// The rays a step of host intersection writes for one slot: the next ray and the
     /// shadow ray leave from the same point (`t_near` < 0: no such ray;
@@ -66,6 +72,8 @@ pub fn wgsl() -> String {
         ("WAVE_RAYS_AT", WAVE_RAYS_AT),
         ("WAVE_HITS_AT", WAVE_HITS_AT),
         ("WAVE_LIST_AT", WAVE_LIST_AT),
+        ("ACCEL_TRIANGLES", ACCEL_TRIANGLES),
+        ("ACCEL_SPHERES", ACCEL_SPHERES),
     ] {
         let _ = writeln!(out, "const {name}: u32 = {value}u;");
     }

@@ -46,8 +46,13 @@ pub struct Resources {
     /// buffers even where they could be written into the code (tests and benchmarks).
     pub scene_data_in_buffers: bool,
     /// Traverse the BVH even where a CPU adapter would intersect a small scene inline: what
-    /// GPU adapters run (tests compare the two on lavapipe).
+    /// GPU adapters without ray queries run (tests compare the two on lavapipe).
     pub traverse_bvh: bool,
+    /// Trace the path tracer's rays through the device's ray queries wherever they can
+    /// trace the scene, even where a CPU adapter would intersect it inline or on the host
+    /// (tests compare them with the WGSL BVH on lavapipe). With `traverse_bvh`, as a GPU
+    /// adapter with ray queries would (`traverse_bvh` alone: as one without).
+    pub ray_queries: bool,
     /// Trace workgroups in image order even on a CPU adapter, where they are otherwise
     /// spread over the image to balance the driver's threads (a test compares the two).
     pub workgroups_in_image_order: bool,
@@ -296,10 +301,13 @@ pub trait NodeExec {
     }
 }
 
-/// What a pass of a kind specialized to the scene compiles in and leaves out, for a CPU
-/// adapter (`true`) or a GPU.
-pub type ShaderFeatures =
-    fn(&Pass, &lumagraph_scene::GpuScene, bool) -> crate::specialize::Features;
+/// What a pass of a kind specialized to the scene compiles in and leaves out, on an adapter
+/// with these traits (a CPU one or a GPU, with or without ray queries).
+pub type ShaderFeatures = fn(
+    &Pass,
+    &lumagraph_scene::GpuScene,
+    crate::specialize::AdapterTraits,
+) -> crate::specialize::Features;
 
 /// The size of the image a source produces from its params (paths relative to the folder
 /// given), or why it cannot tell.
@@ -324,7 +332,8 @@ pub struct NodeImpl {
     pub source_extent: Option<SourceExtent>,
     /// For a kind whose shader is specialized to the scene: what a pass of it compiles in
     /// and leaves out for `scene` (with the default resources), for `lumagraph plan`.
-    /// The `bool` says whether the adapter is a CPU one (lavapipe), where other choices pay.
+    /// The adapter's traits say whether it is a CPU one (lavapipe), where other choices
+    /// pay, and whether it has ray queries.
     pub features: Option<ShaderFeatures>,
 }
 

@@ -26,8 +26,8 @@ const STATS: u64 = 4;
 pub(crate) const IMPL: NodeImpl = NodeImpl::new("PathTrace", |ctx, pass, resources| {
     boxed(PathTrace::new(ctx, pass, resources))
 })
-.with_features(|pass, scene, cpu_adapter| {
-    crate::specialize::Features::decide(scene, options(pass, &Resources::default(), cpu_adapter))
+.with_features(|pass, scene, traits| {
+    crate::specialize::Features::decide(scene, options(pass, &Resources::default(), traits))
 })
 .owning(|pass| {
     adaptive_on(pass).then(|| {
@@ -47,12 +47,19 @@ fn adaptive_on(pass: &Pass) -> bool {
 
 /// How a pass's shader is specialized: to the scene unless the resources ask for the
 /// general shader, to the kind of adapter, with first-hit AOVs when something reads them.
+/// `resources.traverse_bvh` has it run as a GPU adapter would: through the WGSL BVH, or
+/// with `resources.ray_queries` too, through ray queries.
 fn options(
     pass: &Pass,
     resources: &Resources,
-    cpu_adapter: bool,
+    traits: crate::specialize::AdapterTraits,
 ) -> crate::specialize::PathTraceOptions {
+    let cpu_adapter = traits.cpu && !resources.traverse_bvh;
     crate::specialize::PathTraceOptions {
+        ray_query_limit: traits
+            .ray_query_limit
+            .filter(|_| !resources.traverse_bvh || resources.ray_queries),
+        ray_queries_forced: resources.ray_queries || crate::context::ray_queries_asked_for(),
         specialize: !resources.general_shaders,
         cpu_adapter,
         data_in_buffers: resources.scene_data_in_buffers,
@@ -298,6 +305,9 @@ pub(crate) struct PathTrace {
     host_counts: HostCounts,
     /// The `wave` binding's stand-in without host intersection.
     wave_stand_in: wgpu::Buffer,
+    /// The scene's acceleration structure, where the plan says "ray queries", and how long
+    /// it took to build.
+    accel: Option<(crate::accel::SceneAccel, std::time::Duration)>,
 }
 
 impl PathTrace {
@@ -305,7 +315,7 @@ impl PathTrace {
         let scene = resources.scene.clone().ok_or_else(|| {
             RenderError::Gpu("PathTrace needs a scene (lumagraph render --scene FILE)".into())
         })?;
-        let opts = options(pass, resources, ctx.is_cpu() && !resources.traverse_bvh);
+        let opts = options(pass, resources, ctx.traits());
         let specialization = crate::specialize::Specialization::new(&scene, opts);
         let source = specialization.source()?;
         let features = specialization.features;
@@ -318,6 +328,13 @@ impl PathTrace {
         };
         let host = if features.on(Feature::HostRays) {
             Some(HostRays::new(ctx, &scene)?)
+        } else {
+            None
+        };
+        let accel = if features.on(Feature::RayQueries) {
+            let start = std::time::Instant::now();
+            let a = crate::accel::SceneAccel::build(ctx, &scene)?;
+            Some((a, start.elapsed()))
         } else {
             None
         };
@@ -389,6 +406,7 @@ impl PathTrace {
             chunk_sums: storage(ctx, "pathtrace chunk sums", 16),
             host,
             wave_stand_in: storage(ctx, "pathtrace wave stand-in", 16),
+            accel,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -451,7 +469,8 @@ impl PathTrace {
         wave: &'a wgpu::Buffer,
     ) -> PassBuilder<'a> {
         let b = &self.buffers;
-        self.kernel
+        let pass = self
+            .kernel
             .pass(name)
             .write(color)
             .uniform(&self.frame)
@@ -476,7 +495,11 @@ impl PathTrace {
             .buffer(&self.adaptive.active)
             .buffer(sums)
             .buffer(wave)
-            .read(&b.textures)
+            .read(&b.textures);
+        match &self.accel {
+            Some((accel, _)) => pass.accel(&accel.tlas),
+            None => pass,
+        }
     }
 
     /// Records a frame traced with host intersection: the steps of its paths are
@@ -692,6 +715,15 @@ impl NodeExec for PathTrace {
         let mut notes = vec![format!("shader: {}", self.features.summary())];
         if let Some(host) = &self.host {
             notes.push(host.note.clone());
+        }
+        if let Some((accel, took)) = &self.accel {
+            notes.push(format!(
+                "ray queries: acceleration structure over {} triangles and {} spheres                  ({} of corners and boxes) built in {:.1} ms",
+                self.scene.tri_positions.len(),
+                self.scene.spheres.len(),
+                crate::human_bytes(accel.input_bytes),
+                took.as_secs_f64() * 1e3
+            ));
         }
         if self.firefly_clamp > 0.0 {
             notes.push(format!(

@@ -21,6 +21,9 @@ use super::{INLINE_MAX_MATERIALS, INLINE_MAX_PRIMITIVES, PathTraceOptions, codeg
 pub enum Feature {
     /// Intersection through the BVH (WGSL traversal, or the host's).
     BvhTraversal,
+    /// Intersection through the device's ray queries: its acceleration structure finds the
+    /// candidates, the WGSL tests them ([`crate::accel`], `pathtrace/ray_query.wgsl`).
+    RayQueries,
     /// Every primitive tested with its coordinates written into the code.
     InlineIntersection,
     /// Materials and lights (and, with inline intersection, the primitives' shading data)
@@ -64,8 +67,9 @@ pub enum Feature {
 
 impl Feature {
     /// Every feature, in the order `plan` lists them.
-    pub const ALL: [Self; 20] = [
+    pub const ALL: [Self; 21] = [
         Self::BvhTraversal,
+        Self::RayQueries,
         Self::InlineIntersection,
         Self::InlineData,
         Self::LightSampling,
@@ -91,6 +95,7 @@ impl Feature {
     pub const fn label(self) -> &'static str {
         match self {
             Self::BvhTraversal => "BVH traversal",
+            Self::RayQueries => "ray queries",
             Self::InlineIntersection => "inline intersection",
             Self::InlineData => "inline materials and lights",
             Self::LightSampling => "light sampling (NEE + MIS)",
@@ -118,7 +123,9 @@ impl Feature {
     /// scene data, see [`super::Specialization::source`]).
     pub const fn wgsl_const(self) -> Option<&'static str> {
         Some(match self {
-            Self::BvhTraversal | Self::InlineIntersection | Self::InlineData => return None,
+            Self::BvhTraversal | Self::RayQueries | Self::InlineIntersection | Self::InlineData => {
+                return None;
+            }
             Self::LightSampling => "HAS_LIGHTS",
             Self::Environment => "HAS_ENVIRONMENT",
             Self::EnvMapSampling => "HAS_ENV_MAP",
@@ -216,14 +223,17 @@ impl Features {
         let how = match (
             self.on(Feature::InlineIntersection),
             self.on(Feature::HostRays),
+            self.on(Feature::RayQueries),
             self.on(Feature::InlineData),
         ) {
-            (true, _, true) => "intersection inlined, materials and lights inlined",
-            (true, _, false) => "intersection inlined",
-            (false, true, true) => "rays intersected on the host, materials inlined",
-            (false, true, false) => "rays intersected on the host",
-            (false, false, true) => "BVH traversal, materials inlined",
-            (false, false, false) => "BVH traversal",
+            (true, _, _, true) => "intersection inlined, materials and lights inlined",
+            (true, _, _, false) => "intersection inlined",
+            (false, true, _, true) => "rays intersected on the host, materials inlined",
+            (false, true, _, false) => "rays intersected on the host",
+            (false, false, true, true) => "ray queries, materials inlined",
+            (false, false, true, false) => "ray queries",
+            (false, false, false, true) => "BVH traversal, materials inlined",
+            (false, false, false, false) => "BVH traversal",
         };
         let left_out: Vec<&str> = self
             .iter()
@@ -320,6 +330,11 @@ fn material_ranges(scene: &GpuScene, index: usize, m: &GpuMaterial) -> MaterialR
     }
 }
 
+/// Why a CPU adapter does not trace through its ray queries unless asked to (lavapipe
+/// has them from Mesa 25): see `docs/benchmarks.md`.
+const CPU_RAY_QUERIES_REASON: &str =
+    "a CPU adapter: the WGSL BVH is not slower than lavapipe's ray queries";
+
 /// What the decisions are made from, worked out once.
 struct Facts<'a> {
     scene: &'a GpuScene,
@@ -328,6 +343,8 @@ struct Facts<'a> {
     all: bool,
     prims: usize,
     inline: bool,
+    /// Whether the device's ray queries trace the scene ([`Feature::RayQueries`]), and why.
+    ray_queries: Decision,
     inline_data: bool,
     textured: bool,
     materials: Vec<MaterialRanges>,
@@ -336,7 +353,34 @@ struct Facts<'a> {
 impl<'a> Facts<'a> {
     fn new(scene: &'a GpuScene, options: PathTraceOptions) -> Self {
         let prims = scene.tri_positions.len() + scene.spheres.len();
-        let inline = options.specialize && options.cpu_adapter && prims <= INLINE_MAX_PRIMITIVES;
+        // Why the device's ray queries cannot trace this scene, if they cannot.
+        let no_ray_queries = if !options.specialize {
+            Some("general shader: WGSL BVH".to_owned())
+        } else {
+            match options.ray_query_limit {
+                None => Some(if crate::context::ray_queries_turned_off() {
+                    "LUMAGRAPH_RAY_QUERY=off".to_owned()
+                } else {
+                    "the device has no ray queries".to_owned()
+                }),
+                Some(most) => crate::accel::unsupported(scene, most),
+            }
+        };
+        let forced = options.ray_queries_forced && no_ray_queries.is_none();
+        let inline =
+            options.specialize && options.cpu_adapter && prims <= INLINE_MAX_PRIMITIVES && !forced;
+        let host = super::host_rays_decision(scene, options, inline, forced).included;
+        let ray_queries = match no_ray_queries {
+            Some(why) => decision(false, why),
+            None if inline => decision(false, "intersected inline"),
+            None if host => decision(false, "rays intersected on the host"),
+            None if forced => decision(true, "asked for"),
+            None if options.cpu_adapter => decision(false, CPU_RAY_QUERIES_REASON),
+            None => decision(
+                true,
+                "the device's acceleration structure finds the candidates, the WGSL tests them",
+            ),
+        };
         let textured = scene.header.features & FEATURE_TEXTURES != 0;
         // Small scenes have all their data written into the code; larger ones on a CPU
         // adapter their materials (and few lights), the primitives' data staying in buffers.
@@ -352,6 +396,7 @@ impl<'a> Facts<'a> {
             all: !options.specialize,
             prims,
             inline,
+            ray_queries,
             inline_data,
             textured,
             materials: scene
@@ -387,6 +432,7 @@ impl<'a> Facts<'a> {
         let s = self.scene;
         match f {
             Feature::BvhTraversal => self.bvh(),
+            Feature::RayQueries => self.ray_queries.clone(),
             Feature::InlineIntersection => decision(
                 self.inline,
                 super::inline_intersection_reason(s, self.inline),
@@ -494,16 +540,23 @@ impl<'a> Facts<'a> {
                     "BVH traversal: no gain measured on a CPU adapter"
                 },
             ),
-            Feature::HostRays => super::host_rays_decision(s, self.options, self.inline),
+            Feature::HostRays => super::host_rays_decision(
+                s,
+                self.options,
+                self.inline,
+                self.options.ray_queries_forced && self.ray_queries.included,
+            ),
         }
     }
 
     fn bvh(&self) -> Decision {
         let (prims, s) = (self.prims, self.scene);
         decision(
-            !self.inline,
+            !self.inline && !self.ray_queries.included,
             if self.inline {
                 format!("{prims} primitives <= {INLINE_MAX_PRIMITIVES}: tested inline")
+            } else if self.ray_queries.included {
+                "ray queries: the device's acceleration structure".to_owned()
             } else if self.options.specialize
                 && !self.options.cpu_adapter
                 && prims <= INLINE_MAX_PRIMITIVES

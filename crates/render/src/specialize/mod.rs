@@ -28,6 +28,16 @@ pub const INLINE_MAX_PRIMITIVES: usize = 64;
 /// their materials, lights and per-primitive shading data written into the shader.
 pub const INLINE_MAX_MATERIALS: usize = 64;
 
+/// What the path tracer's choices depend on in the adapter.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AdapterTraits {
+    /// A CPU implementation (lavapipe).
+    pub cpu: bool,
+    /// Where the device has ray queries: the most primitives one of its acceleration
+    /// structures holds.
+    pub ray_query_limit: Option<u32>,
+}
+
 /// What the graph needs of the path tracer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PathTraceOptions {
@@ -53,6 +63,14 @@ pub struct PathTraceOptions {
     /// found, [`crate::embree`]) and may: the scene's rays are then traced there when the
     /// BVH would be traversed, and the scene allows (see [`features`]).
     pub host_rays: bool,
+    /// Where the device has ray queries ([`crate::accel`]): the most primitives one of its
+    /// acceleration structures holds. GPU adapters trace through them wherever the scene
+    /// would otherwise traverse the BVH in WGSL.
+    pub ray_query_limit: Option<u32>,
+    /// Trace through the device's ray queries wherever they can trace the scene, even
+    /// where a CPU adapter would intersect inline or on the host (tests compare them with
+    /// the WGSL BVH on lavapipe).
+    pub ray_queries_forced: bool,
 }
 
 /// A path tracer shader specialized to one scene, adapter and graph: its features, decided
@@ -61,7 +79,8 @@ pub struct PathTraceOptions {
 pub struct Specialization {
     /// What is compiled in and left out, and why.
     pub features: Features,
-    /// Replaces `pathtrace/intersect.wgsl` ([`Feature::InlineIntersection`]).
+    /// Replaces `pathtrace/intersect.wgsl` ([`Feature::InlineIntersection`], or
+    /// [`Feature::RayQueries`]: `pathtrace/ray_query.wgsl`).
     intersection: Option<String>,
     /// Replaces `pathtrace/scene_data.wgsl` ([`Feature::InlineData`]).
     scene_data: Option<String>,
@@ -74,6 +93,8 @@ impl Specialization {
         let inline = features.on(Feature::InlineIntersection);
         let intersection = if inline {
             inline_intersection(scene, features.on(Feature::Alpha))
+        } else if features.on(Feature::RayQueries) {
+            Some("#import \"pathtrace/ray_query.wgsl\"\n".to_owned())
         } else {
             None
         };
@@ -104,7 +125,13 @@ impl Specialization {
         if let Some(code) = &self.scene_data {
             overrides.push(("pathtrace/scene_data.wgsl", code.clone()));
         }
-        crate::shader::resolve_with("pathtrace/pathtrace.wgsl", &overrides)
+        let source = crate::shader::resolve_with("pathtrace/pathtrace.wgsl", &overrides)?;
+        Ok(if self.features.on(Feature::RayQueries) {
+            // An `enable` directive comes before any declaration.
+            format!("enable wgpu_ray_query;\n{source}")
+        } else {
+            source
+        })
     }
 }
 
@@ -194,7 +221,12 @@ fn textures_reason(scene: &GpuScene, all: bool) -> String {
 }
 
 /// Whether the host intersects the rays (`HOST_RAYS`), and why (not).
-fn host_rays_decision(scene: &GpuScene, options: PathTraceOptions, inline: bool) -> Decision {
+fn host_rays_decision(
+    scene: &GpuScene,
+    options: PathTraceOptions,
+    inline: bool,
+    ray_queries_forced: bool,
+) -> Decision {
     let media = scene.materials.iter().any(|x| {
         x.flags & (lumagraph_scene::MATERIAL_MEDIUM | lumagraph_scene::MATERIAL_INDEX_MATCHED) != 0
     });
@@ -205,6 +237,8 @@ fn host_rays_decision(scene: &GpuScene, options: PathTraceOptions, inline: bool)
         )
     } else if inline {
         (false, "intersected inline".to_owned())
+    } else if ray_queries_forced {
+        (false, "ray queries asked for".to_owned())
     } else if !options.host_rays {
         (
             false,

@@ -1,0 +1,78 @@
+#import "pathtrace/primitives.wgsl"
+#import "pathtrace/shared.wgsl"
+
+// Scene intersection through the device's ray queries (`enable wgpu_ray_query`, which the
+// renderer puts at the top of the shader): the device's acceleration structure
+// (crates/render/src/accel.rs) finds the candidates, and each is tested here exactly as the
+// BVH traversal of bvh.wgsl tests a leaf's primitives: the same ray/primitive tests, the
+// same rules for rays leaving a surface (`skip_prim`, the origin's error) and the same
+// any-hit test (alpha.wgsl). So the device only replaces the BVH: on GPUs with ray-tracing
+// hardware that is its traversal units, elsewhere (lavapipe) the driver's own BVH.
+//
+// The acceleration structure has one instance per kind of primitive, its custom data saying
+// which: triangles (ACCEL_TRIANGLES) and spheres (ACCEL_SPHERES), each primitive a box, in
+// the order of `tri_positions` and `spheres` (a candidate's primitive index is the
+// primitive's). Every candidate box comes back to this loop, which generates a hit only
+// where the exact test hits, so the device culls the boxes beyond it. (Triangles are boxes,
+// not the device's triangles: its watertight test and Moller-Trumbore disagree at shared
+// edges, and a ray the device sends to one triangle and the exact test to none would go
+// through.)
+//
+// The including shader declares `tri_positions` and `spheres` (as for bvh.wgsl) and the
+// constants HAS_TRIANGLES, HAS_SPHERES and HAS_ALPHA.
+
+@group(0) @binding(24) var scene_accel: acceleration_structure;
+
+// Closest hit (any_hit false) or first hit found (any_hit true) with 0 < t < t_max.
+fn trace_accel(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
+    var hit = Hit(NO_HIT, t_max, 0.0, 0.0);
+    var rq: ray_query;
+    rayQueryInitialize(&rq, scene_accel, RayDesc(RAY_FLAG_NONE, 0xFFu, 0.0, t_max, ray.origin, ray.dir));
+    while (rayQueryProceed(&rq)) {
+        let c = rayQueryGetCandidateIntersection(&rq);
+        let i = c.primitive_index;
+        if (HAS_TRIANGLES && c.instance_custom_data == ACCEL_TRIANGLES) {
+            let tri = tri_positions[i];
+            let r = intersect_triangle(ray.origin, ray.dir, tri.v0, tri.e1, tri.e2, hit.t);
+            if (r.x != 0.0 && i != skip_prim && (!HAS_ALPHA || (tri.flags & TRI_ALPHA) == 0u || triangle_hit_counts(i, r.z, r.w, ray))) {
+                hit = Hit(i, r.y, r.z, r.w);
+                // A hit at a concave corner may come at t <= 0 (primitives.wgsl); the device
+                // takes none below its t_min of 0.
+                // (Bound by a `let`: naga 30 rejects an expression in the call itself.)
+                let at = max(r.y, 0.0);
+                rayQueryGenerateIntersection(&rq, at);
+                if (any_hit) {
+                    rayQueryTerminate(&rq);
+                }
+            }
+        } else if (HAS_SPHERES && c.instance_custom_data == ACCEL_SPHERES) {
+            let s = spheres[i];
+            let t = intersect_sphere_from(i | PRIM_SPHERE, ray.origin, ray.dir, s.center, s.radius, hit.t);
+            if (t > 0.0 && (!HAS_ALPHA || sphere_hit_counts(i, ray))) {
+                hit = Hit(i | PRIM_SPHERE, t, 0.0, 0.0);
+                rayQueryGenerateIntersection(&rq, t);
+                if (any_hit) {
+                    rayQueryTerminate(&rq);
+                }
+            }
+        }
+    }
+    return hit;
+}
+
+// The intersector contract (as bvh.wgsl and the generated inline intersection):
+
+// The closest hit with 0 < t < t_max; hit.prim == NO_HIT on a miss.
+fn intersect_scene_within(ray: Ray, t_max: f32) -> Hit {
+    return trace_accel(ray, t_max, false);
+}
+
+// The closest hit; hit.prim == NO_HIT on a miss.
+fn intersect_scene(ray: Ray) -> Hit {
+    return trace_accel(ray, F32_MAX, false);
+}
+
+// Whether anything is hit with 0 < t < t_max (shadow rays).
+fn occluded(ray: Ray, t_max: f32) -> bool {
+    return trace_accel(ray, t_max, true).prim != NO_HIT;
+}
