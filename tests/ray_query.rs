@@ -169,11 +169,17 @@ fn against_wgsl_bvh(name: &str) -> Option<(usize, f64)> {
     // second one first keeps it. So the depth is bit-identical everywhere, and albedo and
     // normal differ only where the depth says such a tie can be.
     let depth = common::differing(&a[3], &b[3], None);
-    println!("{name} depth: {depth} of 4096 pixels differ");
+    println!(
+        "{name} depth: {depth} of {} pixels differ",
+        a[3].pixels.len()
+    );
     assert_eq!(depth, 0, "{name}: depth differs");
     for (i, port) in [(1, "albedo"), (2, "normal")] {
         let differ = common::differing(&a[i], &b[i], None);
-        println!("{name} {port}: {differ} of 4096 pixels differ (ties)");
+        println!(
+            "{name} {port}: {differ} of {} pixels differ (ties)",
+            a[i].pixels.len()
+        );
         // Ties are on edges: at most a diagonal's worth of pixels (64) per corner line.
         assert!(differ <= 128, "{name} {port}: {differ} pixels differ");
     }

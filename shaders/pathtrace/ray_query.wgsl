@@ -27,7 +27,10 @@
 fn trace_accel(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
     var hit = Hit(NO_HIT, t_max, 0.0, 0.0);
     var rq: ray_query;
-    rayQueryInitialize(&rq, scene_accel, RayDesc(RAY_FLAG_NONE, 0xFFu, 0.0, t_max, ray.origin, ray.dir));
+    // The device's range must be finite and not below its t_min (a shadow ray's may be
+    // neither); the exact tests keep `t_max` itself.
+    let far = clamp(t_max, 0.0, F32_MAX);
+    rayQueryInitialize(&rq, scene_accel, RayDesc(RAY_FLAG_NONE, 0xFFu, 0.0, far, ray.origin, ray.dir));
     while (rayQueryProceed(&rq)) {
         let c = rayQueryGetCandidateIntersection(&rq);
         let i = c.primitive_index;
