@@ -44,6 +44,10 @@ if command -v vulkaninfo >/dev/null 2>&1; then
     vulkaninfo 2>/dev/null | grep -E 'deviceName|VK_KHR_(ray_query|acceleration_structure|ray_tracing_pipeline)' | sort -u | tee -a "$log"
 fi
 
+# Whether an adapter has ray queries (then the GPU's, which render chooses over lavapipe).
+ray_queries=""
+"$lg" adapters 2>/dev/null | grep -q 'ray queries: yes' && ray_queries=yes
+
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 hdr="$repo/assets/hdri/venice_sunset_1k.hdr"
@@ -87,6 +91,13 @@ run_scene() {
     local mps
     mps=$(grep -m1 -oE '[0-9.]+ M paths/s' "$work/bench.txt" | grep -oE '^[0-9.]+')
     [ -n "$mps" ] || { say "== $name: bench printed no paths/s"; rows+=("| $name | failed | | | |"); return; }
+    # On a device with ray queries the specialized shader traces through them: the WGSL BVH
+    # beside it, for the comparison.
+    if [ -n "$ray_queries" ]; then
+        say "== $name: bench without ray queries (LUMAGRAPH_RAY_QUERY=off: the WGSL BVH)"
+        LUMAGRAPH_RAY_QUERY=off timeout $(( $(left) > 60 ? $(left) : 60 )) "$lg" bench --scene "$scene" \
+            --spp "$bench_spp" --runs 3 --specialized-only 2>&1 | tee -a "$log"
+    fi
     # Predicted wall time at 15 000 spp, with 15 % for the graph's other passes.
     local predicted spp note
     predicted=$(awk -v m="$mps" -v s=$full_spp 'BEGIN { printf "%d", 1.15 * 1e6 * s / (m * 1e6) + 1 }')

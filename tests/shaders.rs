@@ -33,11 +33,30 @@ fn entry_shaders() -> Vec<&'static str> {
         .collect()
 }
 
+/// Fragments only the path tracer's specialization imports (in place of
+/// `pathtrace/intersect.wgsl`), with the whole shader it assembles around each.
+fn specialized_sources() -> Vec<(&'static str, String)> {
+    use lumagraph::render::specialize::{PathTraceOptions, Specialization};
+    use lumagraph::scene::{GpuScene, Scene};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell_spheres.ron");
+    let scene = GpuScene::build(&Scene::load(&path).unwrap()).unwrap();
+    let ray_queries = PathTraceOptions {
+        specialize: true,
+        ray_query_limit: Some(1 << 24),
+        ray_queries_forced: true,
+        ..PathTraceOptions::default()
+    };
+    let source = Specialization::new(&scene, ray_queries).source().unwrap();
+    assert!(source.contains("rayQueryInitialize"));
+    vec![("pathtrace/ray_query.wgsl", source)]
+}
+
 #[test]
 fn every_shader_validates_with_naga() {
     let names: Vec<_> = shader::all_names().collect();
     assert!(names.len() >= 4, "shaders not embedded: {names:?}");
     let entries = entry_shaders();
+    let specialized = specialized_sources();
     let mut failures = Vec::new();
     for name in &names {
         if entries.contains(name) {
@@ -45,15 +64,19 @@ fn every_shader_validates_with_naga() {
         }
         let imported = entries
             .iter()
-            .any(|e| shader::imports(e).unwrap().iter().any(|i| i == name));
+            .any(|e| shader::imports(e).unwrap().iter().any(|i| i == name))
+            || specialized.iter().any(|(s, _)| s == name);
         if !imported {
             failures.push(format!(
                 "{name}: a fragment no entry shader imports, so it is never checked"
             ));
         }
     }
-    for name in entries {
-        let source = shader::resolve(name).unwrap();
+    let sources = entries
+        .iter()
+        .map(|&name| (name, shader::resolve(name).unwrap()))
+        .chain(specialized);
+    for (name, source) in sources {
         let module = match naga::front::wgsl::parse_str(&source) {
             Ok(m) => m,
             Err(e) => {
