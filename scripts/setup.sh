@@ -54,7 +54,8 @@ if [ ! -f "$ray_query_dir/lvp_icd.json" ] && grep -q '^VERSION_CODENAME=bookworm
         mkdir -p "$ray_query_dir"
         lib=$(find "$work/root" -name libvulkan_lvp.so | head -n 1)
         cp "$lib" "$ray_query_dir/libvulkan_lvp.so"
-        api=$(sed -n 's/.*"api_version": *"\([^"]*\)".*/\1/p' "$work"/root/usr/share/vulkan/icd.d/lvp_icd*.json | head -n 1)
+        icd=$(find "$work/root" -name 'lvp_icd*.json' | head -n 1)
+        api=$(sed -n 's/.*"api_version": *"\([^"]*\)".*/\1/p' "$icd" | head -n 1)
         printf '{\n  "file_format_version": "1.0.0",\n  "ICD": {\n    "library_path": "%s",\n    "api_version": "%s"\n  }\n}\n' \
             "$ray_query_dir/libvulkan_lvp.so" "$api" >"$ray_query_dir/lvp_icd.json.tmp"
         mv "$ray_query_dir/lvp_icd.json.tmp" "$ray_query_dir/lvp_icd.json"

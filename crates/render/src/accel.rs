@@ -33,7 +33,7 @@ pub struct SceneAccel {
     pub tlas: wgpu::Tlas,
     /// The bottom levels the instances refer to (kept alive with the top level).
     _blas: Vec<wgpu::Blas>,
-    /// Bytes of the build inputs uploaded (corners and boxes).
+    /// Bytes of the build inputs uploaded (the boxes).
     pub input_bytes: u64,
 }
 

@@ -718,7 +718,8 @@ impl NodeExec for PathTrace {
         }
         if let Some((accel, took)) = &self.accel {
             notes.push(format!(
-                "ray queries: acceleration structure over {} triangles and {} spheres                  ({} of corners and boxes) built in {:.1} ms",
+                "ray queries: acceleration structure over {} triangles and {} spheres ({} of \
+                 boxes) built in {:.1} ms",
                 self.scene.tri_positions.len(),
                 self.scene.spheres.len(),
                 crate::human_bytes(accel.input_bytes),
