@@ -2,7 +2,9 @@
 # Every GPU figure of docs/benchmarks.md ("On a real GPU") in one run, with the device named:
 # the adapter and its ray-query support, then for the Cornell box, a mesh of 1.3 M triangles
 # and the Crytek Sponza, each at 1000x1000 and 20 bounces:
-#   - paths/s of the path tracer's shader variants (`lumagraph bench`);
+#   - paths/s of the path tracer's shader variants (`lumagraph bench`): the specialized
+#     shader, the general one, and the specialized one through the 8-wide BVH
+#     (LUMAGRAPH_BVH=wide) with the binary BVH's beside it;
 #   - the wall time of a 15 000-spp render through graphs/pathtrace.ron (the figure seed
 #     renderers give), or, where that would not fit the time left, the time of a shorter
 #     render and its 15 000-spp time extrapolated and marked so.
@@ -87,10 +89,22 @@ run_scene() {
     [ -f "$scene" ] || { say "== $name: skipped (no scene)"; return; }
     say "== $name: bench ($bench_spp spp per run, best of 3)"
     timeout $(( $(left) > 60 ? $(left) : 60 )) "$lg" bench --scene "$scene" --spp "$bench_spp" --runs 3 2>&1 | tee -a "$log" | tee "$work/bench.txt"
-    # The specialized shader's figure (the first paths/s on the bench's lines).
-    local mps
+    # The specialized shader's figure (the first paths/s on the bench's lines) and the
+    # general shader's.
+    local mps general
     mps=$(grep -m1 -oE '[0-9.]+ M paths/s' "$work/bench.txt" | grep -oE '^[0-9.]+')
-    [ -n "$mps" ] || { say "== $name: bench printed no paths/s"; rows+=("| $name | failed | | | |"); return; }
+    general=$(grep -m1 -E '^  general ' "$work/bench.txt" | grep -oE '[0-9.]+ M paths/s' | grep -oE '^[0-9.]+')
+    [ -n "$mps" ] || { say "== $name: bench printed no paths/s"; rows+=("| $name | failed | | | | | | |"); return; }
+    # The 8-wide BVH (LUMAGRAPH_BVH=wide), which bench measures with the binary BVH after it:
+    # two pairs for the wide-against-binary ratio (the binary figure above, and this one).
+    say "== $name: bench with the 8-wide BVH (LUMAGRAPH_BVH=wide), then the binary one"
+    LUMAGRAPH_BVH=wide timeout $(( $(left) > 60 ? $(left) : 60 )) "$lg" bench --scene "$scene" \
+        --spp "$bench_spp" --runs 3 --specialized-only 2>&1 | tee -a "$log" | tee "$work/bench2.txt"
+    local wide binary2 ratio=""
+    wide=$(grep -m1 -oE '[0-9.]+ M paths/s' "$work/bench2.txt" | grep -oE '^[0-9.]+')
+    binary2=$(grep -m1 -E '^  binary BVH ' "$work/bench2.txt" | grep -oE '[0-9.]+ M paths/s' | grep -oE '^[0-9.]+')
+    [ -n "$wide" ] && [ -n "$binary2" ] && ratio=$(awk -v w="$wide" -v a="$mps" -v b="$binary2" \
+        'BEGIN { printf "%.2f, %.2f", w / a, w / b }')
     # On a device with ray queries the specialized shader traces through them: the WGSL BVH
     # beside it, for the comparison.
     if [ -n "$ray_queries" ]; then
@@ -119,12 +133,12 @@ run_scene() {
     secs=$(echo "$line" | grep -oE 'in [0-9.]+ s' | grep -oE '[0-9.]+')
     paths=$(echo "$line" | grep -oE '[0-9.]+ M paths/s' | grep -oE '^[0-9.]+')
     if [ -z "$secs" ]; then
-        rows+=("| $name | $mps | render failed | | |")
+        rows+=("| $name | $mps | $wide | $ratio | $general | render failed | | |")
         return
     fi
     local at_full
     at_full=$(awk -v t="$secs" -v s="$spp" -v f=$full_spp 'BEGIN { printf "%.1f", t * f / s }')
-    rows+=("| $name | $mps | $paths | $at_full s | $note |")
+    rows+=("| $name | $mps | $wide | $ratio | $general | $paths | $at_full s | $note |")
 }
 
 for s in $scenes; do
@@ -136,6 +150,6 @@ done
 
 say ""
 say "== $(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null || "$lg" adapters 2>/dev/null | head -1), ${size}x$size, 20 bounces, $full_spp spp, total $(( $(date +%s) - start )) s"
-say "| scene | bench, specialized, M paths/s | render, M paths/s | wall time to $full_spp spp | |"
-say "|---|---|---|---|---|"
+say "| scene | bench, specialized, M paths/s | 8-wide BVH | wide / binary (two pairs) | general | render, M paths/s | wall time to $full_spp spp | |"
+say "|---|---|---|---|---|---|---|---|"
 for r in "${rows[@]}"; do say "$r"; done

@@ -124,7 +124,8 @@ fn albedos(
 /// first-hit albedo of the path tracer (inline intersection, as lavapipe runs the small
 /// scene, BVH traversal, as GPUs do, and with the wall in 64 quads host intersection, as
 /// lavapipe runs larger scenes with Embree) and of the G-buffer raster against the material
-/// the CPU mirror's traversal finds through the pixel centre. Measured: every pixel agrees
+/// the CPU mirror's traversal finds through the pixel centre, and through the 8-wide BVH
+/// (`LUMAGRAPH_BVH=wide`). Measured: every pixel agrees
 /// (0 of 4096); asserted: at most 0.5 % differ (texel edges that rounding puts on either
 /// side), and the cut-out squares are half the quad's pixels within 10 %.
 #[test]
@@ -135,13 +136,30 @@ fn masked_checkerboard_shows_the_wall_through_its_holes() {
     };
     let wgsl = Resources {
         wgsl_intersection: true,
+        wide_bvh: Some(false),
+        ..Resources::default()
+    };
+    let wide = Resources {
+        traverse_bvh: true,
+        wide_bvh: Some(true),
         ..Resources::default()
     };
     check_checkerboard(
         1,
-        &[("inline", Resources::default()), ("BVH", inline_or_bvh)],
+        &[
+            ("inline", Resources::default()),
+            ("BVH", inline_or_bvh),
+            ("8-wide BVH", wide.clone()),
+        ],
     );
-    check_checkerboard(8, &[("host", Resources::default()), ("WGSL BVH", wgsl)]);
+    check_checkerboard(
+        8,
+        &[
+            ("host", Resources::default()),
+            ("WGSL BVH", wgsl),
+            ("8-wide BVH", wide),
+        ],
+    );
 }
 
 /// [`masked_checkerboard_shows_the_wall_through_its_holes`] through ray queries: each
@@ -216,6 +234,12 @@ fn check_checkerboard(tiles: u32, intersectors: &[(&str, Resources)]) {
         assert_eq!(
             features.on(Feature::RayQueries),
             *name == "ray queries",
+            "{name}: {}",
+            features.summary()
+        );
+        assert_eq!(
+            features.on(Feature::WideBvh),
+            *name == "8-wide BVH",
             "{name}: {}",
             features.summary()
         );

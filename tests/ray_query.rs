@@ -146,8 +146,7 @@ fn ray_queries_are_chosen_where_the_device_has_them() {
 }
 
 /// `name` through ray queries and through the WGSL BVH (as a GPU without ray queries runs
-/// it), at 64×64 and 16 spp: the first-hit AOVs and the color. Returns the pixels of the
-/// color beyond 1e-4 relative and the relative difference of the image means.
+/// it), at 64×64 and 16 spp (`common::same_hits`).
 fn against_wgsl_bvh(name: &str) -> Option<(usize, f64)> {
     // Both as a GPU adapter runs (the same dispatches, materials read from buffers).
     let rq = Resources {
@@ -157,49 +156,13 @@ fn against_wgsl_bvh(name: &str) -> Option<(usize, f64)> {
     };
     let bvh = Resources {
         traverse_bvh: true,
+        wide_bvh: Some(false),
         ..Resources::default()
     };
-    let (a, how_a) = common::render_with(name, (64, 64), 16, rq)?;
-    let (b, how_b) = common::render_with(name, (64, 64), 16, bvh)?;
-    assert_eq!(intersector(&how_a), "ray queries", "{}", how_a.summary());
-    assert_eq!(intersector(&how_b), "WGSL BVH", "{}", how_b.summary());
-    // The first-hit AOVs come from the ray through each pixel's centre: the same hits, but
-    // where that ray meets two surfaces at the same distance (the Cornell box's corners lie
-    // on the image's diagonals, through pixel centres), the intersector that finds the
-    // second one first keeps it. So the depth is bit-identical everywhere, and albedo and
-    // normal differ only where the depth says such a tie can be.
-    let depth = common::differing(&a[3], &b[3], None);
-    println!(
-        "{name} depth: {depth} of {} pixels differ",
-        a[3].pixels.len()
-    );
-    assert_eq!(depth, 0, "{name}: depth differs");
-    for (i, port) in [(1, "albedo"), (2, "normal")] {
-        let differ = common::differing(&a[i], &b[i], None);
-        println!(
-            "{name} {port}: {differ} of {} pixels differ (ties)",
-            a[i].pixels.len()
-        );
-        // Ties are on edges: at most a diagonal's worth of pixels (64) per corner line.
-        assert!(differ <= 128, "{name} {port}: {differ} pixels differ");
-    }
-    let sum = |i: &lumagraph::render::cpu::Image| {
-        i.pixels
-            .iter()
-            .map(|p| f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2]))
-            .sum::<f64>()
-    };
-    let (ca, cb) = (&a[0], &b[0]);
-    assert!(ca.pixels.iter().any(|p| p[0] > 0.0), "{name}: black");
-    let far = common::differing(ca, cb, Some(1e-4));
-    let mean = (sum(ca) - sum(cb)) / sum(cb);
-    println!(
-        "{name} color: {} pixels differ, {far} by more than 1e-4 relative, at most {:.2e}; \
-         means {mean:+.2e} relative",
-        common::differing(ca, cb, None),
-        common::worst_relative(ca, cb)
-    );
-    Some((far, mean))
+    common::same_hits(name, rq, bvh, |a, b| {
+        assert_eq!(intersector(a), "ray queries", "{}", a.summary());
+        assert_eq!(intersector(b), "WGSL BVH", "{}", b.summary());
+    })
 }
 
 /// Ray queries against the WGSL BVH on scenes that exercise every part of the intersector

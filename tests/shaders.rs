@@ -48,7 +48,17 @@ fn specialized_sources() -> Vec<(&'static str, String)> {
     };
     let source = Specialization::new(&scene, ray_queries).source().unwrap();
     assert!(source.contains("rayQueryInitialize"));
-    vec![("pathtrace/ray_query.wgsl", source)]
+    let wide = PathTraceOptions {
+        specialize: true,
+        wide_bvh: Some(true),
+        ..PathTraceOptions::default()
+    };
+    let wide_source = Specialization::new(&scene, wide).source().unwrap();
+    assert!(wide_source.contains("WIDE_ROBUST_FAR"));
+    vec![
+        ("pathtrace/ray_query.wgsl", source),
+        ("pathtrace/wide_bvh.wgsl", wide_source),
+    ]
 }
 
 #[test]

@@ -1,4 +1,6 @@
 #import "pathtrace/primitives.wgsl"
+#import "pathtrace/candidates.wgsl"
+#import "pathtrace/contract.wgsl"
 
 // BVH traversal, a line-for-line mirror of crates/scene/src/traverse.rs. The including
 // shader declares the storage buffers:
@@ -7,7 +9,8 @@
 //   var<storage, read> spheres: array<Sphere>;
 // and the constants HAS_TRIANGLES and HAS_SPHERES (false where the scene has none of them:
 // that leaf test is left out), and HAS_ALPHA with the any-hit tests `triangle_hit_counts` and
-// `sphere_hit_counts` (alpha.wgsl; always true where HAS_ALPHA is false).
+// `sphere_hit_counts` (alpha.wgsl; always true where HAS_ALPHA is false). A leaf's
+// primitives are tested as every intersector tests its candidates (candidates.wgsl).
 // Hits count for 0 < t < t_max; callers offset ray origins off surfaces.
 //
 // `bvh_nodes` holds one 64-byte record per node (4 vec4s): the BvhNode (aabb_min, index;
@@ -19,7 +22,7 @@
 const BVH_END: u32 = 0xffffffffu;
 
 // Closest hit (any_hit false) or first hit found (any_hit true) with 0 < t < t_max.
-fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
+fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
     var hit = Hit(NO_HIT, t_max, 0.0, 0.0);
     let inv_dir = safe_inverse(ray.dir);
     // Bit a set where the direction's component on axis a is negative: such rays visit the
@@ -44,11 +47,8 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
             let first = lo.w;
             if (HAS_TRIANGLES && (!HAS_SPHERES || (hi.w & NODE_SPHERES) == 0u)) {
                 for (var i = first; i < first + count; i = i + 1u) {
-                    let tri = tri_positions[i];
-                    let r = intersect_triangle(ray.origin, ray.dir, tri.v0, tri.e1, tri.e2, hit.t);
-                    // The any-hit test only for triangles whose material needs it (the
-                    // flag rides in the record just read).
-                    if (r.x != 0.0 && i != skip_prim && (!HAS_ALPHA || (tri.flags & TRI_ALPHA) == 0u || triangle_hit_counts(i, r.z, r.w, ray))) {
+                    let r = candidate_triangle(i, ray, hit.t);
+                    if (r.x != 0.0) {
                         hit = Hit(i, r.y, r.z, r.w);
                         if (any_hit) {
                             return hit;
@@ -57,9 +57,8 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                 }
             } else if (HAS_SPHERES) {
                 for (var i = first; i < first + count; i = i + 1u) {
-                    let s = spheres[i];
-                    let t = intersect_sphere_from(i | PRIM_SPHERE, ray.origin, ray.dir, s.center, s.radius, hit.t);
-                    if (t > 0.0 && (!HAS_ALPHA || sphere_hit_counts(i, ray))) {
+                    let t = candidate_sphere(i, ray, hit.t);
+                    if (t > 0.0) {
                         hit = Hit(i | PRIM_SPHERE, t, 0.0, 0.0);
                         if (any_hit) {
                             return hit;
@@ -72,19 +71,4 @@ fn traverse_bvh(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
         node_index = bvh_nodes[node_index * 4u + 2u + (octant >> 2u)][octant & 3u];
     }
     return hit;
-}
-
-// The closest hit with 0 < t < t_max; hit.prim == NO_HIT on a miss.
-fn intersect_scene_within(ray: Ray, t_max: f32) -> Hit {
-    return traverse_bvh(ray, t_max, false);
-}
-
-// The closest hit; hit.prim == NO_HIT on a miss.
-fn intersect_scene(ray: Ray) -> Hit {
-    return traverse_bvh(ray, F32_MAX, false);
-}
-
-// Whether anything is hit with 0 < t < t_max (shadow rays).
-fn occluded(ray: Ray, t_max: f32) -> bool {
-    return traverse_bvh(ray, t_max, true).prim != NO_HIT;
 }

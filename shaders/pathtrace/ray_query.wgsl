@@ -1,4 +1,6 @@
 #import "pathtrace/primitives.wgsl"
+#import "pathtrace/candidates.wgsl"
+#import "pathtrace/contract.wgsl"
 #import "pathtrace/shared.wgsl"
 
 // Scene intersection through the device's ray queries (`enable wgpu_ray_query`, which the
@@ -24,7 +26,7 @@
 @group(0) @binding(24) var scene_accel: acceleration_structure;
 
 // Closest hit (any_hit false) or first hit found (any_hit true) with 0 < t < t_max.
-fn trace_accel(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
+fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
     var hit = Hit(NO_HIT, t_max, 0.0, 0.0);
     var rq: ray_query;
     // The device's range must be finite and not below its t_min (a shadow ray's may be
@@ -35,9 +37,8 @@ fn trace_accel(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
         let c = rayQueryGetCandidateIntersection(&rq);
         let i = c.primitive_index;
         if (HAS_TRIANGLES && c.instance_custom_data == ACCEL_TRIANGLES) {
-            let tri = tri_positions[i];
-            let r = intersect_triangle(ray.origin, ray.dir, tri.v0, tri.e1, tri.e2, hit.t);
-            if (r.x != 0.0 && i != skip_prim && (!HAS_ALPHA || (tri.flags & TRI_ALPHA) == 0u || triangle_hit_counts(i, r.z, r.w, ray))) {
+            let r = candidate_triangle(i, ray, hit.t);
+            if (r.x != 0.0) {
                 hit = Hit(i, r.y, r.z, r.w);
                 // A hit at a concave corner may come at t <= 0 (primitives.wgsl); the device
                 // takes none below its t_min of 0.
@@ -49,9 +50,8 @@ fn trace_accel(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                 }
             }
         } else if (HAS_SPHERES && c.instance_custom_data == ACCEL_SPHERES) {
-            let s = spheres[i];
-            let t = intersect_sphere_from(i | PRIM_SPHERE, ray.origin, ray.dir, s.center, s.radius, hit.t);
-            if (t > 0.0 && (!HAS_ALPHA || sphere_hit_counts(i, ray))) {
+            let t = candidate_sphere(i, ray, hit.t);
+            if (t > 0.0) {
                 hit = Hit(i | PRIM_SPHERE, t, 0.0, 0.0);
                 rayQueryGenerateIntersection(&rq, t);
                 if (any_hit) {
@@ -61,21 +61,4 @@ fn trace_accel(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
         }
     }
     return hit;
-}
-
-// The intersector contract (as bvh.wgsl and the generated inline intersection):
-
-// The closest hit with 0 < t < t_max; hit.prim == NO_HIT on a miss.
-fn intersect_scene_within(ray: Ray, t_max: f32) -> Hit {
-    return trace_accel(ray, t_max, false);
-}
-
-// The closest hit; hit.prim == NO_HIT on a miss.
-fn intersect_scene(ray: Ray) -> Hit {
-    return trace_accel(ray, F32_MAX, false);
-}
-
-// Whether anything is hit with 0 < t < t_max (shadow rays).
-fn occluded(ray: Ray, t_max: f32) -> bool {
-    return trace_accel(ray, t_max, true).prim != NO_HIT;
 }

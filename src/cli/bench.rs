@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use super::progressive::counter;
 use crate::graph::{Edge, Graph, Node, ParamValue};
+use crate::render::specialize::Feature;
 use crate::render::{Executor, GpuContext, Resources, compile};
 use crate::scene::GpuScene;
 use anyhow::Result;
@@ -35,6 +36,8 @@ struct Figures {
     how: String,
     /// Host intersection's figures over all runs, where it was used.
     host: Option<HostFigures>,
+    /// The shader's features (what the variants to compare with are chosen by).
+    features: Option<crate::render::specialize::Features>,
 }
 
 /// Where host intersection's time went, summed over the timed runs.
@@ -48,13 +51,12 @@ struct HostFigures {
     other_ns: u64,
 }
 
-/// Best paths/s of `runs` renders of `spp` samples per pixel.
+/// Best paths/s of `runs` renders of `spp` samples per pixel, with the shader choices of
+/// `variant` (its scene is replaced by `scene`).
 fn measure(
     ctx: &GpuContext,
     scene: &Arc<GpuScene>,
-    general: bool,
-    data_in_buffers: bool,
-    wgsl_intersection: bool,
+    variant: Resources,
     spp: u32,
     runs: u32,
 ) -> Result<Figures> {
@@ -71,12 +73,10 @@ fn measure(
     let plan = compile(&graph, &["accumulate.color".into()], Some(scene))?;
     let resources = Resources {
         scene: Some(Arc::clone(scene)),
-        general_shaders: general,
-        scene_data_in_buffers: data_in_buffers,
-        wgsl_intersection,
-        ..Resources::default()
+        ..variant
     };
     let mut exec = Executor::new(ctx, plan, &resources)?;
+    let features = exec.shader_features("pathtrace").cloned();
     let how = exec
         .notes()
         .into_iter()
@@ -117,7 +117,15 @@ fn measure(
         cpu: best_cpu,
         how,
         host,
+        features,
     })
+}
+
+impl Figures {
+    /// Whether the shader compiled `f` in.
+    fn on(&self, f: Feature) -> bool {
+        self.features.as_ref().is_some_and(|x| x.on(f))
+    }
 }
 
 /// One line of the report.
@@ -154,29 +162,63 @@ pub fn run(scene: &Arc<GpuScene>, spp: u32, runs: u32, specialized_only: bool) -
         "{}x{}, {} bounces, {spp} spp per run, best of {runs}:",
         scene.settings.width, scene.settings.height, scene.settings.max_bounces
     );
-    let special = measure(&ctx, scene, false, false, false, spp, runs)?;
+    let special = measure(&ctx, scene, Resources::default(), spp, runs)?;
     print("specialized", &special);
+    // Where the specialized shader walks the 8-wide BVH, the binary one beside it (the
+    // specialized shader as LUMAGRAPH_BVH=binary runs it).
+    let binary = if special.on(Feature::WideBvh) {
+        let binary = Resources {
+            wide_bvh: Some(false),
+            ..Resources::default()
+        };
+        let binary = measure(&ctx, scene, binary, spp, runs)?;
+        print("binary BVH", &binary);
+        println!(
+            "  specialized (8-wide BVH) / binary BVH: {:.2}x",
+            special.wall / binary.wall
+        );
+        Some(binary)
+    } else {
+        None
+    };
     if specialized_only {
         return Ok(());
     }
-    let wgsl = if special.how.contains("rays intersected on the host") {
-        let wgsl = measure(&ctx, scene, false, false, true, spp, runs)?;
+    let wgsl = if special.on(Feature::HostRays) {
+        let wgsl = Resources {
+            wgsl_intersection: true,
+            ..Resources::default()
+        };
+        let wgsl = measure(&ctx, scene, wgsl, spp, runs)?;
         print("WGSL BVH", &wgsl);
         Some(wgsl)
     } else {
         None
     };
-    let inlined = special.how.contains("materials and lights inlined")
-        || special.how.contains("materials inlined");
-    let buffers = if inlined {
-        let buffers = measure(&ctx, scene, false, true, false, spp, runs)?;
+    let buffers = if special.on(Feature::InlineData) {
+        let buffers = Resources {
+            scene_data_in_buffers: true,
+            ..Resources::default()
+        };
+        let buffers = measure(&ctx, scene, buffers, spp, runs)?;
         print("buffers", &buffers);
         Some(buffers)
     } else {
         None
     };
-    let general = measure(&ctx, scene, true, false, false, spp, runs)?;
+    let general = Resources {
+        general_shaders: true,
+        ..Resources::default()
+    };
+    let general = measure(&ctx, scene, general, spp, runs)?;
     print("general", &general);
+    if binary.is_some() {
+        // The general shader walks the binary BVH.
+        println!(
+            "  (the general shader traverses the binary BVH; specialized / general below is \
+             both changes together)"
+        );
+    }
     if let Some(wgsl) = wgsl {
         println!(
             "  specialized (host intersection) / WGSL BVH: {:.2}x",

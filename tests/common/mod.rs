@@ -512,6 +512,58 @@ pub fn worst_relative(a: &lumagraph::render::cpu::Image, b: &lumagraph::render::
         .fold(0.0f32, f32::max)
 }
 
+/// `name` rendered through two intersectors (`a` and `b`, which `check` checks the
+/// features of) at 64×64 and 16 spp: the first-hit AOVs must agree, and the colors are
+/// compared. Returns the pixels of the color beyond 1e-4 relative and the relative
+/// difference of the image means.
+pub fn same_hits(
+    name: &str,
+    a: lumagraph::render::Resources,
+    b: lumagraph::render::Resources,
+    check: impl Fn(&lumagraph::render::specialize::Features, &lumagraph::render::specialize::Features),
+) -> Option<(usize, f64)> {
+    let (a, how_a) = render_with(name, (64, 64), 16, a)?;
+    let (b, how_b) = render_with(name, (64, 64), 16, b)?;
+    check(&how_a, &how_b);
+    // The first-hit AOVs come from the ray through each pixel's centre: the same hits, but
+    // where that ray meets two surfaces at the same distance (the Cornell box's corners lie
+    // on the image's diagonals, through pixel centres), the intersector that finds the
+    // second one first keeps it. So the depth is bit-identical everywhere, and albedo and
+    // normal differ only where the depth says such a tie can be.
+    let depth = differing(&a[3], &b[3], None);
+    println!(
+        "{name} depth: {depth} of {} pixels differ",
+        a[3].pixels.len()
+    );
+    assert_eq!(depth, 0, "{name}: depth differs");
+    for (i, port) in [(1, "albedo"), (2, "normal")] {
+        let differ = differing(&a[i], &b[i], None);
+        println!(
+            "{name} {port}: {differ} of {} pixels differ (ties)",
+            a[i].pixels.len()
+        );
+        // Ties are on edges: at most a diagonal's worth of pixels (64) per corner line.
+        assert!(differ <= 128, "{name} {port}: {differ} pixels differ");
+    }
+    let sum = |i: &lumagraph::render::cpu::Image| {
+        i.pixels
+            .iter()
+            .map(|p| f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2]))
+            .sum::<f64>()
+    };
+    let (ca, cb) = (&a[0], &b[0]);
+    assert!(ca.pixels.iter().any(|p| p[0] > 0.0), "{name}: black");
+    let far = differing(ca, cb, Some(1e-4));
+    let mean = (sum(ca) - sum(cb)) / sum(cb);
+    println!(
+        "{name} color: {} pixels differ, {far} by more than 1e-4 relative, at most {:.2e}; \
+         means {mean:+.2e} relative",
+        differing(ca, cb, None),
+        worst_relative(ca, cb)
+    );
+    Some((far, mean))
+}
+
 /// For a test that needs ray queries: `true` where this process's device has them (the
 /// test runs here). Otherwise the test `name` runs again in a child process on the driver
 /// that `LUMAGRAPH_RAY_QUERY_ICD` names (Mesa 25's lavapipe, which `scripts/setup.sh`
@@ -556,4 +608,74 @@ pub fn ray_queries_here(name: &str) -> bool {
     );
     println!("{}: no ray queries, {name} not run", ctx.describe());
     false
+}
+
+/// A small PLY mesh in `format` (`ascii`, `binary_little_endian`, `binary_big_endian`):
+/// four vertices with float positions and normals and byte colours, one quad (`uchar`
+/// count, `int` indices) and one triangle, then an `edge` element no importer reads.
+pub fn ply_bytes(format: &str) -> Vec<u8> {
+    const V: [([f32; 3], [f32; 3], [u8; 3]); 4] = [
+        ([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [255, 0, 0]),
+        ([1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0, 255, 0]),
+        ([1.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0, 0, 255]),
+        ([0.0, 1.0, 0.5], [0.0, 0.6, 0.8], [255, 255, 255]),
+    ];
+    const F: [&[i32]; 2] = [&[0, 1, 2, 3], &[0, 2, 3]];
+    let mut out = format!(
+        "ply\nformat {format} 1.0\ncomment lumagraph test\nelement vertex 4\n\
+         property float x\nproperty float y\nproperty float z\nproperty float nx\n\
+         property float ny\nproperty float nz\nproperty uchar red\nproperty uchar green\n\
+         property uchar blue\nproperty float confidence\nelement face 2\n\
+         property list uchar int vertex_indices\nelement edge 1\nproperty int vertex1\n\
+         property int vertex2\nend_header\n"
+    )
+    .into_bytes();
+    let big = format == "binary_big_endian";
+    let f32b = |x: f32| {
+        if big {
+            x.to_be_bytes()
+        } else {
+            x.to_le_bytes()
+        }
+    };
+    let i32b = |x: i32| {
+        if big {
+            x.to_be_bytes()
+        } else {
+            x.to_le_bytes()
+        }
+    };
+    if format == "ascii" {
+        for (p, n, c) in V {
+            out.extend(
+                format!(
+                    "{} {} {} {} {} {} {} {} {} 0.5\n",
+                    p[0], p[1], p[2], n[0], n[1], n[2], c[0], c[1], c[2]
+                )
+                .bytes(),
+            );
+        }
+        for f in F {
+            let list: Vec<String> = f.iter().map(ToString::to_string).collect();
+            out.extend(format!("{} {}\n", f.len(), list.join(" ")).bytes());
+        }
+        out.extend(b"0 1\n");
+    } else {
+        for (p, n, c) in V {
+            for x in p.into_iter().chain(n) {
+                out.extend(f32b(x));
+            }
+            out.extend(c);
+            out.extend(f32b(0.5));
+        }
+        for f in F {
+            out.push(u8::try_from(f.len()).unwrap());
+            for &i in f {
+                out.extend(i32b(i));
+            }
+        }
+        out.extend(i32b(0));
+        out.extend(i32b(1));
+    }
+    out
 }

@@ -13,16 +13,6 @@ use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::shared::{ACCEL_SPHERES, ACCEL_TRIANGLES};
 
-/// A box from `lo` to `hi`, grown by a few ulps of `scale` (the largest magnitude the
-/// primitive's inputs have): a point the shader's tests find on the primitive, computed from
-/// those inputs with rounding, may lie that far outside the exact box (where a sphere
-/// touches a plane through the origin, its box's face is at 0, its computed points not).
-fn padded(lo: glam::Vec3, hi: glam::Vec3, scale: f32) -> [f32; 6] {
-    let grow = glam::Vec3::splat(scale * (16.0 * f32::EPSILON) + f32::MIN_POSITIVE);
-    let (lo, hi) = (lo - grow, hi + grow);
-    [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z]
-}
-
 /// The identity as a TLAS instance's 3×4 row-major transform.
 const IDENTITY: [f32; 12] = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0];
 
@@ -81,29 +71,7 @@ impl SceneAccel {
         // geometry would let the device test the triangles itself, with its own rounding:
         // watertight where Möller-Trumbore is not, so at shared edges the two disagree, and
         // a ray the device sends to one triangle and the exact test to none goes through.)
-        let tri_boxes: Vec<[f32; 6]> = scene
-            .tri_positions
-            .iter()
-            .map(|t| {
-                let v0 = glam::Vec3::from(t.v0);
-                let (e1, e2) = (glam::Vec3::from(t.e1), glam::Vec3::from(t.e2));
-                let (v1, v2) = (v0 + e1, v0 + e2);
-                let scale = [v0, v1, v2, e1, e2]
-                    .iter()
-                    .map(|v| v.abs().max_element())
-                    .fold(0.0f32, f32::max);
-                padded(v0.min(v1).min(v2), v0.max(v1).max(v2), scale)
-            })
-            .collect();
-        let sphere_boxes: Vec<[f32; 6]> = scene
-            .spheres
-            .iter()
-            .map(|s| {
-                let c = glam::Vec3::from(s.center);
-                let r = glam::Vec3::splat(s.radius.abs());
-                padded(c - r, c + r, c.abs().max_element() + s.radius.abs())
-            })
-            .collect();
+        let (tri_boxes, sphere_boxes) = crate::wide_bvh::primitive_boxes(scene);
         let mut tlas = device.create_tlas(&wgpu::CreateTlasDescriptor {
             label: Some("scene accel"),
             max_instances: 2,

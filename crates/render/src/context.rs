@@ -454,6 +454,16 @@ pub fn ray_queries_turned_off() -> bool {
     std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "off" || v == "0")
 }
 
+/// What `LUMAGRAPH_BVH` asks of the WGSL traversal: `wide` the 8-wide BVH, `binary` the
+/// binary one ([`crate::wide_bvh`]); `None` where it is not set (the adapter's default).
+pub fn wide_bvh_asked_for() -> Option<bool> {
+    match std::env::var("LUMAGRAPH_BVH").ok()?.as_str() {
+        "wide" => Some(true),
+        "binary" => Some(false),
+        _ => None,
+    }
+}
+
 /// Whether `LUMAGRAPH_RAY_QUERY=on` asks the path tracer to trace through the device's ray
 /// queries wherever they can trace the scene, even on a CPU adapter (benchmarks).
 pub fn ray_queries_asked_for() -> bool {

@@ -44,6 +44,7 @@ pub mod specialize;
 pub mod tile_set;
 pub mod tiled;
 mod timing;
+pub mod wide_bvh;
 
 pub use checkpoint::Checkpoint;
 pub use context::{GPU_TIMEOUT, GpuContext, for_tests, human_bytes};

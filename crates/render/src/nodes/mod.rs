@@ -53,6 +53,10 @@ pub struct Resources {
     /// (tests compare them with the WGSL BVH on lavapipe). With `traverse_bvh`, as a GPU
     /// adapter with ray queries would (`traverse_bvh` alone: as one without).
     pub ray_queries: bool,
+    /// Whether the WGSL traversal walks the 8-wide BVH ([`crate::wide_bvh`]): `Some`
+    /// forces it on or off (tests compare the two on lavapipe; with `traverse_bvh`, as a
+    /// GPU adapter), `None` leaves it to `LUMAGRAPH_BVH` and the adapter.
+    pub wide_bvh: Option<bool>,
     /// Trace workgroups in image order even on a CPU adapter, where they are otherwise
     /// spread over the image to balance the driver's threads (a test compares the two).
     pub workgroups_in_image_order: bool,

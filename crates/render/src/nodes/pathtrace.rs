@@ -60,6 +60,9 @@ fn options(
             .ray_query_limit
             .filter(|_| !resources.traverse_bvh || resources.ray_queries),
         ray_queries_forced: resources.ray_queries || crate::context::ray_queries_asked_for(),
+        wide_bvh: resources
+            .wide_bvh
+            .or_else(crate::context::wide_bvh_asked_for),
         specialize: !resources.general_shaders,
         cpu_adapter,
         data_in_buffers: resources.scene_data_in_buffers,
@@ -308,6 +311,9 @@ pub(crate) struct PathTrace {
     /// The scene's acceleration structure, where the plan says "ray queries", and how long
     /// it took to build.
     accel: Option<(crate::accel::SceneAccel, std::time::Duration)>,
+    /// The 8-wide BVH's buffer, where the plan says "8-wide BVH" (bound in the binary
+    /// BVH's place), with its node count, depth, size and build time.
+    wide: Option<(wgpu::Buffer, crate::wide_bvh::WideBvh, std::time::Duration)>,
 }
 
 impl PathTrace {
@@ -335,6 +341,20 @@ impl PathTrace {
             let start = std::time::Instant::now();
             let a = crate::accel::SceneAccel::build(ctx, &scene)?;
             Some((a, start.elapsed()))
+        } else {
+            None
+        };
+        let wide = if features.on(Feature::WideBvh) {
+            let start = std::time::Instant::now();
+            let mut bvh = crate::wide_bvh::WideBvh::build(&scene).map_err(|e| {
+                RenderError::Gpu(format!(
+                    "{e} (LUMAGRAPH_BVH=binary traverses the binary BVH)"
+                ))
+            })?;
+            let took = start.elapsed();
+            let buffer = crate::wide_bvh::upload(ctx, &bvh)?;
+            bvh.records = Vec::new();
+            Some((buffer, bvh, took))
         } else {
             None
         };
@@ -407,6 +427,7 @@ impl PathTrace {
             host,
             wave_stand_in: storage(ctx, "pathtrace wave stand-in", 16),
             accel,
+            wide,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -474,7 +495,7 @@ impl PathTrace {
             .pass(name)
             .write(color)
             .uniform(&self.frame)
-            .buffer(&b.bvh_nodes)
+            .buffer(self.wide.as_ref().map_or(&b.bvh_nodes, |(w, _, _)| w))
             .buffer(&b.tri_positions)
             .buffer(&b.tri_shading)
             .buffer(&b.spheres)
@@ -723,6 +744,15 @@ impl NodeExec for PathTrace {
                 self.scene.tri_positions.len(),
                 self.scene.spheres.len(),
                 crate::human_bytes(accel.input_bytes),
+                took.as_secs_f64() * 1e3
+            ));
+        }
+        if let Some((_, bvh, took)) = &self.wide {
+            notes.push(format!(
+                "8-wide BVH: {} nodes, {} deep, {} built in {:.1} ms",
+                bvh.nodes,
+                bvh.depth,
+                crate::human_bytes(bvh.bytes),
                 took.as_secs_f64() * 1e3
             ));
         }

@@ -21,6 +21,11 @@ use super::{INLINE_MAX_MATERIALS, INLINE_MAX_PRIMITIVES, PathTraceOptions, codeg
 pub enum Feature {
     /// Intersection through the BVH (WGSL traversal, or the host's).
     BvhTraversal,
+    /// The WGSL traversal walks the 8-wide compressed BVH ([`crate::wide_bvh`],
+    /// `pathtrace/wide_bvh.wgsl`) instead of the binary stackless one: on CPU adapters,
+    /// where it measured faster, and where asked (`LUMAGRAPH_BVH=wide`); GPU adapters keep
+    /// the binary one, which measured faster there.
+    WideBvh,
     /// Intersection through the device's ray queries: its acceleration structure finds the
     /// candidates, the WGSL tests them ([`crate::accel`], `pathtrace/ray_query.wgsl`).
     RayQueries,
@@ -67,8 +72,9 @@ pub enum Feature {
 
 impl Feature {
     /// Every feature, in the order `plan` lists them.
-    pub const ALL: [Self; 21] = [
+    pub const ALL: [Self; 22] = [
         Self::BvhTraversal,
+        Self::WideBvh,
         Self::RayQueries,
         Self::InlineIntersection,
         Self::InlineData,
@@ -95,6 +101,7 @@ impl Feature {
     pub const fn label(self) -> &'static str {
         match self {
             Self::BvhTraversal => "BVH traversal",
+            Self::WideBvh => "8-wide BVH",
             Self::RayQueries => "ray queries",
             Self::InlineIntersection => "inline intersection",
             Self::InlineData => "inline materials and lights",
@@ -123,7 +130,11 @@ impl Feature {
     /// scene data, see [`super::Specialization::source`]).
     pub const fn wgsl_const(self) -> Option<&'static str> {
         Some(match self {
-            Self::BvhTraversal | Self::RayQueries | Self::InlineIntersection | Self::InlineData => {
+            Self::BvhTraversal
+            | Self::WideBvh
+            | Self::RayQueries
+            | Self::InlineIntersection
+            | Self::InlineData => {
                 return None;
             }
             Self::LightSampling => "HAS_LIGHTS",
@@ -232,6 +243,10 @@ impl Features {
             (false, true, _, false) => "rays intersected on the host",
             (false, false, true, true) => "ray queries, materials inlined",
             (false, false, true, false) => "ray queries",
+            (false, false, false, true) if self.on(Feature::WideBvh) => {
+                "8-wide BVH traversal, materials inlined"
+            }
+            (false, false, false, false) if self.on(Feature::WideBvh) => "8-wide BVH traversal",
             (false, false, false, true) => "BVH traversal, materials inlined",
             (false, false, false, false) => "BVH traversal",
         };
@@ -335,6 +350,17 @@ fn material_ranges(scene: &GpuScene, index: usize, m: &GpuMaterial) -> MaterialR
 const CPU_RAY_QUERIES_REASON: &str = "a CPU adapter: lavapipe's ray queries measured 0.16-0.36x \
      the kernel's own intersection (LUMAGRAPH_RAY_QUERY=on asks for them)";
 
+/// Why a CPU adapter traverses the 8-wide BVH unless asked otherwise: measured in
+/// `docs/benchmarks.md` ("The 8-wide BVH on lavapipe").
+const CPU_WIDE_BVH_REASON: &str = "a CPU adapter: the 8-wide BVH measured 2.3x the binary \
+     one's paths/s on Sponza and 1.4x on an 82 k-triangle mesh on lavapipe \
+     (LUMAGRAPH_BVH=binary asks for the binary one)";
+
+/// Why a GPU adapter traverses the binary BVH unless asked otherwise: measured in
+/// `docs/benchmarks.md` ("The 8-wide BVH against the binary one").
+const GPU_WIDE_BVH_REASON: &str = "the binary BVH: the 8-wide one measured 0.82x on Sponza \
+     and 1.01x on a 1.3 M-triangle mesh on an NVIDIA H200 (LUMAGRAPH_BVH=wide asks for it)";
+
 /// What the decisions are made from, worked out once.
 struct Facts<'a> {
     scene: &'a GpuScene,
@@ -432,6 +458,7 @@ impl<'a> Facts<'a> {
         let s = self.scene;
         match f {
             Feature::BvhTraversal => self.bvh(),
+            Feature::WideBvh => self.wide_bvh(),
             Feature::RayQueries => self.ray_queries.clone(),
             Feature::InlineIntersection => decision(
                 self.inline,
@@ -546,6 +573,30 @@ impl<'a> Facts<'a> {
                 self.inline,
                 self.options.ray_queries_forced && self.ray_queries.included,
             ),
+        }
+    }
+
+    /// Whether the WGSL traversal walks the 8-wide BVH, and why.
+    fn wide_bvh(&self) -> Decision {
+        let o = self.options;
+        let host = super::host_rays_decision(
+            self.scene,
+            o,
+            self.inline,
+            o.ray_queries_forced && self.ray_queries.included,
+        )
+        .included;
+        if !self.bvh().included || host {
+            decision(false, "the BVH is not traversed in WGSL")
+        } else if !o.specialize {
+            decision(false, "general shader: the binary BVH")
+        } else {
+            match o.wide_bvh {
+                Some(true) => decision(true, "asked for"),
+                Some(false) => decision(false, "the binary BVH asked for"),
+                None if o.cpu_adapter => decision(true, CPU_WIDE_BVH_REASON),
+                None => decision(false, GPU_WIDE_BVH_REASON),
+            }
         }
     }
 

@@ -71,6 +71,11 @@ pub struct PathTraceOptions {
     /// where a CPU adapter would intersect inline or on the host (tests compare them with
     /// the WGSL BVH on lavapipe).
     pub ray_queries_forced: bool,
+    /// Whether the WGSL traversal walks the 8-wide BVH ([`crate::wide_bvh`]) where it
+    /// traverses a BVH: `Some` where asked (`LUMAGRAPH_BVH=wide` or `binary`, or tests),
+    /// `None` for the adapter's default: the wide one on CPU adapters, the binary one on
+    /// GPU adapters (measured, see [`Feature::WideBvh`]).
+    pub wide_bvh: Option<bool>,
 }
 
 /// A path tracer shader specialized to one scene, adapter and graph: its features, decided
@@ -80,7 +85,8 @@ pub struct Specialization {
     /// What is compiled in and left out, and why.
     pub features: Features,
     /// Replaces `pathtrace/intersect.wgsl` ([`Feature::InlineIntersection`], or
-    /// [`Feature::RayQueries`]: `pathtrace/ray_query.wgsl`).
+    /// [`Feature::RayQueries`]: `pathtrace/ray_query.wgsl`, or [`Feature::WideBvh`]:
+    /// `pathtrace/wide_bvh.wgsl`).
     intersection: Option<String>,
     /// Replaces `pathtrace/scene_data.wgsl` ([`Feature::InlineData`]).
     scene_data: Option<String>,
@@ -95,6 +101,8 @@ impl Specialization {
             inline_intersection(scene, features.on(Feature::Alpha))
         } else if features.on(Feature::RayQueries) {
             Some("#import \"pathtrace/ray_query.wgsl\"\n".to_owned())
+        } else if features.on(Feature::WideBvh) {
+            Some("#import \"pathtrace/wide_bvh.wgsl\"\n".to_owned())
         } else {
             None
         };

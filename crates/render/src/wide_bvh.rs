@@ -1,0 +1,219 @@
+//! The 8-wide compressed BVH (CWBVH, Ylitie, Karras and Laine, "Efficient Incoherent Ray
+//! Traversal on GPUs Through Compressed Wide BVHs", HPG 2017) that `pathtrace/wide_bvh.wgsl`
+//! traverses where the plan says "8-wide BVH" ([`crate::specialize::Feature::WideBvh`]).
+//! [`obvhs`] builds it (PLOC, reinsertion, then the conversion to eight children per node,
+//! up to three primitives per leaf) over the same padded boxes the device's acceleration
+//! structure gets ([`primitive_boxes`]); this module packs it into one storage buffer that
+//! takes the binary BVH's binding.
+//!
+//! # Layout (`vec4<u32>` records)
+//! | records | what |
+//! |---|---|
+//! | 0 | header: x = the record where the primitive list starts, y = node count, z = depth |
+//! | 1 + 5 i .. 1 + 5 i + 5 | node i: obvhs's 80-byte `CwBvhNode`, byte for byte |
+//! | `x` + 3 j .. `x` + 3 j + 3 | leaf slot j's primitive, copied from the scene in leaf order: a triangle's `GpuTriangle` (v0 and flags, e1, e2) with its index in `tri_positions` in the second record's w; a sphere's center and radius, then its index `| PRIM_SPHERE` in the second record's w |
+//!
+//! A node (80 bytes): its box's corner `p` (3 f32) and per axis the exponent of the child
+//! grid's step (a byte each) and `imask` (which children are inner nodes); the first child
+//! node and first primitive; one meta byte per child (inner: `0b001` then 24 + slot; leaf:
+//! its primitive count in unary in the top 3 bits, its first primitive's offset below); then
+//! the children's boxes on the node's 256-step grid, a byte a bound, per axis and side.
+//! Children are visited nearest first by the ray's octant (the paper's "octant order").
+//! The leaves' primitives are copies, in leaf order, so a leaf's are read from the records
+//! next to each other, with no index to follow; their index in the scene's arrays rides
+//! along for the hit, the shading data and the any-hit test.
+//! The primitives' boxes are the ones [`primitive_boxes`] pads, and the conversion rounds
+//! child bounds outwards, so a child's box holds whatever the exact tests can hit in it.
+
+use glam::Vec3;
+use lumagraph_scene::GpuScene;
+use obvhs::aabb::Aabb;
+use obvhs::cwbvh::CwBvh;
+use wgpu::util::DeviceExt as _;
+
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+
+/// Most nodes on a path from the root: the traversal's stack holds one entry a level.
+pub const WIDE_BVH_STACK: usize = 32;
+
+/// `pathtrace/wide_bvh.wgsl`'s sphere bit in the primitive list (the shader's `PRIM_SPHERE`).
+const PRIM_SPHERE: u32 = lumagraph_scene::PRIM_SPHERE;
+
+/// A box from `lo` to `hi`, grown by a few ulps of `scale` (the largest magnitude the
+/// primitive's inputs have): a point the shader's tests find on the primitive, computed from
+/// those inputs with rounding, may lie that far outside the exact box (where a sphere
+/// touches a plane through the origin, its box's face is at 0, its computed points not).
+fn padded(lo: Vec3, hi: Vec3, scale: f32) -> [f32; 6] {
+    let grow = Vec3::splat(scale * (16.0 * f32::EPSILON) + f32::MIN_POSITIVE);
+    let (lo, hi) = (lo - grow, hi + grow);
+    [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z]
+}
+
+/// Every triangle's and sphere's box (min xyz, max xyz), in the order of
+/// `GpuScene::tri_positions` and `GpuScene::spheres`, padded so that any point the WGSL
+/// tests find on the primitive lies inside: the inputs of both the device's acceleration
+/// structure ([`crate::accel`]) and the wide BVH.
+pub fn primitive_boxes(scene: &GpuScene) -> (Vec<[f32; 6]>, Vec<[f32; 6]>) {
+    let tris = scene
+        .tri_positions
+        .iter()
+        .map(|t| {
+            let v0 = Vec3::from(t.v0);
+            let (e1, e2) = (Vec3::from(t.e1), Vec3::from(t.e2));
+            let (v1, v2) = (v0 + e1, v0 + e2);
+            let scale = [v0, v1, v2, e1, e2]
+                .iter()
+                .map(|v| v.abs().max_element())
+                .fold(0.0f32, f32::max);
+            padded(v0.min(v1).min(v2), v0.max(v1).max(v2), scale)
+        })
+        .collect();
+    let spheres = scene
+        .spheres
+        .iter()
+        .map(|s| {
+            let c = Vec3::from(s.center);
+            let r = Vec3::splat(s.radius.abs());
+            padded(c - r, c + r, c.abs().max_element() + s.radius.abs())
+        })
+        .collect();
+    (tris, spheres)
+}
+
+/// A scene's wide BVH, packed for the GPU.
+#[derive(Clone, Debug)]
+pub struct WideBvh {
+    /// The buffer's records (see the module docs).
+    pub records: Vec<[u32; 4]>,
+    /// Nodes.
+    pub nodes: usize,
+    /// Most nodes on a path from the root.
+    pub depth: usize,
+    /// The buffer's size in bytes.
+    pub bytes: u64,
+}
+
+impl WideBvh {
+    /// Builds the wide BVH over `scene`'s triangles and spheres.
+    ///
+    /// # Errors
+    /// A message when the tree is deeper than the traversal's stack ([`WIDE_BVH_STACK`]).
+    pub fn build(scene: &GpuScene) -> Result<Self, String> {
+        let (tri_boxes, sphere_boxes) = primitive_boxes(scene);
+        let n_tris = u32::try_from(tri_boxes.len()).map_err(|_| "too many triangles")?;
+        let boxes: Vec<Aabb> = tri_boxes
+            .iter()
+            .chain(&sphere_boxes)
+            .map(|b| {
+                Aabb::new(
+                    Vec3::from_slice(&b[..3]).into(),
+                    Vec3::from_slice(&b[3..]).into(),
+                )
+            })
+            .collect();
+        let params = obvhs::BvhBuildParams {
+            max_prims_per_leaf: 3,
+            ..obvhs::BvhBuildParams::medium_build()
+        };
+        let bvh = if boxes.is_empty() {
+            CwBvh::default()
+        } else {
+            obvhs::cwbvh::builder::build_cwbvh(&boxes, params, &mut std::time::Duration::default())
+        };
+        let depth = depth(&bvh);
+        if depth > WIDE_BVH_STACK {
+            return Err(format!(
+                "the 8-wide BVH is {depth} nodes deep, over the traversal's stack of {WIDE_BVH_STACK}"
+            ));
+        }
+        let prims_at = 1 + 5 * bvh.nodes.len();
+        let mut records = Vec::with_capacity(prims_at + 3 * bvh.primitive_indices.len());
+        records.push([
+            u32::try_from(prims_at).map_err(|_| "too many nodes")?,
+            u32::try_from(bvh.nodes.len()).map_err(|_| "too many nodes")?,
+            u32::try_from(depth).unwrap_or(u32::MAX),
+            0,
+        ]);
+        records.extend(
+            bvh.nodes
+                .iter()
+                .flat_map(|n| bytemuck::cast::<_, [[u32; 4]; 5]>(*n)),
+        );
+        for &p in &bvh.primitive_indices {
+            if p < n_tris {
+                let t = &scene.tri_positions[p as usize];
+                let v = |a: [f32; 3], w: u32| [a[0].to_bits(), a[1].to_bits(), a[2].to_bits(), w];
+                records.extend([v(t.v0, t.flags), v(t.e1, p), v(t.e2, 0)]);
+            } else {
+                let i = p - n_tris;
+                let sp = &scene.spheres[i as usize];
+                let c = sp.center.map(f32::to_bits);
+                records.extend([
+                    [c[0], c[1], c[2], sp.radius.to_bits()],
+                    [0, 0, 0, i | PRIM_SPHERE],
+                    [0; 4],
+                ]);
+            }
+        }
+        if records.len() == 1 {
+            // An empty scene: one node record with no children, which rays miss.
+            records.extend([[0u32; 4]; 5]);
+        }
+        let bytes = std::mem::size_of_val(&records[..]) as u64;
+        Ok(Self {
+            records,
+            nodes: bvh.nodes.len(),
+            depth,
+            bytes,
+        })
+    }
+}
+
+/// Uploads `bvh`'s records into a storage buffer.
+///
+/// # Errors
+/// [`RenderError::TooLarge`] when they exceed the device's largest storage binding.
+pub fn upload(ctx: &GpuContext, bvh: &WideBvh) -> Result<wgpu::Buffer> {
+    let limits = ctx.device.limits();
+    let binding = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size);
+    if bvh.bytes > binding {
+        return Err(RenderError::TooLarge {
+            what: format!("scene part \"8-wide BVH\": {} nodes", bvh.nodes),
+            adapter: ctx.info.name.clone(),
+            message: format!(
+                "{} in one storage buffer, over the adapter's largest storage binding of {}; \
+                 LUMAGRAPH_BVH=binary traverses the binary BVH",
+                crate::human_bytes(bvh.bytes),
+                crate::human_bytes(binding)
+            ),
+        });
+    }
+    Ok(ctx
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("8-wide BVH"),
+            contents: bytemuck::cast_slice(&bvh.records),
+            usage: wgpu::BufferUsages::STORAGE,
+        }))
+}
+
+/// Most nodes on a path from the root (0 for an empty tree).
+fn depth(bvh: &CwBvh) -> usize {
+    if bvh.nodes.is_empty() {
+        return 0;
+    }
+    let mut deepest = 0;
+    let mut todo = vec![(0usize, 1usize)];
+    while let Some((i, d)) = todo.pop() {
+        deepest = deepest.max(d);
+        let n = &bvh.nodes[i];
+        let inner = u32::from(n.imask).count_ones() as usize;
+        for k in 0..inner {
+            todo.push((n.child_base_idx as usize + k, d + 1));
+        }
+    }
+    deepest
+}

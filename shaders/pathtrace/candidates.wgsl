@@ -1,0 +1,42 @@
+#import "pathtrace/primitives.wgsl"
+
+// A candidate primitive tested as every intersector tests the primitives it finds (the BVH's
+// leaves, the wide BVH's, the device's ray-query candidates): the exact ray/primitive test,
+// the rules for rays leaving a surface (`skip_prim`, the origin's error, primitives.wgsl) and
+// the any-hit test of alpha-masked and blended materials (alpha.wgsl). The including shader
+// declares `tri_positions` and `spheres` and the constant HAS_ALPHA, with the any-hit tests
+// `triangle_hit_counts` and `sphere_hit_counts`.
+
+// Triangle `i`: vec4(1, t, u, v) where it counts as a hit with 0 < t < t_max, else x = 0.
+fn candidate_triangle(i: u32, ray: Ray, t_max: f32) -> vec4<f32> {
+    let tri = tri_positions[i];
+    return candidate_triangle_at(i, tri.v0, tri.e1, tri.e2, tri.flags, ray, t_max);
+}
+
+// Triangle `i` whose record (`tri_positions[i]`, or a copy of it) is `v0`, `e1`, `e2`,
+// `flags`.
+fn candidate_triangle_at(i: u32, v0: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>, flags: u32, ray: Ray, t_max: f32) -> vec4<f32> {
+    let r = intersect_triangle(ray.origin, ray.dir, v0, e1, e2, t_max);
+    // The any-hit test only for triangles whose material needs it (the flag rides in the
+    // record just read).
+    if (r.x != 0.0 && i != skip_prim && (!HAS_ALPHA || (flags & TRI_ALPHA) == 0u || triangle_hit_counts(i, r.z, r.w, ray))) {
+        return r;
+    }
+    return vec4<f32>(0.0);
+}
+
+// Sphere `i` (its index in `spheres`, without PRIM_SPHERE): t where it counts as a hit with
+// 0 < t < t_max, else 0.
+fn candidate_sphere(i: u32, ray: Ray, t_max: f32) -> f32 {
+    let s = spheres[i];
+    return candidate_sphere_at(i, s.center, s.radius, ray, t_max);
+}
+
+// Sphere `i` whose center and radius are `center` and `radius`.
+fn candidate_sphere_at(i: u32, center: vec3<f32>, radius: f32, ray: Ray, t_max: f32) -> f32 {
+    let t = intersect_sphere_from(i | PRIM_SPHERE, ray.origin, ray.dir, center, radius, t_max);
+    if (t > 0.0 && (!HAS_ALPHA || sphere_hit_counts(i, ray))) {
+        return t;
+    }
+    return 0.0;
+}
