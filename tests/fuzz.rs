@@ -44,6 +44,7 @@ const GROUP_CASES: u32 = 300;
 const SCENE_CASES: u32 = 1000;
 const GLTF_CASES: u32 = 1000;
 const OBJ_CASES: u32 = 600;
+const PLY_CASES: u32 = 400;
 const PNG_CASES: u32 = 600;
 const HDR_CASES: u32 = 500;
 const EXR_CASES: u32 = 600;
@@ -52,6 +53,7 @@ const DEFAULT_TOTAL: u32 = GRAPH_CASES
     + SCENE_CASES
     + GLTF_CASES
     + OBJ_CASES
+    + PLY_CASES
     + PNG_CASES
     + HDR_CASES
     + EXR_CASES;
@@ -188,6 +190,16 @@ const OBJ_TOKENS: &[&str] = &[
     "-1/-1/-1", "0/0/0", "1//1", "f 1 2 3\n", "f 1 2 3 4 5\n", "f -1 -2 -3\n", "f 99 1 2\n",
     "v 1 2\n", "v nan nan nan\n", "vt 0.5\n", "usemtl missing\n", "mtllib missing.mtl\n",
     "tex.png", "CornellBox.mtl", "leftWall",
+];
+
+/// PLY header words and values.
+#[rustfmt::skip]
+const PLY_TOKENS: &[&str] = &[
+    "ply\n", "format ascii 1.0\n", "format binary_little_endian 1.0\n",
+    "format binary_big_endian 1.0\n", "element ", "vertex ", "face ", "property ", "list ",
+    "uchar ", "int ", "uint ", "float ", "double ", "char ", "short ", "vertex_indices",
+    "vertex_index", "end_header\n", "comment ", "obj_info ", " ", "\n", "4294967295",
+    "-1", "nan", "1e39", "255 ", "0 ",
 ];
 
 /// Tokens worth inserting into a binary file: magic numbers and chunk and attribute names
@@ -863,6 +875,29 @@ fn obj_files() {
         "obj",
         OBJ_CASES,
         &mutated(obj_seeds(), OBJ_TOKENS),
+        move |input| load_mesh(&input.write_to(&dir)),
+    );
+}
+
+fn ply_seeds() -> Vec<FileSet> {
+    ["ascii", "binary_little_endian", "binary_big_endian"]
+        .into_iter()
+        .map(|format| FileSet {
+            label: format!("{format} PLY"),
+            files: vec![("mesh.ply".into(), common::ply_bytes(format))],
+            main: 0,
+        })
+        .collect()
+}
+
+#[test]
+fn ply_files() {
+    let work = tempfile::tempdir().unwrap();
+    let dir = work.path().to_owned();
+    fuzz(
+        "ply",
+        PLY_CASES,
+        &mutated(ply_seeds(), PLY_TOKENS),
         move |input| load_mesh(&input.write_to(&dir)),
     );
 }

@@ -70,12 +70,16 @@ pub enum ErrorKind {
     /// An OBJ face refers to an element the file does not have: the line and what.
     #[error("OBJ: {0}")]
     ObjData(String),
+    /// A PLY file could not be read, or refers to what it does not have: what, and where
+    /// (the element, the face).
+    #[error("PLY: {0}")]
+    PlyData(String),
     /// A texture's image could not be read or decoded: the texture
     /// (`texture 0 (image 1, "wood.png")`) and what went wrong.
     #[error("{0}")]
     Texture(String),
     /// A mesh file has an extension this build does not import.
-    #[error("unsupported mesh file type \"{0}\" (use .gltf, .glb or .obj)")]
+    #[error("unsupported mesh file type \"{0}\" (use .gltf, .glb, .obj or .ply)")]
     MeshType(String),
     /// The BVH is deeper than the flattening accepts.
     #[error("BVH depth {depth} exceeds the most accepted, {max}")]

@@ -182,3 +182,85 @@ fn an_mtllib_naming_a_device_is_not_read() {
         m.report.warnings
     );
 }
+
+/// A PNG of `w`×`h` texels, each `f(x, y)`.
+fn png(path: &std::path::Path, w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 3]) {
+    image::RgbImage::from_fn(w, h, |x, y| image::Rgb(f(x, y)))
+        .save(path)
+        .unwrap();
+}
+
+/// MTL maps: `map_Kd` is the base colour texture, `norm` the normal map, a coloured
+/// `map_Bump` a normal map too and a grey one (a height map) not read and said so; `map_Ke`
+/// the emission (in full where `Ke` is absent); `d` below 1 blends; `Pr` and `Pm` set
+/// roughness and metallic; maps not read are named; OBJ's `v` is flipped to glTF's; an image
+/// two materials use is decoded once; a missing image is an error naming its material and
+/// file.
+#[test]
+fn obj_textures_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    png(&d.join("albedo.png"), 4, 2, |x, _| [x as u8 * 60, 10, 200]);
+    png(&d.join("normal.png"), 2, 2, |_, _| [128, 128, 255]);
+    png(&d.join("height.png"), 2, 2, |x, y| [(x + y) as u8 * 90; 3]);
+    std::fs::write(
+        d.join("m.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 0.25\nvn 0 0 1\n\
+         usemtl a\nf 1/1/1 2/2/1 3/3/1\nusemtl b\nf 1/1/1 3/3/1 2/2/1\nusemtl c\nf 2/2/1 1/1/1 3/3/1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("m.mtl"),
+        "newmtl a\nKd 1 1 1\nmap_Kd albedo.png\nnorm normal.png\nd 0.5\nPr 0.3\nPm 1\n\
+         map_Ks albedo.png\nmap_d albedo.png\n\
+         newmtl b\nKd 1 1 1\nmap_Kd albedo.png\nmap_Bump -bm 1.0 height.png\nmap_Ke albedo.png\n\
+         newmtl c\nKd 1 1 1\nbump normal.png\n",
+    )
+    .unwrap();
+    let m = import_mesh(&d.join("m.obj"), Mat4::IDENTITY).unwrap();
+    let names: Vec<&str> = m.textures.iter().map(|t| t.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["albedo.png", "normal.png", "height.png"],
+        "decoded once each"
+    );
+    let (a, b, c) = (&m.materials[0], &m.materials[1], &m.materials[2]);
+    assert_eq!(a.textures.base_color, 0);
+    assert_eq!(a.textures.normal, 1);
+    assert_eq!(a.opacity, 0.5);
+    assert_eq!(a.alpha_mode, lumagraph_scene::AlphaMode::Blend);
+    assert_eq!((a.roughness, a.metallic), (0.3, 1.0));
+    assert_eq!(b.textures.base_color, 0);
+    assert_eq!(
+        b.textures.normal,
+        lumagraph_scene::NO_TEXTURE,
+        "grey bump map read"
+    );
+    assert_eq!(b.textures.emissive, 0);
+    assert_eq!(b.emission, Vec3::ONE);
+    assert_eq!(b.alpha_mode, lumagraph_scene::AlphaMode::Opaque);
+    assert_eq!(c.textures.normal, 1, "a coloured bump map is a normal map");
+    let warnings = m.report.warnings.join("\n");
+    assert!(
+        warnings.contains("\"a\": map_d, map_Ks not read"),
+        "{warnings}"
+    );
+    assert!(
+        warnings.contains("bump map \"-bm 1.0 height.png\" not read"),
+        "{warnings}"
+    );
+    assert_eq!(m.decode.images, 3);
+    // OBJ v = 0.25 is glTF's 0.75.
+    let uvs = m.triangles[0].uvs.expect("texture coordinates kept");
+    assert_eq!(uvs[2], glam::Vec2::new(1.0, 0.75));
+    assert_eq!(m.textures[0].texels[1], [60, 10, 200, 255]);
+
+    std::fs::write(d.join("m.mtl"), "newmtl a\nmap_Kd missing.png\n").unwrap();
+    let e = import_mesh(&d.join("m.obj"), Mat4::IDENTITY)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("m.obj") && e.contains("material \"a\"") && e.contains("missing.png"),
+        "{e}"
+    );
+}

@@ -1,4 +1,4 @@
-//! Mesh import: glTF 2.0 ([`gltf`]) and OBJ + MTL ([`obj`]).
+//! Mesh import: glTF 2.0 ([`gltf`]), OBJ + MTL ([`obj`]) and PLY ([`ply`]).
 //!
 //! An importer returns world-space triangles (the file's node hierarchy and the caller's
 //! transform applied), its materials with indices local to the file, its cameras and its
@@ -9,6 +9,7 @@
 pub mod gltf;
 mod gltf_extensions;
 pub mod obj;
+pub mod ply;
 
 use std::path::Path;
 
@@ -59,7 +60,7 @@ impl DecodeStats {
     }
 }
 
-/// Imports a `.gltf`, `.glb` or `.obj` file, placed by `transform`.
+/// Imports a `.gltf`, `.glb`, `.obj` or `.ply` file, placed by `transform`.
 ///
 /// # Errors
 /// When the file cannot be read or parsed, or its extension is not one of these; the
@@ -73,6 +74,7 @@ pub fn import_mesh(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
     let result = match ext.as_str() {
         "gltf" | "glb" => gltf::import_gltf(path, transform),
         "obj" => obj::import_obj(path, transform),
+        "ply" => ply::import_ply(path, transform),
         _ => Err(SceneError::new(ErrorKind::MeshType(ext))),
     };
     result.map_err(|e| e.in_file(path))

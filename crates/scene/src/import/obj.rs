@@ -1,6 +1,11 @@
 //! OBJ + MTL import ([`tobj`]): polygons triangulated, `Kd` → base color, `Ke` →
-//! emission, `Ks` black or absent → specular 0 (else 0.5), `Ni` → IOR, roughness 1.
-//! Vertex normals are kept when every corner has one.
+//! emission, `Ks` black or absent → specular 0 (else 0.5), `Ni` → IOR, roughness 1 (or
+//! `Pr`), metallic 0 (or `Pm`), `d` (or 1 − `Tr`) below 1 → alpha blending. Textures:
+//! `map_Kd` → base colour (sRGB), `map_Ke` → emission, `norm` → tangent-space normal map,
+//! and `map_Bump`/`bump` as a normal map where its texels are coloured (a grey height map is
+//! not read, and said so). Other maps are named in a warning. Texture coordinates are kept
+//! when every corner has them (OBJ's `v` runs up, glTF's down: `v` is flipped). Vertex
+//! normals are kept when every corner has one.
 
 use std::cell::RefCell;
 use std::path::Path;
@@ -9,7 +14,8 @@ use glam::{Mat4, Vec3};
 
 use super::ImportedMesh;
 use crate::error::{ErrorKind, SceneError};
-use crate::scene::{Material, Triangle, push_triangle, transform_triangle};
+use crate::scene::{AlphaMode, Material, Triangle, push_triangle, transform_triangle};
+use crate::texture::{Texture, UvTransform, Wrap};
 
 /// Imports an `.obj` file and the `.mtl` files it names.
 ///
@@ -46,7 +52,23 @@ pub fn import_obj(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneErr
     })?;
     let mut out = ImportedMesh::default();
     match materials {
-        Ok(mats) => out.materials = mats.iter().map(material).collect(),
+        Ok(mats) => {
+            let start = std::time::Instant::now();
+            let mut textures = Textures::new(base);
+            out.materials = mats
+                .iter()
+                .map(|m| material(m, &mut textures, &mut out.report.warnings))
+                .collect::<Result<_, _>>()?;
+            out.decode.images = textures.textures.len();
+            out.decode.bytes = textures
+                .textures
+                .iter()
+                .map(|t| 4 * t.texels.len() as u64)
+                .sum();
+            out.decode.threads = 1;
+            out.decode.time = start.elapsed();
+            out.textures = textures.textures;
+        }
         Err(e) => out.report.warnings.push(match mtl_problem.into_inner() {
             Some(problem) => format!("materials not loaded: {problem}"),
             None => format!("materials not loaded: {e}"),
@@ -67,6 +89,13 @@ pub fn import_obj(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneErr
             data.get(i..i + 3).map(Vec3::from_slice)
         };
         let has_normals = mesh.normals.len() == mesh.positions.len();
+        let has_uvs = mesh.texcoords.len() / 2 == mesh.positions.len() / 3;
+        let uv = |i: u32| {
+            let i = i as usize * 2;
+            mesh.texcoords
+                .get(i..i + 2)
+                .map(|t| glam::Vec2::new(t[0], 1.0 - t[1]))
+        };
         for t in mesh.indices.chunks_exact(3) {
             let p = [t[0], t[1], t[2]].map(|i| vertex(i, &mesh.positions));
             let [Some(p0), Some(p1), Some(p2)] = p else {
@@ -85,10 +114,14 @@ pub fn import_obj(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneErr
             } else {
                 None
             };
+            let uvs = match [t[0], t[1], t[2]].map(uv) {
+                [Some(a), Some(b), Some(c)] if has_uvs => Some([a, b, c]),
+                _ => None,
+            };
             let tri = Triangle {
                 positions: [p0, p1, p2],
                 normals,
-                uvs: None,
+                uvs,
                 uvs1: None,
                 colors: None,
                 tangents: None,
@@ -171,17 +204,147 @@ fn check_mtl(text: &[u8]) -> Option<String> {
     })
 }
 
-fn material(m: &tobj::Material) -> Material {
+/// The textures an MTL file's materials use, each image decoded once.
+struct Textures<'a> {
+    /// The folder texture paths are relative to.
+    base: &'a Path,
+    textures: Vec<Texture>,
+    /// File → index.
+    loaded: std::collections::HashMap<String, u32>,
+}
+
+impl<'a> Textures<'a> {
+    fn new(base: &'a Path) -> Self {
+        Self {
+            base,
+            textures: Vec::new(),
+            loaded: std::collections::HashMap::new(),
+        }
+    }
+
+    /// The texture of an MTL map statement's argument (options such as `-bm 1` first, the
+    /// file last), decoded; the error names the material and the file.
+    fn get(&mut self, material: &str, statement: &str, arg: &str) -> Result<u32, SceneError> {
+        let file = arg.split_whitespace().last().unwrap_or(arg).to_owned();
+        if let Some(&i) = self.loaded.get(&file) {
+            return Ok(i);
+        }
+        let path = self.base.join(&file);
+        let fail = |message: String| {
+            SceneError::new(ErrorKind::Texture(format!(
+                "material \"{material}\": {statement} \"{file}\": {message}"
+            )))
+        };
+        if std::fs::metadata(&path).is_ok_and(|m| !m.is_file()) {
+            return Err(fail("not a file".to_owned()));
+        }
+        let image = image::ImageReader::open(&path)
+            .map_err(|e| fail(format!("cannot read it: {e}")))?
+            .with_guessed_format()
+            .map_err(|e| fail(format!("cannot read it: {e}")))?
+            .decode()
+            .map_err(|e| fail(format!("cannot decode it: {e}")))?
+            .into_rgba8();
+        let (width, height) = image.dimensions();
+        if width == 0 || height == 0 {
+            return Err(fail("the image is empty".to_owned()));
+        }
+        let texels: Vec<[u8; 4]> = image.pixels().map(|p| p.0).collect();
+        let index = u32::try_from(self.textures.len()).unwrap_or(u32::MAX);
+        self.textures.push(Texture {
+            name: file.clone(),
+            width,
+            height,
+            texels: texels.into(),
+            wrap: [Wrap::Repeat; 2],
+            nearest: false,
+            uv_set: 0,
+            transform: UvTransform::IDENTITY,
+        });
+        self.loaded.insert(file, index);
+        Ok(index)
+    }
+}
+
+/// Whether every texel of `t` is grey (R = G = B): a height map rather than a normal map.
+fn grey(t: &Texture) -> bool {
+    t.texels.iter().all(|p| p[0] == p[1] && p[1] == p[2])
+}
+
+fn material(
+    m: &tobj::Material,
+    textures: &mut Textures<'_>,
+    warnings: &mut Vec<String>,
+) -> Result<Material, SceneError> {
     let specular = match m.specular {
         Some(ks) if ks.iter().any(|&c| c > 0.0) => 0.5,
         _ => 0.0,
     };
-    Material {
+    let param = |key: &str| m.unknown_param.get(key).map(String::as_str);
+    let number = |key: &str| param(key).and_then(|v| v.trim().parse::<f32>().ok());
+    let opacity = m
+        .dissolve
+        .or_else(|| number("Tr").map(|tr| 1.0 - tr))
+        .unwrap_or(1.0)
+        .clamp(0.0, 1.0);
+    let mut out = Material {
         base_color: m.diffuse.map_or(Vec3::splat(0.8), Vec3::from),
         emission: m.emissive.map_or(Vec3::ZERO, Vec3::from),
-        roughness: 1.0,
+        roughness: number("Pr").map_or(1.0, |r| r.clamp(0.0, 1.0)),
+        metallic: number("Pm").map_or(0.0, |x| x.clamp(0.0, 1.0)),
         specular,
         ior: m.optical_density.unwrap_or(1.5),
+        opacity,
+        alpha_mode: if opacity < 1.0 {
+            AlphaMode::Blend
+        } else {
+            AlphaMode::Opaque
+        },
         ..Material::named(m.name.clone())
+    };
+    let name = &m.name;
+    if let Some(t) = &m.diffuse_texture {
+        out.textures.base_color = textures.get(name, "map_Kd", t)?;
     }
+    if let Some(t) = param("map_Ke") {
+        out.textures.emissive = textures.get(name, "map_Ke", t)?;
+        if out.emission == Vec3::ZERO {
+            // The map is the emission (an MTL without `Ke` means it in full).
+            out.emission = Vec3::ONE;
+        }
+    }
+    if let Some(t) = param("norm") {
+        out.textures.normal = textures.get(name, "norm", t)?;
+    } else if let Some(t) = &m.normal_texture {
+        let i = textures.get(name, "map_Bump", t)?;
+        if grey(&textures.textures[i as usize]) {
+            warnings.push(format!(
+                "material \"{name}\": bump map \"{t}\" not read: it is a grey height map, and \
+                 only normal maps are (`norm`)"
+            ));
+        } else {
+            out.textures.normal = i;
+        }
+    }
+    let unread: Vec<&str> = [
+        ("map_d", m.dissolve_texture.is_some()),
+        ("map_Ka", m.ambient_texture.is_some()),
+        ("map_Ks", m.specular_texture.is_some()),
+        ("map_Ns", m.shininess_texture.is_some()),
+        ("map_Pr", param("map_Pr").is_some()),
+        ("map_Pm", param("map_Pm").is_some()),
+        ("disp", param("disp").is_some()),
+        ("refl", param("refl").is_some()),
+    ]
+    .into_iter()
+    .filter(|(_, set)| *set)
+    .map(|(key, _)| key)
+    .collect();
+    if !unread.is_empty() {
+        warnings.push(format!(
+            "material \"{name}\": {} not read",
+            unread.join(", ")
+        ));
+    }
+    Ok(out)
 }
