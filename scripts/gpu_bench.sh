@@ -4,7 +4,8 @@
 # and the Crytek Sponza, each at 1000x1000 and 20 bounces:
 #   - paths/s of the path tracer's shader variants (`lumagraph bench`): the specialized
 #     shader, the general one, and the specialized one through the 8-wide BVH
-#     (LUMAGRAPH_BVH=wide) with the binary BVH's beside it;
+#     (LUMAGRAPH_BVH=wide) with the binary BVH's beside it; traversal alone
+#     (`bench --traversal`: primary and diffuse closest-hit queries, both BVHs);
 #   - the wall time of a 15 000-spp render through graphs/pathtrace.ron (the figure seed
 #     renderers give), or, where that would not fit the time left, the time of a shorter
 #     render and its 15 000-spp time extrapolated and marked so.
@@ -105,6 +106,9 @@ run_scene() {
     binary2=$(grep -m1 -E '^  binary BVH ' "$work/bench2.txt" | grep -oE '[0-9.]+ M paths/s' | grep -oE '^[0-9.]+')
     [ -n "$wide" ] && [ -n "$binary2" ] && ratio=$(awk -v w="$wide" -v a="$mps" -v b="$binary2" \
         'BEGIN { printf "%.2f, %.2f", w / a, w / b }')
+    # Traversal alone: closest-hit queries through both BVHs, no shading.
+    say "== $name: traversal alone (bench --traversal)"
+    timeout $(( $(left) > 60 ? $(left) : 60 )) "$lg" bench --scene "$scene" --traversal --runs 3 2>&1 | tee -a "$log"
     # On a device with ray queries the specialized shader traces through them: the WGSL BVH
     # beside it, for the comparison.
     if [ -n "$ray_queries" ]; then

@@ -181,6 +181,11 @@ enum Command {
         /// where it walks the 8-wide BVH, the binary one beside it.
         #[arg(long)]
         specialized_only: bool,
+        /// Time traversal alone instead: a primary ray through each pixel centre and a
+        /// diffuse ray from each primary hit, through the binary and the 8-wide BVH (M rays/s
+        /// of closest-hit queries, no shading).
+        #[arg(long, conflicts_with = "specialized_only")]
+        traversal: bool,
     },
     /// Render one image per node kind into OUT/gallery/ and the page that shows them,
     /// OUT/gallery.md (the docs' node gallery).
@@ -697,9 +702,10 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             spp,
             runs,
             specialized_only,
+            traversal,
         } => {
             let loaded = load_scene(Some(&scene))?.context("no scene")?;
-            bench::run(&loaded.gpu, spp, runs, specialized_only)
+            bench::run(&loaded.gpu, spp, runs, specialized_only, traversal)
         }
         Command::Edit {
             graph,

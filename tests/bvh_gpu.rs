@@ -128,3 +128,50 @@ fn gpu_and_cpu_traversals_agree_on_100k_rays() {
     assert!(hits > 30_000, "too few hits to mean anything: {hits}");
     assert!(ties * 1000 < hits, "{ties} ties in {hits} hits");
 }
+
+/// The 8-wide BVH (`Raycaster::wide`, its buffer bound in the binary one's place) finds the
+/// same hits on the same 100 000 rays: every ray hits or misses alike, at the same distance
+/// to the bit (the same exact tests); only at ties may the primitive differ, as rarely as
+/// against the CPU above.
+#[test]
+fn the_wide_bvh_finds_the_binary_bvhs_hits() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = Scene::from_ron(SCENE, &common::repo("assets")).unwrap();
+    let gpu_scene = GpuScene::build(&scene).unwrap();
+    let buffers = SceneBuffers::upload(ctx, &gpu_scene).unwrap();
+    let wide = lumagraph::render::wide_bvh::WideBvh::build(&gpu_scene).unwrap();
+    let wide_nodes = lumagraph::render::wide_bvh::upload(ctx, &wide).unwrap();
+    let rays = random_rays(100_000);
+    let binary = Raycaster::new(ctx)
+        .unwrap()
+        .cast(ctx, &buffers, &rays)
+        .unwrap();
+    let through_wide = Raycaster::wide(ctx)
+        .unwrap()
+        .cast_through(ctx, &buffers, &wide_nodes, &rays)
+        .unwrap();
+    let (mut hits, mut ties) = (0, 0);
+    for ((q, b), w) in rays.iter().zip(&binary).zip(&through_wide) {
+        assert_eq!(
+            b.prim == NO_HIT,
+            w.prim == NO_HIT,
+            "{b:?} against {w:?} for {q:?}"
+        );
+        if b.prim == NO_HIT {
+            continue;
+        }
+        assert_eq!(
+            b.t.to_bits(),
+            w.t.to_bits(),
+            "{b:?} against {w:?} for {q:?}"
+        );
+        if b.prim == w.prim {
+            hits += 1;
+        } else {
+            ties += 1;
+        }
+    }
+    eprintln!("{hits} hits agree, {ties} ties at equal distance");
+    assert!(hits > 30_000, "too few hits to mean anything: {hits}");
+    assert!(ties * 1000 < hits, "{ties} ties in {hits} hits");
+}

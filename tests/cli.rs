@@ -1142,3 +1142,33 @@ fn bench_reports_where_host_intersection_spends_its_time() {
     );
     assert!(numbers[2] > 0.0, "{line}");
 }
+
+/// `bench --traversal` times closest-hit queries alone through both BVHs: a line each with
+/// primary and diffuse M rays/s (positive), and their ratio.
+#[test]
+fn bench_traversal_times_both_bvhs() {
+    let Some(_) = common::gpu() else { return };
+    let o = lumagraph(&[
+        "bench",
+        "--scene",
+        "tests/scenes/mesh_env.ron",
+        "--traversal",
+        "--runs",
+        "1",
+    ]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{out}\n{err}");
+    for name in ["binary BVH", "8-wide BVH"] {
+        let line = out
+            .lines()
+            .find(|l| l.trim_start().starts_with(name) && l.contains("M rays/s"))
+            .unwrap_or_else(|| panic!("no {name} line: {out}"));
+        let rates: Vec<f64> = line
+            .split_whitespace()
+            .filter_map(|w| w.parse().ok())
+            .collect();
+        assert_eq!(rates.len(), 2, "{line}");
+        assert!(rates.iter().all(|&r| r > 0.0), "{line}");
+    }
+    assert!(out.contains("8-wide / binary: primary"), "{out}");
+}

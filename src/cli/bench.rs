@@ -154,8 +154,17 @@ fn print(label: &str, f: &Figures) {
     }
 }
 
-/// Runs the benchmark and prints the figures.
-pub fn run(scene: &Arc<GpuScene>, spp: u32, runs: u32, specialized_only: bool) -> Result<()> {
+/// Runs the benchmark and prints the figures (with `traversal`, [`traversal`]'s).
+pub fn run(
+    scene: &Arc<GpuScene>,
+    spp: u32,
+    runs: u32,
+    specialized_only: bool,
+    traversal: bool,
+) -> Result<()> {
+    if traversal {
+        return self::traversal(scene, runs);
+    }
     let ctx = GpuContext::headless()?;
     println!("adapter: {}", ctx.describe());
     println!(
@@ -235,5 +244,159 @@ pub fn run(scene: &Arc<GpuScene>, spp: u32, runs: u32, specialized_only: bool) -
         "  specialized / general: {:.2}x",
         special.wall / general.wall
     );
+    Ok(())
+}
+
+/// A ray of `raycast` through the centre of pixel (x, y), as the path tracer's pinhole
+/// camera makes it.
+fn pixel_ray(scene: &GpuScene, x: u32, y: u32) -> crate::render::raycast::RayQuery {
+    use glam::Vec3;
+    let c = &scene.camera;
+    #[expect(clippy::cast_precision_loss, reason = "pixel coordinates")]
+    let (u, v) = (
+        (x as f32 + 0.5) / scene.settings.width as f32,
+        (y as f32 + 0.5) / scene.settings.height as f32,
+    );
+    let dir = Vec3::from(c.forward)
+        + (2.0 * u - 1.0) * c.tan_half_fov * c.aspect * Vec3::from(c.right)
+        - (2.0 * v - 1.0) * c.tan_half_fov * Vec3::from(c.up);
+    crate::render::raycast::RayQuery {
+        origin: c.position,
+        t_max: f32::MAX,
+        dir: dir.normalize().to_array(),
+        pad: 0,
+    }
+}
+
+/// A diffuse ray from where `ray` hits (`hit`): cosine-distributed about the surface's
+/// normal on the ray's side, from a point pushed off the surface by a little of its
+/// coordinates' magnitude; `None` on a miss.
+fn diffuse_ray(
+    scene: &GpuScene,
+    ray: &crate::render::raycast::RayQuery,
+    hit: &crate::scene::Hit,
+    i: u32,
+) -> Option<crate::render::raycast::RayQuery> {
+    use glam::Vec3;
+    if hit.prim == crate::scene::NO_HIT {
+        return None;
+    }
+    let (o, d) = (Vec3::from(ray.origin), Vec3::from(ray.dir));
+    let p = o + d * hit.t;
+    let n = if hit.prim & crate::scene::PRIM_SPHERE != 0 {
+        let s = scene
+            .spheres
+            .get((hit.prim & !crate::scene::PRIM_SPHERE) as usize)?;
+        (p - Vec3::from(s.center)).normalize_or_zero()
+    } else {
+        let t = scene.tri_positions.get(hit.prim as usize)?;
+        Vec3::from(t.e1).cross(Vec3::from(t.e2)).normalize_or_zero()
+    };
+    let n = if n.dot(d) > 0.0 { -n } else { n };
+    // Two uniform numbers from the index (a hash: the same rays every run).
+    let h = |k: u32| {
+        let mut x = i.wrapping_mul(0x9E37_79B9) ^ k.wrapping_mul(0x85EB_CA6B);
+        x ^= x >> 16;
+        x = x.wrapping_mul(0x7FEB_352D);
+        x ^= x >> 15;
+        x = x.wrapping_mul(0x846C_A68B);
+        x ^= x >> 16;
+        #[expect(clippy::cast_precision_loss, reason = "24 bits")]
+        let f = (x >> 8) as f32 / (1u32 << 24) as f32;
+        f
+    };
+    let (r, phi) = (h(1).sqrt(), std::f32::consts::TAU * h(2));
+    let (b1, b2) = n.any_orthonormal_pair();
+    let dir = b1 * (r * phi.cos()) + b2 * (r * phi.sin()) + n * (1.0 - r * r).max(0.0).sqrt();
+    let origin = p + n * (1e-4 * p.abs().max_element().max(1.0));
+    Some(crate::render::raycast::RayQuery {
+        origin: origin.to_array(),
+        t_max: f32::MAX,
+        dir: dir.to_array(),
+        pad: 0,
+    })
+}
+
+/// `lumagraph bench --traversal`: closest-hit queries alone, through the binary and the
+/// 8-wide BVH. Primary rays: one through each pixel centre; diffuse rays: one from each
+/// primary hit. Each set is cast in one submission of several dispatches (enough for about
+/// a quarter of a second), best of `runs`; prints M rays/s and the rays that hit.
+pub fn traversal(scene: &Arc<GpuScene>, runs: u32) -> Result<()> {
+    use crate::render::raycast::Raycaster;
+    use crate::render::wide_bvh::{WideBvh, upload};
+    let ctx = GpuContext::headless()?;
+    println!("adapter: {}", ctx.describe());
+    let buffers = crate::render::SceneBuffers::upload(&ctx, scene)?;
+    let start = Instant::now();
+    let wide = WideBvh::build(scene).map_err(anyhow::Error::msg)?;
+    println!(
+        "8-wide BVH: {} nodes, {} deep, built in {:.1} ms; binary BVH: {} nodes",
+        wide.nodes,
+        wide.depth,
+        start.elapsed().as_secs_f64() * 1e3,
+        scene.bvh_nodes.len()
+    );
+    let wide_nodes = upload(&ctx, &wide)?;
+    let (w, h) = (scene.settings.width, scene.settings.height);
+    let primary: Vec<_> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| pixel_ray(scene, x, y))
+        .collect();
+    let binary = Raycaster::new(&ctx)?;
+    let hits = binary.cast(&ctx, &buffers, &primary)?;
+    let diffuse: Vec<_> = primary
+        .iter()
+        .zip(&hits)
+        .zip(0u32..)
+        .filter_map(|((r, hit), i)| diffuse_ray(scene, r, hit, i))
+        .collect();
+    let diffuse_hits = binary
+        .cast(&ctx, &buffers, &diffuse)?
+        .iter()
+        .filter(|h| h.prim != crate::scene::NO_HIT)
+        .count();
+    println!(
+        "{w}x{h}: {} primary rays ({} hit), {} diffuse rays ({diffuse_hits} hit); best of {runs}:",
+        primary.len(),
+        diffuse.len(),
+        diffuse.len()
+    );
+    let wide_kernel = Raycaster::wide(&ctx)?;
+    let mut figures = Vec::new();
+    for (name, kernel, nodes) in [
+        ("binary BVH", &binary, &buffers.bvh_nodes),
+        ("8-wide BVH", &wide_kernel, &wide_nodes),
+    ] {
+        let mut line = Vec::new();
+        for (kind, rays) in [("primary", &primary), ("diffuse", &diffuse)] {
+            if rays.is_empty() {
+                continue;
+            }
+            // One dispatch to size the runs (and compile the pipeline).
+            let once = kernel.time(&ctx, &buffers, nodes, rays, 1)?.as_secs_f64();
+            #[expect(clippy::cast_possible_truncation, reason = "clamped to 1..=64")]
+            #[expect(clippy::cast_sign_loss, reason = "clamped to 1..=64")]
+            let repeats = (0.25 / once.max(1e-6)).clamp(1.0, 64.0) as u32;
+            let mut best = 0.0f64;
+            for _ in 0..runs.max(1) {
+                let secs = kernel
+                    .time(&ctx, &buffers, nodes, rays, repeats)?
+                    .as_secs_f64();
+                #[expect(clippy::cast_precision_loss, reason = "a rate")]
+                let rate = rays.len() as f64 * f64::from(repeats) / secs;
+                best = best.max(rate);
+            }
+            line.push(format!("{kind} {:.1} M rays/s", best / 1e6));
+            figures.push(best);
+        }
+        println!("  {name:<11} {}", line.join(", "));
+    }
+    if let [bp, bd, wp, wd] = figures[..] {
+        println!(
+            "  8-wide / binary: primary {:.2}x, diffuse {:.2}x",
+            wp / bp,
+            wd / bd
+        );
+    }
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! Ray queries on the GPU: the closest hit of each ray, through the path tracer's BVH
-//! traversal (`shaders/pathtrace/raycast.wgsl`). Used to check the GPU traversal against
-//! the CPU one and for picking.
+//! traversal (`shaders/pathtrace/raycast.wgsl`, over the binary BVH or the 8-wide one).
+//! Used to check the GPU traversal against the CPU one, for picking, and to time traversal
+//! alone (`lumagraph bench --traversal`).
 
 use bytemuck::{Pod, Zeroable};
 use lumagraph_scene::Hit;
@@ -41,13 +42,76 @@ pub struct Raycaster {
 }
 
 impl Raycaster {
-    /// Compiles the kernel.
+    /// Compiles the kernel over the binary BVH.
     ///
     /// # Errors
     /// When the shader does not compile.
     pub fn new(ctx: &GpuContext) -> Result<Self> {
         let kernel = Kernel::new(ctx, "pathtrace/raycast.wgsl")?;
         Ok(Self { kernel })
+    }
+
+    /// Compiles the kernel over the 8-wide BVH ([`crate::wide_bvh`]): its buffer goes where
+    /// [`Raycaster::cast_through`] and [`Raycaster::time`] take the nodes.
+    ///
+    /// # Errors
+    /// When the shader does not compile.
+    pub fn wide(ctx: &GpuContext) -> Result<Self> {
+        let source = crate::shader::resolve_with(
+            "pathtrace/raycast.wgsl",
+            &[(
+                "pathtrace/bvh.wgsl",
+                "#import \"pathtrace/wide_bvh.wgsl\"\n".to_owned(),
+            )],
+        )?;
+        let kernel = Kernel::from_source(ctx, "pathtrace/raycast.wgsl (8-wide BVH)", &source)?;
+        Ok(Self { kernel })
+    }
+
+    /// The wall time of `repeats` dispatches over `rays` (one submission, hits not read
+    /// back), through `nodes` (the binary BVH's `scene.bvh_nodes`, or the wide BVH's buffer
+    /// for a kernel made by [`Raycaster::wide`]).
+    ///
+    /// # Errors
+    /// When the GPU work fails.
+    pub fn time(
+        &self,
+        ctx: &GpuContext,
+        scene: &SceneBuffers,
+        nodes: &wgpu::Buffer,
+        rays: &[RayQuery],
+        repeats: u32,
+    ) -> Result<std::time::Duration> {
+        let count = u32::try_from(rays.len()).unwrap_or(u32::MAX);
+        let params = uniform_buffer(ctx, "raycast params", bytemuck::bytes_of(&[count, 0, 0, 0]));
+        let queries = storage_buffer(ctx, "raycast queries", bytemuck::cast_slice(rays));
+        let hits = storage_buffer(
+            ctx,
+            "raycast hits",
+            &vec![0u8; rays.len().max(1) * std::mem::size_of::<GpuHit>()],
+        );
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("raycast timing"),
+            });
+        for _ in 0..repeats {
+            self.kernel
+                .pass("raycast")
+                .uniform(&params)
+                .buffer(&queries)
+                .buffer(&hits)
+                .buffer(nodes)
+                .buffer(&scene.tri_positions)
+                .buffer(&scene.spheres)
+                .dispatch(ctx, &mut encoder, groups_1d(count, 64), None)?;
+        }
+        // Uploads done before the clock starts.
+        ctx.wait()?;
+        let start = std::time::Instant::now();
+        ctx.queue.submit([encoder.finish()]);
+        ctx.wait()?;
+        Ok(start.elapsed())
     }
 
     /// The closest hit of every ray (`prim == NO_HIT` for a miss).
@@ -58,6 +122,20 @@ impl Raycaster {
         &self,
         ctx: &GpuContext,
         scene: &SceneBuffers,
+        rays: &[RayQuery],
+    ) -> Result<Vec<Hit>> {
+        self.cast_through(ctx, scene, &scene.bvh_nodes, rays)
+    }
+
+    /// [`Raycaster::cast`] through `nodes` (see [`Raycaster::time`]).
+    ///
+    /// # Errors
+    /// When the GPU work fails.
+    pub fn cast_through(
+        &self,
+        ctx: &GpuContext,
+        scene: &SceneBuffers,
+        nodes: &wgpu::Buffer,
         rays: &[RayQuery],
     ) -> Result<Vec<Hit>> {
         if rays.is_empty() {
@@ -73,7 +151,7 @@ impl Raycaster {
                     .uniform(&params)
                     .buffer(&queries)
                     .buffer(output)
-                    .buffer(&scene.bvh_nodes)
+                    .buffer(nodes)
                     .buffer(&scene.tri_positions)
                     .buffer(&scene.spheres)
                     .dispatch(ctx, encoder, groups_1d(count, 64), None)
