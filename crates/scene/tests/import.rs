@@ -190,10 +190,11 @@ fn png(path: &std::path::Path, w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 3]) 
         .unwrap();
 }
 
-/// MTL maps: `map_Kd` is the base colour texture, `norm` the normal map, a coloured
-/// `map_Bump` a normal map too and a grey one (a height map) not read and said so; `map_Ke`
-/// the emission (in full where `Ke` is absent); `d` below 1 blends; `Pr` and `Pm` set
-/// roughness and metallic; maps not read are named; OBJ's `v` is flipped to glTF's; an image
+/// MTL maps: `map_Kd` is the base colour texture and `map_d` its alpha (blended), `norm` the
+/// normal map, a coloured `map_Bump` a normal map too and a grey one (a height map) not read
+/// and said so; `map_Ke` the emission (in full where `Ke` is absent); `d` below 1 blends; `Pr`
+/// and `Pm` set roughness and metallic; maps not read are named; OBJ's `v` is flipped to
+/// glTF's; textures no material uses alone are not kept; an image
 /// two materials use is decoded once; a missing image is an error naming its material and
 /// file.
 #[test]
@@ -203,6 +204,7 @@ fn obj_textures_are_read() {
     png(&d.join("albedo.png"), 4, 2, |x, _| [x as u8 * 60, 10, 200]);
     png(&d.join("normal.png"), 2, 2, |_, _| [128, 128, 255]);
     png(&d.join("height.png"), 2, 2, |x, y| [(x + y) as u8 * 90; 3]);
+    png(&d.join("mask.png"), 2, 1, |x, _| [x as u8 * 255; 3]);
     std::fs::write(
         d.join("m.obj"),
         "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 0.25\nvn 0 0 1\n\
@@ -212,21 +214,30 @@ fn obj_textures_are_read() {
     std::fs::write(
         d.join("m.mtl"),
         "newmtl a\nKd 1 1 1\nmap_Kd albedo.png\nnorm normal.png\nd 0.5\nPr 0.3\nPm 1\n\
-         map_Ks albedo.png\nmap_d albedo.png\n\
+         map_Ks albedo.png\nmap_d mask.png\n\
          newmtl b\nKd 1 1 1\nmap_Kd albedo.png\nmap_Bump -bm 1.0 height.png\nmap_Ke albedo.png\n\
          newmtl c\nKd 1 1 1\nbump normal.png\n",
     )
     .unwrap();
     let m = import_mesh(&d.join("m.obj"), Mat4::IDENTITY).unwrap();
     let names: Vec<&str> = m.textures.iter().map(|t| t.name.as_str()).collect();
+    // Each image decoded once; the mask merged into the base colour and the grey bump map
+    // not kept on their own.
     assert_eq!(
         names,
-        ["albedo.png", "normal.png", "height.png"],
-        "decoded once each"
+        [
+            "albedo.png",
+            "albedo.png with alpha from mask.png",
+            "normal.png"
+        ]
     );
     let (a, b, c) = (&m.materials[0], &m.materials[1], &m.materials[2]);
-    assert_eq!(a.textures.base_color, 0);
-    assert_eq!(a.textures.normal, 1);
+    assert_eq!(a.textures.base_color, 1);
+    // The 2x1 mask over the 4x2 albedo, nearest texel: columns 0-1 from 0, 2-3 from 255.
+    let alphas: Vec<u8> = m.textures[1].texels.iter().map(|p| p[3]).collect();
+    assert_eq!(alphas, [0, 0, 255, 255, 0, 0, 255, 255]);
+    assert_eq!(m.textures[1].texels[1][..3], [60, 10, 200]);
+    assert_eq!(a.textures.normal, 2);
     assert_eq!(a.opacity, 0.5);
     assert_eq!(a.alpha_mode, lumagraph_scene::AlphaMode::Blend);
     assert_eq!((a.roughness, a.metallic), (0.3, 1.0));
@@ -239,17 +250,14 @@ fn obj_textures_are_read() {
     assert_eq!(b.textures.emissive, 0);
     assert_eq!(b.emission, Vec3::ONE);
     assert_eq!(b.alpha_mode, lumagraph_scene::AlphaMode::Opaque);
-    assert_eq!(c.textures.normal, 1, "a coloured bump map is a normal map");
+    assert_eq!(c.textures.normal, 2, "a coloured bump map is a normal map");
     let warnings = m.report.warnings.join("\n");
-    assert!(
-        warnings.contains("\"a\": map_d, map_Ks not read"),
-        "{warnings}"
-    );
+    assert!(warnings.contains("\"a\": map_Ks not read"), "{warnings}");
     assert!(
         warnings.contains("bump map \"-bm 1.0 height.png\" not read"),
         "{warnings}"
     );
-    assert_eq!(m.decode.images, 3);
+    assert_eq!(m.decode.images, 4);
     // OBJ v = 0.25 is glTF's 0.75.
     let uvs = m.triangles[0].uvs.expect("texture coordinates kept");
     assert_eq!(uvs[2], glam::Vec2::new(1.0, 0.75));

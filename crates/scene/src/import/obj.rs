@@ -1,7 +1,8 @@
 //! OBJ + MTL import ([`tobj`]): polygons triangulated, `Kd` → base color, `Ke` →
 //! emission, `Ks` black or absent → specular 0 (else 0.5), `Ni` → IOR, roughness 1 (or
 //! `Pr`), metallic 0 (or `Pm`), `d` (or 1 − `Tr`) below 1 → alpha blending. Textures:
-//! `map_Kd` → base colour (sRGB), `map_Ke` → emission, `norm` → tangent-space normal map,
+//! `map_Kd` → base colour (sRGB), `map_d` → its alpha (blended: the plants and chains of
+//! OBJ scenes are cut out by it), `map_Ke` → emission, `norm` → tangent-space normal map,
 //! and `map_Bump`/`bump` as a normal map where its texels are coloured (a grey height map is
 //! not read, and said so). Other maps are named in a warning. Texture coordinates are kept
 //! when every corner has them (OBJ's `v` runs up, glTF's down: `v` is flipped). Vertex
@@ -14,7 +15,7 @@ use glam::{Mat4, Vec3};
 
 use super::ImportedMesh;
 use crate::error::{ErrorKind, SceneError};
-use crate::scene::{AlphaMode, Material, Triangle, push_triangle, transform_triangle};
+use crate::scene::{AlphaMode, Material, NO_TEXTURE, Triangle, push_triangle, transform_triangle};
 use crate::texture::{Texture, UvTransform, Wrap};
 
 /// Imports an `.obj` file and the `.mtl` files it names.
@@ -59,7 +60,9 @@ pub fn import_obj(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneErr
                 .iter()
                 .map(|m| material(m, &mut textures, &mut out.report.warnings))
                 .collect::<Result<_, _>>()?;
-            out.decode.images = textures.textures.len();
+            out.decode.images = textures.loaded.len();
+            // Masks merged into a base colour texture are not used on their own.
+            compact(&mut textures.textures, &mut out.materials);
             out.decode.bytes = textures
                 .textures
                 .iter()
@@ -211,6 +214,8 @@ struct Textures<'a> {
     textures: Vec<Texture>,
     /// File → index.
     loaded: std::collections::HashMap<String, u32>,
+    /// (base colour texture or none, alpha texture) → the texture that merges them.
+    merged: std::collections::HashMap<(u32, u32), u32>,
 }
 
 impl<'a> Textures<'a> {
@@ -219,7 +224,63 @@ impl<'a> Textures<'a> {
             base,
             textures: Vec::new(),
             loaded: std::collections::HashMap::new(),
+            merged: std::collections::HashMap::new(),
         }
+    }
+
+    /// A texture with `base`'s colour (white where `base` is [`NO_TEXTURE`]) and `alpha`'s
+    /// opacity: its alpha channel where it has one below 255, else its red channel (a grey
+    /// mask). `alpha` is read at `base`'s size, nearest texel.
+    fn with_alpha(&mut self, base: u32, alpha: u32) -> u32 {
+        if let Some(&i) = self.merged.get(&(base, alpha)) {
+            return i;
+        }
+        let a = &self.textures[alpha as usize];
+        let has_alpha = a.texels.iter().any(|p| p[3] < 255);
+        let opacity = |x: u32, y: u32, w: u32, h: u32| {
+            let ax = (u64::from(x) * u64::from(a.width) / u64::from(w)) as usize;
+            let ay = (u64::from(y) * u64::from(a.height) / u64::from(h)) as usize;
+            let p = a.texels[ay * a.width as usize + ax];
+            if has_alpha { p[3] } else { p[0] }
+        };
+        let (name, width, height, texels): (String, u32, u32, Vec<[u8; 4]>) = if base == NO_TEXTURE
+        {
+            let (w, h) = (a.width, a.height);
+            let texels = (0..h)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .map(|(x, y)| [255, 255, 255, opacity(x, y, w, h)])
+                .collect();
+            (format!("white with alpha from {}", a.name), w, h, texels)
+        } else {
+            let b = &self.textures[base as usize];
+            let (w, h) = (b.width, b.height);
+            let texels = (0..h)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .map(|(x, y)| {
+                    let c = b.texels[y as usize * w as usize + x as usize];
+                    [c[0], c[1], c[2], opacity(x, y, w, h)]
+                })
+                .collect();
+            (
+                format!("{} with alpha from {}", b.name, a.name),
+                w,
+                h,
+                texels,
+            )
+        };
+        let index = u32::try_from(self.textures.len()).unwrap_or(u32::MAX);
+        self.textures.push(Texture {
+            name,
+            width,
+            height,
+            texels: texels.into(),
+            wrap: [Wrap::Repeat; 2],
+            nearest: false,
+            uv_set: 0,
+            transform: UvTransform::IDENTITY,
+        });
+        self.merged.insert((base, alpha), index);
+        index
     }
 
     /// The texture of an MTL map statement's argument (options such as `-bm 1` first, the
@@ -266,6 +327,38 @@ impl<'a> Textures<'a> {
     }
 }
 
+/// Drops the textures no material uses, renumbering the materials' slots.
+fn compact(textures: &mut Vec<Texture>, materials: &mut [Material]) {
+    let mut used = vec![false; textures.len()];
+    for m in materials.iter() {
+        for t in m.textures.all() {
+            if let Some(u) = used.get_mut(t as usize) {
+                *u = true;
+            }
+        }
+    }
+    let mut new_index = vec![NO_TEXTURE; textures.len()];
+    let mut next = 0u32;
+    for (i, &u) in used.iter().enumerate() {
+        if u {
+            new_index[i] = next;
+            next += 1;
+        }
+    }
+    let mut i = 0;
+    textures.retain(|_| {
+        i += 1;
+        used[i - 1]
+    });
+    for m in materials.iter_mut() {
+        for t in m.textures.all_mut() {
+            if let Some(&n) = new_index.get(*t as usize) {
+                *t = n;
+            }
+        }
+    }
+}
+
 /// Whether every texel of `t` is grey (R = G = B): a height map rather than a normal map.
 fn grey(t: &Texture) -> bool {
     t.texels.iter().all(|p| p[0] == p[1] && p[1] == p[2])
@@ -306,6 +399,11 @@ fn material(
     if let Some(t) = &m.diffuse_texture {
         out.textures.base_color = textures.get(name, "map_Kd", t)?;
     }
+    if let Some(t) = &m.dissolve_texture {
+        let alpha = textures.get(name, "map_d", t)?;
+        out.textures.base_color = textures.with_alpha(out.textures.base_color, alpha);
+        out.alpha_mode = AlphaMode::Blend;
+    }
     if let Some(t) = param("map_Ke") {
         out.textures.emissive = textures.get(name, "map_Ke", t)?;
         if out.emission == Vec3::ZERO {
@@ -327,7 +425,6 @@ fn material(
         }
     }
     let unread: Vec<&str> = [
-        ("map_d", m.dissolve_texture.is_some()),
         ("map_Ka", m.ambient_texture.is_some()),
         ("map_Ks", m.specular_texture.is_some()),
         ("map_Ns", m.shininess_texture.is_some()),
