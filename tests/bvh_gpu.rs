@@ -81,6 +81,14 @@ fn random_rays(n: usize) -> Vec<RayQuery> {
         .collect()
 }
 
+/// Enough of the rays hit for the comparison to mean something, and ties (the same distance,
+/// another primitive) stay rare.
+fn enough_hits_few_ties(hits: usize, ties: usize) {
+    eprintln!("{hits} hits agree, {ties} ties at equal distance");
+    assert!(hits > 30_000, "too few hits to mean anything: {hits}");
+    assert!(ties * 1000 < hits, "{ties} ties in {hits} hits");
+}
+
 #[test]
 fn gpu_and_cpu_traversals_agree_on_100k_rays() {
     let Some(ctx) = common::gpu() else { return };
@@ -124,9 +132,7 @@ fn gpu_and_cpu_traversals_agree_on_100k_rays() {
             }
         }
     }
-    eprintln!("{hits} hits agree, {ties} ties at equal distance");
-    assert!(hits > 30_000, "too few hits to mean anything: {hits}");
-    assert!(ties * 1000 < hits, "{ties} ties in {hits} hits");
+    enough_hits_few_ties(hits, ties);
 }
 
 /// The 8-wide BVH (`Raycaster::wide`, its buffer bound in the binary one's place) finds the
@@ -171,7 +177,5 @@ fn the_wide_bvh_finds_the_binary_bvhs_hits() {
             ties += 1;
         }
     }
-    eprintln!("{hits} hits agree, {ties} ties at equal distance");
-    assert!(hits > 30_000, "too few hits to mean anything: {hits}");
-    assert!(ties * 1000 < hits, "{ties} ties in {hits} hits");
+    enough_hits_few_ties(hits, ties);
 }

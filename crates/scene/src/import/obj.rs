@@ -268,6 +268,14 @@ impl<'a> Textures<'a> {
                 texels,
             )
         };
+        let index = self.push(name, width, height, texels);
+        self.merged.insert((base, alpha), index);
+        index
+    }
+
+    /// Adds a texture of `texels` (row by row from the top), repeating, bilinear, read
+    /// through the first texture coordinates; returns its index.
+    fn push(&mut self, name: String, width: u32, height: u32, texels: Vec<[u8; 4]>) -> u32 {
         let index = u32::try_from(self.textures.len()).unwrap_or(u32::MAX);
         self.textures.push(Texture {
             name,
@@ -279,7 +287,6 @@ impl<'a> Textures<'a> {
             uv_set: 0,
             transform: UvTransform::IDENTITY,
         });
-        self.merged.insert((base, alpha), index);
         index
     }
 
@@ -311,17 +318,7 @@ impl<'a> Textures<'a> {
             return Err(fail("the image is empty".to_owned()));
         }
         let texels: Vec<[u8; 4]> = image.pixels().map(|p| p.0).collect();
-        let index = u32::try_from(self.textures.len()).unwrap_or(u32::MAX);
-        self.textures.push(Texture {
-            name: file.clone(),
-            width,
-            height,
-            texels: texels.into(),
-            wrap: [Wrap::Repeat; 2],
-            nearest: false,
-            uv_set: 0,
-            transform: UvTransform::IDENTITY,
-        });
+        let index = self.push(file.clone(), width, height, texels);
         self.loaded.insert(file, index);
         Ok(index)
     }
