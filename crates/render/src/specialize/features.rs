@@ -371,6 +371,9 @@ struct Facts<'a> {
     inline: bool,
     /// Whether the device's ray queries trace the scene ([`Feature::RayQueries`]), and why.
     ray_queries: Decision,
+    /// Whether the host intersects the rays ([`Feature::HostRays`]), and why: decided once,
+    /// for that feature and for the ones it rules out.
+    host: Decision,
     inline_data: bool,
     textured: bool,
     materials: Vec<MaterialRanges>,
@@ -395,11 +398,11 @@ impl<'a> Facts<'a> {
         let forced = options.ray_queries_forced && no_ray_queries.is_none();
         let inline =
             options.specialize && options.cpu_adapter && prims <= INLINE_MAX_PRIMITIVES && !forced;
-        let host = super::host_rays_decision(scene, options, inline, forced).included;
+        let host = super::host_rays_decision(scene, options, inline, forced);
         let ray_queries = match no_ray_queries {
             Some(why) => decision(false, why),
             None if inline => decision(false, "intersected inline"),
-            None if host => decision(false, "rays intersected on the host"),
+            None if host.included => decision(false, "rays intersected on the host"),
             None if forced => decision(true, "asked for"),
             None if options.cpu_adapter => decision(false, CPU_RAY_QUERIES_REASON),
             None => decision(
@@ -423,6 +426,7 @@ impl<'a> Facts<'a> {
             prims,
             inline,
             ray_queries,
+            host,
             inline_data,
             textured,
             materials: scene
@@ -567,26 +571,14 @@ impl<'a> Facts<'a> {
                     "BVH traversal: no gain measured on a CPU adapter"
                 },
             ),
-            Feature::HostRays => super::host_rays_decision(
-                s,
-                self.options,
-                self.inline,
-                self.options.ray_queries_forced && self.ray_queries.included,
-            ),
+            Feature::HostRays => self.host.clone(),
         }
     }
 
     /// Whether the WGSL traversal walks the 8-wide BVH, and why.
     fn wide_bvh(&self) -> Decision {
         let o = self.options;
-        let host = super::host_rays_decision(
-            self.scene,
-            o,
-            self.inline,
-            o.ray_queries_forced && self.ray_queries.included,
-        )
-        .included;
-        if !self.bvh().included || host {
+        if !self.bvh().included || self.host.included {
             decision(false, "the BVH is not traversed in WGSL")
         } else if !o.specialize {
             decision(false, "general shader: the binary BVH")
