@@ -11,7 +11,7 @@ if [ -z "${XDG_RUNTIME_DIR:-}" ] || [ ! -d "${XDG_RUNTIME_DIR}" ]; then
     export XDG_RUNTIME_DIR
 fi
 # Mesa 25's lavapipe, unpacked by scripts/setup.sh: the driver with ray queries that
-# tests/ray_query.rs runs on.
+# tests/pathtrace/ray_query.rs runs on.
 ray_query_icd="${XDG_CACHE_HOME:-$HOME/.cache}/lumagraph/lavapipe-ray-query/lvp_icd.json"
 if [ -z "${LUMAGRAPH_RAY_QUERY_ICD:-}" ] && [ -f "$ray_query_icd" ]; then
     export LUMAGRAPH_RAY_QUERY_ICD="$ray_query_icd"

@@ -31,7 +31,7 @@ fi
 
 # Mesa 25's lavapipe, beside the system's Vulkan drivers (not instead of them): it has ray
 # queries, which the path tracer uses where a device offers them and whose tests need them
-# (tests/ray_query.rs runs them on it). Debian bookworm's own Mesa (22.3) has none, and
+# (tests/pathtrace/ray_query.rs runs them on it). Debian bookworm's own Mesa (22.3) has none, and
 # compiles shaders 2-3x faster, which the rest of the tests depend on. On bookworm, the
 # bookworm-backports suite is added to apt's sources and the driver unpacked from its
 # mesa-vulkan-drivers package into $ray_query_dir; scripts/env.sh points

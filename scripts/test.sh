@@ -6,6 +6,6 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 . scripts/env.sh
-# The mesh of assets/bench/mesh_env.ron (a suite scene of tests/denoise_suite.rs) is made, not stored.
+# The mesh of assets/bench/mesh_env.ron (a suite scene of tests/denoise/suite.rs) is made, not stored.
 [ -f assets/bench/blob.obj ] || python3 scripts/bench/mesh_env.py make assets/bench/blob.obj
 cargo test --locked --workspace "$@"

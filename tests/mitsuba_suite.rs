@@ -3,7 +3,7 @@
 //! made by `scripts/references/make.py` from `lumagraph export` of the same scene file
 //! (Mitsuba 3.9.1 `llvm_ad_rgb`, 16 384 spp; see each reference's `.json`).
 //!
-//! Per scene, as for the Cornell box (`tests/pathtrace.rs`):
+//! Per scene, as for the Cornell box (`tests/pathtrace/images.rs`):
 //! - at 256 spp, relMSE against the reference at most 1.25× Mitsuba's own relMSE at 256 spp
 //!   (the mean over 4 seeds, in the reference's `.json`);
 //! - at 1024 spp, every 32×32 block mean of every channel whose reference mean exceeds 0.02

@@ -3,7 +3,7 @@
 // index is computed from the direction vectors, and a second, per-dimension Owen scramble
 // randomizes its digits. Bit for bit the `sobol_burley` crate's `sample(index, dimension,
 // seed)` (Joe and Kuo direction numbers, Laine-Karras-style hash with the crate's constants) for
-// index < 2^16 and the first four dimensions; `tests/sampler.rs` checks it on the GPU.
+// index < 2^16 and the first four dimensions; `tests/light_transport/sampler.rs` checks it on the GPU.
 // `_rev` values have their bits reversed, as in the crate.
 
 const SOBOL_DIMENSIONS: u32 = 4u;

@@ -1,6 +1,6 @@
 // Bloom's downsampling (crates/render/src/nodes/bloom.rs): output pixel (x, y) is the
 // [1 3 3 1]/8 ⊗ [1 3 3 1]/8 average of input pixels 2x−1 … 2x+2 (and in y), clamped to the
-// edge (the CPU reference is in tests/post_blur_bloom.rs).
+// edge (the CPU reference is in tests/post/blur_bloom.rs).
 
 @group(0) @binding(0) var input: texture_2d<f32>;
 @group(0) @binding(1) var output: texture_storage_2d<rgba32float, write>;

@@ -1,7 +1,7 @@
 // Bloom's upsample-and-add (crates/render/src/nodes/bloom.rs): out = fine_weight × fine +
 // coarse_weight × bilinear(coarse) at the fine pixel's center, the coarse image taken as
 // half the fine one's resolution (coarse coordinate (x + 0.5) / 2 − 0.5, clamped to the
-// edge) (the CPU reference is in tests/post_blur_bloom.rs).
+// edge) (the CPU reference is in tests/post/blur_bloom.rs).
 
 struct Params {
     fine_weight: f32,

@@ -1,6 +1,6 @@
 // One pass of the separable Gaussian blur (crates/render/src/nodes/blur.rs): along x or y,
 // the taps within `radius` pixels weighted exp(−d²/2σ²), normalized, clamped to the edge
-// (the CPU reference is in tests/post_blur_bloom.rs).
+// (the CPU reference is in tests/post/blur_bloom.rs).
 
 struct Params {
     sigma: f32,

@@ -1,5 +1,5 @@
 // ASC CDL: out = clamp(in × slope + offset, 0)^power per channel, then saturation around
-// the Rec.709 luma (the CPU reference is in tests/post_grade.rs).
+// the Rec.709 luma (the CPU reference is in tests/post/grade.rs).
 #import "post/filter.wgsl"
 
 struct Params {

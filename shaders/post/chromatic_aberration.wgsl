@@ -1,6 +1,6 @@
 // Lateral chromatic aberration: red read at center + (p − center)(1 + strength), blue at
 // (1 − strength), green in place, bilinear through the sampler (the CPU reference is in
-// tests/post_effects.rs).
+// tests/post/effects.rs).
 #import "post/resample.wgsl"
 
 struct Params {

@@ -1,6 +1,6 @@
 // Combine: the red channels of `r`, `g`, `b` (and `a` when connected, else 1) as one image.
 // A generic post filter (crates/render/src/nodes/post_filter.rs) with an optional input;
-// the CPU reference is in tests/post_combine.rs.
+// the CPU reference is in tests/post/combine.rs.
 
 @group(0) @binding(0) var input_r: texture_2d<f32>;
 @group(0) @binding(1) var input_g: texture_2d<f32>;

@@ -1,6 +1,6 @@
 // Contrast around a pivot, for linear HDR color: pivot × (c / pivot)^contrast per channel,
 // so the pivot stays and ratios above and below it are raised to `contrast` (the CPU
-// reference is in tests/post_grade.rs).
+// reference is in tests/post/grade.rs).
 #import "post/filter.wgsl"
 
 struct Params {

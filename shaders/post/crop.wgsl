@@ -1,5 +1,5 @@
 // Crop: the output's pixel (x, y) is the input's (x + params.x, y + params.y); the size
-// comes from the node's size rule (the CPU reference is in tests/post_effects.rs).
+// comes from the node's size rule (the CPU reference is in tests/post/effects.rs).
 #import "post/filter_at.wgsl"
 
 struct Params {

@@ -1,6 +1,6 @@
 // Film grain: color × (1 + intensity × n), n standard normal from a hash of the pixel and
 // the seed (Box-Muller on two PCG draws), the same for all channels; negative results
-// clipped to 0 (the CPU reference is in tests/post_effects.rs).
+// clipped to 0 (the CPU reference is in tests/post/effects.rs).
 #import "post/filter.wgsl"
 
 struct Params {

@@ -1,6 +1,6 @@
 // Hue, saturation, value: the color rotated by `hue` degrees around the grey axis,
 // its distance from grey (the mean of r, g, b) scaled by `saturation`, the result scaled
-// by `value`; negative channels clipped to 0 (the CPU reference is in tests/post_grade.rs).
+// by `value`; negative channels clipped to 0 (the CPU reference is in tests/post/grade.rs).
 #import "post/filter.wgsl"
 
 struct Params {

@@ -1,7 +1,7 @@
 // LUT: each pixel's rgb, mapped from the LUT's domain to [0, 1] (clamped), looked up in the
 // 3D LUT (red the fastest axis, as in .cube files) with trilinear or tetrahedral
 // interpolation of its texels; alpha kept (crates/render/src/nodes/lut.rs has the CPU
-// reference, tests/post_lut.rs compares them).
+// reference, tests/post/lut.rs compares them).
 
 struct Params {
     size: u32,

@@ -1,5 +1,5 @@
 // Math: one operation with `value` on each of r, g, b (alpha kept) (the CPU reference is in
-// tests/post_combine.rs).
+// tests/post/combine.rs).
 #import "post/filter.wgsl"
 
 struct Params {

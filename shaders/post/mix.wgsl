@@ -1,5 +1,5 @@
 // Mix: b blended over a by `mode`, then lerp(a, blended, factor); alpha from a (the CPU
-// reference is in tests/post_combine.rs). Overlay and screen are defined for [0, 1] and
+// reference is in tests/post/combine.rs). Overlay and screen are defined for [0, 1] and
 // applied as is to HDR values.
 #import "post/filter2.wgsl"
 

@@ -1,5 +1,5 @@
 // Resize: bilinear through the sampler, or Lanczos-3 widened by 1/scale when shrinking,
-// normalized, negative results clipped to 0 (the CPU reference is in tests/post_resize.rs).
+// normalized, negative results clipped to 0 (the CPU reference is in tests/post/resize.rs).
 // Pixel centers map to pixel centers: u_in = (x + 0.5) · in / out − 0.5.
 #import "post/resample.wgsl"
 

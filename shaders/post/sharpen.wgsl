@@ -1,6 +1,6 @@
 // Sharpen: unsharp mask c + amount × (c − G_sigma * c), the Gaussian's taps within
 // ceil(3 sigma) pixels, clamped to the edge, normalized; negative results clipped to 0
-// (the CPU reference is in tests/post_effects.rs).
+// (the CPU reference is in tests/post/effects.rs).
 #import "post/resample.wgsl"
 
 struct Params {

@@ -1,6 +1,6 @@
 // Split: each channel of `input` as a grey image (value in rgb, alpha 1). A generic post
 // filter (crates/render/src/nodes/post_filter.rs) with four outputs and no params (so no param block); the CPU reference is
-// in tests/post_combine.rs.
+// in tests/post/combine.rs.
 
 @group(0) @binding(0) var input: texture_2d<f32>;
 @group(0) @binding(1) var out_r: texture_storage_2d<rgba32float, write>;

@@ -1,6 +1,6 @@
 // Vignette: color × (1 − strength · smoothstep(radius, radius + softness, d)), d the distance
 // of the pixel center from the image center in half-diagonals (the CPU reference is in
-// tests/post_vignette.rs).
+// tests/post/vignette.rs).
 #import "post/filter.wgsl"
 
 struct Params {

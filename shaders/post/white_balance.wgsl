@@ -1,7 +1,7 @@
 // White balance: the image's white (a color temperature on the Planckian locus, moved
 // along the isotherm by `tint`) adapted with the Bradford transform to the locus's white
 // at 6504 K (so the defaults change nothing), in linear Rec.709 / sRGB primaries (the CPU
-// reference is in tests/post_grade.rs).
+// reference is in tests/post/grade.rs).
 #import "post/filter.wgsl"
 
 struct Params {

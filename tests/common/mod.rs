@@ -582,8 +582,11 @@ pub fn ray_queries_here(name: &str) -> bool {
         .ok()
         .filter(|p| Path::new(p).is_file());
     if let (Some(icd), false) = (&icd, child) {
+        // The test's whole name, with its module (the test thread is named after it).
+        let current = std::thread::current();
+        let full = current.name().filter(|t| t.ends_with(name)).unwrap_or(name);
         let out = std::process::Command::new(std::env::current_exe().unwrap())
-            .args([name, "--exact", "--nocapture", "--test-threads=1"])
+            .args([full, "--exact", "--nocapture", "--test-threads=1"])
             .env("VK_ICD_FILENAMES", icd)
             .env("LUMAGRAPH_RAY_QUERY_CHILD", "1")
             .output()

@@ -87,7 +87,7 @@ fn a_required_extension_that_is_read_loads() {
     assert_eq!(m.materials[0].transmission, 1.0);
     assert!(m.report.warnings.is_empty(), "{:?}", m.report.warnings);
     // SheenChair's case: a file requiring KHR_texture_transform loads (the extension is
-    // read; its use on textures is tested in tests/textures.rs).
+    // read; its use on textures is tested in tests/pathtrace/textures.rs).
     let text = gltf(
         r#"{"name": "cloth"}"#,
         "",

@@ -1,0 +1,15 @@
+//! Light transport, statistically: every BSDF lobe, media, the sampler, MIS strategies,
+//! and stability on stiff and extreme cases.
+//!
+//! One test binary per area (`cargo test --test light_transport`); one module per subject
+//! (`cargo test --test light_transport bsdf_lobes::`).
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod bsdf_lobes;
+mod media;
+mod rough_diffuse;
+mod sampler;
+mod stability;
+mod strategies;

@@ -1,0 +1,378 @@
+//! Khronos glTF feature-test models (`assets/gltf-conformance/`, each with its README saying
+//! what a correct renderer shows) render as their READMEs say, held by pixel statistics of
+//! the albedo AOV (first hit: base colour × textures × vertex colours) and the CPU ray
+//! cast's material per pixel. Each statistic is also computed on the model with the feature
+//! taken away (a negative control): there it must fail, so that it tells a correct render
+//! from one that ignores the feature.
+
+use crate::common;
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
+use lumagraph::graph::{Graph, Node, ParamValue};
+use lumagraph::render::cpu::Image;
+use lumagraph::render::{Executor, Resources, compile};
+use lumagraph::scene::{GpuScene, Scene, UvTransform, intersect};
+
+/// A scene around the model `rel` (under `assets/gltf-conformance/`), looked at from +z,
+/// framed on its bounding box, `w`×`h` pixels.
+fn scene(rel: &str, w: u32, h: u32) -> Scene {
+    let dir = tempfile::tempdir().unwrap();
+    let model = common::repo(&format!("assets/gltf-conformance/{rel}"));
+    let probe = write_scene(
+        dir.path(),
+        &model,
+        Vec3::new(0.0, 0.0, 10.0),
+        Vec3::ZERO,
+        w,
+        h,
+    );
+    let s = Scene::load(&probe).unwrap();
+    let (lo, hi) = s.triangles.iter().flat_map(|t| t.positions).fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    );
+    let center = 0.5 * (lo + hi);
+    let half = 0.5 * (hi - lo);
+    // fov_y 40°: the larger of the half-height and half-width (over the aspect) fills 90 %.
+    let fit = half.y.max(half.x * h as f32 / w as f32) / 0.9;
+    let eye = center + Vec3::new(0.0, 0.0, half.z + fit / 20f32.to_radians().tan());
+    Scene::load(&write_scene(dir.path(), &model, eye, center, w, h)).unwrap()
+}
+
+fn write_scene(
+    dir: &Path,
+    model: &Path,
+    eye: Vec3,
+    target: Vec3,
+    w: u32,
+    h: u32,
+) -> std::path::PathBuf {
+    let text = format!(
+        "(version: 2,
+  camera: Perspective(position: ({:?}, {:?}, {:?}), target: ({:?}, {:?}, {:?}), up: (0.0, 1.0, 0.0), fov_y: 40.0),
+  shapes: [Mesh(name: \"m\", path: {:?})],
+  environment: Constant((1.0, 1.0, 1.0)),
+  render: (width: {w}, height: {h}, max_bounces: 1, spp: 1, seed: 3),
+)",
+        eye.x, eye.y, eye.z, target.x, target.y, target.z, model.to_string_lossy()
+    );
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Per pixel: the albedo AOV of `PathTrace` (1 spp) and the name of the material the CPU ray
+/// cast meets through the pixel's center (without the mesh's `m/` prefix).
+struct Render {
+    w: u32,
+    albedo: Image,
+    material: Vec<Option<String>>,
+    /// The index in [`Scene::triangles`] of the triangle met.
+    triangle: Vec<Option<u32>>,
+}
+
+impl Render {
+    fn of(scene: &Scene) -> Option<Self> {
+        let ctx = common::gpu()?;
+        let gpu = Arc::new(GpuScene::build(scene).unwrap());
+        let graph = Graph {
+            nodes: vec![Node::new("pt", "PathTrace").with("samples_per_frame", ParamValue::Int(1))],
+            edges: Vec::new(),
+            ..Graph::default()
+        };
+        let plan = compile(&graph, &["pt.albedo".to_owned()], Some(&gpu)).unwrap();
+        let resources = Resources {
+            scene: Some(Arc::clone(&gpu)),
+            traverse_bvh: true,
+            ..Resources::default()
+        };
+        let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+        exec.run_frame().unwrap();
+        let albedo = exec.read_port("pt.albedo").unwrap();
+        let (w, h) = (gpu.settings.width, gpu.settings.height);
+        let hits: Vec<_> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                let ray = common::image_ray(&gpu, Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                intersect(&gpu, &ray)
+            })
+            .collect();
+        let material = hits
+            .iter()
+            .map(|hit| {
+                hit.as_ref().map(|hit| {
+                    let m = gpu.tri_shading[hit.prim as usize].material as usize;
+                    let name = &scene.materials[m].name;
+                    name.strip_prefix("m/").unwrap_or(name).to_owned()
+                })
+            })
+            .collect();
+        let triangle = hits
+            .iter()
+            .map(|hit| hit.as_ref().map(|hit| gpu.tri_source[hit.prim as usize]))
+            .collect();
+        Some(Self {
+            w,
+            albedo,
+            material,
+            triangle,
+        })
+    }
+
+    fn rgb(&self, i: usize) -> Vec3 {
+        let p = self.albedo.pixels[i];
+        Vec3::new(p[0], p[1], p[2])
+    }
+
+    fn xy(&self, i: usize) -> Vec2 {
+        Vec2::new((i as u32 % self.w) as f32, (i as u32 / self.w) as f32)
+    }
+
+    /// The pixels whose material is `name`.
+    fn of_material<'a>(&'a self, name: &'a str) -> impl Iterator<Item = usize> + 'a {
+        (0..self.material.len()).filter(move |&i| self.material[i].as_deref() == Some(name))
+    }
+}
+
+/// Yellow: `TextureTransformTest`'s "offset not applied".
+fn yellow(c: Vec3) -> bool {
+    c.x > 0.35 && c.y > 0.35 && c.z < 0.1
+}
+
+/// A pixel showing two channels and not the third: the secondary colours (cyan, magenta,
+/// yellow) of `VertexColorTest`'s X marks and of `TextureTransformTest`'s "not applied" yellow.
+fn secondary(c: Vec3) -> bool {
+    let (hi, lo) = (0.35, 0.1);
+    let high = [c.x > hi, c.y > hi, c.z > hi];
+    let low = [c.x < lo, c.y < lo, c.z < lo];
+    high.iter().filter(|&&b| b).count() == 2 && low.iter().filter(|&&b| b).count() == 1
+}
+
+/// The share of hit pixels of secondary colour.
+fn secondary_share(r: &Render) -> f64 {
+    let hits: Vec<usize> = (0..r.material.len())
+        .filter(|&i| r.material[i].is_some())
+        .collect();
+    let n = hits.iter().filter(|&&i| secondary(r.rgb(i))).count();
+    n as f64 / hits.len() as f64
+}
+
+/// `VertexColorTest`: "For engines that read the vertex colors and apply them, you should see
+/// two rows of checkmarks … For engines that ignore vertex colors, the top row of checks
+/// will look noticeably mangled: the red check has a cyan X, the green check has a magenta
+/// X, and the blue check has a yellow X." Held: under 0.1 % of the model's pixels are of a
+/// secondary colour (measured 0 %); with the vertex colours dropped, over 1 % (measured
+/// 2.3 %).
+#[test]
+fn vertex_color_test_shows_checks_without_x_marks() {
+    let s = scene("VertexColorTest/VertexColorTest.glb", 240, 240);
+    assert!(s.report.warnings.is_empty(), "{:?}", s.report.warnings);
+    assert!(s.triangles.iter().any(|t| t.colors.is_some()));
+    let Some(applied) = Render::of(&s) else {
+        return;
+    };
+    let mut ignored = s.clone();
+    for t in &mut ignored.triangles {
+        t.colors = None;
+    }
+    let ignored = Render::of(&ignored).unwrap();
+    let (a, b) = (secondary_share(&applied), secondary_share(&ignored));
+    println!(
+        "secondary-colour pixels: {:.3} % applied, {:.3} % ignored",
+        100.0 * a,
+        100.0 * b
+    );
+    assert!(a < 1e-3, "X marks show through the vertex colours: {a}");
+    assert!(b > 1e-2, "the negative control shows no X marks: {b}");
+}
+
+/// The share of a material's pixels that are yellow ("offset not applied").
+fn yellow_share(r: &Render, name: &str) -> f64 {
+    let px: Vec<usize> = r.of_material(name).collect();
+    assert!(px.len() > 200, "{name}: {} pixels", px.len());
+    px.iter().filter(|&&i| yellow(r.rgb(i))).count() as f64 / px.len() as f64
+}
+
+/// Connected groups of the pixels of material `name` (4-neighbours), as their centroids.
+fn blobs(r: &Render, name: &str) -> Vec<Vec2> {
+    let mine: std::collections::HashSet<usize> = r.of_material(name).collect();
+    let mut seen = std::collections::HashSet::new();
+    let mut out = Vec::new();
+    for &start in &mine {
+        if !seen.insert(start) {
+            continue;
+        }
+        let (mut sum, mut n, mut stack) = (Vec2::ZERO, 0.0, vec![start]);
+        while let Some(i) = stack.pop() {
+            sum += r.xy(i);
+            n += 1.0;
+            let w = r.w as usize;
+            let near = [i.wrapping_sub(1), i + 1, i.wrapping_sub(w), i + w];
+            for j in near {
+                let same_row = j / w == i / w || j % w == i % w;
+                if mine.contains(&j) && same_row && seen.insert(j) {
+                    stack.push(j);
+                }
+            }
+        }
+        if n >= 4.0 {
+            out.push(sum / n);
+        }
+    }
+    out
+}
+
+/// For each of `TextureTransformTest`'s Rotation, Scale and All quads: its width in pixels,
+/// and the distance from each of its markers (Correct, `NotSupported`, Error: the marker
+/// quads nearest it) to the nearest pixel of its arrow (its near-black pixels).
+fn arrow_distances(r: &Render) -> Vec<(&'static str, f32, HashMap<&'static str, f32>)> {
+    let quads = ["Rotation", "Scale", "All"].map(|q| {
+        let px: Vec<usize> = r.of_material(q).collect();
+        let (lo, hi) = px.iter().fold((Vec2::MAX, Vec2::MIN), |(lo, hi), &i| {
+            (lo.min(r.xy(i)), hi.max(r.xy(i)))
+        });
+        let arrow: Vec<Vec2> = px
+            .iter()
+            .filter(|&&i| r.rgb(i).max_element() < 0.15)
+            .map(|&i| r.xy(i))
+            .collect();
+        assert!(arrow.len() > 50, "{q}: {} arrow pixels", arrow.len());
+        (q, 0.5 * (lo + hi), hi.x - lo.x, arrow)
+    });
+    let mut out: Vec<_> = quads
+        .iter()
+        .map(|(q, _, w, _)| (*q, *w, HashMap::new()))
+        .collect();
+    for marker in ["Correct", "NotSupported", "Error"] {
+        for c in blobs(r, marker) {
+            let (k, (_, _, _, arrow)) = quads
+                .iter()
+                .enumerate()
+                .min_by(|a, b| a.1.1.distance(c).total_cmp(&b.1.1.distance(c)))
+                .unwrap();
+            let near = arrow.iter().map(|a| a.distance(c)).fold(f32::MAX, f32::min);
+            let e = out[k].2.entry(marker).or_insert(f32::MAX);
+            *e = e.min(near);
+        }
+    }
+    out
+}
+
+/// Whether every quad's arrow points at its Correct marker: within a fifth of the quad's
+/// width of it, and over three tenths of the width from each of its other markers.
+fn arrows_point_at_correct(d: &[(&'static str, f32, HashMap<&'static str, f32>)]) -> bool {
+    d.iter().all(|(_, width, m)| {
+        m.iter().all(|(k, &v)| {
+            if *k == "Correct" {
+                v < 0.2 * width
+            } else {
+                v > 0.3 * width
+            }
+        }) && m.contains_key("Correct")
+    })
+}
+
+/// `TextureTransformTest`: the top row's offsets ("a yellow image indicates that offset was
+/// not applied") and the bottom row's rotation, scale and all three ("the arrow should
+/// point to the green marker"; yellow: not applied; red: rotated the other way). Held: no
+/// yellow pixel on the offset quads (measured 0 %; 75 % with the transforms dropped), and
+/// each arrow within a fifth of its quad's width of its Correct marker and over three
+/// tenths from its other markers (measured at 480×320, quads 130 pixels wide: 17.7, 12.7
+/// and 11.7 pixels to the Correct markers, 52 and more to the others); with the transforms
+/// dropped, or the rotation reversed, some arrow is not (the rotation's arrow 18 pixels
+/// from its `NotSupported` marker, or from its Error marker).
+#[test]
+fn texture_transform_test_arrows_point_at_the_correct_markers() {
+    let s = scene("TextureTransformTest/TextureTransformTest.gltf", 480, 320);
+    assert!(s.report.warnings.is_empty(), "{:?}", s.report.warnings);
+    let Some(applied) = Render::of(&s) else {
+        return;
+    };
+    let mut dropped = s.clone();
+    for t in &mut dropped.textures {
+        t.transform = UvTransform::IDENTITY;
+    }
+    let dropped = Render::of(&dropped).unwrap();
+    // The rotation the other way: the transpose of each 2×2 matrix.
+    let mut reversed = s.clone();
+    for t in &mut reversed.textures {
+        t.transform.m.swap(1, 2);
+    }
+    let reversed = Render::of(&reversed).unwrap();
+    for quad in ["Offset U", "Offset V", "Offset UV"] {
+        let (a, b) = (yellow_share(&applied, quad), yellow_share(&dropped, quad));
+        println!(
+            "{quad}: yellow {:.1} % applied, {:.1} % dropped",
+            100.0 * a,
+            100.0 * b
+        );
+        assert!(a < 0.01, "{quad}: offset not applied ({a})");
+        assert!(b > 0.5, "{quad}: the negative control is not yellow ({b})");
+    }
+    let [a, b, c] = [&applied, &dropped, &reversed].map(arrow_distances);
+    println!("arrow to marker, pixels: applied {a:?}\ndropped {b:?}\nreversed {c:?}");
+    assert!(arrows_point_at_correct(&a), "{a:?}");
+    assert!(
+        !arrows_point_at_correct(&b),
+        "dropped transforms pass: {b:?}"
+    );
+    assert!(
+        !arrows_point_at_correct(&c),
+        "a reversed rotation passes: {c:?}"
+    );
+}
+
+/// `MultiUVTest`: its emissive texture reads `TEXCOORD_1` (the base colour `TEXCOORD_0`), and
+/// both sets are kept.
+#[test]
+fn multi_uv_test_reads_the_second_set() {
+    let s = scene("MultiUVTest/MultiUVTest.glb", 64, 64);
+    assert!(s.report.warnings.is_empty(), "{:?}", s.report.warnings);
+    let m = &s.materials[0];
+    assert_eq!(s.textures[m.textures.emissive as usize].uv_set, 1);
+    assert_eq!(s.textures[m.textures.base_color as usize].uv_set, 0);
+    assert!(
+        s.triangles
+            .iter()
+            .all(|t| t.uvs.is_some() && t.uvs1.is_some())
+    );
+    assert!(s.triangles.iter().any(|t| t.uvs != t.uvs1));
+}
+
+/// `SimpleInstancing`: "125 instances of one cube" — the cube's triangles at each of the 125
+/// instances (distinct centres), and every instance seen in the render.
+#[test]
+fn simple_instancing_draws_every_instance() {
+    let s = scene("SimpleInstancing/SimpleInstancing.glb", 200, 200);
+    assert!(s.report.warnings.is_empty(), "{:?}", s.report.warnings);
+    assert_eq!(
+        s.triangles.len() % 125,
+        0,
+        "{} triangles",
+        s.triangles.len()
+    );
+    // Each of the mesh's triangles at every instance in turn: instance i's are i, i + 125, …
+    let centres: std::collections::HashSet<[i64; 3]> = (0..125)
+        .map(|i| {
+            let tris: Vec<_> = s.triangles.iter().skip(i).step_by(125).collect();
+            let m = tris.iter().flat_map(|t| t.positions).sum::<Vec3>() / (3 * tris.len()) as f32;
+            (m * 1e3).round().as_i64vec3().to_array()
+        })
+        .collect();
+    assert_eq!(centres.len(), 125);
+    let Some(r) = Render::of(&s) else { return };
+    // Seen from +z, the grid's front layer of 25 cubes hides most of the others: at least
+    // those 25 instances are met by the ray cast, and the render covers exactly the pixels
+    // the ray cast hits.
+    let seen: std::collections::HashSet<u32> =
+        r.triangle.iter().flatten().map(|t| t % 125).collect();
+    println!("{} instances seen", seen.len());
+    assert!(seen.len() >= 25, "{} instances seen", seen.len());
+    for (i, m) in r.material.iter().enumerate() {
+        assert_eq!(m.is_some(), r.rgb(i) != Vec3::ZERO, "pixel {i}");
+    }
+}
