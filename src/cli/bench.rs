@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use super::progressive::counter;
 use crate::graph::{Edge, Graph, Node, ParamValue};
-use crate::render::specialize::Feature;
+use crate::render::specialize::{Feature, Intersector};
 use crate::render::{Executor, GpuContext, Resources, compile};
 use crate::scene::GpuScene;
 use anyhow::Result;
@@ -177,7 +177,7 @@ pub fn run(
     // specialized shader as LUMAGRAPH_BVH=binary runs it).
     let binary = if special.on(Feature::WideBvh) {
         let binary = Resources {
-            wide_bvh: Some(false),
+            intersector: Intersector::BinaryBvh,
             ..Resources::default()
         };
         let binary = measure(&ctx, scene, binary, spp, runs)?;
@@ -195,7 +195,7 @@ pub fn run(
     }
     let wgsl = if special.on(Feature::HostRays) {
         let wgsl = Resources {
-            wgsl_intersection: true,
+            intersector: Intersector::WideBvh,
             ..Resources::default()
         };
         let wgsl = measure(&ctx, scene, wgsl, spp, runs)?;

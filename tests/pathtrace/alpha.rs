@@ -10,7 +10,7 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 use lumagraph::graph::{Edge, Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
-use lumagraph::render::specialize::Feature;
+use lumagraph::render::specialize::{Feature, Intersector};
 use lumagraph::render::{Executor, Resources, compile};
 use lumagraph::scene::traverse::{Ray, intersect};
 use lumagraph::scene::{AlphaMode, GpuScene, Scene, Texture, Wrap};
@@ -131,17 +131,16 @@ fn albedos(
 #[test]
 fn masked_checkerboard_shows_the_wall_through_its_holes() {
     let inline_or_bvh = Resources {
-        traverse_bvh: true,
+        as_gpu_adapter: true,
         ..Resources::default()
     };
     let wgsl = Resources {
-        wgsl_intersection: true,
-        wide_bvh: Some(false),
+        intersector: Intersector::BinaryBvh,
         ..Resources::default()
     };
     let wide = Resources {
-        traverse_bvh: true,
-        wide_bvh: Some(true),
+        as_gpu_adapter: true,
+        intersector: Intersector::WideBvh,
         ..Resources::default()
     };
     check_checkerboard(
@@ -171,7 +170,7 @@ fn masked_checkerboard_shows_the_wall_through_ray_queries() {
         return;
     }
     let ray_queries = Resources {
-        ray_queries: true,
+        intersector: Intersector::RayQueries,
         ..Resources::default()
     };
     check_checkerboard(1, &[("ray queries", ray_queries.clone())]);
@@ -280,7 +279,7 @@ fn blended_quad_passes_one_minus_its_opacity() {
         .unwrap();
         let resources = Resources {
             scene: Some(Arc::clone(&gpu)),
-            traverse_bvh: bvh,
+            as_gpu_adapter: bvh,
             ..Resources::default()
         };
         let mut exec = Executor::new(ctx, plan, &resources).unwrap();

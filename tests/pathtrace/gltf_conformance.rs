@@ -87,7 +87,7 @@ impl Render {
         let plan = compile(&graph, &["pt.albedo".to_owned()], Some(&gpu)).unwrap();
         let resources = Resources {
             scene: Some(Arc::clone(&gpu)),
-            traverse_bvh: true,
+            as_gpu_adapter: true,
             ..Resources::default()
         };
         let mut exec = Executor::new(ctx, plan, &resources).unwrap();

@@ -16,7 +16,7 @@ use std::sync::Arc;
 
 use lumagraph::graph::{Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
-use lumagraph::render::specialize::{Feature, Features};
+use lumagraph::render::specialize::{Feature, Features, Intersector};
 use lumagraph::render::{Executor, Resources, compile, image_io, metrics};
 use lumagraph::scene::{GpuScene, Scene};
 
@@ -182,7 +182,11 @@ fn a_frame_of_many_samples_traces_every_path() {
         let plan = compile(&graph, &["acc.color".to_owned()], Some(&grid)).unwrap();
         let resources = Resources {
             scene: Some(Arc::clone(&grid)),
-            wgsl_intersection: wgsl,
+            intersector: if wgsl {
+                Intersector::WideBvh
+            } else {
+                Intersector::Auto
+            },
             ..Resources::default()
         };
         let mut exec = Executor::new(ctx, plan, &resources).unwrap();
@@ -293,7 +297,7 @@ fn render_small(
         spp,
         Resources {
             scene_data_in_buffers: in_buffers,
-            traverse_bvh: bvh,
+            as_gpu_adapter: bvh,
             ..Resources::default()
         },
     )
@@ -404,7 +408,7 @@ fn leaving_out_a_missing_primitive_kind_renders_bit_identical_images() {
                 8,
                 Resources {
                     general_shaders: general,
-                    traverse_bvh: true,
+                    as_gpu_adapter: true,
                     scene_data_in_buffers: true,
                     ..Resources::default()
                 },
@@ -496,7 +500,7 @@ fn host_against_wgsl(name: &str, size: (u32, u32), spp: u32) -> Option<HostAgain
         return None;
     }
     let wgsl_only = Resources {
-        wgsl_intersection: true,
+        intersector: Intersector::WideBvh,
         ..Resources::default()
     };
     let (wgsl, how_wgsl) = common::render_with(name, size, spp, wgsl_only).unwrap();

@@ -11,7 +11,7 @@ use crate::common;
 
 use lumagraph::render::Resources;
 use lumagraph::render::specialize::{
-    AdapterTraits, Feature, Features, PathTraceOptions, Specialization,
+    AdapterTraits, Feature, Features, Intersector, PathTraceOptions, Specialization,
 };
 use lumagraph::scene::{GpuScene, Scene};
 
@@ -24,7 +24,11 @@ fn options(traits: AdapterTraits, forced: bool) -> PathTraceOptions {
         specialize: true,
         cpu_adapter: traits.cpu,
         ray_query_limit: traits.ray_query_limit,
-        ray_queries_forced: forced,
+        intersector: if forced {
+            Intersector::RayQueries
+        } else {
+            Intersector::Auto
+        },
         ..PathTraceOptions::default()
     }
 }
@@ -150,13 +154,13 @@ fn ray_queries_are_chosen_where_the_device_has_them() {
 fn against_wgsl_bvh(name: &str) -> Option<(usize, f64)> {
     // Both as a GPU adapter runs (the same dispatches, materials read from buffers).
     let rq = Resources {
-        ray_queries: true,
-        traverse_bvh: true,
+        intersector: Intersector::RayQueries,
+        as_gpu_adapter: true,
         ..Resources::default()
     };
     let bvh = Resources {
-        traverse_bvh: true,
-        wide_bvh: Some(false),
+        as_gpu_adapter: true,
+        intersector: Intersector::BinaryBvh,
         ..Resources::default()
     };
     common::same_hits(name, rq, bvh, |a, b| {

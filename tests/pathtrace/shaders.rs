@@ -36,21 +36,21 @@ fn entry_shaders() -> Vec<&'static str> {
 /// Fragments only the path tracer's specialization imports (in place of
 /// `pathtrace/intersect.wgsl`), with the whole shader it assembles around each.
 fn specialized_sources() -> Vec<(&'static str, String)> {
-    use lumagraph::render::specialize::{PathTraceOptions, Specialization};
+    use lumagraph::render::specialize::{Intersector, PathTraceOptions, Specialization};
     use lumagraph::scene::{GpuScene, Scene};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell_spheres.ron");
     let scene = GpuScene::build(&Scene::load(&path).unwrap()).unwrap();
     let ray_queries = PathTraceOptions {
         specialize: true,
         ray_query_limit: Some(1 << 24),
-        ray_queries_forced: true,
+        intersector: Intersector::RayQueries,
         ..PathTraceOptions::default()
     };
     let source = Specialization::new(&scene, ray_queries).source().unwrap();
     assert!(source.contains("rayQueryInitialize"));
     let wide = PathTraceOptions {
         specialize: true,
-        wide_bvh: Some(true),
+        intersector: Intersector::WideBvh,
         ..PathTraceOptions::default()
     };
     let wide_source = Specialization::new(&scene, wide).source().unwrap();

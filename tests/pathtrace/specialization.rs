@@ -195,7 +195,7 @@ fn frames(scene: &GpuScene, general: bool, seed: u32) -> Option<(Vec<Image>, Fea
     let resources = Resources {
         scene: Some(Arc::clone(&scene)),
         general_shaders: general,
-        traverse_bvh: true,
+        as_gpu_adapter: true,
         scene_data_in_buffers: true,
         ..Resources::default()
     };

@@ -323,7 +323,7 @@ fn render(scene: &Arc<GpuScene>, spp: i64) -> Option<[Image; 5]> {
     // scene, x = y = 0.667 on a quad from (0, 0) to (1, 1), is such a crack).
     let resources = Resources {
         scene: Some(Arc::clone(scene)),
-        traverse_bvh: true,
+        as_gpu_adapter: true,
         ..Resources::default()
     };
     let mut exec = Executor::new(ctx, plan, &resources).unwrap();

@@ -7,7 +7,9 @@
 use crate::common;
 
 use lumagraph::render::Resources;
-use lumagraph::render::specialize::{Feature, Features, PathTraceOptions, Specialization};
+use lumagraph::render::specialize::{
+    Feature, Features, Intersector, PathTraceOptions, Specialization,
+};
 use lumagraph::render::wide_bvh::{WIDE_BVH_STACK, WideBvh};
 use lumagraph::scene::{GpuScene, PRIM_SPHERE, Scene};
 
@@ -16,50 +18,91 @@ fn scene(rel: &str) -> GpuScene {
 }
 
 /// The choice, without a device: a CPU adapter walks the wide BVH where it traverses one in
-/// WGSL (not where it intersects a small scene inline), a GPU adapter the binary one;
-/// `Some(true)` / `Some(false)` (`LUMAGRAPH_BVH=wide` / `binary`) ask for either; ray queries
-/// and the general shader never use it. The shader traverses the wide BVH (`wide_bvh.wgsl`)
+/// WGSL (not where it intersects a small scene inline or on the host), a GPU adapter the
+/// binary one, and neither where ray queries trace the scene; `Intersector::WideBvh` /
+/// `BinaryBvh` (`LUMAGRAPH_BVH=wide` / `binary`) ask for either, over inline, host and ray
+/// queries alike; the general shader never uses it. The shader traverses the wide BVH (`wide_bvh.wgsl`)
 /// exactly where it is chosen, and the plan's reasons name the measurements.
 #[test]
 fn the_wide_bvh_is_chosen_on_cpu_adapters_and_where_asked() {
     let small = scene("assets/cornell_spheres.ron");
     let large = scene("tests/scenes/mesh_env.ron");
-    let opts = |cpu: bool, ray_query_limit: Option<u32>, wide_bvh: Option<bool>| PathTraceOptions {
+    let opts = |cpu: bool, ray_query_limit: Option<u32>, intersector| PathTraceOptions {
         specialize: true,
         cpu_adapter: cpu,
         ray_query_limit,
-        wide_bvh,
+        intersector,
         ..PathTraceOptions::default()
     };
     let cases = [
-        ("GPU", &large, opts(false, None, None), false),
-        ("GPU, asked", &large, opts(false, None, Some(true)), true),
+        ("GPU", &large, opts(false, None, Intersector::Auto), false),
+        (
+            "GPU, asked",
+            &large,
+            opts(false, None, Intersector::WideBvh),
+            true,
+        ),
         (
             "GPU, small scene, asked",
             &small,
-            opts(false, None, Some(true)),
+            opts(false, None, Intersector::WideBvh),
             true,
+        ),
+        (
+            "GPU with ray queries",
+            &large,
+            opts(false, Some(1 << 24), Intersector::Auto),
+            false,
         ),
         (
             "GPU with ray queries, asked",
             &large,
-            opts(false, Some(1 << 24), Some(true)),
-            false,
+            opts(false, Some(1 << 24), Intersector::WideBvh),
+            true,
         ),
-        ("CPU", &large, opts(true, None, None), true),
+        ("CPU", &large, opts(true, None, Intersector::Auto), true),
         (
             "CPU, binary asked for",
             &large,
-            opts(true, None, Some(false)),
+            opts(true, None, Intersector::BinaryBvh),
             false,
         ),
-        ("CPU, small scene", &small, opts(true, None, None), false),
+        (
+            "CPU, small scene",
+            &small,
+            opts(true, None, Intersector::Auto),
+            false,
+        ),
+        (
+            "CPU, small scene, asked",
+            &small,
+            opts(true, None, Intersector::WideBvh),
+            true,
+        ),
+        (
+            "CPU with a host intersector",
+            &large,
+            PathTraceOptions {
+                host_rays: true,
+                ..opts(true, None, Intersector::Auto)
+            },
+            false,
+        ),
+        (
+            "CPU with a host intersector, asked",
+            &large,
+            PathTraceOptions {
+                host_rays: true,
+                ..opts(true, None, Intersector::WideBvh)
+            },
+            true,
+        ),
         (
             "general shader, asked",
             &large,
             PathTraceOptions {
                 specialize: false,
-                ..opts(false, None, Some(true))
+                ..opts(false, None, Intersector::WideBvh)
             },
             false,
         ),
@@ -79,7 +122,7 @@ fn the_wide_bvh_is_chosen_on_cpu_adapters_and_where_asked() {
         assert_eq!(source.contains("WIDE_ROBUST_FAR"), expected, "{what}");
     }
     for (cpu, measured_on) in [(false, "H200"), (true, "lavapipe")] {
-        let f = Features::decide(&large, opts(cpu, None, None));
+        let f = Features::decide(&large, opts(cpu, None, Intersector::Auto));
         let why = f.reason(Feature::WideBvh);
         assert!(why.contains(measured_on), "{why}");
     }
@@ -260,13 +303,13 @@ fn records_nodes(bvh: &WideBvh) -> usize {
 #[test]
 fn the_wide_bvh_renders_what_the_binary_bvh_renders() {
     let wide = Resources {
-        traverse_bvh: true,
-        wide_bvh: Some(true),
+        as_gpu_adapter: true,
+        intersector: Intersector::WideBvh,
         ..Resources::default()
     };
     let binary = Resources {
-        traverse_bvh: true,
-        wide_bvh: Some(false),
+        as_gpu_adapter: true,
+        intersector: Intersector::BinaryBvh,
         ..Resources::default()
     };
     for name in [

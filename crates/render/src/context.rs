@@ -454,18 +454,19 @@ pub fn ray_queries_turned_off() -> bool {
     std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "off" || v == "0")
 }
 
-/// What `LUMAGRAPH_BVH` asks of the WGSL traversal: `wide` the 8-wide BVH, `binary` the
-/// binary one ([`crate::wide_bvh`]); `None` where it is not set (the adapter's default).
-pub fn wide_bvh_asked_for() -> Option<bool> {
-    match std::env::var("LUMAGRAPH_BVH").ok()?.as_str() {
-        "wide" => Some(true),
-        "binary" => Some(false),
-        _ => None,
+/// The intersector the environment asks for: `LUMAGRAPH_RAY_QUERY=on` the device's ray
+/// queries wherever they can trace the scene, even on a CPU adapter; `LUMAGRAPH_BVH=wide`
+/// or `binary` the 8-wide or the binary BVH in WGSL ([`crate::wide_bvh`]), even where the
+/// scene would be intersected inline or on the host. Otherwise
+/// [`Intersector::Auto`](crate::specialize::Intersector::Auto).
+pub fn intersector_asked_for() -> crate::specialize::Intersector {
+    use crate::specialize::Intersector;
+    if std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "on" || v == "1") {
+        return Intersector::RayQueries;
     }
-}
-
-/// Whether `LUMAGRAPH_RAY_QUERY=on` asks the path tracer to trace through the device's ray
-/// queries wherever they can trace the scene, even on a CPU adapter (benchmarks).
-pub fn ray_queries_asked_for() -> bool {
-    std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "on" || v == "1")
+    match std::env::var("LUMAGRAPH_BVH").as_deref() {
+        Ok("wide") => Intersector::WideBvh,
+        Ok("binary") => Intersector::BinaryBvh,
+        _ => Intersector::Auto,
+    }
 }

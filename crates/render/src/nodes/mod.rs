@@ -45,24 +45,17 @@ pub struct Resources {
     /// In the specialized shader, keep materials, lights and shading data in their storage
     /// buffers even where they could be written into the code (tests and benchmarks).
     pub scene_data_in_buffers: bool,
-    /// Traverse the BVH even where a CPU adapter would intersect a small scene inline: what
-    /// GPU adapters without ray queries run (tests compare the two on lavapipe).
-    pub traverse_bvh: bool,
-    /// Trace the path tracer's rays through the device's ray queries wherever they can
-    /// trace the scene, even where a CPU adapter would intersect it inline or on the host
-    /// (tests compare them with the WGSL BVH on lavapipe). With `traverse_bvh`, as a GPU
-    /// adapter with ray queries would (`traverse_bvh` alone: as one without).
-    pub ray_queries: bool,
-    /// Whether the WGSL traversal walks the 8-wide BVH ([`crate::wide_bvh`]): `Some`
-    /// forces it on or off (tests compare the two on lavapipe; with `traverse_bvh`, as a
-    /// GPU adapter), `None` leaves it to `LUMAGRAPH_BVH` and the adapter.
-    pub wide_bvh: Option<bool>,
+    /// Decide the path tracer's shader as a GPU adapter would (no inline intersection, no
+    /// host, no spreading of workgroups, ray queries only where `intersector` asks for them)
+    /// even on a CPU adapter: tests run what GPUs run on lavapipe.
+    pub as_gpu_adapter: bool,
+    /// The path tracer's intersector, where a test or a benchmark asks for one
+    /// ([`crate::specialize::Intersector`]; `Auto`, the default: the scene, the adapter and
+    /// `LUMAGRAPH_BVH` / `LUMAGRAPH_RAY_QUERY` decide).
+    pub intersector: crate::specialize::Intersector,
     /// Trace workgroups in image order even on a CPU adapter, where they are otherwise
     /// spread over the image to balance the driver's threads (a test compares the two).
     pub workgroups_in_image_order: bool,
-    /// Intersect in WGSL even on a CPU adapter where the host could (Embree found): what
-    /// the path tracer runs without Embree (tests compare the two).
-    pub wgsl_intersection: bool,
 }
 
 /// An image a sink would write: its pixels and what they are.

@@ -47,22 +47,24 @@ fn adaptive_on(pass: &Pass) -> bool {
 
 /// How a pass's shader is specialized: to the scene unless the resources ask for the
 /// general shader, to the kind of adapter, with first-hit AOVs when something reads them.
-/// `resources.traverse_bvh` has it run as a GPU adapter would: through the WGSL BVH, or
-/// with `resources.ray_queries` too, through ray queries.
+/// `resources.as_gpu_adapter` has it decided as on a GPU adapter, `resources.intersector`
+/// (else `LUMAGRAPH_BVH` or `LUMAGRAPH_RAY_QUERY`) asks for an intersector.
 fn options(
     pass: &Pass,
     resources: &Resources,
     traits: crate::specialize::AdapterTraits,
 ) -> crate::specialize::PathTraceOptions {
-    let cpu_adapter = traits.cpu && !resources.traverse_bvh;
+    use crate::specialize::Intersector;
+    let cpu_adapter = traits.cpu && !resources.as_gpu_adapter;
+    let intersector = match resources.intersector {
+        Intersector::Auto => crate::context::intersector_asked_for(),
+        asked => asked,
+    };
     crate::specialize::PathTraceOptions {
         ray_query_limit: traits
             .ray_query_limit
-            .filter(|_| !resources.traverse_bvh || resources.ray_queries),
-        ray_queries_forced: resources.ray_queries || crate::context::ray_queries_asked_for(),
-        wide_bvh: resources
-            .wide_bvh
-            .or_else(crate::context::wide_bvh_asked_for),
+            .filter(|_| !resources.as_gpu_adapter || intersector == Intersector::RayQueries),
+        intersector,
         specialize: !resources.general_shaders,
         cpu_adapter,
         data_in_buffers: resources.scene_data_in_buffers,
@@ -71,9 +73,7 @@ fn options(
             .iter()
             .any(|p| pass.output(p).is_some()),
         adaptive: adaptive_on(pass),
-        host_rays: cpu_adapter
-            && !resources.wgsl_intersection
-            && crate::embree::Embree::load().is_ok(),
+        host_rays: cpu_adapter && crate::embree::Embree::load().is_ok(),
     }
 }
 

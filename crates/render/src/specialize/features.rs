@@ -14,7 +14,7 @@ use lumagraph_scene::{
     MATERIAL_ALPHA_MASK, MATERIAL_INDEX_MATCHED, MATERIAL_MEDIUM,
 };
 
-use super::{INLINE_MAX_MATERIALS, INLINE_MAX_PRIMITIVES, PathTraceOptions, codegen};
+use super::{INLINE_MAX_MATERIALS, INLINE_MAX_PRIMITIVES, Intersector, PathTraceOptions, codegen};
 
 /// One part of the path tracer that a shader compiles in or leaves out.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -365,6 +365,9 @@ const GPU_WIDE_BVH_REASON: &str = "the binary BVH: the 8-wide one measured 0.82x
 struct Facts<'a> {
     scene: &'a GpuScene,
     options: PathTraceOptions,
+    /// The intersector asked for, where it can trace the scene ([`Intersector::Auto`]
+    /// where it cannot: the adapter's choice).
+    asked: Intersector,
     /// The general shader: everything compiled in.
     all: bool,
     prims: usize,
@@ -395,15 +398,30 @@ impl<'a> Facts<'a> {
                 Some(most) => crate::accel::unsupported(scene, most),
             }
         };
-        let forced = options.ray_queries_forced && no_ray_queries.is_none();
-        let inline =
-            options.specialize && options.cpu_adapter && prims <= INLINE_MAX_PRIMITIVES && !forced;
-        let host = super::host_rays_decision(scene, options, inline, forced);
+        // The intersector asked for where it can trace the scene; else the adapter decides.
+        let asked = match options.intersector {
+            Intersector::RayQueries if no_ray_queries.is_some() => Intersector::Auto,
+            Intersector::Inline if !options.specialize || prims > INLINE_MAX_PRIMITIVES => {
+                Intersector::Auto
+            }
+            asked => asked,
+        };
+        let inline = options.specialize
+            && prims <= INLINE_MAX_PRIMITIVES
+            && match asked {
+                Intersector::Auto => options.cpu_adapter,
+                Intersector::Inline => true,
+                _ => false,
+            };
+        let host = super::host_rays_decision(scene, options, inline, asked);
         let ray_queries = match no_ray_queries {
             Some(why) => decision(false, why),
             None if inline => decision(false, "intersected inline"),
             None if host.included => decision(false, "rays intersected on the host"),
-            None if forced => decision(true, "asked for"),
+            None if asked == Intersector::RayQueries => decision(true, "asked for"),
+            None if asked != Intersector::Auto => {
+                decision(false, format!("{} asked for", asked.describe()))
+            }
             None if options.cpu_adapter => decision(false, CPU_RAY_QUERIES_REASON),
             None => decision(
                 true,
@@ -422,6 +440,7 @@ impl<'a> Facts<'a> {
         Self {
             scene,
             options,
+            asked,
             all: !options.specialize,
             prims,
             inline,
@@ -583,11 +602,11 @@ impl<'a> Facts<'a> {
         } else if !o.specialize {
             decision(false, "general shader: the binary BVH")
         } else {
-            match o.wide_bvh {
-                Some(true) => decision(true, "asked for"),
-                Some(false) => decision(false, "the binary BVH asked for"),
-                None if o.cpu_adapter => decision(true, CPU_WIDE_BVH_REASON),
-                None => decision(false, GPU_WIDE_BVH_REASON),
+            match self.asked {
+                Intersector::WideBvh => decision(true, "asked for"),
+                Intersector::BinaryBvh => decision(false, "the binary BVH asked for"),
+                _ if o.cpu_adapter => decision(true, CPU_WIDE_BVH_REASON),
+                _ => decision(false, GPU_WIDE_BVH_REASON),
             }
         }
     }

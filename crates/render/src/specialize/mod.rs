@@ -38,6 +38,46 @@ pub struct AdapterTraits {
     pub ray_query_limit: Option<u32>,
 }
 
+/// The path tracer's intersectors. Each implements the contract of
+/// `shaders/pathtrace/contract.wgsl` (the closest hit, occlusion up to a distance, the
+/// alpha any-hit test); the Rust mirror (`lumagraph_scene::traverse`) follows it on the CPU.
+/// Which one traces a scene is decided once per shader ([`Feature`]); this is what a test,
+/// a benchmark or an environment variable may ask for instead of that decision.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Intersector {
+    /// The scene and the adapter decide: on CPU adapters, small scenes inline, larger ones
+    /// on the host (Embree) where it can trace them, else the 8-wide BVH; on GPU adapters,
+    /// ray queries where the device has them, else the binary BVH.
+    #[default]
+    Auto,
+    /// Every primitive tested in code written for the scene (`codegen`), for scenes of at
+    /// most [`INLINE_MAX_PRIMITIVES`] primitives.
+    Inline,
+    /// The host (Embree), on CPU adapters, for the scenes it can trace.
+    Host,
+    /// The binary stackless BVH traversed in WGSL (`pathtrace/bvh.wgsl`).
+    BinaryBvh,
+    /// The 8-wide compressed BVH traversed in WGSL (`pathtrace/wide_bvh.wgsl`).
+    WideBvh,
+    /// The device's ray queries (`pathtrace/ray_query.wgsl`), where it has them and they
+    /// can trace the scene.
+    RayQueries,
+}
+
+impl Intersector {
+    /// What it is, in the plan's words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Auto => "the adapter's choice",
+            Self::Inline => "inline intersection",
+            Self::Host => "host intersection",
+            Self::BinaryBvh => "the binary BVH",
+            Self::WideBvh => "the 8-wide BVH",
+            Self::RayQueries => "ray queries",
+        }
+    }
+}
+
 /// What the graph needs of the path tracer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PathTraceOptions {
@@ -60,22 +100,16 @@ pub struct PathTraceOptions {
     /// image (the images are bit-identical; a test compares the two).
     pub in_image_order: bool,
     /// On a CPU adapter, whether the host can intersect the path tracer's rays (Embree was
-    /// found, [`crate::embree`]) and may: the scene's rays are then traced there when the
-    /// BVH would be traversed, and the scene allows (see [`features`]).
+    /// found, [`crate::embree`]): the scene's rays are then traced there when the BVH would
+    /// be traversed, and the scene allows (see [`features`]).
     pub host_rays: bool,
     /// Where the device has ray queries ([`crate::accel`]): the most primitives one of its
     /// acceleration structures holds. GPU adapters trace through them wherever the scene
     /// would otherwise traverse the BVH in WGSL.
     pub ray_query_limit: Option<u32>,
-    /// Trace through the device's ray queries wherever they can trace the scene, even
-    /// where a CPU adapter would intersect inline or on the host (tests compare them with
-    /// the WGSL BVH on lavapipe).
-    pub ray_queries_forced: bool,
-    /// Whether the WGSL traversal walks the 8-wide BVH ([`crate::wide_bvh`]) where it
-    /// traverses a BVH: `Some` where asked (`LUMAGRAPH_BVH=wide` or `binary`, or tests),
-    /// `None` for the adapter's default: the wide one on CPU adapters, the binary one on
-    /// GPU adapters (measured, see [`Feature::WideBvh`]).
-    pub wide_bvh: Option<bool>,
+    /// The intersector asked for (tests, benchmarks, `LUMAGRAPH_BVH`, `LUMAGRAPH_RAY_QUERY`),
+    /// or [`Intersector::Auto`]: the scene and the adapter decide.
+    pub intersector: Intersector,
 }
 
 /// A path tracer shader specialized to one scene, adapter and graph: its features, decided
@@ -233,7 +267,7 @@ fn host_rays_decision(
     scene: &GpuScene,
     options: PathTraceOptions,
     inline: bool,
-    ray_queries_forced: bool,
+    asked: Intersector,
 ) -> Decision {
     let media = scene.materials.iter().any(|x| {
         x.flags & (lumagraph_scene::MATERIAL_MEDIUM | lumagraph_scene::MATERIAL_INDEX_MATCHED) != 0
@@ -245,8 +279,8 @@ fn host_rays_decision(
         )
     } else if inline {
         (false, "intersected inline".to_owned())
-    } else if ray_queries_forced {
-        (false, "ray queries asked for".to_owned())
+    } else if !matches!(asked, Intersector::Auto | Intersector::Host) {
+        (false, format!("{} asked for", asked.describe()))
     } else if !options.host_rays {
         (
             false,
