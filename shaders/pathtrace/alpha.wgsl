@@ -8,9 +8,10 @@
 // the ray and the primitive alone, so it is the same wherever the ray is traced). Camera
 // rays, bounces and shadow rays all take it. Compiled in with HAS_ALPHA only.
 //
-// Uses the includer's scene access (`scene_material`, `scene_tri_shading`, `scene_sphere`,
-// `tri_texcoords`) and textures.wgsl.
+// From its includer: the bindings `tri_texcoords` and `textures`.
 #import "pathtrace/scene_types.wgsl"
+#import "pathtrace/options.wgsl"
+#import "pathtrace/scene_data.wgsl"
 #import "common/rng.wgsl"
 #import "pathtrace/textures.wgsl"
 

@@ -16,7 +16,9 @@
 // The GGX albedo tables (`ggx_table`, computed by crates/render/src/bsdf_tables.rs and
 // declared by the includer) make the white furnace white at every roughness.
 // Vectors are in the shading frame (normal = +z); wo points to the viewer.
+// From its includer: the binding `ggx_table` (the GGX albedo tables, crates/render/src/bsdf_tables.rs).
 #import "pathtrace/scene_types.wgsl"
+#import "pathtrace/options.wgsl"
 #import "common/color.wgsl"
 #import "common/sampling.wgsl"
 #import "pathtrace/eon.wgsl"

@@ -3,9 +3,9 @@
 // A candidate primitive tested as every intersector tests the primitives it finds (the BVH's
 // leaves, the wide BVH's, the device's ray-query candidates): the exact ray/primitive test,
 // the rules for rays leaving a surface (`skip_prim`, the origin's error, primitives.wgsl) and
-// the any-hit test of alpha-masked and blended materials (alpha.wgsl). The including shader
-// declares `tri_positions` and `spheres` and the constant HAS_ALPHA, with the any-hit tests
-// `triangle_hit_counts` and `sphere_hit_counts`.
+// the any-hit test of alpha-masked and blended materials (alpha.wgsl).
+// From its includer: the bindings `tri_positions` and `spheres`, the constant `HAS_ALPHA`,
+// and the any-hit tests `triangle_hit_counts` and `sphere_hit_counts`.
 
 // Triangle `i`: vec4(1, t, u, v) where it counts as a hit with 0 < t < t_max, else x = 0.
 fn candidate_triangle(i: u32, ray: Ray, t_max: f32) -> vec4<f32> {

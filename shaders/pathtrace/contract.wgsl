@@ -1,4 +1,7 @@
+// From its includer: `trace_scene(ray, t_max, any_hit)`, the intersector's walk (bvh.wgsl,
+// wide_bvh.wgsl and ray_query.wgsl each define it and import this file).
 #import "pathtrace/scene_types.wgsl"
+#import "pathtrace/primitives.wgsl"
 
 // The intersector contract, for intersectors that trace a ray with one function: the
 // including file defines

@@ -6,8 +6,15 @@
 // boundary, MATERIAL_INDEX_MATCHED) and leaves it through its front. One medium at a time:
 // the scene loader refuses media that overlap (so none is nested in another), and paths
 // start outside every medium (the camera must not be in one).
-// Uses the includer's scene access (`scene_material`, `surface_at`, `leave`,
-// `intersect_scene_within`) and its `ray_count`.
+// Also next-event estimation from a point in a medium (`medium_next_event`).
+// From its includer (pathtrace/pathtrace.wgsl): `frame`, the binding `lights` and
+// `ray_count`.
+#import "pathtrace/scene_types.wgsl"
+#import "pathtrace/intersect.wgsl"
+#import "pathtrace/scene_data.wgsl"
+#import "pathtrace/surface.wgsl"
+#import "pathtrace/lights.wgsl"
+#import "pathtrace/mis.wgsl"
 
 // `medium_id` when the path is in no medium.
 const NO_MEDIUM: u32 = 0xffffffffu;
@@ -84,4 +91,25 @@ fn shadow_transmittance(shadow: Ray, t_max: f32, medium: u32) -> vec3f {
     }
     skip_prim = saved_skip;
     return tr;
+}
+
+// Light reaching medium point `p` (a ray travelling along `dir` scattered there, phase
+// asymmetry `g`) by next-event estimation, over the scattering coefficient: phase function
+// times radiance times transmittance over the light sample's pdf, MIS-weighted against
+// phase sampling.
+fn medium_next_event(p: vec3f, dir: vec3f, g: f32, bounce: u32, has_lights: bool) -> vec3f {
+    let p_env = env_select_prob();
+    if !(has_lights || p_env > 0.0) {
+        return vec3f(0.0);
+    }
+    let ls = sample_next_event(p, bounce, p_env);
+    if !(ls.pdf > 0.0) || !(ls.delta || frame.strategy != STRATEGY_BSDF) {
+        return vec3f(0.0);
+    }
+    let phase = hg_eval(dot(dir, ls.wi), g);
+    leave_no_surface();
+    ray_count += 1u;
+    let tr = shadow_transmittance(Ray(p, ls.wi), ls.dist - ls.margin, medium_id);
+    let w = select(light_weight(ls.pdf, phase), 1.0, ls.delta);
+    return phase * ls.radiance * tr * (w / ls.pdf);
 }

@@ -20,8 +20,9 @@
 // edges, and a ray the device sends to one triangle and the exact test to none would go
 // through.)
 //
-// The including shader declares `tri_positions` and `spheres` (as for bvh.wgsl) and the
-// constants HAS_TRIANGLES, HAS_SPHERES and HAS_ALPHA.
+// From its includer: the bindings `tri_positions` and `spheres` (as for bvh.wgsl), the
+// constants `HAS_TRIANGLES`, `HAS_SPHERES` and `HAS_ALPHA`, and the any-hit tests
+// `triangle_hit_counts` and `sphere_hit_counts`.
 
 @group(0) @binding(24) var scene_accel: acceleration_structure;
 

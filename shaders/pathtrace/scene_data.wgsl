@@ -3,6 +3,8 @@
 // buffers the includer declares. For small scenes the renderer replaces this file with
 // generated code that returns them from `switch` statements with the values written into the
 // shader, so no bounce loads them from memory (see crates/render/src/specialize.rs).
+// From its includer: the bindings `materials`, `lights`, `light_alias`, `tri_positions`,
+// `tri_shading` and `spheres`.
 #import "pathtrace/scene_types.wgsl"
 
 fn scene_material(id: u32) -> Material {

@@ -1,3 +1,7 @@
+// From its includer: the bindings `bvh_nodes`, `tri_positions` and `spheres`, the constants
+// `HAS_TRIANGLES`, `HAS_SPHERES` and `HAS_ALPHA`, and the any-hit tests `triangle_hit_counts`
+// and `sphere_hit_counts` (in the path tracer options.wgsl and alpha.wgsl; raycast.wgsl
+// declares its own).
 #import "pathtrace/primitives.wgsl"
 #import "pathtrace/candidates.wgsl"
 #import "pathtrace/contract.wgsl"

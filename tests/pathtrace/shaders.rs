@@ -105,6 +105,151 @@ fn every_shader_validates_with_naga() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// The identifiers of WGSL source `text` (comments left out, and members after a `.`),
+/// each with the character that follows it (`(` for a call, `:` for a parameter or a
+/// member declared).
+fn identifiers(text: &str) -> Vec<(String, char)> {
+    let code: String = text
+        .lines()
+        .map(|l| l.split("//").next().unwrap_or(""))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let chars: Vec<char> = code.chars().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        if c.is_ascii_alphabetic() || c == '_' {
+            let start = i;
+            while i < chars.len() && (chars[i].is_ascii_alphanumeric() || chars[i] == '_') {
+                i += 1;
+            }
+            let word: String = chars[start..i].iter().collect();
+            let mut j = i;
+            while j < chars.len() && chars[j].is_whitespace() {
+                j += 1;
+            }
+            let preceded_by_dot = start > 0 && chars[start - 1] == '.';
+            if !preceded_by_dot {
+                out.push((word, chars.get(j).copied().unwrap_or(' ')));
+            }
+        } else if c.is_ascii_digit() {
+            while i < chars.len() && (chars[i].is_ascii_alphanumeric() || chars[i] == '.') {
+                i += 1;
+            }
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+/// The module-scope names `text` declares: functions, structs, constants, variables
+/// (what is inside braces, bodies and members, left out).
+fn declared(text: &str) -> std::collections::BTreeSet<String> {
+    let mut depth = 0usize;
+    let mut top = String::new();
+    for line in text.lines() {
+        for c in line.split("//").next().unwrap_or("").chars() {
+            match c {
+                '{' => depth += 1,
+                '}' => depth = depth.saturating_sub(1),
+                _ if depth == 0 => top.push(c),
+                _ => {}
+            }
+        }
+        top.push('\n');
+    }
+    let words = identifiers(&top);
+    let mut out = std::collections::BTreeSet::new();
+    for (k, (word, _)) in words.iter().enumerate() {
+        if matches!(
+            word.as_str(),
+            "fn" | "struct" | "const" | "alias" | "override"
+        ) && let Some((name, _)) = words.get(k + 1)
+        {
+            out.insert(name.clone());
+        }
+    }
+    // `var<storage, read> name`, `var<private> name`, `var name`: the first word after the
+    // address space that is not one.
+    for (k, (word, _)) in words.iter().enumerate() {
+        if word == "var" {
+            let name = words[k + 1..].iter().map(|(w, _)| w).find(|w| {
+                !matches!(
+                    w.as_str(),
+                    "storage"
+                        | "read"
+                        | "read_write"
+                        | "private"
+                        | "uniform"
+                        | "workgroup"
+                        | "function"
+                )
+            });
+            if let Some(name) = name {
+                out.insert(name.clone());
+            }
+        }
+    }
+    out
+}
+
+/// No file of the path tracer leans on its includer unannounced: what a file of
+/// `shaders/pathtrace/` or `shaders/common/` uses (a function it calls, a module-scope
+/// variable, binding or constant it reads) is defined by the file itself or by what it
+/// imports, or is named on its `From its includer` line. Checked against everything those
+/// files define at module scope, so a new file cannot silently call what only one includer
+/// defines, and each file says what it needs to be read or replaced on its own.
+#[test]
+fn every_path_tracer_file_imports_or_names_what_it_uses() {
+    let names: Vec<&str> = shader::all_names()
+        .filter(|n| n.starts_with("pathtrace/") || n.starts_with("common/"))
+        .collect();
+    let mut everywhere = std::collections::BTreeSet::new();
+    for name in &names {
+        everywhere.extend(declared(&shader::raw(name).unwrap()));
+    }
+    let mut failures = Vec::new();
+    for name in &names {
+        let own = shader::raw(name).unwrap();
+        let visible = declared(&shader::resolve(name).unwrap());
+        let words = identifiers(&own);
+        // Names the file declares for itself inside functions: locals and parameters.
+        let locals: std::collections::BTreeSet<&str> = words
+            .iter()
+            .enumerate()
+            .filter(|(k, (_, next))| {
+                *next == ':' || (*k > 0 && matches!(words[k - 1].0.as_str(), "let" | "var"))
+            })
+            .map(|(_, (w, _))| w.as_str())
+            .collect();
+        // The comment lines from "From its includer" to the end of that comment.
+        let announced: Vec<String> = own
+            .lines()
+            .skip_while(|l| !l.contains("From its includer"))
+            .take_while(|l| l.trim_start().starts_with("//"))
+            .flat_map(|l| identifiers(l.trim_start().trim_start_matches('/')))
+            .map(|(w, _)| w)
+            .collect();
+        let missing: std::collections::BTreeSet<&str> = words
+            .iter()
+            .filter(|(w, next)| *next == '(' || !locals.contains(w.as_str()))
+            .map(|(w, _)| w.as_str())
+            .filter(|w| everywhere.contains(*w) && !visible.contains(*w))
+            .filter(|w| !announced.iter().any(|a| a == w))
+            .collect();
+        if !missing.is_empty() {
+            failures.push(format!(
+                "{name}: uses {} without importing or naming it",
+                missing.into_iter().collect::<Vec<_>>().join(", ")
+            ));
+        }
+    }
+    assert!(names.len() >= 20, "{} files", names.len());
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
 #[test]
 fn imports_are_resolved_once() {
     let text = shader::resolve("post/tonemap.wgsl").unwrap();

@@ -586,7 +586,7 @@ impl PathTrace {
     }
 }
 
-/// `Frame::wave` (`pathtrace/pathtrace.wgsl`): a step of a frame's paths (its entry points
+/// `Frame::wave` (`pathtrace/wave.wgsl`): a step of a frame's paths (its entry points
 /// `wave_start`, `wave_misses`, `wave_hits`), the pass writing the means.
 const WAVE_STEP: u32 = 1;
 const WAVE_FINISH: u32 = 2;

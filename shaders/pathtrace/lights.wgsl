@@ -1,0 +1,171 @@
+// Light sampling: picking a light (alias table by power, with a uniform share), sampling
+// a point on it or a direction to it (triangles, spheres by solid angle, point, spot and
+// directional lights, the environment map), and the pdfs MIS needs.
+// From its includer (pathtrace/pathtrace.wgsl): `frame` and the bindings `tri_texcoords`
+// and `textures`.
+#import "pathtrace/scene_types.wgsl"
+#import "pathtrace/options.wgsl"
+#import "pathtrace/shared.wgsl"
+#import "pathtrace/sampler.wgsl"
+#import "common/sampling.wgsl"
+#import "pathtrace/env.wgsl"
+#import "pathtrace/scene_data.wgsl"
+#import "pathtrace/textures.wgsl"
+#import "pathtrace/surface.wgsl"
+
+struct LightSample {
+    // Unit direction from the shading point to the light.
+    wi: vec3f,
+    dist: f32,
+    radiance: vec3f,
+    // Solid-angle pdf, light selection included; 0 when the sample is invalid.
+    pdf: f32,
+    // How far the shadow ray stops short of `dist`, so that it does not reach the light (or
+    // what is coplanar with it): the sampled point's error off the light's plane over the
+    // cosine there, and a relative term for the error of t.
+    margin: f32,
+    // A point, spot or directional light: `pdf` is only its selection probability, and no
+    // BSDF-sampled ray can reach it (no MIS).
+    delta: bool,
+}
+
+fn env_map_on() -> bool {
+    return HAS_ENV_MAP && frame.settings.env_kind == ENV_MAP;
+}
+
+// Probability that light sampling takes the environment map rather than an area light.
+fn env_select_prob() -> f32 {
+    if !env_map_on() {
+        return 0.0;
+    }
+    return select(1.0, 0.5, HAS_LIGHTS && frame.header.num_lights > 0u);
+}
+
+// Probability that light sampling picks `l`: LIGHT_UNIFORM_SHARE uniformly, the rest by
+// power (as `light_selection` in crates/scene/src/flatten.rs builds the alias table).
+
+fn light_select_pdf(l: Light) -> f32 {
+    let total = frame.header.total_light_power;
+    let uniform = 1.0 / f32(frame.header.num_lights);
+    let by_power = select(uniform, l.power / total, total > 0.0);
+    return (1.0 - env_select_prob()) * mix(by_power, uniform, LIGHT_UNIFORM_SHARE);
+}
+
+// Solid-angle pdf of sampling the point `y` (normal `ny`) on light `l` from `x`.
+fn light_pdf(l: Light, x: vec3f, y: vec3f, ny: vec3f) -> f32 {
+    let d = y - x;
+    let dist2 = dot(d, d);
+    if (l.flags & LIGHT_SPHERE) != 0u {
+        let r = l.e1.x;
+        let s = min(1.0, r * r / dot(l.p0 - x, l.p0 - x));
+        let cone = one_minus_sqrt_one_minus(s);
+        return light_select_pdf(l) / (TWO_PI * cone);
+    }
+    let cos_y = abs(dot(ny, d)) / sqrt(dist2);
+    return light_select_pdf(l) * dist2 / (l.area * cos_y);
+}
+
+fn pick_light(u: f32) -> u32 {
+    let n = frame.header.num_lights;
+    let scaled = u * f32(n);
+    let i = min(u32(scaled), n - 1u);
+    let e = scene_light_alias(i);
+    return select(e.other, i, scaled - f32(i) < e.prob);
+}
+
+// A light sample seen from `x`; `bounce` picks the point's random numbers (sampler.wgsl).
+fn sample_light(x: vec3f, bounce: u32) -> LightSample {
+    var out: LightSample;
+    out.pdf = 0.0;
+    out.delta = false;
+    let l = scene_light(pick_light(rand()));
+    let u = sample_2d_at(PAIR_LIGHT, bounce);
+    if (l.flags & LIGHT_DELTA) != 0u {
+        out.delta = true;
+        out.pdf = light_select_pdf(l);
+        if (l.flags & LIGHT_DIRECTIONAL) != 0u {
+            out.wi = -l.e1;
+            out.dist = F32_MAX;
+            out.radiance = l.emission;
+            out.margin = 0.0;
+            return out;
+        }
+        let d = l.p0 - x;
+        let dist2 = dot(d, d);
+        let dist = sqrt(dist2);
+        out.wi = d / dist;
+        out.dist = dist;
+        out.margin = EDGE_ERR * dist;
+        var falloff = 1.0;
+        if (l.flags & LIGHT_SPOT) != 0u {
+            // Full within the beam width e2.y, linear in angle to 0 at the cutoff e2.x.
+            let theta = acos(clamp(dot(-out.wi, l.e1), -1.0, 1.0));
+            falloff = clamp((l.e2.x - theta) / max(l.e2.x - l.e2.y, 1e-12), 0.0, 1.0);
+        }
+        out.radiance = l.emission * (falloff / dist2);
+        return out;
+    }
+    if (l.flags & LIGHT_SPHERE) != 0u {
+        // Uniform direction in the cone the sphere subtends.
+        let r = l.e1.x;
+        let to_c = l.p0 - x;
+        let d2 = dot(to_c, to_c);
+        if d2 <= r * r {
+            return out;
+        }
+        let d = sqrt(d2);
+        let cone = one_minus_sqrt_one_minus(r * r / d2);
+        let cos_t = 1.0 - u.x * cone;
+        let sin_t = sqrt(max(0.0, (1.0 - cos_t) * (1.0 + cos_t)));
+        let phi = TWO_PI * u.y;
+        let axis = to_c / d;
+        let wi = normalize(onb(axis) * vec3f(sin_t * cos(phi), sin_t * sin(phi), cos_t));
+        // Distance to the near intersection with the sphere.
+        let b = dot(to_c, wi);
+        let h = to_c - b * wi;
+        let dist = b - sqrt(max(0.0, r * r - dot(h, h)));
+        out.wi = wi;
+        out.dist = dist;
+        out.radiance = l.emission;
+        out.pdf = light_select_pdf(l) / (TWO_PI * cone);
+        out.margin = 1e-4 * dist;
+        return out;
+    }
+    let b = sample_triangle(u);
+    let y = l.p0 + b.x * l.e1 + b.y * l.e2;
+    let ny = normalize(cross(l.e1, l.e2));
+    let d = y - x;
+    let dist2 = dot(d, d);
+    let dist = sqrt(dist2);
+    let wi = d / dist;
+    let cos_y = dot(ny, -wi);
+    let two_sided = (l.flags & LIGHT_TWO_SIDED) != 0u;
+    if !(cos_y > 0.0 || (two_sided && cos_y < 0.0)) {
+        return out;
+    }
+    out.wi = wi;
+    out.dist = dist;
+    out.radiance = l.emission;
+    if HAS_TEXTURES {
+        // An emissive texture varies the emission over the triangle (selection goes by its
+        // mean over the triangle: `GpuLight::power`).
+        let m = scene_material(scene_tri_shading(l.prim).material);
+        if tex_lo(m.tex_emissive_normal) != NO_TEX {
+            out.radiance = textured_emission(m, tri_uv(tri_texcoords[l.prim], b.x, b.y));
+        }
+    }
+    out.pdf = light_select_pdf(l) * dist2 / (l.area * abs(cos_y));
+    let err = barycentric_err(l.p0, l.e1, l.e2, b.x, b.y);
+    out.margin = dot(abs(ny), err) / abs(cos_y) + EDGE_ERR * dist;
+    return out;
+}
+
+// A light sample for next-event estimation from `x`: the environment map with probability
+// `p_env`, else an emitter.
+fn sample_next_event(x: vec3f, bounce: u32, p_env: f32) -> LightSample {
+    if rand() < p_env {
+        let es = sample_env(rand(), rand2());
+        return LightSample(es.wi, F32_MAX, es.radiance, es.pdf * p_env, 0.0, false);
+    }
+    return sample_light(x, bounce);
+}

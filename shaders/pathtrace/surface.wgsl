@@ -1,0 +1,109 @@
+// What a hit is: the surface point (position and its rounding error, normals, material,
+// light, texture coordinates) reconstructed from the intersector's hit, and the robust
+// origin of a ray leaving it.
+// From its includer (pathtrace/pathtrace.wgsl): the bindings `tri_texcoords` and
+// `textures`.
+#import "pathtrace/scene_types.wgsl"
+#import "pathtrace/options.wgsl"
+#import "pathtrace/intersect.wgsl"
+#import "pathtrace/scene_data.wgsl"
+#import "pathtrace/textures.wgsl"
+
+struct Surface {
+    p: vec3f,
+    // Geometric normal, front side (triangles: e1 x e2; spheres: outward).
+    ng: vec3f,
+    // Shading normal, front side.
+    ns: vec3f,
+    material: u32,
+    light: u32,
+    // Componentwise bound on the rounding error of `p` (triangles; 0 on spheres).
+    err: vec3f,
+    // Texture coordinates, set 0 in xy and set 1 in zw (HAS_TEXTURES; 0 on spheres).
+    uv: vec4f,
+    // Vertex colour (HAS_TEXTURES; white on spheres).
+    color: vec4f,
+}
+
+// Rounding error bounds of a point computed as v0 + u e1 + v e2 in f32: a float step of each
+// term (2^-23 relative) for the sum, plus 2^-20 of the edges for the error of the plane
+// distance Moller-Trumbore computes against a neighbouring triangle. At 1e5 this is 1.5 float
+// steps (0.012 units); at the origin of a unit-sized scene, about 4e-6.
+const POSITION_ERR: f32 = 1.1920929e-7;
+const EDGE_ERR: f32 = 9.536743e-7;
+
+fn barycentric_err(v0: vec3f, e1: vec3f, e2: vec3f, u: f32, v: f32) -> vec3f {
+    return POSITION_ERR * (abs(v0) + abs(u * e1) + abs(v * e2)) + EDGE_ERR * (abs(e1) + abs(e2));
+}
+
+// Whether `prim` (a hit's) is a sphere; a constant where the scene has one kind only.
+fn is_sphere(prim: u32) -> bool {
+    return HAS_SPHERES && (!HAS_TRIANGLES || (prim & PRIM_SPHERE) != 0u);
+}
+
+fn surface_at(ray: Ray, hit: Hit) -> Surface {
+    var s: Surface;
+    s.p = ray.origin + hit.t * ray.dir;
+    s.err = vec3f(0.0);
+    s.uv = vec4f(0.0);
+    s.color = vec4f(1.0);
+    if is_sphere(hit.prim) {
+        let sph = scene_sphere(hit.prim & ~PRIM_SPHERE);
+        s.ng = normalize(s.p - sph.center);
+        s.ns = s.ng;
+        s.material = sph.material;
+        s.light = sph.light;
+    } else {
+        let tri = scene_tri_positions(hit.prim);
+        let sh = scene_tri_shading(hit.prim);
+        // Position from the barycentrics: more accurate than origin + t * dir far away.
+        s.p = tri.v0 + hit.u * tri.e1 + hit.v * tri.e2;
+        s.err = barycentric_err(tri.v0, tri.e1, tri.e2, hit.u, hit.v);
+        s.ng = normalize(cross(tri.e1, tri.e2));
+        if (sh.flags & TRI_VERTEX_NORMALS) != 0u {
+            let n = (1.0 - hit.u - hit.v) * sh.n0 + hit.u * sh.n1 + hit.v * sh.n2;
+            s.ns = select(s.ng, normalize(n), dot(n, n) > 0.0);
+        } else {
+            s.ns = s.ng;
+        }
+        s.material = sh.material;
+        s.light = sh.light;
+        if HAS_TEXTURES {
+            let tc = tri_texcoords[hit.prim];
+            s.uv = tri_uv(tc, hit.u, hit.v);
+            s.color = tri_color(tc, hit.u, hit.v);
+            s.ns = normal_mapped(scene_material(sh.material), s.ns, s.ng, s.uv, tri_tangent(tc, hit.u, hit.v));
+        }
+    }
+    return s;
+}
+
+// For a ray that leaves no surface (a camera ray, a ray from a point in a medium): no
+// primitive skipped, no origin error.
+fn leave_no_surface() {
+    skip_prim = NO_HIT;
+    origin_n = vec3f(0.0);
+    origin_err = vec3f(0.0);
+    origin_off = 0.0;
+    origin_slab = 0.0;
+}
+
+// The origin of a ray leaving `s` towards the side `n` faces, and its error for the
+// intersection routines (`origin_n`, `origin_err`, `origin_off`, `origin_slab`,
+// `skip_inward`). Rays start at the hit itself, never offset (`skip_prim`).
+fn leave(s: Surface, on_sphere: bool, n: vec3f, dir: vec3f) -> vec3f {
+    if on_sphere {
+        origin_n = vec3f(0.0);
+        origin_err = vec3f(0.0);
+        origin_off = 0.0;
+        origin_slab = 0.0;
+        skip_inward = dot(dir, s.ng) < 0.0;
+        return s.p;
+    }
+    // The front of the plane left is the side the ray goes to.
+    origin_n = n;
+    origin_err = s.err;
+    origin_off = dot(abs(n), s.err);
+    origin_slab = origin_off / abs(dot(n, dir));
+    return s.p;
+}
