@@ -234,7 +234,7 @@ fn trace_pixel(at: vec2u) {
             start_path(pixel);
             loop {
                 if path_step() {
-                    add_sample(path_radiance, &sum, &dropped);
+                    add_sample(path.radiance, &sum, &dropped);
                     i++;
                     if i >= end {
                         break;

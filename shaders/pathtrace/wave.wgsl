@@ -73,14 +73,14 @@ struct WaveHit {
 // and stores a buffer word lane by lane, and a step touches every slot's state: the fewer
 // words and cache lines a step moves, the faster it runs.)
 fn save_slot(b: u32, c: u32, flags: u32, moved: bool, i: u32, sum: vec3f, dropped: u32) {
-    wave[b] = vec4u(bitcast<vec3u>(path_ray.dir), bitcast<u32>(path_bsdf_pdf));
-    wave[b + 1u] = vec4u(bitcast<vec3u>(path_throughput), rng_state);
-    wave[b + 2u] = vec4u(bitcast<vec3u>(path_radiance), path_bounce | (flags << SLOT_FLAGS_SHIFT));
+    wave[b] = vec4u(bitcast<vec3u>(path.ray.dir), bitcast<u32>(path.bsdf_pdf));
+    wave[b + 1u] = vec4u(bitcast<vec3u>(path.throughput), rng_state);
+    wave[b + 2u] = vec4u(bitcast<vec3u>(path.radiance), path.bounce | (flags << SLOT_FLAGS_SHIFT));
     if HAS_LIGHTS || HAS_MEDIA {
-        wave[c] = vec4u(bitcast<vec3u>(path_prev_p), path_crossings);
+        wave[c] = vec4u(bitcast<vec3u>(path.prev_p), path.crossings);
     }
-    if shadow_pending || path_bounce == 0u {
-        wave[c + 1u] = vec4u(bitcast<vec3u>(shadow_contribution), sampler_index);
+    if host_shadow.pending || path.bounce == 0u {
+        wave[c + 1u] = vec4u(bitcast<vec3u>(host_shadow.contribution), sampler_index);
     }
     if moved {
         wave[c + 2u] = vec4u(bitcast<vec3u>(sum), sampler_seed);
@@ -115,8 +115,8 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
     var dropped = 0u;
     // Whether the sum or the sample moved on (a path ended): [6] and [7] are saved.
     var moved = true;
-    shadow_pending = false;
-    shadow_contribution = vec3f(0.0);
+    host_shadow.pending = false;
+    host_shadow.contribution = vec3f(0.0);
     // The slot's state: what every step moves, then the rest (see `save_slot`).
     let b = WAVE_HOT_VEC4S * (slot - frame.wave_base);
     let c = WAVE_HOT_VEC4S * slots + WAVE_COLD_VEC4S * (slot - frame.wave_base);
@@ -129,30 +129,30 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
         let s1 = wave[b + 1u];
         let s2 = wave[b + 2u];
         // No origin: a hit's point comes from its triangle's barycentrics.
-        path_ray = Ray(vec3f(0.0), bitcast<vec3f>(s0.xyz));
-        path_bsdf_pdf = bitcast<f32>(s0.w);
-        path_throughput = bitcast<vec3f>(s1.xyz);
+        path.ray = Ray(vec3f(0.0), bitcast<vec3f>(s0.xyz));
+        path.bsdf_pdf = bitcast<f32>(s0.w);
+        path.throughput = bitcast<vec3f>(s1.xyz);
         rng_state = s1.w;
-        path_radiance = bitcast<vec3f>(s2.xyz);
-        path_bounce = s2.w & SLOT_BOUNCE_MASK;
+        path.radiance = bitcast<vec3f>(s2.xyz);
+        path.bounce = s2.w & SLOT_BOUNCE_MASK;
         flags = s2.w >> SLOT_FLAGS_SHIFT;
         if HAS_LIGHTS || HAS_MEDIA {
             let s3 = wave[c];
-            path_prev_p = bitcast<vec3f>(s3.xyz);
-            path_crossings = s3.w;
+            path.prev_p = bitcast<vec3f>(s3.xyz);
+            path.crossings = s3.w;
         }
         sampler_sobol = frame.sampler == SAMPLER_SOBOL;
         // The `WaveHit` of this slot's ray; the sign bit of its `t` answers the shadow ray.
         let hv = wave[WAVE_HITS_AT * slots + j];
         let shadow_out = (flags & SLOT_SHADOW) != 0u;
-        if shadow_out || path_bounce == 0u {
+        if shadow_out || path.bounce == 0u {
             let s4 = wave[c + 1u];
             sampler_index = s4.w;
             if shadow_out && (hv.x >> 31u) == 0u {
-                path_radiance += bitcast<vec3f>(s4.xyz);
+                path.radiance += bitcast<vec3f>(s4.xyz);
             }
         }
-        if path_bounce == 0u {
+        if path.bounce == 0u {
             sampler_seed = wave[c + 2u].w;
         }
         var ended = (flags & SLOT_ENDED) != 0u;
@@ -165,7 +165,7 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
                 ended = path_step_from(Hit(hv.w, t, bitcast<f32>(hv.y), bitcast<f32>(hv.z)), false);
             }
         }
-        if ended && (shadow_pending || kind == WAVE_KIND_HIT) {
+        if ended && (host_shadow.pending || kind == WAVE_KIND_HIT) {
             // The path's last shadow ray is still to be answered; or the path ended at a
             // surface, and the next step's `wave_misses` adds its sample and starts the next
             // one (so `wave_hits` carries none of that code).
@@ -177,7 +177,7 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
             sampler_seed = s5.w;
             i = wave[c + 3u].x;
             dropped = wave[c + 3u].y;
-            add_sample(path_radiance, &sum, &dropped);
+            add_sample(path.radiance, &sum, &dropped);
             i++;
             if i >= end {
                 flags = SLOT_DONE;
@@ -195,8 +195,8 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
     // rays leave from one point (`leave`): the next ray's origin is the shadow ray's.
     let r = WAVE_RAYS_AT * slots + WAVE_RAYS_VEC4S * j;
     let next = flags == 0u;
-    if next || shadow_pending {
-        let origin = select(shadow_ray.origin, path_ray.origin, next);
+    if next || host_shadow.pending {
+        let origin = select(host_shadow.ray.origin, path.ray.origin, next);
         // Within `origin_slab` of its origin a hit is the origin's own error (see `leave`).
         wave[r] = vec4u(bitcast<vec3u>(origin), bitcast<u32>(select(WAVE_NO_RAY, origin_slab, next)));
     } else {
@@ -206,12 +206,12 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
     }
     if next {
         // A shadow ray ending before it starts is still a ray (never occluded), not none.
-        wave[r + 1u] = vec4u(bitcast<vec3u>(path_ray.dir), bitcast<u32>(shadow_near));
-    } else if shadow_pending {
-        wave[r + 1u].w = bitcast<u32>(shadow_near);
+        wave[r + 1u] = vec4u(bitcast<vec3u>(path.ray.dir), bitcast<u32>(host_shadow.near));
+    } else if host_shadow.pending {
+        wave[r + 1u].w = bitcast<u32>(host_shadow.near);
     }
-    if shadow_pending {
-        wave[r + 2u] = vec4u(bitcast<vec3u>(shadow_ray.dir), bitcast<u32>(max(shadow_far, 0.0)));
+    if host_shadow.pending {
+        wave[r + 2u] = vec4u(bitcast<vec3u>(host_shadow.ray.dir), bitcast<u32>(max(host_shadow.far, 0.0)));
         flags |= SLOT_SHADOW;
     } else {
         wave[r + 2u].w = bitcast<u32>(WAVE_NO_RAY);

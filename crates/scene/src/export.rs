@@ -143,17 +143,15 @@ enum EnvironmentOut {
     },
 }
 
+/// `text` to `path` atomically (the repository's one writer, [`lumagraph_graph::write_atomic`]).
 fn write_atomic(path: &Path, text: &str) -> Result<(), SceneError> {
-    let io = |source| {
+    lumagraph_graph::write_atomic(path, text.as_bytes()).map_err(|source| {
         SceneError::new(ErrorKind::Io {
             what: "export file",
             source,
         })
         .in_file(path)
-    };
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, text).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)
+    })
 }
 
 /// Writes the triangles of `scene` into `dir` as OBJ files, one per material and shading,

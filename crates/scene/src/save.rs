@@ -21,10 +21,8 @@
 
 use std::collections::BTreeMap;
 use std::fmt::Debug;
-use std::io::Write as _;
 use std::ops::Range;
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::{ErrorKind, SceneError};
 use crate::file::{CameraDesc, Environment, MaterialDesc, RenderSettings, SceneFile, V3};
@@ -73,43 +71,9 @@ pub fn write(original: &str, edited: &SceneFile) -> Result<String, SceneError> {
 /// As [`write()`], and when the file cannot be written; errors name `path`.
 pub fn save(path: &Path, original: &str, edited: &SceneFile) -> Result<String, SceneError> {
     let text = write(original, edited).map_err(|e| e.in_file(path))?;
-    let failed = |source| SceneError::new(ErrorKind::Write { source }).in_file(path);
-    let name = path.file_name().ok_or_else(|| {
-        failed(std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            "not a file name",
-        ))
-    })?;
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let tmp = dir.join(format!(
-        ".{}.{}-{}.tmp",
-        name.to_string_lossy(),
-        std::process::id(),
-        TEMP_COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    if let Err(source) = write_and_rename(&tmp, path, &text) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(failed(source));
-    }
+    lumagraph_graph::write_atomic(path, text.as_bytes())
+        .map_err(|source| SceneError::new(ErrorKind::Write { source }).in_file(path))?;
     Ok(text)
-}
-
-/// Tells apart the temporary files of saves running at the same time.
-static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
-
-/// `text` into `tmp`, flushed to disk with the permissions of `path`, then renamed to `path`.
-fn write_and_rename(tmp: &Path, path: &Path, text: &str) -> std::io::Result<()> {
-    let mut file = std::fs::File::create(tmp)?;
-    file.write_all(text.as_bytes())?;
-    if let Ok(meta) = std::fs::metadata(path) {
-        file.set_permissions(meta.permissions())?;
-    }
-    file.sync_all()?;
-    drop(file);
-    std::fs::rename(tmp, path)
 }
 
 fn unwritable(message: impl Into<String>) -> SceneError {
