@@ -268,7 +268,7 @@ impl NodeExec for Accumulate {
     }
 
     fn merge_states(&mut self, states: &[&[u8]]) -> Result<Vec<u8>> {
-        crate::partial::merge_accumulations(states, self.variance == VARIANCE_HALVES)
+        merge_accumulations(states, self.variance == VARIANCE_HALVES)
             .map_err(|e| crate::error::RenderError::Gpu(format!("accumulation state: {e}")))
     }
 
@@ -316,5 +316,384 @@ impl NodeExec for Accumulate {
             .buffer(m2)
             .write(view(var, 1))
             .dispatch_2d(ctx, encoder, pass.extent, timer)
+    }
+}
+
+// Merging the states of partial renders (`lumagraph merge`, crate::partial).
+
+/// Rec. 709 luminance weights, as `post/accumulate.wgsl` has them (`m2.a` is of the
+/// luminance).
+const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
+/// An accumulation's state (see `Accumulate::save_state`): size, and per pixel the Kahan
+/// sum (`rgb`, frames in `a`), its compensation, and the second moment (or a 16-byte
+/// stand-in), all `vec4<f32>`.
+#[derive(Debug)]
+struct Accumulation {
+    width: u32,
+    height: u32,
+    sum: Vec<[f32; 4]>,
+    comp: Vec<[f32; 4]>,
+    m2: Vec<[f32; 4]>,
+}
+
+impl Accumulation {
+    fn parse(state: &[u8]) -> std::result::Result<Self, String> {
+        if state.is_empty() {
+            return Err("a partial render without samples".into());
+        }
+        let u32_at = |i: usize| {
+            state
+                .get(i..i + 4)
+                .and_then(|b| b.try_into().ok())
+                .map(u32::from_le_bytes)
+        };
+        let u64_at = |i: usize| {
+            state
+                .get(i..i + 8)
+                .and_then(|b| b.try_into().ok())
+                .map(u64::from_le_bytes)
+        };
+        let (Some(width), Some(height)) = (u32_at(0), u32_at(4)) else {
+            return Err("truncated".into());
+        };
+        let mut at: usize = 8 + 3 * 8;
+        let mut buffers = Vec::new();
+        for i in 0..3 {
+            let size = u64_at(8 + 8 * i).ok_or("truncated")?;
+            let len = usize::try_from(size).map_err(|_| "too large")?;
+            let bytes = state
+                .get(at..at.checked_add(len).ok_or("too large")?)
+                .ok_or("truncated")?;
+            if len % 16 != 0 {
+                return Err(format!("a buffer of {len} bytes, not whole pixels"));
+            }
+            buffers.push(
+                bytes
+                    .chunks_exact(16)
+                    .map(|p| {
+                        let mut v = [0f32; 4];
+                        for (c, b) in v.iter_mut().zip(p.chunks_exact(4)) {
+                            *c = f32::from_le_bytes(b.try_into().unwrap_or_default());
+                        }
+                        v
+                    })
+                    .collect::<Vec<_>>(),
+            );
+            at += len;
+        }
+        if at != state.len() {
+            return Err(format!("{} bytes too many", state.len() - at));
+        }
+        let m2 = buffers.pop().unwrap_or_default();
+        let comp = buffers.pop().unwrap_or_default();
+        let sum = buffers.pop().unwrap_or_default();
+        let pixels = u64::from(width) * u64::from(height);
+        if sum.len() as u64 != pixels || comp.len() != sum.len() {
+            return Err(format!(
+                "{width}×{height} with buffers of {} and {} pixels",
+                sum.len(),
+                comp.len()
+            ));
+        }
+        Ok(Self {
+            width,
+            height,
+            sum,
+            comp,
+            m2,
+        })
+    }
+
+    fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::new();
+        out.extend_from_slice(&self.width.to_le_bytes());
+        out.extend_from_slice(&self.height.to_le_bytes());
+        for b in [&self.sum, &self.comp, &self.m2] {
+            out.extend_from_slice(&(b.len() as u64 * 16).to_le_bytes());
+        }
+        for b in [&self.sum, &self.comp, &self.m2] {
+            for p in b {
+                for c in p {
+                    out.extend_from_slice(&c.to_le_bytes());
+                }
+            }
+        }
+        out
+    }
+}
+
+/// `a + b` as a sum and its exact rounding error (Knuth's `TwoSum`).
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    (s, (a - (s - bb)) + (b - bb))
+}
+
+/// A sum of `f64` kept as an unevaluated pair (`hi + lo`), exact for the few terms of a
+/// merge (the low parts' own rounding is below 2^-100 of the sum).
+#[derive(Clone, Copy, Default)]
+struct Exact {
+    hi: f64,
+    lo: f64,
+}
+
+impl Exact {
+    fn plus(self, x: f64) -> Self {
+        let (hi, e) = two_sum(self.hi, x);
+        let (hi, lo) = two_sum(hi, self.lo + e);
+        Self { hi, lo }
+    }
+
+    /// Rounded once to the nearest `f32` (ties to even), looking at both parts.
+    fn to_f32(self) -> f32 {
+        #[expect(clippy::cast_possible_truncation, reason = "the rounding is the point")]
+        let r = self.hi as f32;
+        if !r.is_finite() {
+            return r;
+        }
+        // How far the exact value lies from r (hi - r is exact: they share the top bits).
+        let d = (self.hi - f64::from(r)) + self.lo;
+        let next = if d > 0.0 { r.next_up() } else { r.next_down() };
+        let half = (f64::from(next) - f64::from(r)).abs() / 2.0;
+        if d.abs() > half || (d.abs() == half && r.to_bits() & 1 == 1) {
+            next
+        } else {
+            r
+        }
+    }
+}
+
+/// Merges accumulation states of disjoint sample ranges into one: per pixel and channel
+/// the exact sum of every part's compensated Kahan sum (sum − compensation), rounded once
+/// to `f32`, with the rounding error as the new compensation, so the mean is the correctly
+/// rounded mean of every frame added; the frame counts summed; the variance's buffer
+/// combined: with `halves` (Accumulate's `variance_estimate: halves`) the second halves'
+/// sums and counts added (in `f64`, rounded once), otherwise the second moments with the
+/// pairwise formula of Chan, Golub and `LeVeque` (in `f64`, rounded once).
+///
+/// # Errors
+/// When a state does not parse or the states are of other sizes.
+pub(crate) fn merge_accumulations(
+    states: &[&[u8]],
+    halves: bool,
+) -> std::result::Result<Vec<u8>, String> {
+    let parts = states
+        .iter()
+        .map(|s| Accumulation::parse(s))
+        .collect::<std::result::Result<Vec<_>, _>>()?;
+    let Some(first) = parts.first() else {
+        return Err("nothing to merge".into());
+    };
+    for p in &parts {
+        if (p.width, p.height, p.m2.len()) != (first.width, first.height, first.m2.len()) {
+            return Err(format!(
+                "partial renders of {}×{} and {}×{} pixels (or with and without variance)",
+                first.width, first.height, p.width, p.height
+            ));
+        }
+    }
+    if let [one] = states {
+        // Nothing to add: the state as it is (a merge of one range equals its render).
+        return Ok(one.to_vec());
+    }
+    let variance = first.m2.len() == first.sum.len();
+    let mut merged = Accumulation {
+        width: first.width,
+        height: first.height,
+        sum: Vec::with_capacity(first.sum.len()),
+        comp: Vec::with_capacity(first.sum.len()),
+        m2: first.m2.clone(),
+    };
+    for i in 0..first.sum.len() {
+        let mut sum = [0f32; 4];
+        let mut comp = [0f32; 4];
+        let mut frames = 0f32;
+        for p in &parts {
+            frames += p.sum[i][3];
+        }
+        for c in 0..3 {
+            let exact = parts.iter().fold(Exact::default(), |e, p| {
+                e.plus(f64::from(p.sum[i][c]))
+                    .plus(-f64::from(p.comp[i][c]))
+            });
+            sum[c] = exact.to_f32();
+            // Kahan's invariant: the exact sum is sum − compensation.
+            #[expect(clippy::cast_possible_truncation, reason = "f32 state")]
+            let residual = ((f64::from(sum[c]) - exact.hi) - exact.lo) as f32;
+            comp[c] = residual;
+        }
+        sum[3] = frames;
+        merged.sum.push(sum);
+        merged.comp.push(comp);
+        if variance {
+            merged.m2[i] = if halves {
+                half_sums(&parts, i)
+            } else {
+                chan(&parts, i)
+            };
+        }
+    }
+    Ok(merged.to_bytes())
+}
+
+/// The sum (rgb) and count (alpha) of every part's second half of frames together.
+fn half_sums(parts: &[Accumulation], i: usize) -> [f32; 4] {
+    let total: [f64; 4] =
+        std::array::from_fn(|c| parts.iter().map(|p| f64::from(p.m2[i][c])).sum());
+    #[expect(clippy::cast_possible_truncation, reason = "f32 state")]
+    total.map(|v| v as f32)
+}
+
+/// The second moment (per channel, and of the luminance) of every part's frames together:
+/// `M2 = M2_a + M2_b + δ² n_a n_b / n`, part by part.
+fn chan(parts: &[Accumulation], i: usize) -> [f32; 4] {
+    let mut n = 0f64;
+    let mut mean = [0f64; 3];
+    let mut m2 = [0f64; 4];
+    for p in parts {
+        let nb = f64::from(p.sum[i][3]);
+        if nb == 0.0 {
+            continue;
+        }
+        let mb: [f64; 3] =
+            std::array::from_fn(|c| (f64::from(p.sum[i][c]) - f64::from(p.comp[i][c])) / nb);
+        let total = n + nb;
+        let delta: [f64; 3] = std::array::from_fn(|c| mb[c] - mean[c]);
+        let w = n * nb / total;
+        for c in 0..3 {
+            m2[c] += f64::from(p.m2[i][c]) + delta[c] * delta[c] * w;
+            mean[c] += delta[c] * nb / total;
+        }
+        let dl: f64 = (0..3).map(|c| delta[c] * f64::from(LUMA[c])).sum();
+        m2[3] += f64::from(p.m2[i][3]) + dl * dl * w;
+        n = total;
+    }
+    #[expect(clippy::cast_possible_truncation, reason = "f32 state")]
+    m2.map(|v| v as f32)
+}
+
+#[cfg(test)]
+mod merge_tests {
+    use super::*;
+
+    /// Kahan sums of a sequence in one go and in four parts: the merged sum is the exact
+    /// sum rounded once, as is the single one but where the exact sum lies within the
+    /// single sum's tiny error of a rounding boundary.
+    #[test]
+    fn merged_kahan_sums_are_the_exact_sum_rounded_once() {
+        let kahan = |xs: &[f32]| {
+            let (mut s, mut c) = (0f32, 0f32);
+            for &x in xs {
+                let y = x - c;
+                let t = s + y;
+                c = (t - s) - y;
+                s = t;
+            }
+            (s, c)
+        };
+        let mut state = 12345u64;
+        let mut differ = 0;
+        let trials = 2000;
+        for _ in 0..trials {
+            let xs: Vec<f32> = (0..64)
+                .map(|_| {
+                    state = state
+                        .wrapping_mul(6_364_136_223_846_793_005)
+                        .wrapping_add(1);
+                    #[expect(clippy::cast_precision_loss, reason = "test values")]
+                    let u = (state >> 40) as f32 / (1u64 << 24) as f32;
+                    u * u * 3.0
+                })
+                .collect();
+            let pixel = |s: f32, c: f32, n: f32| {
+                let mut b = Vec::new();
+                for v in [1u32, 1] {
+                    b.extend_from_slice(&v.to_le_bytes());
+                }
+                for v in [16u64, 16, 16] {
+                    b.extend_from_slice(&v.to_le_bytes());
+                }
+                for v in [s, s, s, n, c, c, c, 0.0, 0.0, 0.0, 0.0, 0.0] {
+                    b.extend_from_slice(&v.to_le_bytes());
+                }
+                b
+            };
+            let states: Vec<Vec<u8>> = xs
+                .chunks(16)
+                .map(|part| {
+                    let (s, c) = kahan(part);
+                    pixel(s, c, 16.0)
+                })
+                .collect();
+            let refs: Vec<&[u8]> = states.iter().map(Vec::as_slice).collect();
+            let merged = Accumulation::parse(&merge_accumulations(&refs, false).unwrap()).unwrap();
+            let exact: f64 = xs.iter().map(|&x| f64::from(x)).sum();
+            #[expect(clippy::cast_possible_truncation, reason = "rounding once")]
+            let rounded = exact as f32;
+            let ulps = |a: f32, b: f32| a.to_bits().abs_diff(b.to_bits());
+            assert!(
+                ulps(merged.sum[0][0], rounded) <= 1,
+                "{merged:?} vs {exact}"
+            );
+            assert_eq!(merged.sum[0][3], 64.0);
+            let single = kahan(&xs).0;
+            if single != merged.sum[0][0] {
+                differ += 1;
+                assert!(
+                    ulps(single, merged.sum[0][0]) <= 1,
+                    "{single} vs {merged:?}"
+                );
+            }
+        }
+        eprintln!("{differ} of {trials} merged sums differ from the single one (by 1 ulp)");
+        // f32 Kahan loses the low bits of the compensation in `x − c` (about 0.03 ulp of
+        // the sum over 64 terms of 1), so a few per cent of sums fall on the other side of a
+        // rounding boundary.
+        assert!(differ * 10 < trials, "{differ} of {trials} differ");
+    }
+
+    #[test]
+    fn second_moments_merge_as_one_pass_over_all_frames() {
+        let xs = [0.5f32, 2.0, 0.25, 4.0, 1.0, 3.0];
+        let welford = |xs: &[f32]| {
+            let (mut n, mut mean, mut m2) = (0f64, 0f64, 0f64);
+            for &x in xs {
+                n += 1.0;
+                let d = f64::from(x) - mean;
+                mean += d / n;
+                m2 += d * (f64::from(x) - mean);
+            }
+            (mean * n, m2)
+        };
+        let state = |part: &[f32]| {
+            let (s, m2) = welford(part);
+            #[expect(clippy::cast_possible_truncation, reason = "f32 state")]
+            let (s, m2) = (s as f32, m2 as f32);
+            #[expect(clippy::cast_precision_loss, reason = "small counts")]
+            let n = part.len() as f32;
+            let mut b = Vec::new();
+            for v in [1u32, 1] {
+                b.extend_from_slice(&v.to_le_bytes());
+            }
+            for v in [16u64, 16, 16] {
+                b.extend_from_slice(&v.to_le_bytes());
+            }
+            let l = m2 * LUMA.iter().sum::<f32>().powi(2);
+            for v in [s, s, s, n, 0.0, 0.0, 0.0, 0.0, m2, m2, m2, l] {
+                b.extend_from_slice(&v.to_le_bytes());
+            }
+            b
+        };
+        let (a, b) = (state(&xs[..2]), state(&xs[2..]));
+        let merged = Accumulation::parse(&merge_accumulations(&[&a, &b], false).unwrap()).unwrap();
+        let (_, m2) = welford(&xs);
+        assert!(
+            (f64::from(merged.m2[0][0]) - m2).abs() < 1e-5 * m2,
+            "{merged:?}"
+        );
+        let l = m2 * f64::from(LUMA.iter().sum::<f32>()).powi(2);
+        assert!((f64::from(merged.m2[0][3]) - l).abs() < 1e-5 * m2);
+        assert_eq!(merged.sum[0][3], 6.0);
     }
 }

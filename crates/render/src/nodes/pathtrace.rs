@@ -820,7 +820,7 @@ impl NodeExec for PathTrace {
     }
 
     fn merge_states(&mut self, states: &[&[u8]]) -> Result<Vec<u8>> {
-        crate::partial::merge_path_tracers(states).map_err(RenderError::Gpu)
+        merge_path_tracers(states).map_err(RenderError::Gpu)
     }
 
     fn counters(&mut self, ctx: &GpuContext) -> Result<Vec<Counter>> {
@@ -864,4 +864,33 @@ impl NodeExec for PathTrace {
         }
         Ok(counters)
     }
+}
+
+/// Merges path tracer states (samples, dropped samples, rays, `u64` each): the samples of
+/// the last range's end, the counts summed.
+///
+/// # Errors
+/// When a state is not a path tracer's.
+fn merge_path_tracers(states: &[&[u8]]) -> std::result::Result<Vec<u8>, String> {
+    let mut merged = [0u64; 3];
+    for state in states {
+        if state.len() != 24 {
+            return Err(if state.len() > 24 {
+                "adaptive sampling cannot be split into sample ranges: each part would stop \
+                 pixels by its own samples (render it whole, or tile it)"
+                    .to_owned()
+            } else {
+                format!(
+                    "a path tracer's state is 24 bytes, this one {}",
+                    state.len()
+                )
+            });
+        }
+        let word =
+            |i: usize| u64::from_le_bytes(state[8 * i..8 * i + 8].try_into().unwrap_or_default());
+        merged[0] = merged[0].max(word(0));
+        merged[1] += word(1);
+        merged[2] += word(2);
+    }
+    Ok(merged.iter().flat_map(|v| v.to_le_bytes()).collect())
 }
