@@ -193,21 +193,7 @@ impl NodeExec for Accumulate {
         }
         let bad =
             |why: String| crate::error::RenderError::Gpu(format!("accumulation state: {why}"));
-        let u32_at = |i: usize| {
-            state
-                .get(i..i + 4)
-                .and_then(|b| b.try_into().ok())
-                .map(u32::from_le_bytes)
-        };
-        let u64_at = |i: usize| {
-            state
-                .get(i..i + 8)
-                .and_then(|b| b.try_into().ok())
-                .map(u64::from_le_bytes)
-        };
-        let (Some(w), Some(h)) = (u32_at(0), u32_at(4)) else {
-            return Err(bad("truncated".into()));
-        };
+        let (w, h, sections) = sections(state).map_err(bad)?;
         if Extent::new(w, h) != pass.extent {
             return Err(bad(format!("{w}×{h}, but the image is {}", pass.extent)));
         }
@@ -215,24 +201,15 @@ impl NodeExec for Accumulate {
         let Some((_, sum, comp, m2)) = &self.history else {
             return Err(bad("no buffers".into()));
         };
-        let mut at = 8 + 3 * 8;
-        for (i, b) in [sum, comp, m2].into_iter().enumerate() {
-            let size = u64_at(8 + 8 * i).ok_or_else(|| bad("truncated".into()))?;
-            if size != b.size() {
+        for (b, bytes) in [sum, comp, m2].into_iter().zip(sections) {
+            if bytes.len() as u64 != b.size() {
                 return Err(bad(format!(
-                    "a buffer of {size} bytes where {} are expected (variance on or off?)",
+                    "a buffer of {} bytes where {} are expected (variance on or off?)",
+                    bytes.len(),
                     b.size()
                 )));
             }
-            let len = usize::try_from(size).map_err(|_| bad("too large".into()))?;
-            let bytes = state
-                .get(at..at + len)
-                .ok_or_else(|| bad("truncated".into()))?;
             ctx.queue.write_buffer(b, 0, bytes);
-            at += len;
-        }
-        if at != state.len() {
-            return Err(bad(format!("{} bytes too many", state.len() - at)));
         }
         self.write_params(ctx, pass.extent);
         self.clear = false;
@@ -325,6 +302,41 @@ impl NodeExec for Accumulate {
 /// luminance).
 const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
 
+/// The layout [`Accumulate::save_state`] writes, split: width, height, and the bytes of
+/// the sum, compensation and second-moment buffers (each preceded by its size in the
+/// header). Read by `load_state` and by the merge of partial renders.
+fn sections(state: &[u8]) -> std::result::Result<(u32, u32, [&[u8]; 3]), String> {
+    let u32_at = |i: usize| {
+        state
+            .get(i..i + 4)
+            .and_then(|b| b.try_into().ok())
+            .map(u32::from_le_bytes)
+    };
+    let u64_at = |i: usize| {
+        state
+            .get(i..i + 8)
+            .and_then(|b| b.try_into().ok())
+            .map(u64::from_le_bytes)
+    };
+    let (Some(width), Some(height)) = (u32_at(0), u32_at(4)) else {
+        return Err("truncated".into());
+    };
+    let mut at: usize = 8 + 3 * 8;
+    let mut out: [&[u8]; 3] = [&[]; 3];
+    for (i, section) in out.iter_mut().enumerate() {
+        let size = u64_at(8 + 8 * i).ok_or("truncated")?;
+        let len = usize::try_from(size).map_err(|_| "too large")?;
+        *section = state
+            .get(at..at.checked_add(len).ok_or("too large")?)
+            .ok_or("truncated")?;
+        at += len;
+    }
+    if at != state.len() {
+        return Err(format!("{} bytes too many", state.len() - at));
+    }
+    Ok((width, height, out))
+}
+
 /// An accumulation's state (see `Accumulate::save_state`): size, and per pixel the Kahan
 /// sum (`rgb`, frames in `a`), its compensation, and the second moment (or a 16-byte
 /// stand-in), all `vec4<f32>`.
@@ -342,31 +354,14 @@ impl Accumulation {
         if state.is_empty() {
             return Err("a partial render without samples".into());
         }
-        let u32_at = |i: usize| {
-            state
-                .get(i..i + 4)
-                .and_then(|b| b.try_into().ok())
-                .map(u32::from_le_bytes)
-        };
-        let u64_at = |i: usize| {
-            state
-                .get(i..i + 8)
-                .and_then(|b| b.try_into().ok())
-                .map(u64::from_le_bytes)
-        };
-        let (Some(width), Some(height)) = (u32_at(0), u32_at(4)) else {
-            return Err("truncated".into());
-        };
-        let mut at: usize = 8 + 3 * 8;
+        let (width, height, sections) = sections(state)?;
         let mut buffers = Vec::new();
-        for i in 0..3 {
-            let size = u64_at(8 + 8 * i).ok_or("truncated")?;
-            let len = usize::try_from(size).map_err(|_| "too large")?;
-            let bytes = state
-                .get(at..at.checked_add(len).ok_or("too large")?)
-                .ok_or("truncated")?;
-            if len % 16 != 0 {
-                return Err(format!("a buffer of {len} bytes, not whole pixels"));
+        for bytes in sections {
+            if bytes.len() % 16 != 0 {
+                return Err(format!(
+                    "a buffer of {} bytes, not whole pixels",
+                    bytes.len()
+                ));
             }
             buffers.push(
                 bytes
@@ -380,10 +375,6 @@ impl Accumulation {
                     })
                     .collect::<Vec<_>>(),
             );
-            at += len;
-        }
-        if at != state.len() {
-            return Err(format!("{} bytes too many", state.len() - at));
         }
         let m2 = buffers.pop().unwrap_or_default();
         let comp = buffers.pop().unwrap_or_default();
