@@ -89,6 +89,16 @@ fn the_wide_bvh_is_chosen_on_cpu_adapters_and_where_asked() {
             false,
         ),
         (
+            // The host cannot trace spheres: the adapter's choice, inline, as unasked.
+            "CPU, small scene of spheres, the host asked for",
+            &small,
+            PathTraceOptions {
+                host_rays: true,
+                ..opts(true, None, Intersector::Host)
+            },
+            false,
+        ),
+        (
             "CPU with a host intersector, asked",
             &large,
             PathTraceOptions {

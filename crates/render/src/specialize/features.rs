@@ -406,14 +406,26 @@ impl<'a> Facts<'a> {
             }
             asked => asked,
         };
-        let inline = options.specialize
-            && prims <= INLINE_MAX_PRIMITIVES
-            && match asked {
-                Intersector::Auto => options.cpu_adapter,
-                Intersector::Inline => true,
-                _ => false,
-            };
-        let host = super::host_rays_decision(scene, options, inline, asked);
+        let inline_for = |asked| {
+            options.specialize
+                && prims <= INLINE_MAX_PRIMITIVES
+                && match asked {
+                    Intersector::Auto => options.cpu_adapter,
+                    Intersector::Inline => true,
+                    _ => false,
+                }
+        };
+        let mut inline = inline_for(asked);
+        let mut host = super::host_rays_decision(scene, options, inline, asked);
+        // The host asked for where it cannot trace the scene (no Embree, spheres, media…):
+        // the adapter decides, as for the others.
+        let asked = if asked == Intersector::Host && !host.included {
+            inline = inline_for(Intersector::Auto);
+            host = super::host_rays_decision(scene, options, inline, Intersector::Auto);
+            Intersector::Auto
+        } else {
+            asked
+        };
         let ray_queries = match no_ray_queries {
             Some(why) => decision(false, why),
             None if inline => decision(false, "intersected inline"),
