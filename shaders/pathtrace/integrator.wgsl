@@ -31,13 +31,16 @@ struct PathState {
     crossings: u32,
 }
 
-// With HOST_RAYS: the shadow ray of the step's next-event estimate, which the host traces
-// (from `near` to `far` along it), and what it adds to the path's radiance unless occluded.
+// With WAVES: the shadow ray of the step's next-event estimate, which the host or the
+// wavefront's `wave_trace` traces (from `near` to `far` along it; `n`, the normal of the
+// plane it leaves, towards it: `origin_n` when it left), and what it adds to the path's
+// radiance unless occluded.
 struct HostShadow {
     pending: bool,
     ray: Ray,
     near: f32,
     far: f32,
+    n: vec3f,
     contribution: vec3f,
 }
 
@@ -218,7 +221,7 @@ fn cross_boundary(p: ptr<function, PathState>, s: Surface, mat: Material, on_sph
 // the shading frame `to_local`; `ng` the geometric normal on the side the ray came from,
 // `toward_ng` whether lit directions lie on its side): a light sample, MIS-weighted against
 // BSDF sampling, and its shadow ray, traced here (through the media on the way) or, with
-// HOST_RAYS, left for the host in `host_shadow`. Point, spot and directional lights,
+// WAVES, left for the host or `wave_trace` in `host_shadow`. Point, spot and directional lights,
 // which no ray can hit, are sampled so even with BSDF sampling only.
 fn next_event(
     p: ptr<function, PathState>,
@@ -257,10 +260,11 @@ fn next_event(
         return;
     }
     let contribution = (*p).throughput * e.f_cos * ls.radiance * (w / ls.pdf);
-    if HOST_RAYS {
-        // The host answers the shadow ray before the next step.
+    if WAVES {
+        // The host or `wave_trace` answers the shadow ray before the next step.
         host_shadow.ray = shadow;
         host_shadow.near = origin_slab;
+        host_shadow.n = origin_n;
         host_shadow.far = ls.dist - ls.margin;
         host_shadow.contribution = contribution;
         host_shadow.pending = true;

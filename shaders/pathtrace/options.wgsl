@@ -49,3 +49,9 @@ const HAS_ALPHA: bool = true;
 // media): each dispatch takes every path one step, between the host's answers (`wave_step`
 // in pathtrace.wgsl), instead of tracing whole paths.
 const HOST_RAYS: bool = true;
+
+// The paths of a frame are taken one bounce at a time by small kernels (`wave_trace` traces
+// the rays the steps write, on the device; `pathtrace/wave.wgsl`).
+const WAVEFRONT: bool = true;
+// Paths traced in steps (`pathtrace/wave.wgsl`): HOST_RAYS or WAVEFRONT.
+const WAVES: bool = true;

@@ -15,7 +15,7 @@
 // selection and sampling), mis.wgsl (MIS weights), camera.wgsl, bsdf.wgsl (the layered
 // material), medium.wgsl, env.wgsl, textures.wgsl, alpha.wgsl, and the intersector behind
 // intersect.wgsl (its contract in contract.wgsl; the specialization replaces the file).
-// wave.wgsl holds host intersection's steps. This file: the frame's uniform block, the
+// wave.wgsl holds the steps of host intersection and of the wavefront. This file: the frame's uniform block, the
 // bindings, the entry point and the loop over a pixel's samples.
 #import "pathtrace/scene_types.wgsl"
 #import "pathtrace/sampler.wgsl"
@@ -55,14 +55,15 @@ struct Frame {
     chunk_count: u32,
     // CHUNK_FIRST | CHUNK_LAST.
     chunk_flags: u32,
-    // With HOST_RAYS: WAVE_STEP or WAVE_FINISH (wave.wgsl); the first slot of the batch of
+    // With WAVES: WAVE_STEP or WAVE_FINISH (wave.wgsl); the first slot of the batch of
     // slots being traced, how many slots `wave`'s sections hold, and how many of the step's
-    // listed slots `wave_misses` takes (`wave_hits` the rest).
+    // listed slots `wave_misses` takes (`wave_hits` the rest); with WAVEFRONT, which of the
+    // two lists is the step's.
     wave: u32,
     wave_base: u32,
     wave_capacity: u32,
     wave_split: u32,
-    pad1: u32,
+    wave_list: u32,
 }
 
 const CHUNK_FIRST: u32 = 1u;
@@ -101,8 +102,8 @@ const CHUNK_LAST: u32 = 2u;
 @group(0) @binding(20) var<storage, read> adaptive_active: array<u32>;
 // Per pixel of the window: the sum of the frame's samples traced by its earlier dispatches.
 @group(0) @binding(21) var<storage, read_write> chunk_sums: array<vec4f>;
-// With HOST_RAYS, the paths in flight and the rays the host intersects (a 16-byte stand-in
-// otherwise): see `wave_step`.
+// With WAVES, the paths in flight and the rays the host or `wave_trace` intersects (a
+// 16-byte stand-in otherwise): see `wave_step`.
 @group(0) @binding(22) var<storage, read_write> wave: array<vec4<u32>>;
 // The texture atlas: every texture of the scene in the RGBA8 pages of one array texture.
 @group(0) @binding(23) var textures: texture_2d_array<f32>;
@@ -174,7 +175,7 @@ fn main(
             at = vec2u(packed & 0xffffu, packed >> 16u);
         }
     }
-    if HOST_RAYS {
+    if WAVES {
         if frame.wave == WAVE_FINISH {
             let slot = id.y * frame.window.z + id.x;
             if all(id < frame.window.zw) {

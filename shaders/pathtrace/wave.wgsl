@@ -1,8 +1,10 @@
-// Host intersection's side of the kernel (HOST_RAYS): the `wave_*` entry points.
+// Paths traced in steps (WAVES): the `wave_*` entry points of host intersection (HOST_RAYS)
+// and of the wavefront (WAVEFRONT).
 // From its includer (pathtrace/pathtrace.wgsl): `frame`, the bindings `wave`, `chunk_sums`
 // and `stats`, and `add_sample`.
 #import "pathtrace/shared.wgsl"
 #import "pathtrace/integrator.wgsl"
+#import "pathtrace/intersect.wgsl"
 
 // Host intersection (HOST_RAYS). The paths of a frame are traced in steps: each dispatch
 // takes every pixel's path one bounce on, as `path_step` does, from the closest hit the host
@@ -24,6 +26,19 @@
 //   [11S, ...)  the step's slots: their count, then each one, a u32 each (`wave_list_at`)
 // The random numbers, their order and the arithmetic are `trace_pixel`'s; only the hits are
 // the host's. The host counts the rays (`ray_count` is not kept).
+//
+// The wavefront (WAVEFRONT) takes the same steps, and `wave_trace` traces their rays on the
+// device in between, through the intersector the megakernel would use, with the same rules
+// for rays leaving a surface: its images are the megakernel's. Its sections differ from the
+// list on:
+//   [11S, 13S)  how the step's rays leave their surface, 2 vec4 per position j of the step:
+//               the normal of the plane left towards the next ray (`origin_n`) and the
+//               primitive left (`skip_prim`); the origin's error (`origin_err`) and 1 where
+//               the shadow ray leaves towards the other side
+//   [13S, ...)  two lists of slots, S words each: the step's and the next step's
+//               (`frame.wave_list` is the step's); the slots whose ray missed (or that only
+//               await a shadow ray) from the start, those whose ray hit from the end. List l
+//               counts them in `stats[WAVE_COUNTS_AT + 2 l]` and the word after it.
 const WAVE_STEP: u32 = 1u;
 // Writes the pixels' means from `chunk_sums` (and the AOVs): recorded with the graph.
 const WAVE_FINISH: u32 = 2u;
@@ -216,6 +231,14 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
     } else {
         wave[r + 2u].w = bitcast<u32>(WAVE_NO_RAY);
     }
+    if WAVEFRONT && (next || host_shadow.pending) {
+        // How the rays leave the surface, for `wave_trace`: the state `leave` set for the
+        // last ray it made (the next ray's, or the shadow ray's where no next ray is out).
+        let l = WAVE_LIST_AT * slots + WAVE_LEAVE_VEC4S * j;
+        let other_side = host_shadow.pending && any(host_shadow.n != origin_n);
+        wave[l] = vec4u(bitcast<vec3u>(origin_n), skip_prim);
+        wave[l + 1u] = vec4u(bitcast<vec3u>(origin_err), select(0u, 1u, other_side));
+    }
     save_slot(b, c, flags, moved, i, sum, dropped);
 }
 
@@ -233,6 +256,10 @@ const WAVE_KIND_HIT: u32 = 2u;
 // llvmpipe pays a fixed cost per invocation, as much as a step of a path when the kernel is
 // this large, so an invocation per slot would pay it for every step.
 fn wave_run(kind: u32, group: u32, groups: u32, lane: u32) {
+    if WAVEFRONT {
+        wavefront_run(kind, group * 64u + lane, lane);
+        return;
+    }
     let threads = groups * 64u;
     let count = wave_word(wave_list_at(), 0u);
     let first = select(0u, frame.wave_split, kind == WAVE_KIND_HIT);
@@ -244,21 +271,185 @@ fn wave_run(kind: u32, group: u32, groups: u32, lane: u32) {
 
 @compute @workgroup_size(8, 8)
 fn wave_start(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) groups: vec3u, @builtin(local_invocation_index) lane: u32) {
-    if HOST_RAYS {
+    if WAVES {
         wave_run(WAVE_KIND_START, group.x, groups.x, lane);
     }
 }
 
 @compute @workgroup_size(8, 8)
 fn wave_misses(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) groups: vec3u, @builtin(local_invocation_index) lane: u32) {
-    if HOST_RAYS {
+    if WAVES {
         wave_run(WAVE_KIND_MISS, group.x, groups.x, lane);
     }
 }
 
 @compute @workgroup_size(8, 8)
 fn wave_hits(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) groups: vec3u, @builtin(local_invocation_index) lane: u32) {
-    if HOST_RAYS {
+    if WAVES {
         wave_run(WAVE_KIND_HIT, group.x, groups.x, lane);
+    }
+}
+
+// The wavefront's list `list`: where it starts in `wave` (vec4), and the index in `stats` of
+// its count of slots whose ray missed (that of those whose ray hit follows).
+fn wavefront_list_at(list: u32) -> u32 {
+    let slots = wave_slots();
+    return WAVE_FRONT_LISTS_AT * slots + list * (slots / 4u);
+}
+
+fn wavefront_counts_at(list: u32) -> u32 {
+    return WAVE_COUNTS_AT + 2u * list;
+}
+
+// The counts of the step's list, loaded once per workgroup (a load of one word by every
+// invocation of a dispatch over a million slots costs more than the step's own loads).
+var<workgroup> wave_counts: array<u32, 2>;
+
+// Loads the counts of list `list` into `wave_counts` for the whole workgroup (called by all
+// its invocations).
+fn wavefront_load_counts(list: u32, lane: u32) {
+    if lane == 0u {
+        let counts = wavefront_counts_at(list);
+        wave_counts[0] = atomicLoad(&stats[counts]);
+        wave_counts[1] = atomicLoad(&stats[counts + 1u]);
+    }
+    workgroupBarrier();
+}
+
+// A step of the wavefront: invocation `i` of a dispatch over the batch's slots takes the
+// i-th slot of its kind in the step's list (misses from its start, hits from its end).
+fn wavefront_run(kind: u32, i: u32, lane: u32) {
+    let slots = wave_slots();
+    let list = frame.wave_list;
+    wavefront_load_counts(list, lane);
+    if i == 0u && kind != WAVE_KIND_HIT {
+        // The next step's list fills from empty (`wave_trace`, after this step's kernels);
+        // the step before this one read it last.
+        let next = wavefront_counts_at(1u - list);
+        atomicStore(&stats[next], 0u);
+        atomicStore(&stats[next + 1u], 0u);
+    }
+    let misses = wave_counts[0];
+    let hits = wave_counts[1];
+    if kind == WAVE_KIND_HIT {
+        if i < hits {
+            let j = slots - hits + i;
+            wave_step(wave_word(wavefront_list_at(list), j), j, kind);
+        }
+    } else if i < misses {
+        wave_step(wave_word(wavefront_list_at(list), i), i, kind);
+    }
+}
+
+// What `wavefront_trace` found for a position of the step's list: the slot, the hit of its
+// next ray (with the shadow ray's answer in the sign bit of `t`), which part of the next list
+// it goes to (`TRACED_MISS`, `TRACED_HIT`, or `TRACED_DONE`: none, the slot traced all its
+// samples), and the rays traced.
+struct Traced {
+    slot: u32,
+    hit: vec4u,
+    kind: u32,
+    rays: u32,
+}
+
+const TRACED_MISS: u32 = 0u;
+const TRACED_HIT: u32 = 1u;
+const TRACED_DONE: u32 = 2u;
+
+// The rays the step wrote at position `j` of its list, traced as `trace_pixel`'s path would
+// trace them: the next ray's closest hit, whether the shadow ray is occluded, each leaving
+// the surface as `leave` set it up.
+fn wavefront_trace(j: u32) -> Traced {
+    let slots = wave_slots();
+    let r = WAVE_RAYS_AT * slots + WAVE_RAYS_VEC4S * j;
+    let r0 = wave[r];
+    let r1 = wave[r + 1u];
+    let r2 = wave[r + 2u];
+    let next_near = bitcast<f32>(r0.w);
+    let shadow_far = bitcast<f32>(r2.w);
+    let has_next = next_near >= 0.0;
+    let has_shadow = shadow_far >= 0.0;
+    var out = Traced(0u, vec4u(0u), TRACED_DONE, 0u);
+    if !(has_next || has_shadow || next_near == WAVE_FINISH_ME) {
+        return out;
+    }
+    let origin = bitcast<vec3f>(r0.xyz);
+    let l = WAVE_LIST_AT * slots + WAVE_LEAVE_VEC4S * j;
+    let l0 = wave[l];
+    let l1 = wave[l + 1u];
+    let n = bitcast<vec3f>(l0.xyz);
+    skip_prim = l0.w;
+    origin_err = bitcast<vec3f>(l1.xyz);
+    // `leave`'s, the same for either side of the plane.
+    origin_off = dot(abs(n), origin_err);
+    var occluded_bit = 0u;
+    if has_shadow {
+        origin_n = select(n, -n, l1.w != 0u);
+        origin_slab = bitcast<f32>(r1.w);
+        if occluded(Ray(origin, bitcast<vec3f>(r2.xyz)), shadow_far) {
+            occluded_bit = 0x80000000u;
+        }
+    }
+    var hit = Hit(NO_HIT, F32_MAX, 0.0, 0.0);
+    if has_next {
+        origin_n = n;
+        origin_slab = next_near;
+        hit = intersect_scene(Ray(origin, bitcast<vec3f>(r1.xyz)));
+    }
+    out.slot = wave_word(wavefront_list_at(frame.wave_list), j);
+    out.hit = vec4u(bitcast<u32>(hit.t) | occluded_bit, bitcast<u32>(hit.u), bitcast<u32>(hit.v), hit.prim);
+    out.kind = select(TRACED_MISS, TRACED_HIT, has_next && hit.prim != NO_HIT);
+    out.rays = select(0u, 1u, has_next) + select(0u, 1u, has_shadow);
+    return out;
+}
+
+// Per workgroup of `wave_trace`: its slots of each part of the next list and the rays it
+// traced (workgroup atomics), then where its slots go in the next list: one global atomic
+// per part and workgroup, not per slot (a million atomics on two words serialize).
+var<workgroup> wave_parts: array<atomic<u32>, 3>;
+var<workgroup> wave_part_base: array<u32, 2>;
+
+// The wavefront's tracing kernel, between two steps: one invocation per position of the
+// step's list (a 1D dispatch over the batch's slots), each listing its slot for the next
+// step with its ray's hit.
+@compute @workgroup_size(64)
+fn wave_trace(@builtin(global_invocation_id) id: vec3u, @builtin(local_invocation_index) lane: u32) {
+    if !WAVEFRONT {
+        return;
+    }
+    let slots = wave_slots();
+    let list = frame.wave_list;
+    if lane < 3u {
+        atomicStore(&wave_parts[lane], 0u);
+    }
+    wavefront_load_counts(list, lane);
+    let j = id.x;
+    var t = Traced(0u, vec4u(0u), TRACED_DONE, 0u);
+    if j < slots && (j < wave_counts[0] || j >= slots - wave_counts[1]) {
+        t = wavefront_trace(j);
+    }
+    var local = 0u;
+    if t.kind != TRACED_DONE {
+        local = atomicAdd(&wave_parts[t.kind], 1u);
+    }
+    atomicAdd(&wave_parts[2], t.rays);
+    workgroupBarrier();
+    if lane == 0u {
+        let counts = wavefront_counts_at(1u - list);
+        wave_part_base[0] = atomicAdd(&stats[counts], atomicLoad(&wave_parts[0]));
+        wave_part_base[1] = atomicAdd(&stats[counts + 1u], atomicLoad(&wave_parts[1]));
+        // 64-bit ray count in two words, as `trace_pixel` keeps it.
+        let rays = atomicLoad(&wave_parts[2]);
+        let before = atomicAdd(&stats[1], rays);
+        if before > 0xffffffffu - rays {
+            atomicAdd(&stats[2], 1u);
+        }
+    }
+    workgroupBarrier();
+    if t.kind != TRACED_DONE {
+        let k = select(wave_part_base[0] + local, slots - 1u - (wave_part_base[1] + local), t.kind == TRACED_HIT);
+        let at = wavefront_list_at(1u - list);
+        wave[at + k / 4u][k % 4u] = t.slot;
+        wave[WAVE_HITS_AT * slots + k] = t.hit;
     }
 }

@@ -190,6 +190,32 @@ pub fn run(
     } else {
         None
     };
+    // The wavefront beside the megakernel (or the megakernel beside the wavefront, where
+    // the specialized shader is one), where the scene allows it: the specialized shader as
+    // LUMAGRAPH_WAVEFRONT=on or off runs it.
+    if !special.on(Feature::HostRays) {
+        use crate::render::specialize::Schedule;
+        let front = special.on(Feature::Wavefront);
+        let other = Resources {
+            schedule: if front {
+                Schedule::Megakernel
+            } else {
+                Schedule::Wavefront
+            },
+            ..Resources::default()
+        };
+        let other = measure(&ctx, scene, other, spp, runs)?;
+        if other.on(Feature::Wavefront) != front {
+            let (mega, wave) = if front {
+                print("megakernel", &other);
+                (&other, &special)
+            } else {
+                print("wavefront", &other);
+                (&special, &other)
+            };
+            println!("  megakernel / wavefront: {:.2}x", mega.wall / wave.wall);
+        }
+    }
     if specialized_only {
         return Ok(());
     }

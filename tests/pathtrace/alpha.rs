@@ -10,7 +10,7 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 use lumagraph::graph::{Edge, Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
-use lumagraph::render::specialize::{Feature, Intersector};
+use lumagraph::render::specialize::{Feature, Intersector, Schedule};
 use lumagraph::render::{Executor, Resources, compile};
 use lumagraph::scene::traverse::{Ray, intersect};
 use lumagraph::scene::{AlphaMode, GpuScene, Scene, Texture, Wrap};
@@ -23,7 +23,7 @@ fn front_and_wall(size: u32) -> Scene {
 
 /// [`front_and_wall`] with the wall made of `tiles`² quads (over 64 primitives: past what a
 /// CPU adapter intersects inline, so the host does it where Embree is found).
-fn front_and_tiled_wall(size: u32, tiles: u32) -> Scene {
+pub(super) fn front_and_tiled_wall(size: u32, tiles: u32) -> Scene {
     let mut wall = String::new();
     let step = 6.0 / tiles as f32;
     for j in 0..tiles {
@@ -54,7 +54,7 @@ fn front_and_tiled_wall(size: u32, tiles: u32) -> Scene {
 
 /// `scene` with the front quad's material alpha-masked by an 8×8 checkerboard (alpha 0 and
 /// 255, nearest texels) at cutoff 0.5, its UVs over the quad.
-fn checker_masked(mut scene: Scene) -> Scene {
+pub(super) fn checker_masked(mut scene: Scene) -> Scene {
     scene.textures = vec![Texture {
         name: "checker".into(),
         width: 8,
@@ -89,7 +89,7 @@ fn pixel_ray(g: &GpuScene, x: u32, y: u32) -> Ray {
 
 /// `PathTrace` (with its first-hit albedo) and `GBuffer` albedo of `scene`, `resources`'
 /// intersector, one frame of 4 spp, and the path tracer's shader features.
-fn albedos(
+pub(super) fn albedos(
     scene: &Arc<GpuScene>,
     resources: Resources,
 ) -> Option<(Image, Image, Image, lumagraph::render::specialize::Features)> {
@@ -130,8 +130,11 @@ fn albedos(
 /// side), and the cut-out squares are half the quad's pixels within 10 %.
 #[test]
 fn masked_checkerboard_shows_the_wall_through_its_holes() {
+    // GPU adapters as the megakernel runs them (the wavefront's tracing takes the same
+    // any-hit test: `wavefront.rs`).
     let inline_or_bvh = Resources {
         as_gpu_adapter: true,
+        schedule: Schedule::Megakernel,
         ..Resources::default()
     };
     let wgsl = Resources {
@@ -141,6 +144,7 @@ fn masked_checkerboard_shows_the_wall_through_its_holes() {
     let wide = Resources {
         as_gpu_adapter: true,
         intersector: Intersector::WideBvh,
+        schedule: Schedule::Megakernel,
         ..Resources::default()
     };
     check_checkerboard(

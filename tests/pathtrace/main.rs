@@ -17,4 +17,5 @@ mod shaders;
 mod specialization;
 mod texture_atlas;
 mod textures;
+mod wavefront;
 mod wide_bvh;

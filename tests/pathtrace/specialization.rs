@@ -20,7 +20,7 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 use lumagraph::graph::{Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
-use lumagraph::render::specialize::{Feature, Features};
+use lumagraph::render::specialize::{Feature, Features, Schedule};
 use lumagraph::render::{Executor, Resources, compile};
 use lumagraph::scene::{AlphaMode, GpuScene, NO_TEXTURE, Scene, Texture, Wrap};
 
@@ -196,6 +196,9 @@ fn frames(scene: &GpuScene, general: bool, seed: u32) -> Option<(Vec<Image>, Fea
         scene: Some(Arc::clone(&scene)),
         general_shaders: general,
         as_gpu_adapter: true,
+        // The megakernel: a GPU adapter would step textured scenes as a wavefront, whose
+        // images are the megakernel's (`wavefront.rs`) at several times the compile time.
+        schedule: Schedule::Megakernel,
         scene_data_in_buffers: true,
         ..Resources::default()
     };
@@ -210,6 +213,62 @@ fn frames(scene: &GpuScene, general: bool, seed: u32) -> Option<(Vec<Image>, Fea
     Some((images, features))
 }
 
+/// What one seed of [`specialized_shaders_render_what_the_general_shader_renders`] found: the
+/// features its specialized shader left out, whether it needs the alpha test, and whether
+/// its frames were bit-identical to the general shader's. `None` without a GPU.
+fn check_seed(seed: u32) -> Option<(Vec<&'static str>, bool, bool)> {
+    let base = if seed.is_multiple_of(2) {
+        "assets/cornell.ron"
+    } else {
+        "assets/furnace_materials.ron"
+    };
+    let mut scene = Scene::load(&common::repo(base)).unwrap();
+    scene.settings.width = 40;
+    scene.settings.height = 40;
+    randomize(&mut scene, &mut Rng(u64::from(seed)), seed == 0);
+    let gpu = GpuScene::build(&scene).unwrap();
+    let (specialized, features) = frames(&gpu, false, seed)?;
+    let (general, _) = frames(&gpu, true, seed).unwrap();
+    let left_out = features
+        .iter()
+        .filter(|(_, d)| !d.included)
+        .map(|(f, _)| f.label())
+        .collect();
+    if seed == 0 {
+        assert!(
+            features.on(Feature::GlassLobe),
+            "glass left out though a texture lowers metallic: {}",
+            features.reason(Feature::GlassLobe)
+        );
+    }
+    assert!(
+        specialized
+            .iter()
+            .any(|f| f.pixels.iter().any(|p| p[0] > 0.0)),
+        "seed {seed}: black image"
+    );
+    let alpha = features.on(Feature::Alpha);
+    if specialized == general {
+        println!(
+            "seed {seed} ({base}): bit-identical; {}",
+            features.summary()
+        );
+        return Some((left_out, alpha, true));
+    }
+    let (other, _) = frames(&gpu, true, seed + 1000).unwrap();
+    match common::same_means(&specialized, &other, 8, 1e-3, ALPHA) {
+        Ok((tests, worst)) => println!(
+            "seed {seed} ({base}): same means ({tests} tests, largest |t| {worst:.2} of the critical value); {}",
+            features.summary()
+        ),
+        Err(e) => panic!(
+            "seed {seed} ({base}): the specialized shader renders another image than the general one: {e}; {}",
+            features.summary()
+        ),
+    }
+    Some((left_out, alpha, false))
+}
+
 /// 16 scenes drawn from seeds 0-15 over the Cornell box (triangles, an area light) and the
 /// sphere furnace (spheres, a constant environment), 40×40 pixels. With the same random
 /// seed the two shaders render the same frames bit for bit where the arithmetic on every
@@ -221,62 +280,25 @@ fn frames(scene: &GpuScene, general: bool, seed: u32) -> Option<(Vec<Image>, Fea
 /// asserted: each lobe is left out in some scene, and the first scene keeps the glass lobe.
 #[test]
 fn specialized_shaders_render_what_the_general_shader_renders() {
+    // The seeds on two threads: each compiles a shader of its own, which the driver does on
+    // one core (the renders use them all).
+    let found: Vec<_> = std::thread::scope(|s| {
+        let halves: Vec<_> = [0u32, 1]
+            .map(|h| s.spawn(move || (h..16).step_by(2).map(check_seed).collect::<Vec<_>>()))
+            .into_iter()
+            .collect();
+        halves.into_iter().flat_map(|h| h.join().unwrap()).collect()
+    });
+    let Some(found) = found.into_iter().collect::<Option<Vec<_>>>() else {
+        return;
+    };
     let mut left_out_somewhere = std::collections::BTreeSet::new();
     let mut alpha_somewhere = false;
     let mut identical = 0;
-    for seed in 0..16u32 {
-        let base = if seed % 2 == 0 {
-            "assets/cornell.ron"
-        } else {
-            "assets/furnace_materials.ron"
-        };
-        let mut scene = Scene::load(&common::repo(base)).unwrap();
-        scene.settings.width = 40;
-        scene.settings.height = 40;
-        randomize(&mut scene, &mut Rng(u64::from(seed)), seed == 0);
-        let gpu = GpuScene::build(&scene).unwrap();
-        let Some((specialized, features)) = frames(&gpu, false, seed) else {
-            return;
-        };
-        let (general, _) = frames(&gpu, true, seed).unwrap();
-        for (f, d) in features.iter() {
-            if !d.included {
-                left_out_somewhere.insert(f.label());
-            }
-        }
-        alpha_somewhere |= features.on(Feature::Alpha);
-        if seed == 0 {
-            assert!(
-                features.on(Feature::GlassLobe),
-                "glass left out though a texture lowers metallic: {}",
-                features.reason(Feature::GlassLobe)
-            );
-        }
-        assert!(
-            specialized
-                .iter()
-                .any(|f| f.pixels.iter().any(|p| p[0] > 0.0)),
-            "seed {seed}: black image"
-        );
-        if specialized == general {
-            identical += 1;
-            println!(
-                "seed {seed} ({base}): bit-identical; {}",
-                features.summary()
-            );
-            continue;
-        }
-        let (other, _) = frames(&gpu, true, seed + 1000).unwrap();
-        match common::same_means(&specialized, &other, 8, 1e-3, ALPHA) {
-            Ok((tests, worst)) => println!(
-                "seed {seed} ({base}): same means ({tests} tests, largest |t| {worst:.2} of the critical value); {}",
-                features.summary()
-            ),
-            Err(e) => panic!(
-                "seed {seed} ({base}): the specialized shader renders another image than the general one: {e}; {}",
-                features.summary()
-            ),
-        }
+    for (left_out, alpha, same) in found {
+        left_out_somewhere.extend(left_out);
+        alpha_somewhere |= alpha;
+        identical += usize::from(same);
     }
     println!(
         "{identical} of 16 scenes bit-identical; left out in some scene: {left_out_somewhere:?}"
@@ -312,12 +334,19 @@ fn each_feature_sets_its_own_wgsl_constant() {
             "two features called {}",
             f.label()
         );
-        let on = all.clone().with(f, true).wgsl_options();
-        let off = all.clone().with(f, false).wgsl_options();
+        let on = all.clone().with(f, true);
+        let off = all.clone().with(f, false);
+        // `WAVES` is derived: paths traced in steps, by host intersection or the wavefront.
+        for x in [&on, &off] {
+            let waves = x.on(Feature::HostRays) || x.on(Feature::Wavefront);
+            let line = format!("const WAVES: bool = {waves};");
+            assert!(x.wgsl_options().lines().any(|l| l == line), "{f:?}: {line}");
+        }
+        let (on, off) = (on.wgsl_options(), off.wgsl_options());
         let changed: Vec<_> = on
             .lines()
             .zip(off.lines())
-            .filter(|(a, b)| a != b)
+            .filter(|(a, b)| a != b && !a.starts_with("const WAVES:"))
             .collect();
         match f.wgsl_const() {
             Some(name) => assert_eq!(

@@ -470,3 +470,15 @@ pub fn intersector_asked_for() -> crate::specialize::Intersector {
         _ => Intersector::Auto,
     }
 }
+
+/// The schedule the environment asks for: `LUMAGRAPH_WAVEFRONT=on` the wavefront
+/// ([`crate::wavefront`]) wherever it can trace the scene, `off` the megakernel. Otherwise
+/// [`Schedule::Auto`](crate::specialize::Schedule::Auto).
+pub fn schedule_asked_for() -> crate::specialize::Schedule {
+    use crate::specialize::Schedule;
+    match std::env::var("LUMAGRAPH_WAVEFRONT").as_deref() {
+        Ok("on" | "1") => Schedule::Wavefront,
+        Ok("off" | "0") => Schedule::Megakernel,
+        _ => Schedule::Auto,
+    }
+}

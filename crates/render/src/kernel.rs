@@ -593,20 +593,17 @@ impl<'a> PassBuilder<'a> {
         workgroups: [u32; 3],
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
+        let entry = self.entry;
+        self.bound(ctx)?.dispatch(encoder, entry, workgroups, timer)
+    }
+
+    /// The pass's bind group, made once, for several dispatches of the kernel's entry
+    /// points (the steps of a wavefront, which bind the same resources again and again).
+    ///
+    /// # Errors
+    /// When the resources given do not match the kernel's bindings.
+    pub fn bound(self, ctx: &GpuContext) -> Result<BoundPass<'a>> {
         self.check()?;
-        let pipeline = match self.entry {
-            None => &self.kernel.pipeline,
-            Some(entry) => self
-                .kernel
-                .entries
-                .iter()
-                .find(|(e, _)| e == entry)
-                .map(|(_, p)| p)
-                .ok_or_else(|| RenderError::Shader {
-                    name: self.kernel.label.clone(),
-                    message: format!("pass `{}`: no entry point `{entry}` built", self.name),
-                })?,
-        };
         let entries: Vec<_> = self
             .resources
             .into_iter()
@@ -621,13 +618,55 @@ impl<'a> PassBuilder<'a> {
             layout: &self.kernel.layout,
             entries: &entries,
         });
+        Ok(BoundPass {
+            kernel: self.kernel,
+            name: self.name,
+            bind_group,
+        })
+    }
+}
+
+/// A pass whose resources are bound ([`PassBuilder::bound`]): dispatches of its kernel's
+/// entry points, each recorded as a compute pass of its own.
+#[derive(Debug)]
+pub struct BoundPass<'a> {
+    kernel: &'a Kernel,
+    name: &'a str,
+    bind_group: wgpu::BindGroup,
+}
+
+impl BoundPass<'_> {
+    /// Records a dispatch of `entry` (`None`: `main`) over `workgroups`.
+    ///
+    /// # Errors
+    /// When `entry` is not one of the kernel's entry points.
+    pub fn dispatch(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        entry: Option<&str>,
+        workgroups: [u32; 3],
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let pipeline = match entry {
+            None => &self.kernel.pipeline,
+            Some(entry) => self
+                .kernel
+                .entries
+                .iter()
+                .find(|(e, _)| e == entry)
+                .map(|(_, p)| p)
+                .ok_or_else(|| RenderError::Shader {
+                    name: self.kernel.label.clone(),
+                    message: format!("pass `{}`: no entry point `{entry}` built", self.name),
+                })?,
+        };
         let timestamp_writes = timer.and_then(|t| t.writes(self.name));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(self.name),
             timestamp_writes,
         });
         pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_bind_group(0, &self.bind_group, &[]);
         pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
         Ok(())
     }

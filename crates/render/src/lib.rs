@@ -44,6 +44,7 @@ pub mod specialize;
 pub mod tile_set;
 pub mod tiled;
 mod timing;
+mod wavefront;
 pub mod wide_bvh;
 
 pub use checkpoint::Checkpoint;

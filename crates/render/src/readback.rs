@@ -37,7 +37,10 @@ pub fn map_read_after<T>(
 }
 
 /// Waits until submission `index` is done.
-fn wait_for(ctx: &GpuContext, index: wgpu::SubmissionIndex) -> Result<()> {
+///
+/// # Errors
+/// When the device is lost or the wait times out.
+pub fn wait_for(ctx: &GpuContext, index: wgpu::SubmissionIndex) -> Result<()> {
     ctx.device
         .poll(wgpu::PollType::Wait {
             submission_index: Some(index),

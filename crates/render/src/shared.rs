@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 /// The generated file's name, as shaders import it.
 pub const FILE: &str = "pathtrace/shared.wgsl";
 
-/// Host intersection's `wave` buffer, per slot of the batch (vec4 units): the path state a
+/// The `wave` buffer of host intersection and of the wavefront, per slot of the batch (vec4 units): the path state a
 /// step always moves ...
 pub const WAVE_HOT_VEC4S: u32 = 3;
 /// ... the path state it moves now and then ...
@@ -27,6 +27,15 @@ pub const WAVE_RAYS_AT: u32 = WAVE_HOT_VEC4S + WAVE_COLD_VEC4S;
 pub const WAVE_HITS_AT: u32 = WAVE_RAYS_AT + WAVE_RAYS_VEC4S;
 /// Where the list of slots starts.
 pub const WAVE_LIST_AT: u32 = WAVE_HITS_AT + 1;
+/// The wavefront ([`crate::wavefront`]) keeps, in the host's list's place, how each step's
+/// rays leave their surface (`WAVE_LEAVE_VEC4S` vec4 per listed position, from
+/// [`WAVE_LIST_AT`]) ...
+pub const WAVE_LEAVE_VEC4S: u32 = 2;
+/// ... then its two lists of slots, the step's and the next step's, a word per slot each.
+pub const WAVE_FRONT_LISTS_AT: u32 = WAVE_LIST_AT + WAVE_LEAVE_VEC4S;
+/// Where in the path tracer's `stats` the wavefront's lists keep their counts: for list `l`,
+/// the slots whose ray missed at `WAVE_COUNTS_AT + 2 l`, those whose ray hit after it.
+pub const WAVE_COUNTS_AT: u32 = 4;
 
 /// The next ray's `t_near` for a slot with no ray out that is to be stepped all the same:
 /// its path ended at a surface, and the next step's `wave_misses` adds its sample and starts
@@ -72,6 +81,9 @@ pub fn wgsl() -> String {
         ("WAVE_RAYS_AT", WAVE_RAYS_AT),
         ("WAVE_HITS_AT", WAVE_HITS_AT),
         ("WAVE_LIST_AT", WAVE_LIST_AT),
+        ("WAVE_LEAVE_VEC4S", WAVE_LEAVE_VEC4S),
+        ("WAVE_FRONT_LISTS_AT", WAVE_FRONT_LISTS_AT),
+        ("WAVE_COUNTS_AT", WAVE_COUNTS_AT),
         ("ACCEL_TRIANGLES", ACCEL_TRIANGLES),
         ("ACCEL_SPHERES", ACCEL_SPHERES),
     ] {

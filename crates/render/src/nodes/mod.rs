@@ -53,6 +53,10 @@ pub struct Resources {
     /// ([`crate::specialize::Intersector`]; `Auto`, the default: the scene, the adapter and
     /// `LUMAGRAPH_BVH` / `LUMAGRAPH_RAY_QUERY` decide).
     pub intersector: crate::specialize::Intersector,
+    /// The path tracer's schedule, where a test or a benchmark asks for one
+    /// ([`crate::specialize::Schedule`]; `Auto`, the default: the adapter and
+    /// `LUMAGRAPH_WAVEFRONT` decide).
+    pub schedule: crate::specialize::Schedule,
     /// Trace workgroups in image order even on a CPU adapter, where they are otherwise
     /// spread over the image to balance the driver's threads (a test compares the two).
     pub workgroups_in_image_order: bool,

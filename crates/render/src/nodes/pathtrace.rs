@@ -22,8 +22,9 @@ use crate::scene_gpu::SceneBuffers;
 use crate::specialize::{Feature, Features};
 
 /// `stats` slots: dropped (non-finite) samples, rays traced (low, high 32 bits), samples
-/// adaptive sampling took (since the last read).
-const STATS: u64 = 4;
+/// adaptive sampling took (since the last read); then the wavefront's list counts
+/// ([`crate::shared::WAVE_COUNTS_AT`]).
+const STATS: u64 = 8;
 
 /// The `PathTrace` kind.
 pub(crate) const IMPL: NodeImpl = NodeImpl::new("PathTrace", |ctx, pass, resources| {
@@ -77,6 +78,10 @@ fn options(
             .any(|p| pass.output(p).is_some()),
         adaptive: adaptive_on(pass),
         host_rays: cpu_adapter && crate::embree::Embree::load().is_ok(),
+        schedule: match resources.schedule {
+            crate::specialize::Schedule::Auto => crate::context::schedule_asked_for(),
+            asked => asked,
+        },
     }
 }
 
@@ -109,14 +114,15 @@ crate::param_block! {
         chunk_count: u32,
         /// `CHUNK_FIRST` | `CHUNK_LAST` (`pathtrace/pathtrace.wgsl`).
         chunk_flags: u32,
-        /// With host intersection: `WAVE_STEP` or `WAVE_FINISH`; the batch of slots
-        /// traced: its first, and the slots the `wave` buffer holds; how many of a step's
-        /// listed slots `wave_misses` takes (`wave_hits` the rest).
+        /// With host intersection or the wavefront: `WAVE_STEP` or `WAVE_FINISH`; the batch
+        /// of slots traced: its first, and the slots the `wave` buffer holds; how many of a
+        /// step's listed slots `wave_misses` takes (`wave_hits` the rest); with the
+        /// wavefront, which of its two lists is the step's ([`crate::wavefront`]).
         wave: u32,
         wave_base: u32,
         wave_capacity: u32,
         wave_split: u32,
-        pad1: u32,
+        wave_list: u32,
     }
 }
 
@@ -309,8 +315,10 @@ pub(crate) struct PathTrace {
     host: Option<HostRays>,
     /// Host intersection's steps and times since the last reset (its rays go to `rays`).
     host_counts: HostCounts,
-    /// The `wave` binding's stand-in without host intersection.
+    /// The `wave` binding's stand-in without host intersection or the wavefront.
     wave_stand_in: wgpu::Buffer,
+    /// The wavefront's buffers, where the plan says "wavefront".
+    wavefront: Option<crate::wavefront::Wavefront>,
     /// The scene's acceleration structure, where the plan says "ray queries", and how long
     /// it took to build.
     accel: Option<(crate::accel::SceneAccel, std::time::Duration)>,
@@ -361,8 +369,15 @@ impl PathTrace {
         } else {
             None
         };
-        let entries: &[&str] = if host.is_some() { &WAVE_ENTRIES } else { &[] };
-        let kernel = Kernel::with_entries(ctx, "pathtrace/pathtrace.wgsl", &source, entries)?;
+        let wavefront = features
+            .on(Feature::Wavefront)
+            .then(|| crate::wavefront::Wavefront::new(ctx));
+        let kernel = Kernel::with_entries(
+            ctx,
+            "pathtrace/pathtrace.wgsl",
+            &source,
+            entry_points(&features),
+        )?;
         let env = match &scene.environment_map {
             Some(path) => crate::env_map::EnvMap::load(
                 ctx,
@@ -429,6 +444,7 @@ impl PathTrace {
             chunk_sums: storage(ctx, "pathtrace chunk sums", 16),
             host,
             wave_stand_in: storage(ctx, "pathtrace wave stand-in", 16),
+            wavefront,
             accel,
             wide,
         };
@@ -463,7 +479,7 @@ impl PathTrace {
             wave_base: 0,
             wave_capacity: 0,
             wave_split: 0,
-            pad1: 0,
+            wave_list: 0,
         }
     }
 }
@@ -589,6 +605,82 @@ impl PathTrace {
     }
 }
 
+impl PathTrace {
+    /// Records a frame traced by the wavefront: its steps are recorded and submitted here,
+    /// all on the device; the pass that writes the pixels' means (and AOVs) is recorded into
+    /// `encoder` with the graph.
+    fn record_wavefront(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        io: &FrameIo<'_>,
+        pass: &Pass,
+        frame: Frame,
+        timer: Option<&mut crate::timing::GpuTimer>,
+    ) -> Result<()> {
+        let Some(mut front) = self.wavefront.take() else {
+            return Ok(());
+        };
+        let extent = pass.extent;
+        front.fit(ctx, extent);
+        let sums = storage(ctx, "pathtrace wavefront sums", 16 * extent.pixels());
+        let views = self.views(pass, io);
+        // As for host intersection: each step at most one bounce of one path per slot, or
+        // a path's last shadow ray.
+        let max_steps = u64::from(frame.samples_per_frame.max(1))
+            * (2 * u64::from(self.scene.settings.max_bounces) + 4)
+            + 2;
+        let list_at = std::mem::offset_of!(Frame, wave_list) as u64;
+        let words = front.list_words().clone();
+        let wave = front.wave().clone();
+        let result = self
+            .bind(&pass.node, views, &sums, &wave)
+            .bound(ctx)
+            .and_then(|bound| {
+                front.trace_frame(ctx, &self.stats, max_steps, |step, enc| {
+                    if step.first {
+                        let f = Frame {
+                            wave: WAVE_STEP,
+                            wave_base: step.base,
+                            wave_capacity: step.capacity,
+                            wave_split: 0,
+                            wave_list: step.list,
+                            ..frame
+                        };
+                        stage_frame(ctx, enc, &f, &self.frame);
+                    } else {
+                        enc.copy_buffer_to_buffer(
+                            &words,
+                            4 * u64::from(step.list),
+                            &self.frame,
+                            list_at,
+                            4,
+                        );
+                    }
+                    let groups = [step.groups, 1, 1];
+                    if step.first {
+                        bound.dispatch(enc, Some("wave_start"), groups, None)?;
+                    } else {
+                        bound.dispatch(enc, Some("wave_misses"), groups, None)?;
+                        bound.dispatch(enc, Some("wave_hits"), groups, None)?;
+                    }
+                    bound.dispatch(enc, Some("wave_trace"), groups, None)
+                })
+            });
+        let finish = result.and_then(|()| {
+            let f = Frame {
+                wave: WAVE_FINISH,
+                ..frame
+            };
+            stage_frame(ctx, encoder, &f, &self.frame);
+            self.bind(&pass.node, views, &sums, front.wave())
+                .dispatch_2d(ctx, encoder, extent, timer)
+        });
+        self.wavefront = Some(front);
+        finish
+    }
+}
+
 /// `Frame::wave` (`pathtrace/wave.wgsl`): a step of a frame's paths (its entry points
 /// `wave_start`, `wave_misses`, `wave_hits`), the pass writing the means.
 const WAVE_STEP: u32 = 1;
@@ -596,6 +688,20 @@ const WAVE_FINISH: u32 = 2;
 
 /// The path tracer's entry points for host intersection's steps (see [`WaveStep`]).
 const WAVE_ENTRIES: [&str; 3] = ["wave_start", "wave_misses", "wave_hits"];
+
+/// The wavefront's: the steps, and the tracing between them ([`crate::wavefront`]).
+const WAVEFRONT_ENTRIES: [&str; 4] = ["wave_start", "wave_misses", "wave_hits", "wave_trace"];
+
+/// The entry points beside `main` that a shader of `features` runs.
+fn entry_points(features: &Features) -> &'static [&'static str] {
+    if features.on(Feature::Wavefront) {
+        &WAVEFRONT_ENTRIES
+    } else if features.on(Feature::HostRays) {
+        &WAVE_ENTRIES
+    } else {
+        &[]
+    }
+}
 
 /// Records a copy of `frame` into the uniform buffer `dst` through a staging buffer, in
 /// order with the passes recorded around it.
@@ -701,6 +807,9 @@ impl NodeExec for PathTrace {
         self.samples += self.samples_per_frame;
         if self.host.is_some() {
             return self.record_host(ctx, encoder, io, pass, frame, timer);
+        }
+        if self.wavefront.is_some() {
+            return self.record_wavefront(ctx, encoder, io, pass, frame, timer);
         }
         // The frame's samples in dispatches of at most `samples_per_dispatch` (one on GPU
         // adapters), the partial sums kept per pixel between them.

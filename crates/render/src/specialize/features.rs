@@ -68,11 +68,14 @@ pub enum Feature {
     PathRegeneration,
     /// The host (Embree) intersects the rays; the WGSL shades them step by step.
     HostRays,
+    /// The wavefront: the WGSL shades the paths step by step, as for host intersection, and
+    /// a kernel of its own traces each step's rays on the device ([`crate::wavefront`]).
+    Wavefront,
 }
 
 impl Feature {
     /// Every feature, in the order `plan` lists them.
-    pub const ALL: [Self; 22] = [
+    pub const ALL: [Self; 23] = [
         Self::BvhTraversal,
         Self::WideBvh,
         Self::RayQueries,
@@ -95,6 +98,7 @@ impl Feature {
         Self::SpreadWorkgroups,
         Self::PathRegeneration,
         Self::HostRays,
+        Self::Wavefront,
     ];
 
     /// What `plan` and the render's shader line call it: words for people, never looked up.
@@ -122,6 +126,7 @@ impl Feature {
             Self::SpreadWorkgroups => "spread workgroups",
             Self::PathRegeneration => "path regeneration",
             Self::HostRays => "host intersection",
+            Self::Wavefront => "wavefront",
         }
     }
 
@@ -154,6 +159,7 @@ impl Feature {
             Self::SpreadWorkgroups => "SPREAD_WORKGROUPS",
             Self::PathRegeneration => "REGENERATE_PATHS",
             Self::HostRays => "HOST_RAYS",
+            Self::Wavefront => "WAVEFRONT",
         })
     }
 }
@@ -225,6 +231,9 @@ impl Features {
                 let _ = writeln!(out, "const {name}: bool = {};", d.included);
             }
         }
+        // Paths traced in steps (`pathtrace/wave.wgsl`), by either.
+        let waves = self.on(Feature::HostRays) || self.on(Feature::Wavefront);
+        let _ = writeln!(out, "const WAVES: bool = {waves};");
         out
     }
 
@@ -249,6 +258,11 @@ impl Features {
             (false, false, false, false) if self.on(Feature::WideBvh) => "8-wide BVH traversal",
             (false, false, false, true) => "BVH traversal, materials inlined",
             (false, false, false, false) => "BVH traversal",
+        };
+        let how = if self.on(Feature::Wavefront) {
+            format!("{how}, in wavefront steps")
+        } else {
+            how.to_owned()
         };
         let left_out: Vec<&str> = self
             .iter()
@@ -603,6 +617,9 @@ impl<'a> Facts<'a> {
                 },
             ),
             Feature::HostRays => self.host.clone(),
+            Feature::Wavefront => {
+                super::wavefront_decision(s, self.options, self.inline, self.host.included)
+            }
         }
     }
 

@@ -78,6 +78,34 @@ impl Intersector {
     }
 }
 
+/// How the path tracer's work is laid out on the device.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Schedule {
+    /// The adapter decides: on GPU adapters the wavefront for scenes with textured
+    /// materials, the megakernel for the others; on CPU adapters the megakernel (or host
+    /// intersection's steps). Measured in `docs/benchmarks.md`.
+    #[default]
+    Auto,
+    /// One invocation traces a pixel's whole paths (`main` in `pathtrace/pathtrace.wgsl`).
+    Megakernel,
+    /// The paths of a frame are taken one bounce at a time by small kernels: the steps of
+    /// host intersection shade (`pathtrace/wave.wgsl`) and `wave_trace` traces the rays they
+    /// wrote, on the device, between them ([`crate::wavefront`]). For the scenes host
+    /// intersection takes (triangles, no media, no adaptive sampling).
+    Wavefront,
+}
+
+impl Schedule {
+    /// What it is, in the plan's words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Auto => "the adapter's choice",
+            Self::Megakernel => "the megakernel",
+            Self::Wavefront => "the wavefront",
+        }
+    }
+}
+
 /// What the graph needs of the path tracer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PathTraceOptions {
@@ -110,6 +138,9 @@ pub struct PathTraceOptions {
     /// The intersector asked for (tests, benchmarks, `LUMAGRAPH_BVH`, `LUMAGRAPH_RAY_QUERY`),
     /// or [`Intersector::Auto`]: the scene and the adapter decide.
     pub intersector: Intersector,
+    /// The schedule asked for (tests, benchmarks, `LUMAGRAPH_WAVEFRONT`), or
+    /// [`Schedule::Auto`].
+    pub schedule: Schedule,
 }
 
 /// A path tracer shader specialized to one scene, adapter and graph: its features, decided
@@ -229,9 +260,9 @@ fn inline_data_reason(
     }
 }
 
-/// Why texture sampling and vertex colours are (or are not) compiled in.
-fn textures_reason(scene: &GpuScene, all: bool) -> String {
-    let textured_materials = scene
+/// How many of the scene's materials have a texture.
+fn textured_materials(scene: &GpuScene) -> usize {
+    scene
         .materials
         .iter()
         .filter(|x| {
@@ -244,7 +275,12 @@ fn textures_reason(scene: &GpuScene, all: bool) -> String {
             .iter()
             .any(|&t| t & 0xFFFF != 0xFFFF || t >> 16 != 0xFFFF)
         })
-        .count();
+        .count()
+}
+
+/// Why texture sampling and vertex colours are (or are not) compiled in.
+fn textures_reason(scene: &GpuScene, all: bool) -> String {
+    let textured_materials = textured_materials(scene);
     if all {
         "general shader (specialization off)".to_owned()
     } else if textured_materials > 0 {
@@ -262,6 +298,29 @@ fn textures_reason(scene: &GpuScene, all: bool) -> String {
     }
 }
 
+/// Why the steps of host intersection and of the wavefront cannot trace `scene`, if they
+/// cannot: they shade triangle hits only, without media, adaptive sampling or bounce counts
+/// beyond what a step keeps.
+fn steps_cannot_trace(scene: &GpuScene, options: PathTraceOptions) -> Option<String> {
+    let media = scene.materials.iter().any(|x| {
+        x.flags & (lumagraph_scene::MATERIAL_MEDIUM | lumagraph_scene::MATERIAL_INDEX_MATCHED) != 0
+    });
+    if scene.tri_positions.is_empty() || !scene.spheres.is_empty() {
+        Some("spheres or no triangles: the steps shade triangle hits only".to_owned())
+    } else if media {
+        Some("participating media: shadow rays cross boundaries in WGSL".to_owned())
+    } else if options.adaptive {
+        Some("adaptive sampling: traced in WGSL".to_owned())
+    } else if scene.settings.max_bounces >= HOST_RAYS_MAX_BOUNCES {
+        Some(format!(
+            "{} bounces: a step keeps at most {HOST_RAYS_MAX_BOUNCES}",
+            scene.settings.max_bounces
+        ))
+    } else {
+        None
+    }
+}
+
 /// Whether the host intersects the rays (`HOST_RAYS`), and why (not).
 fn host_rays_decision(
     scene: &GpuScene,
@@ -269,9 +328,6 @@ fn host_rays_decision(
     inline: bool,
     asked: Intersector,
 ) -> Decision {
-    let media = scene.materials.iter().any(|x| {
-        x.flags & (lumagraph_scene::MATERIAL_MEDIUM | lumagraph_scene::MATERIAL_INDEX_MATCHED) != 0
-    });
     let (included, reason) = if !options.cpu_adapter || !options.specialize {
         (
             false,
@@ -286,26 +342,8 @@ fn host_rays_decision(
             false,
             format!("no host intersector: {}", host_rays_unavailable()),
         )
-    } else if scene.tri_positions.is_empty() || !scene.spheres.is_empty() {
-        (
-            false,
-            "spheres or no triangles: the host intersects triangles only".to_owned(),
-        )
-    } else if media {
-        (
-            false,
-            "participating media: shadow rays cross boundaries in WGSL".to_owned(),
-        )
-    } else if options.adaptive {
-        (false, "adaptive sampling: traced in WGSL".to_owned())
-    } else if scene.settings.max_bounces >= HOST_RAYS_MAX_BOUNCES {
-        (
-            false,
-            format!(
-                "{} bounces: a step keeps at most {HOST_RAYS_MAX_BOUNCES}",
-                scene.settings.max_bounces
-            ),
-        )
+    } else if let Some(why) = steps_cannot_trace(scene, options) {
+        (false, why)
     } else {
         (
             true,
@@ -315,6 +353,52 @@ fn host_rays_decision(
                 scene.tri_positions.len()
             ),
         )
+    };
+    Decision { included, reason }
+}
+
+/// Why a GPU adapter schedules textured scenes as a wavefront unless asked otherwise:
+/// measured in `docs/benchmarks.md` ("The wavefront against the megakernel").
+const GPU_WAVEFRONT_REASON: &str = "a GPU adapter and textured materials: the wavefront \
+     measured 1.11x the megakernel's paths/s on Sponza on an NVIDIA H200 \
+     (LUMAGRAPH_WAVEFRONT=off asks for the megakernel)";
+
+/// Why a GPU adapter keeps the megakernel for untextured scenes.
+const GPU_MEGAKERNEL_REASON: &str = "no textured material: the megakernel measured 1.81x the \
+     wavefront's paths/s on the Cornell box and 1.75x on a 1.3 M-triangle mesh on an NVIDIA \
+     H200 (LUMAGRAPH_WAVEFRONT=on asks for the wavefront)";
+
+/// Whether the wavefront schedules the paths (`WAVEFRONT`), and why (not): where asked
+/// for, or on a GPU adapter for textured scenes, wherever its steps can trace the scene.
+fn wavefront_decision(
+    scene: &GpuScene,
+    options: PathTraceOptions,
+    inline: bool,
+    host: bool,
+) -> Decision {
+    let wanted = match options.schedule {
+        Schedule::Megakernel => Err("the megakernel asked for".to_owned()),
+        Schedule::Wavefront => Ok("asked for"),
+        Schedule::Auto if options.cpu_adapter => Err(
+            "a CPU adapter: the megakernel, or the host's steps (the wavefront measured 0.5x \
+             the megakernel on lavapipe; LUMAGRAPH_WAVEFRONT=on asks for it)"
+                .to_owned(),
+        ),
+        Schedule::Auto if textured_materials(scene) == 0 => Err(GPU_MEGAKERNEL_REASON.to_owned()),
+        Schedule::Auto => Ok(GPU_WAVEFRONT_REASON),
+    };
+    let (included, reason) = match wanted {
+        Err(why) => (false, why),
+        Ok(_) if !options.specialize => (false, "general shader: the megakernel".to_owned()),
+        Ok(_) if host => (
+            false,
+            "rays intersected on the host, which steps the paths itself".to_owned(),
+        ),
+        Ok(_) if inline => (false, "intersected inline: the megakernel".to_owned()),
+        Ok(why) => match steps_cannot_trace(scene, options) {
+            Some(cannot) => (false, format!("{cannot}: the megakernel")),
+            None => (true, why.to_owned()),
+        },
     };
     Decision { included, reason }
 }

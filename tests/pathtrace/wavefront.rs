@@ -1,0 +1,143 @@
+//! The wavefront (`Schedule::Wavefront`, `LUMAGRAPH_WAVEFRONT=on`): the paths of a frame
+//! taken one bounce at a time by the steps of `pathtrace/wave.wgsl`, each step's rays traced
+//! on the device by `wave_trace` through the intersector the megakernel uses, with the same
+//! rules for rays leaving a surface. Same random numbers, same arithmetic, same hits: the
+//! images are the megakernel's, bit for bit.
+
+use crate::common;
+
+use std::sync::Arc;
+
+use lumagraph::render::Resources;
+use lumagraph::render::specialize::{Feature, Intersector, Schedule};
+use lumagraph::scene::GpuScene;
+
+fn as_gpu(intersector: Intersector, schedule: Schedule) -> Resources {
+    Resources {
+        as_gpu_adapter: true,
+        intersector,
+        schedule,
+        ..Resources::default()
+    }
+}
+
+/// The wavefront against the megakernel, both as a GPU adapter runs them, at 64×64 and
+/// 16 spp (4 frames of 4): glass and an area light through the binary BVH
+/// (`tests/scenes/host/cornell_glass.ron`: refraction, MIS at emitter hits, shadow rays
+/// leaving either side of a surface), 5 120 triangles under an environment map through the
+/// 8-wide BVH (`mesh_env.ron`). Asserted: color, albedo, normal and depth bit-identical
+/// (measured so, and on `cornell_metals.ron`'s rough and smooth metals too).
+#[test]
+fn the_wavefront_renders_what_the_megakernel_renders() {
+    for (name, intersector) in [
+        (
+            "../tests/scenes/host/cornell_glass.ron",
+            Intersector::BinaryBvh,
+        ),
+        ("../tests/scenes/mesh_env.ron", Intersector::WideBvh),
+    ] {
+        let Some((front, how_front)) =
+            common::render_with(name, (64, 64), 16, as_gpu(intersector, Schedule::Wavefront))
+        else {
+            return;
+        };
+        let (mega, how_mega) = common::render_with(
+            name,
+            (64, 64),
+            16,
+            as_gpu(intersector, Schedule::Megakernel),
+        )
+        .unwrap();
+        assert!(how_front.on(Feature::Wavefront), "{}", how_front.summary());
+        assert!(!how_mega.on(Feature::Wavefront), "{}", how_mega.summary());
+        assert!(front[0].pixels.iter().any(|p| p[0] > 0.0), "{name}: black");
+        for (i, port) in ["color", "albedo", "normal", "depth"].iter().enumerate() {
+            let differ = common::differing(&front[i], &mega[i], None);
+            println!("{name} ({intersector:?}) {port}: {differ} pixels differ");
+            assert_eq!(differ, 0, "{name} ({intersector:?}) {port}");
+        }
+    }
+}
+
+/// Alpha masks in the wavefront's tracing: the checkerboard-masked quad before a wall of
+/// 8×8 quads (`alpha.rs`), under a white sky, 4 spp: camera rays and bounces pass its holes
+/// as in the megakernel. Asserted: the color bit-identical.
+#[test]
+fn the_wavefront_sees_through_alpha_masks_as_the_megakernel_does() {
+    use super::alpha::{albedos, checker_masked, front_and_tiled_wall};
+    let scene = Arc::new(GpuScene::build(&checker_masked(front_and_tiled_wall(64, 8))).unwrap());
+    let Some((_, _, front, how)) =
+        albedos(&scene, as_gpu(Intersector::BinaryBvh, Schedule::Wavefront))
+    else {
+        return;
+    };
+    let (_, _, mega, _) =
+        albedos(&scene, as_gpu(Intersector::BinaryBvh, Schedule::Megakernel)).unwrap();
+    assert!(
+        how.on(Feature::Wavefront) && how.on(Feature::Alpha),
+        "{}",
+        how.summary()
+    );
+    let differ = common::differing(&front, &mega, None);
+    println!("masked checkerboard: {differ} pixels differ");
+    assert_eq!(differ, 0);
+}
+
+/// Where the wavefront is compiled in: asked for, or (the default) on a GPU adapter for a
+/// scene with textured materials, where it measured faster (Sponza on an NVIDIA H200,
+/// `docs/benchmarks.md`); never where its steps cannot trace the scene (spheres, media: the
+/// steps shade triangle hits only); and the plan says why.
+#[test]
+fn the_wavefront_is_used_where_asked_for_or_measured_faster() {
+    use lumagraph::render::specialize::{Features, PathTraceOptions};
+    let decide = |name: &str, schedule, cpu_adapter| {
+        let scene = common::gpu_scene(name, Some(32));
+        Features::decide(
+            &scene,
+            PathTraceOptions {
+                specialize: true,
+                cpu_adapter,
+                schedule,
+                ..PathTraceOptions::default()
+            },
+        )
+    };
+    let (mesh, textured) = ("tests/scenes/mesh_env.ron", "assets/boxtextured.ron");
+    // Asked for.
+    assert!(decide(mesh, Schedule::Wavefront, false).on(Feature::Wavefront));
+    let off = decide(textured, Schedule::Megakernel, false);
+    assert!(!off.on(Feature::Wavefront), "{}", off.summary());
+    // The default: textured scenes on GPU adapters.
+    let gpu_textured = decide(textured, Schedule::Auto, false);
+    assert!(
+        gpu_textured.on(Feature::Wavefront),
+        "{}",
+        gpu_textured.reason(Feature::Wavefront)
+    );
+    assert!(gpu_textured.reason(Feature::Wavefront).contains("textured"));
+    let gpu_plain = decide(mesh, Schedule::Auto, false);
+    assert!(!gpu_plain.on(Feature::Wavefront));
+    assert!(
+        gpu_plain
+            .reason(Feature::Wavefront)
+            .contains("LUMAGRAPH_WAVEFRONT=on")
+    );
+    let cpu_textured = decide(textured, Schedule::Auto, true);
+    assert!(!cpu_textured.on(Feature::Wavefront));
+    assert!(
+        cpu_textured
+            .reason(Feature::Wavefront)
+            .contains("CPU adapter")
+    );
+    // Never where the steps cannot trace the scene.
+    let spheres = decide("assets/cornell_spheres.ron", Schedule::Wavefront, false);
+    assert!(!spheres.on(Feature::Wavefront));
+    let why = spheres.reason(Feature::Wavefront);
+    assert!(why.contains("spheres"), "{why}");
+    let media = decide(
+        "tests/scenes/media_scattering.ron",
+        Schedule::Wavefront,
+        false,
+    );
+    assert!(!media.on(Feature::Wavefront));
+}
