@@ -10,7 +10,7 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 use lumagraph::graph::{Edge, Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
-use lumagraph::render::specialize::{Feature, Intersector, Schedule};
+use lumagraph::render::specialize::{Feature, Intersector};
 use lumagraph::render::{Executor, Resources, compile};
 use lumagraph::scene::traverse::{Ray, intersect};
 use lumagraph::scene::{AlphaMode, GpuScene, Scene, Texture, Wrap};
@@ -130,11 +130,8 @@ pub(super) fn albedos(
 /// side), and the cut-out squares are half the quad's pixels within 10 %.
 #[test]
 fn masked_checkerboard_shows_the_wall_through_its_holes() {
-    // GPU adapters as the megakernel runs them (the wavefront's tracing takes the same
-    // any-hit test: `wavefront.rs`).
     let inline_or_bvh = Resources {
         as_gpu_adapter: true,
-        schedule: Schedule::Megakernel,
         ..Resources::default()
     };
     let wgsl = Resources {
@@ -144,7 +141,6 @@ fn masked_checkerboard_shows_the_wall_through_its_holes() {
     let wide = Resources {
         as_gpu_adapter: true,
         intersector: Intersector::WideBvh,
-        schedule: Schedule::Megakernel,
         ..Resources::default()
     };
     check_checkerboard(

@@ -14,7 +14,6 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 use lumagraph::graph::{Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
-use lumagraph::render::specialize::Schedule;
 use lumagraph::render::{Executor, Resources, compile};
 use lumagraph::scene::{GpuScene, Scene, UvTransform, intersect};
 
@@ -89,8 +88,6 @@ impl Render {
         let resources = Resources {
             scene: Some(Arc::clone(&gpu)),
             as_gpu_adapter: true,
-            // The megakernel (the wavefront's images are its own, `wavefront.rs`).
-            schedule: Schedule::Megakernel,
             ..Resources::default()
         };
         let mut exec = Executor::new(ctx, plan, &resources).unwrap();

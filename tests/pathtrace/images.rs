@@ -16,7 +16,7 @@ use std::sync::Arc;
 
 use lumagraph::graph::{Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
-use lumagraph::render::specialize::{Feature, Features, Intersector, Schedule};
+use lumagraph::render::specialize::{Feature, Features, Intersector};
 use lumagraph::render::{Executor, Resources, compile, image_io, metrics};
 use lumagraph::scene::{GpuScene, Scene};
 
@@ -409,7 +409,6 @@ fn leaving_out_a_missing_primitive_kind_renders_bit_identical_images() {
                 Resources {
                     general_shaders: general,
                     as_gpu_adapter: true,
-                    schedule: Schedule::Megakernel,
                     scene_data_in_buffers: true,
                     ..Resources::default()
                 },

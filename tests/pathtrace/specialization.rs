@@ -20,7 +20,7 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 use lumagraph::graph::{Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
-use lumagraph::render::specialize::{Feature, Features, Schedule};
+use lumagraph::render::specialize::{Feature, Features};
 use lumagraph::render::{Executor, Resources, compile};
 use lumagraph::scene::{AlphaMode, GpuScene, NO_TEXTURE, Scene, Texture, Wrap};
 
@@ -196,9 +196,6 @@ fn frames(scene: &GpuScene, general: bool, seed: u32) -> Option<(Vec<Image>, Fea
         scene: Some(Arc::clone(&scene)),
         general_shaders: general,
         as_gpu_adapter: true,
-        // The megakernel: a GPU adapter would step textured scenes as a wavefront, whose
-        // images are the megakernel's (`wavefront.rs`) at several times the compile time.
-        schedule: Schedule::Megakernel,
         scene_data_in_buffers: true,
         ..Resources::default()
     };

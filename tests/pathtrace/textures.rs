@@ -14,7 +14,6 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3, Vec4};
 use lumagraph::graph::{Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
-use lumagraph::render::specialize::Schedule;
 use lumagraph::render::{Executor, Resources, compile};
 use lumagraph::scene::texture::{Texture, srgb_decode, triangle_tangents};
 use lumagraph::scene::{GpuScene, NO_TEXTURE, Ray, Scene, UvTransform, Wrap};
@@ -325,8 +324,6 @@ fn render(scene: &Arc<GpuScene>, spp: i64) -> Option<[Image; 5]> {
     let resources = Resources {
         scene: Some(Arc::clone(scene)),
         as_gpu_adapter: true,
-        // The megakernel (the wavefront's images are its own, `wavefront.rs`).
-        schedule: Schedule::Megakernel,
         ..Resources::default()
     };
     let mut exec = Executor::new(ctx, plan, &resources).unwrap();

@@ -84,16 +84,17 @@ fn the_wavefront_sees_through_alpha_masks_as_the_megakernel_does() {
 }
 
 /// Where the wavefront is compiled in: asked for, or (the default) on a GPU adapter for a
-/// scene with textured materials, where it measured faster (Sponza on an NVIDIA H200,
-/// `docs/benchmarks.md`); never where its steps cannot trace the scene (spheres, media: the
-/// steps shade triangle hits only); and the plan says why.
+/// scene of textured materials and at least `WAVEFRONT_MIN_TRIANGLES` triangles, the kind of
+/// scene it measured faster on (Sponza on an NVIDIA H200, `docs/benchmarks.md`); never where
+/// its steps cannot trace the scene (spheres, media: the steps shade triangle hits only); and
+/// the plan says why.
 #[test]
 fn the_wavefront_is_used_where_asked_for_or_measured_faster() {
-    use lumagraph::render::specialize::{Features, PathTraceOptions};
-    let decide = |name: &str, schedule, cpu_adapter| {
-        let scene = common::gpu_scene(name, Some(32));
+    use lumagraph::render::specialize::{Features, PathTraceOptions, WAVEFRONT_MIN_TRIANGLES};
+    use lumagraph::scene::Scene;
+    let decide = |scene: &GpuScene, schedule, cpu_adapter| {
         Features::decide(
-            &scene,
+            scene,
             PathTraceOptions {
                 specialize: true,
                 cpu_adapter,
@@ -102,42 +103,52 @@ fn the_wavefront_is_used_where_asked_for_or_measured_faster() {
             },
         )
     };
-    let (mesh, textured) = ("tests/scenes/mesh_env.ron", "assets/boxtextured.ron");
+    let mesh = common::gpu_scene("tests/scenes/mesh_env.ron", Some(32));
+    let small_textured = common::gpu_scene("assets/boxtextured.ron", Some(32));
+    // The textured box, its 12 triangles copied side by side past the threshold.
+    let mut scene = Scene::load(&common::repo("assets/boxtextured.ron")).unwrap();
+    let box_triangles = scene.triangles.clone();
+    for i in 1..=WAVEFRONT_MIN_TRIANGLES / box_triangles.len() {
+        let offset = glam::Vec3::new(3.0 * i as f32, 0.0, 0.0);
+        scene.triangles.extend(box_triangles.iter().map(|t| {
+            let mut t = *t;
+            t.positions = t.positions.map(|p| p + offset);
+            t
+        }));
+    }
+    let large_textured = GpuScene::build(&scene).unwrap();
+    assert!(large_textured.tri_positions.len() >= WAVEFRONT_MIN_TRIANGLES);
     // Asked for.
-    assert!(decide(mesh, Schedule::Wavefront, false).on(Feature::Wavefront));
-    let off = decide(textured, Schedule::Megakernel, false);
+    assert!(decide(&mesh, Schedule::Wavefront, false).on(Feature::Wavefront));
+    assert!(decide(&small_textured, Schedule::Wavefront, false).on(Feature::Wavefront));
+    let off = decide(&large_textured, Schedule::Megakernel, false);
     assert!(!off.on(Feature::Wavefront), "{}", off.summary());
-    // The default: textured scenes on GPU adapters.
-    let gpu_textured = decide(textured, Schedule::Auto, false);
-    assert!(
-        gpu_textured.on(Feature::Wavefront),
-        "{}",
-        gpu_textured.reason(Feature::Wavefront)
-    );
-    assert!(gpu_textured.reason(Feature::Wavefront).contains("textured"));
-    let gpu_plain = decide(mesh, Schedule::Auto, false);
-    assert!(!gpu_plain.on(Feature::Wavefront));
-    assert!(
-        gpu_plain
-            .reason(Feature::Wavefront)
-            .contains("LUMAGRAPH_WAVEFRONT=on")
-    );
-    let cpu_textured = decide(textured, Schedule::Auto, true);
-    assert!(!cpu_textured.on(Feature::Wavefront));
-    assert!(
-        cpu_textured
-            .reason(Feature::Wavefront)
-            .contains("CPU adapter")
-    );
+    // The default: large textured scenes on GPU adapters.
+    let chosen = decide(&large_textured, Schedule::Auto, false);
+    let why = chosen.reason(Feature::Wavefront);
+    assert!(chosen.on(Feature::Wavefront), "{why}");
+    assert!(why.contains("textured"), "{why}");
+    for (scene, what) in [
+        (&mesh, "no textured material"),
+        (&small_textured, "triangles <"),
+    ] {
+        let f = decide(scene, Schedule::Auto, false);
+        let why = f.reason(Feature::Wavefront);
+        assert!(!f.on(Feature::Wavefront), "{why}");
+        assert!(
+            why.contains(what) && why.contains("LUMAGRAPH_WAVEFRONT=on"),
+            "{why}"
+        );
+    }
+    let cpu = decide(&large_textured, Schedule::Auto, true);
+    assert!(!cpu.on(Feature::Wavefront));
+    assert!(cpu.reason(Feature::Wavefront).contains("CPU adapter"));
     // Never where the steps cannot trace the scene.
-    let spheres = decide("assets/cornell_spheres.ron", Schedule::Wavefront, false);
-    assert!(!spheres.on(Feature::Wavefront));
-    let why = spheres.reason(Feature::Wavefront);
+    let spheres = common::gpu_scene("assets/cornell_spheres.ron", Some(32));
+    let f = decide(&spheres, Schedule::Wavefront, false);
+    assert!(!f.on(Feature::Wavefront));
+    let why = f.reason(Feature::Wavefront);
     assert!(why.contains("spheres"), "{why}");
-    let media = decide(
-        "tests/scenes/media_scattering.ron",
-        Schedule::Wavefront,
-        false,
-    );
-    assert!(!media.on(Feature::Wavefront));
+    let media = common::gpu_scene("tests/scenes/media_scattering.ron", Some(32));
+    assert!(!decide(&media, Schedule::Wavefront, false).on(Feature::Wavefront));
 }

@@ -81,9 +81,10 @@ impl Intersector {
 /// How the path tracer's work is laid out on the device.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Schedule {
-    /// The adapter decides: on GPU adapters the wavefront for scenes with textured
-    /// materials, the megakernel for the others; on CPU adapters the megakernel (or host
-    /// intersection's steps). Measured in `docs/benchmarks.md`.
+    /// The adapter decides: on GPU adapters the wavefront for scenes of textured materials
+    /// and at least [`WAVEFRONT_MIN_TRIANGLES`] triangles, the megakernel for the others; on
+    /// CPU adapters the megakernel (or host intersection's steps). Measured in
+    /// `docs/benchmarks.md`.
     #[default]
     Auto,
     /// One invocation traces a pixel's whole paths (`main` in `pathtrace/pathtrace.wgsl`).
@@ -357,19 +358,25 @@ fn host_rays_decision(
     Decision { included, reason }
 }
 
-/// Why a GPU adapter schedules textured scenes as a wavefront unless asked otherwise:
-/// measured in `docs/benchmarks.md` ("The wavefront against the megakernel").
-const GPU_WAVEFRONT_REASON: &str = "a GPU adapter and textured materials: the wavefront \
-     measured 1.11x the megakernel's paths/s on Sponza on an NVIDIA H200 \
+/// GPU adapters step scenes of at least this many triangles with textured materials as a
+/// wavefront: the one scene it measured faster on (Sponza, 262 087 triangles, 24 textured
+/// materials) has both; a 1.3 M-triangle mesh without textures and a 12-triangle textured
+/// box traced faster through the megakernel (`docs/benchmarks.md`).
+pub const WAVEFRONT_MIN_TRIANGLES: usize = 100_000;
+
+/// Why a GPU adapter schedules such scenes as a wavefront unless asked otherwise.
+const GPU_WAVEFRONT_REASON: &str = "a GPU adapter, textured materials and a large BVH: the \
+     wavefront measured 1.11x the megakernel's paths/s on Sponza on an NVIDIA H200 \
      (LUMAGRAPH_WAVEFRONT=off asks for the megakernel)";
 
-/// Why a GPU adapter keeps the megakernel for untextured scenes.
-const GPU_MEGAKERNEL_REASON: &str = "no textured material: the megakernel measured 1.81x the \
-     wavefront's paths/s on the Cornell box and 1.75x on a 1.3 M-triangle mesh on an NVIDIA \
-     H200 (LUMAGRAPH_WAVEFRONT=on asks for the wavefront)";
+/// Why a GPU adapter keeps the megakernel for the other scenes.
+const GPU_MEGAKERNEL_REASON: &str = "the megakernel measured 1.8x the wavefront's paths/s on \
+     the Cornell box, 1.7x on a 1.3 M-triangle mesh and 6.7x on a textured 12-triangle box on \
+     an NVIDIA H200 (LUMAGRAPH_WAVEFRONT=on asks for the wavefront)";
 
 /// Whether the wavefront schedules the paths (`WAVEFRONT`), and why (not): where asked
-/// for, or on a GPU adapter for textured scenes, wherever its steps can trace the scene.
+/// for, or on a GPU adapter for large scenes with textured materials
+/// ([`WAVEFRONT_MIN_TRIANGLES`]), wherever its steps can trace the scene.
 fn wavefront_decision(
     scene: &GpuScene,
     options: PathTraceOptions,
@@ -384,7 +391,13 @@ fn wavefront_decision(
              the megakernel on lavapipe; LUMAGRAPH_WAVEFRONT=on asks for it)"
                 .to_owned(),
         ),
-        Schedule::Auto if textured_materials(scene) == 0 => Err(GPU_MEGAKERNEL_REASON.to_owned()),
+        Schedule::Auto if textured_materials(scene) == 0 => {
+            Err(format!("no textured material: {GPU_MEGAKERNEL_REASON}"))
+        }
+        Schedule::Auto if scene.tri_positions.len() < WAVEFRONT_MIN_TRIANGLES => Err(format!(
+            "{} triangles < {WAVEFRONT_MIN_TRIANGLES}: {GPU_MEGAKERNEL_REASON}",
+            scene.tri_positions.len()
+        )),
         Schedule::Auto => Ok(GPU_WAVEFRONT_REASON),
     };
     let (included, reason) = match wanted {
