@@ -10,6 +10,10 @@
 #   - the wall time of a 15 000-spp render through graphs/pathtrace.ron (the figure seed
 #     renderers give), or, where that would not fit the time left, the time of a shorter
 #     render and its 15 000-spp time extrapolated and marked so.
+#   - with MITSUBA_PYTHON (a Python that imports mitsuba 3.9.1 and drjit), Mitsuba 3's
+#     paths/s on the Cornell box and the mesh, same size, bounces and spp
+#     (scripts/bench/mitsuba_time.py on `lumagraph export`'s scene, scripts/bench/mesh_env.py
+#     mitsuba), variant MITSUBA_VARIANT (default cuda_ad_rgb); Sponza has no Mitsuba scene.
 # The last lines are a table. Meant to finish in under 8 minutes on an H100-class GPU.
 #
 #   LUMAGRAPH=target/release/lumagraph SPONZA=path/to/Sponza bash scripts/gpu_bench.sh [OUT]
@@ -99,7 +103,7 @@ run_scene() {
     # The megakernel against the wavefront, where the scene allows the wavefront.
     local front
     front=$(grep -m1 -oE 'megakernel / wavefront: [0-9.]+x' "$work/bench.txt" | grep -oE '[0-9.]+x')
-    [ -n "$mps" ] || { say "== $name: bench printed no paths/s"; rows+=("| $name | failed | | | | | | | |"); return; }
+    [ -n "$mps" ] || { say "== $name: bench printed no paths/s"; rows+=("| $name | failed | | | | | | | | |"); return; }
     # The 8-wide BVH (LUMAGRAPH_BVH=wide), which bench measures with the binary BVH after it:
     # two pairs for the wide-against-binary ratio (the binary figure above, and this one).
     say "== $name: bench with the 8-wide BVH (LUMAGRAPH_BVH=wide), then the binary one"
@@ -119,6 +123,23 @@ run_scene() {
         say "== $name: bench without ray queries (LUMAGRAPH_RAY_QUERY=off: the WGSL BVH)"
         LUMAGRAPH_RAY_QUERY=off timeout $(( $(left) > 60 ? $(left) : 60 )) "$lg" bench --scene "$scene" \
             --spp "$bench_spp" --runs 3 --specialized-only 2>&1 | tee -a "$log"
+    fi
+    # Mitsuba 3 on the same scene, where MITSUBA_PYTHON names a Python with it.
+    local mitsuba=""
+    if [ -n "${MITSUBA_PYTHON:-}" ] && [ "$name" != sponza ]; then
+        local variant=${MITSUBA_VARIANT:-cuda_ad_rgb} json=""
+        say "== $name: Mitsuba 3 ($variant, $bench_spp spp, best of 3)"
+        if [ "$name" = cornell ]; then
+            "$lg" export "$scene" --out "$work/cornell_export" >/dev/null 2>&1
+            json=$(timeout 300 "$MITSUBA_PYTHON" scripts/bench/mitsuba_time.py "$work/cornell_export" \
+                --spp "$bench_spp" --runs 3 --variant "$variant" 2>>"$log" | tail -n 1)
+        else
+            json=$(timeout 300 "$MITSUBA_PYTHON" scripts/bench/mesh_env.py mitsuba "$mesh_obj" --spp "$bench_spp" \
+                --runs 3 --variant "$variant" --width "$size" --height "$size" 2>>"$log" | tail -n 1)
+        fi
+        say "$json"
+        mitsuba=$(python3 -c 'import json, sys; print("%.1f" % (json.loads(sys.argv[1])["paths_per_s"] / 1e6))' "$json" 2>/dev/null)
+        [ -n "$mitsuba" ] && mitsuba="$mitsuba ($(awk -v a="$mps" -v b="$mitsuba" 'BEGIN { printf "%.2f", a / b }')x)"
     fi
     # Predicted wall time at 15 000 spp, with 15 % for the graph's other passes.
     local predicted spp note
@@ -141,12 +162,12 @@ run_scene() {
     secs=$(echo "$line" | grep -oE 'in [0-9.]+ s' | grep -oE '[0-9.]+')
     paths=$(echo "$line" | grep -oE '[0-9.]+ M paths/s' | grep -oE '^[0-9.]+')
     if [ -z "$secs" ]; then
-        rows+=("| $name | $mps | $front | $wide | $ratio | $general | render failed | | |")
+        rows+=("| $name | $mps | $front | $wide | $ratio | $general | $mitsuba | render failed | | |")
         return
     fi
     local at_full
     at_full=$(awk -v t="$secs" -v s="$spp" -v f=$full_spp 'BEGIN { printf "%.1f", t * f / s }')
-    rows+=("| $name | $mps | $front | $wide | $ratio | $general | $paths | $at_full s | $note |")
+    rows+=("| $name | $mps | $front | $wide | $ratio | $general | $mitsuba | $paths | $at_full s | $note |")
 }
 
 for s in $scenes; do
@@ -158,6 +179,6 @@ done
 
 say ""
 say "== $(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null || "$lg" adapters 2>/dev/null | head -1), ${size}x$size, 20 bounces, $full_spp spp, total $(( $(date +%s) - start )) s"
-say "| scene | bench, specialized, M paths/s | megakernel / wavefront | 8-wide BVH | wide / binary (two pairs) | general | render, M paths/s | wall time to $full_spp spp | |"
-say "|---|---|---|---|---|---|---|---|---|"
+say "| scene | bench, specialized, M paths/s | megakernel / wavefront | 8-wide BVH | wide / binary (two pairs) | general | Mitsuba 3, M paths/s (lumagraph / Mitsuba) | render, M paths/s | wall time to $full_spp spp | |"
+say "|---|---|---|---|---|---|---|---|---|---|"
 for r in "${rows[@]}"; do say "$r"; done
