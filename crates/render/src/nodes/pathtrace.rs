@@ -542,6 +542,35 @@ impl PathTrace {
         }
     }
 
+    /// The most steps a frame of paths traced in steps may take (host intersection, the
+    /// wavefront): each step takes at most one bounce of one path per slot, or a path's
+    /// last shadow ray.
+    fn max_steps(&self, frame: &Frame) -> u64 {
+        u64::from(frame.samples_per_frame.max(1))
+            * (2 * u64::from(self.scene.settings.max_bounces) + 4)
+            + 2
+    }
+
+    /// Records the pass that writes the pixels' means from a frame's `sums` (and the AOVs)
+    /// into the output `views` after its steps, with the steps' `wave` buffer bound.
+    fn record_finish(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: &Pass,
+        frame: Frame,
+        (views, sums, wave): ([&wgpu::TextureView; 4], &wgpu::Buffer, &wgpu::Buffer),
+        timer: Option<&mut crate::timing::GpuTimer>,
+    ) -> Result<()> {
+        let f = Frame {
+            wave: WAVE_FINISH,
+            ..frame
+        };
+        stage_frame(ctx, encoder, &f, &self.frame);
+        self.bind(&pass.node, views, sums, wave)
+            .dispatch_2d(ctx, encoder, pass.extent, timer)
+    }
+
     /// Records a frame traced with host intersection: the steps of its paths are
     /// dispatched and submitted here, the host intersecting the rays of each step; the pass
     /// that writes the pixels' means (and AOVs) is recorded into `encoder` with the graph.
@@ -557,16 +586,10 @@ impl PathTrace {
         let Some(mut host) = self.host.take() else {
             return Ok(());
         };
-        let extent = pass.extent;
-        host.fit(ctx, extent);
-        // The frame's sums: a buffer of its own, which the finish pass, recorded now and
-        // run later, reads whatever frames follow before it runs.
-        let sums = storage(ctx, "pathtrace host sums", 16 * extent.pixels());
+        host.fit(ctx, pass.extent);
+        let sums = steps_sums(ctx, pass);
         let views = self.views(pass, io);
-        // Each step at most one bounce of one path per pixel, or a path's last shadow ray.
-        let max_steps = u64::from(frame.samples_per_frame.max(1))
-            * (2 * u64::from(self.scene.settings.max_bounces) + 4)
-            + 2;
+        let max_steps = self.max_steps(&frame);
         let result = host.trace_frame(ctx, max_steps, |step, enc, wave| {
             let f = Frame {
                 wave: WAVE_STEP,
@@ -592,13 +615,14 @@ impl PathTrace {
             Ok(())
         });
         let finish = result.and_then(|()| {
-            let f = Frame {
-                wave: WAVE_FINISH,
-                ..frame
-            };
-            stage_frame(ctx, encoder, &f, &self.frame);
-            self.bind(&pass.node, views, &sums, host.wave())
-                .dispatch_2d(ctx, encoder, extent, timer)
+            self.record_finish(
+                ctx,
+                encoder,
+                pass,
+                frame,
+                (views, &sums, host.wave()),
+                timer,
+            )
         });
         self.host = Some(host);
         finish
@@ -621,15 +645,10 @@ impl PathTrace {
         let Some(mut front) = self.wavefront.take() else {
             return Ok(());
         };
-        let extent = pass.extent;
-        front.fit(ctx, extent);
-        let sums = storage(ctx, "pathtrace wavefront sums", 16 * extent.pixels());
+        front.fit(ctx, pass.extent);
+        let sums = steps_sums(ctx, pass);
         let views = self.views(pass, io);
-        // As for host intersection: each step at most one bounce of one path per slot, or
-        // a path's last shadow ray.
-        let max_steps = u64::from(frame.samples_per_frame.max(1))
-            * (2 * u64::from(self.scene.settings.max_bounces) + 4)
-            + 2;
+        let max_steps = self.max_steps(&frame);
         let list_at = std::mem::offset_of!(Frame, wave_list) as u64;
         let words = front.list_words().clone();
         let wave = front.wave().clone();
@@ -668,13 +687,7 @@ impl PathTrace {
                 })
             });
         let finish = result.and_then(|()| {
-            let f = Frame {
-                wave: WAVE_FINISH,
-                ..frame
-            };
-            stage_frame(ctx, encoder, &f, &self.frame);
-            self.bind(&pass.node, views, &sums, front.wave())
-                .dispatch_2d(ctx, encoder, extent, timer)
+            self.record_finish(ctx, encoder, pass, frame, (views, &sums, &wave), timer)
         });
         self.wavefront = Some(front);
         finish
@@ -701,6 +714,13 @@ fn entry_points(features: &Features) -> &'static [&'static str] {
     } else {
         &[]
     }
+}
+
+/// A frame's sums for the steps of host intersection or the wavefront: a buffer of its own,
+/// which the finish pass, recorded now and run later, reads whatever frames follow before
+/// it runs.
+fn steps_sums(ctx: &GpuContext, pass: &Pass) -> wgpu::Buffer {
+    storage(ctx, "pathtrace steps sums", 16 * pass.extent.pixels())
 }
 
 /// Records a copy of `frame` into the uniform buffer `dst` through a staging buffer, in
