@@ -10,9 +10,12 @@
 //!
 //! The random numbers, their order and the arithmetic are the megakernel's, and the rays
 //! leave their surfaces by the same rules, so the images are the megakernel's
-//! (`tests/pathtrace/wavefront.rs`). Whether the split pays is the adapter's question:
-//! smaller kernels keep more paths in flight and their traversal loops together, at the cost
-//! of writing each path's state to memory between steps (`docs/benchmarks.md`).
+//! (`tests/pathtrace/wavefront.rs`). Whether the split pays depends on the adapter and the
+//! scene: a kernel that only traverses may keep more paths in flight than the whole textured
+//! shader does, at the cost of writing each path's state to memory between steps and of
+//! four dispatches per step. On an NVIDIA H200 it paid on Sponza (1.11×) and lost 1.7× to
+//! 6.7× on smaller or untextured scenes; where `Schedule::Auto` chooses it follows
+//! (`specialize::WAVEFRONT_MIN_TRIANGLES`, `docs/benchmarks.md`).
 
 use wgpu::util::DeviceExt as _;
 
