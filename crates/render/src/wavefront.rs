@@ -34,7 +34,7 @@ const SLOT_BYTES: u64 = 16 * WAVE_FRONT_LISTS_AT as u64 + 8;
 
 /// Steps recorded into one submission before the host reads whether any slot is left: a
 /// step over a list that emptied costs a few empty dispatches.
-pub(crate) const STEPS_PER_SUBMIT: u64 = 16;
+const STEPS_PER_SUBMIT: u64 = 16;
 
 /// Slots per workgroup of the steps and of `wave_trace` (1D dispatches).
 const GROUP: u64 = 64;
@@ -64,8 +64,6 @@ pub(crate) struct Wavefront {
     counts_read: [wgpu::Buffer; 2],
     extent: lumagraph_graph::Extent,
     capacity: u64,
-    /// Steps taken since the last count.
-    pub(crate) steps: u64,
 }
 
 impl Wavefront {
@@ -89,7 +87,6 @@ impl Wavefront {
             }),
             extent: lumagraph_graph::Extent::new(0, 0),
             capacity: GROUP,
-            steps: 0,
         }
     }
 
@@ -173,7 +170,6 @@ impl Wavefront {
                     )?;
                     n += 1;
                 }
-                self.steps += STEPS_PER_SUBMIT;
                 // The list the last step's `wave_trace` filled: the next step's.
                 let read = &self.counts_read[chunk % 2];
                 encoder.copy_buffer_to_buffer(stats, counts_at + 8 * (n % 2), read, 0, 8);
