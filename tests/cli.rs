@@ -683,9 +683,15 @@ fn gltf_gallery_lists_each_model_with_what_it_tests() {
         .unwrap();
     }
     std::fs::write(
-        models.join("Coated.gltf"),
-        r#"{"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_materials_clearcoat"],
-  "extensionsRequired": ["KHR_materials_clearcoat"]}"#,
+        models.join("Iridescent.gltf"),
+        r#"{"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_materials_iridescence"],
+  "extensionsRequired": ["KHR_materials_iridescence"]}"#,
+    )
+    .unwrap();
+    // A file that loads but holds nothing to render.
+    std::fs::write(
+        models.join("Empty.gltf"),
+        r#"{"asset": {"version": "2.0"}}"#,
     )
     .unwrap();
     let out = dir.path().join("out");
@@ -707,9 +713,11 @@ fn gltf_gallery_lists_each_model_with_what_it_tests() {
     for want in [
         "## VertexColorTest\n\nTests if vertex colors are supported.",
         "![VertexColorTest](gltf-gallery/VertexColorTest.png)",
-        "## Coated",
+        "## Iridescent",
         "Does not load: `",
-        "requires the extension KHR_materials_clearcoat",
+        "requires the extension KHR_materials_iridescence",
+        "## Empty",
+        "the scene has no triangle or sphere",
     ] {
         assert!(page.contains(want), "missing «{want}» in:\n{page}");
     }

@@ -69,6 +69,9 @@ def bsdf(m):
         raise Refused(f"material {m['name']}: textured materials have no mapping here")
     if m.get("index_matched"):
         return {"type": "null"}, notes
+    if m.get("clearcoat", 0.0) > 0.0 or max(m.get("sheen_color", [0.0])) > 0.0:
+        raise Refused(f"material {m['name']}: clear coat and sheen (the glTF lobes) have no "
+                      "Mitsuba equivalent (principled's are other models)")
     alpha = m["roughness"] ** 2
     smooth = alpha < ALPHA_MIN
     metallic, transmission, specular = m["metallic"], m["transmission"], m["specular"]

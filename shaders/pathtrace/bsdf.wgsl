@@ -9,6 +9,8 @@
 //                     plus Kulla-Conty multiple-scattering compensation;
 //   glass             (1 - metallic) transmission: dielectric interface (exact Fresnel with
 //                     ior), reflection or refraction chosen by Fresnel, rough by GGX.
+// Over these, layered by albedo scaling (`eval_bsdf`, `sample_bsdf`): glTF's sheen
+// (sheen.wgsl, compiled in with HAS_SHEEN), and on top the clear coat (coat.wgsl, HAS_COAT).
 // MATERIAL_SINGLE_SCATTER leaves out what stands in for multiple scattering (the metal's
 // Kulla-Conty term; rough glass's reflections into the surface, sent back out, and its
 // missing shadowing of the outgoing direction), as Mitsuba's roughconductor and
@@ -22,78 +24,12 @@
 #import "common/color.wgsl"
 #import "common/sampling.wgsl"
 #import "pathtrace/eon.wgsl"
+#import "pathtrace/microfacet.wgsl"
+#import "pathtrace/coat.wgsl"
+#import "pathtrace/sheen.wgsl"
 
-// Below this alpha (= roughness^2) a lobe is a perfect mirror or interface.
-const ALPHA_MIN: f32 = 1e-3;
-const GGX_TABLE_N: u32 = 32u;
-
-// Albedo of a GGX lobe with Schlick Fresnel F0, F90 at view cosine mu is F0 t.x + F90 t.y.
-fn ggx_albedo(mu: f32, roughness: f32) -> vec2f {
-    let last = f32(GGX_TABLE_N - 1u);
-    let x = clamp(mu, 0.0, 1.0) * last;
-    let y = clamp(roughness, 0.0, 1.0) * last;
-    let x0 = min(u32(x), GGX_TABLE_N - 2u);
-    let y0 = min(u32(y), GGX_TABLE_N - 2u);
-    let i = y0 * GGX_TABLE_N + x0;
-    let lo = mix(ggx_table[i], ggx_table[i + 1u], x - f32(x0));
-    let hi = mix(ggx_table[i + GGX_TABLE_N], ggx_table[i + GGX_TABLE_N + 1u], x - f32(x0));
-    return mix(lo, hi, y - f32(y0));
-}
-
-// Cosine-weighted hemispherical average of `ggx_albedo`.
-fn ggx_albedo_avg(roughness: f32) -> vec2f {
-    let last = f32(GGX_TABLE_N - 1u);
-    let y = clamp(roughness, 0.0, 1.0) * last;
-    let y0 = min(u32(y), GGX_TABLE_N - 2u);
-    let base = GGX_TABLE_N * GGX_TABLE_N;
-    return mix(ggx_table[base + y0], ggx_table[base + y0 + 1u], y - f32(y0));
-}
-
-fn ggx_d(z: f32, a2: f32) -> f32 {
-    let t = z * z * (a2 - 1.0) + 1.0;
-    return a2 / (PI * t * t);
-}
-
-fn smith_term(z: f32, a2: f32) -> f32 {
-    return sqrt(a2 + (1.0 - a2) * z * z);
-}
-
-fn smith_g1(z: f32, a2: f32) -> f32 {
-    return 2.0 * z / (z + smith_term(z, a2));
-}
-
-// Height-correlated masking-shadowing.
-fn smith_g2(zo: f32, zi: f32, a2: f32) -> f32 {
-    return 2.0 * zo * zi / (zo * smith_term(zi, a2) + zi * smith_term(zo, a2));
-}
-
-// Visible normal of GGX seen from wo (wo.z > 0), by the spherical cap method
-// (Dupuy and Benyoub 2023).
-fn sample_vndf(wo: vec3f, alpha: f32, u: vec2f) -> vec3f {
-    let v = normalize(vec3f(wo.xy * alpha, wo.z));
-    let phi = TWO_PI * u.x;
-    let z = (1.0 - u.y) * (1.0 + v.z) - v.z;
-    let sin_t = sqrt(clamp(1.0 - z * z, 0.0, 1.0));
-    let h = vec3f(sin_t * cos(phi), sin_t * sin(phi), z) + v;
-    return normalize(vec3f(h.xy * alpha, max(h.z, 1e-7)));
-}
-
-// Reflectance at grazing incidence: 1 for real materials, 0 when F0 is 0, so a material
-// with no specular is purely Lambertian (F90 = min(1, 50 F0), as Filament does).
-fn schlick_f90(f0: vec3f) -> f32 {
-    return clamp(50.0 * max(f0.x, max(f0.y, f0.z)), 0.0, 1.0);
-}
-
-fn schlick(f0: vec3f, c: f32) -> vec3f {
-    let m = clamp(1.0 - c, 0.0, 1.0);
-    let m2 = m * m;
-    return f0 + (schlick_f90(f0) - f0) * (m2 * m2 * m);
-}
-
-// Albedo of a GGX lobe with Fresnel `schlick(f0, .)` from the (A, B) table entry t.
-fn lobe_albedo(f0: vec3f, t: vec2f) -> vec3f {
-    return f0 * t.x + schlick_f90(f0) * t.y;
-}
+// The largest f32 below 1.
+const ONE_MINUS_EPSILON: f32 = 0.99999994;
 
 // Unpolarized Fresnel reflectance of a conductor of complex index eta + i k (per channel) at
 // incidence cosine cos_i; mirrors crates/scene/src/conductor.rs.
@@ -211,15 +147,8 @@ fn metal_ss_sample_prob(m: Material, lp: LobeParams, e_o: f32) -> f32 {
     return select(metal_ss_prob(e_o), 1.0, lp.is_smooth || !multiscatter(m));
 }
 
-// The non-delta, non-glass part of the BSDF: f * cos(wi) and the solid-angle pdf with which
-// `sample_bsdf` produces wi (lobe choice included). Light sampling evaluates this; the
-// glass lobe and perfect mirrors are reached by BSDF sampling only.
-struct BsdfEval {
-    f_cos: vec3f,
-    pdf: f32,
-}
-
-fn eval_bsdf(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
+// The three lobes without the layers on top (`eval_bsdf`).
+fn eval_base(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
     var out = BsdfEval(vec3f(0.0), 0.0);
     if wo.z <= 0.0 || wi.z <= 0.0 {
         return out;
@@ -343,7 +272,9 @@ fn sample_glass(m: Material, lp: LobeParams, wo: vec3f, u: vec3f) -> BsdfSample 
     return BsdfSample(normalize(vec3f(wi.xy, wi.z * s)), weight, 0.0, true);
 }
 
-fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
+// A sample of the three lobes; its non-delta samples weighted by the whole BSDF
+// (`eval_bsdf`, layers included), as one-sample MIS over every lobe asks.
+fn sample_base(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     var out = BsdfSample(vec3f(0.0, 0.0, 1.0), vec3f(0.0), 0.0, false);
     let w = lobe_weights(m);
     let lp = lobe_params(m);
@@ -403,6 +334,14 @@ fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     } else {
         wi = sample_cosine(vec3f(0.0, 0.0, 1.0), u.xy);
     }
+    return sampled_by_eval(m, wo, wi);
+}
+
+// A non-delta sample towards wi: weighted by the whole BSDF's f * cos over its pdf
+// (`eval_bsdf`), as one-sample MIS over every lobe asks; none below the surface or where
+// no lobe could have drawn it.
+fn sampled_by_eval(m: Material, wo: vec3f, wi: vec3f) -> BsdfSample {
+    var out = BsdfSample(vec3f(0.0, 0.0, 1.0), vec3f(0.0), 0.0, false);
     if wi.z <= 0.0 {
         return out;
     }
@@ -415,4 +354,85 @@ fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     out.pdf = e.pdf;
     out.valid = true;
     return out;
+}
+
+// The layers over the three lobes at view cosine mu_o > 0: the coat and what it reflects,
+// and the share of the sheen. Each layer's albedo (coat: clearcoat E_c(mu_o); sheen:
+// max(sheen_color) E_s(mu_o)) is taken from what lies below and is also the probability of
+// sampling it, so a sample of a lower layer keeps the weight it has alone.
+struct Layers {
+    coat: CoatParams,
+    p_coat: f32,
+    sheen_alpha: f32,
+    p_sheen: f32,
+}
+
+fn layers(m: Material, mu_o: f32) -> Layers {
+    var l = Layers(CoatParams(0.0, 0.0, 0.0, true), 0.0, 1.0, 0.0);
+    if HAS_COAT && m.clearcoat > 0.0 {
+        l.coat = coat_params(m);
+        l.p_coat = clamp(coat_albedo(l.coat, mu_o), 0.0, 1.0);
+    }
+    let sheen = max(m.sheen_color.x, max(m.sheen_color.y, m.sheen_color.z));
+    if HAS_SHEEN && sheen > 0.0 {
+        l.sheen_alpha = sheen_alpha(m.sheen_roughness);
+        l.p_sheen = clamp(sheen * sheen_albedo(mu_o, m.sheen_roughness), 0.0, 1.0);
+    }
+    return l;
+}
+
+// The non-delta, non-glass part of the BSDF, the coat over the sheen over the three lobes
+// (`eval_base`): f * cos(wi) and the solid-angle pdf with which `sample_bsdf` produces wi
+// (lobe choice included). Light sampling evaluates this; the glass lobe and perfect mirrors
+// are reached by BSDF sampling only.
+fn eval_bsdf(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
+    var out = eval_base(m, wo, wi);
+    if !(HAS_COAT || HAS_SHEEN) || wo.z <= 0.0 || wi.z <= 0.0 {
+        return out;
+    }
+    let l = layers(m, wo.z);
+    if l.p_sheen > 0.0 {
+        out.f_cos = m.sheen_color * sheen_f_cos(l.sheen_alpha, wo, wi) + (1.0 - l.p_sheen) * out.f_cos;
+        out.pdf = l.p_sheen * wi.z * INV_PI + (1.0 - l.p_sheen) * out.pdf;
+    }
+    if l.p_coat > 0.0 {
+        let c = coat_eval(l.coat, wo, wi);
+        out.f_cos = c.f_cos + (1.0 - l.p_coat) * out.f_cos;
+        out.pdf = l.p_coat * c.pdf + (1.0 - l.p_coat) * out.pdf;
+    }
+    return out;
+}
+
+// A sample of the whole BSDF: the coat, the sheen or the three lobes, chosen by u_lobe with
+// the layers' probabilities (`layers`), the rest of u_lobe choosing among the lobes.
+fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
+    if !(HAS_COAT || HAS_SHEEN) || wo.z <= 0.0 {
+        return sample_base(m, wo, u_lobe, u);
+    }
+    let l = layers(m, wo.z);
+    if l.p_coat == 0.0 && l.p_sheen == 0.0 {
+        return sample_base(m, wo, u_lobe, u);
+    }
+    var wi: vec3f;
+    if u_lobe < l.p_coat {
+        wi = coat_sample(l.coat, wo, u.xy);
+        if l.coat.is_smooth {
+            // The mirror reflects clearcoat F(mu_o), the probability of choosing it.
+            return BsdfSample(wi, vec3f(1.0), 0.0, true);
+        }
+    } else {
+        let v = (u_lobe - l.p_coat) / max(1.0 - l.p_coat, 1e-7);
+        if v < l.p_sheen {
+            wi = sample_cosine(vec3f(0.0, 0.0, 1.0), u.xy);
+        } else {
+            let s = sample_base(m, wo, min((v - l.p_sheen) / max(1.0 - l.p_sheen, 1e-7), ONE_MINUS_EPSILON), u);
+            if !s.valid || s.pdf == 0.0 {
+                // A delta sample (mirror, glass) or none: the layers take from it exactly
+                // the probability of passing them.
+                return s;
+            }
+            wi = s.wi;
+        }
+    }
+    return sampled_by_eval(m, wo, wi);
 }

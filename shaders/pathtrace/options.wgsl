@@ -36,6 +36,9 @@ const HAS_TEXTURES: bool = true;
 // Some material has diffuse_roughness > 0: the energy-preserving Oren-Nayar (EON) diffuse
 // base and its sampling compiled in (else the diffuse base is Lambertian only).
 const HAS_ROUGH_DIFFUSE: bool = true;
+// Some material has a clear coat (coat.wgsl); some has a sheen (sheen.wgsl).
+const HAS_COAT: bool = true;
+const HAS_SHEEN: bool = true;
 // Some material has a medium inside (absorbing glass, scattering media) or is an
 // index-matched boundary: medium tracking, distance sampling and shadow-ray transmittance
 // compiled in.

@@ -114,15 +114,25 @@ struct Material {
     // MATERIAL_ALPHA_MASK's cutoff.
     alpha_cutoff: f32,
     k: vec3<f32>,
-    pad3: u32,
+    // Clear coat texture (low 16 bits, R) and clear coat roughness texture (high, G).
+    tex_coat: u32,
     f_avg: vec3<f32>,
-    pad4: u32,
+    // Sheen colour texture (low 16 bits, RGB sRGB) and sheen roughness texture (high, A).
+    tex_sheen: u32,
     // Homogeneous medium inside (MATERIAL_MEDIUM): absorption and scattering coefficients
     // per unit length, and the Henyey-Greenstein asymmetry of its phase function.
     sigma_a: vec3<f32>,
     phase_g: f32,
     sigma_s: vec3<f32>,
     pad5: u32,
+    // Sheen (sheen.wgsl): colour (black: none) and perceptual roughness; clear coat
+    // (coat.wgsl): weight (0: none) and perceptual roughness.
+    sheen_color: vec3<f32>,
+    sheen_roughness: f32,
+    clearcoat: f32,
+    clearcoat_roughness: f32,
+    pad6: u32,
+    pad7: u32,
 }
 
 // A triangle's tangents (xyz, w = handedness), UVs (two sets) and vertex colours (RGBA8, R in

@@ -116,7 +116,8 @@ fn textured_emission(m: Material, uv: vec4f) -> vec3f {
 // (sRGB; alpha is the any-hit test's) x vertex colour, roughness x G and metallic x B of the
 // metallic-roughness texture, emission x texture (sRGB), transmission x R of the
 // transmission texture, specular x A of the specular texture x max channel of the specular
-// color texture (sRGB).
+// color texture (sRGB), clear coat x R and its roughness x G of their textures, sheen colour x
+// its texture (sRGB) and sheen roughness x A of its texture.
 fn textured_material(m_in: Material, uv: vec4f, color: vec4f) -> Material {
     var m = m_in;
     m.base_color *= color.rgb;
@@ -143,6 +144,22 @@ fn textured_material(m_in: Material, uv: vec4f, color: vec4f) -> Material {
     if sc != NO_TEX {
         let c = tex_sample(sc, uv, true).rgb;
         m.specular *= max(c.x, max(c.y, c.z));
+    }
+    let cc = tex_lo(m.tex_coat);
+    if cc != NO_TEX {
+        m.clearcoat *= tex_sample(cc, uv, false).r;
+    }
+    let cr = tex_hi(m.tex_coat);
+    if cr != NO_TEX {
+        m.clearcoat_roughness *= tex_sample(cr, uv, false).g;
+    }
+    let sh = tex_lo(m.tex_sheen);
+    if sh != NO_TEX {
+        m.sheen_color *= tex_sample(sh, uv, true).rgb;
+    }
+    let sr = tex_hi(m.tex_sheen);
+    if sr != NO_TEX {
+        m.sheen_roughness *= tex_sample(sr, uv, false).a;
     }
     return m;
 }

@@ -148,15 +148,19 @@ pub fn run(
             .file_stem()
             .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
         let _ = write!(page, "\n## {name}\n\n{}\n\n", what_it_tests(model));
-        let scene = match model_scene(&root, model, size) {
-            Ok(s) => s,
+        // A model that does not load, or loads nothing to render (no mesh), is listed
+        // with its error; the rest still render.
+        let (scene, gpu) = match model_scene(&root, model, size).and_then(|scene| {
+            let gpu = Arc::new(GpuScene::build(&scene)?);
+            Ok((scene, gpu))
+        }) {
+            Ok(loaded) => loaded,
             Err(e) => {
                 println!("{name}: does not load: {e}");
                 let _ = writeln!(page, "Does not load: `{e}`");
                 continue;
             }
         };
-        let gpu = Arc::new(GpuScene::build(&scene)?);
         let plan = library
             .compile_with(
                 &graph,

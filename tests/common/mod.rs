@@ -435,6 +435,54 @@ pub fn guarded<T: Send + 'static>(
 
 /// The pinhole ray through image position `p` (in pixels from the top-left corner), as
 /// the shader makes it: through the pixel centre at `(x + 0.5, y + 0.5)`.
+/// `frames` frames of `samples_per_frame` samples of `scene` through the progressive graph
+/// (`PathTrace` into `Accumulate`) on `ctx`, with `resources` but the scene: the accumulated
+/// colour.
+pub fn accumulate(
+    ctx: &lumagraph::render::GpuContext,
+    scene: &std::sync::Arc<lumagraph::scene::GpuScene>,
+    samples_per_frame: i64,
+    frames: u32,
+    resources: lumagraph::render::Resources,
+) -> lumagraph::render::cpu::Image {
+    use lumagraph::render::{Executor, Resources, compile};
+    let plan = compile(
+        &progressive_graph(&[(
+            "samples_per_frame",
+            lumagraph::graph::ParamValue::Int(samples_per_frame),
+        )]),
+        &["acc.color".to_owned()],
+        Some(scene),
+    )
+    .unwrap();
+    let resources = Resources {
+        scene: Some(std::sync::Arc::clone(scene)),
+        ..resources
+    };
+    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    exec.run_frames(frames, true).unwrap();
+    exec.read_port("acc.color").unwrap()
+}
+
+/// The rays through 4 × 4 points of pixel (`x`, `y`) (a regular grid over its footprint),
+/// each with what the CPU traversal hits.
+pub fn footprint(
+    g: &lumagraph::scene::GpuScene,
+    x: u32,
+    y: u32,
+) -> Vec<(lumagraph::scene::Ray, Option<lumagraph::scene::Hit>)> {
+    (0..16)
+        .map(|k| {
+            let at = glam::Vec2::new(
+                x as f32 + (0.5 + (k % 4) as f32) / 4.0,
+                y as f32 + (0.5 + (k / 4) as f32) / 4.0,
+            );
+            let ray = image_ray(g, at);
+            (ray, lumagraph::scene::intersect(g, &ray))
+        })
+        .collect()
+}
+
 pub fn image_ray(g: &lumagraph::scene::GpuScene, p: glam::Vec2) -> lumagraph::scene::Ray {
     use glam::Vec3;
     let c = &g.camera;

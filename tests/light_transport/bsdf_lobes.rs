@@ -28,7 +28,7 @@ use lumagraph::render::bsdf_check::{BsdfCheck, BsdfSample};
 use lumagraph::scene::conductor;
 use lumagraph::scene::{GpuMaterial, Material};
 
-const SAMPLES: u32 = 200_000;
+pub(super) const SAMPLES: u32 = 200_000;
 const THETA_BINS: usize = 36;
 const PHI_BINS: usize = 72;
 const ALPHA: f64 = 0.01;
@@ -42,20 +42,20 @@ const GL: [(f64, f64); 6] = [
     (0.932_469_514_203_152, 0.171_324_492_379_170),
 ];
 
-struct Case {
-    name: String,
-    material: Material,
+pub(super) struct Case {
+    pub(super) name: String,
+    pub(super) material: Material,
     /// Incidence angle, degrees; negative: from inside (below the surface).
-    theta_o: f64,
+    pub(super) theta_o: f64,
 }
 
-fn material(name: &str, f: impl FnOnce(&mut Material)) -> Material {
+pub(super) fn material(name: &str, f: impl FnOnce(&mut Material)) -> Material {
     let mut m = Material::named(name);
     f(&mut m);
     m
 }
 
-fn gold(roughness: f32, multiscatter: bool) -> Material {
+pub(super) fn gold(roughness: f32, multiscatter: bool) -> Material {
     material("gold", |m| {
         m.conductor = conductor::preset("Au");
         m.base_color = m.conductor.unwrap().normal_reflectance();
@@ -116,6 +116,11 @@ fn reflecting_cases() -> Vec<Case> {
             materials.push(m);
         }
     }
+    at_four_angles(materials)
+}
+
+/// Each material seen at 5°, 35°, 65° and 85° (grazing).
+pub(super) fn at_four_angles(materials: impl IntoIterator<Item = Material>) -> Vec<Case> {
     let mut cases = Vec::new();
     for m in materials {
         for theta_o in [5.0, 35.0, 65.0, 85.0] {
@@ -148,7 +153,7 @@ fn glass_cases() -> Vec<Case> {
     cases
 }
 
-fn wo(theta_o: f64) -> Vec3 {
+pub(super) fn wo(theta_o: f64) -> Vec3 {
     let t = theta_o.abs().to_radians();
     let z = t.cos();
     Vec3::new(
@@ -158,7 +163,7 @@ fn wo(theta_o: f64) -> Vec3 {
     )
 }
 
-fn dir(theta: f64, phi: f64) -> DVec3 {
+pub(super) fn dir(theta: f64, phi: f64) -> DVec3 {
     DVec3::new(
         theta.sin() * phi.cos(),
         theta.sin() * phi.sin(),
@@ -315,7 +320,7 @@ fn worst_cells(samples: &[BsdfSample], masses: &[f64]) -> String {
         .join("\n")
 }
 
-fn ggx_d(z: f64, a2: f64) -> f64 {
+pub(super) fn ggx_d(z: f64, a2: f64) -> f64 {
     if z <= 0.0 {
         return 0.0;
     }
@@ -327,7 +332,7 @@ fn smith_g1(z: f64, a2: f64) -> f64 {
     2.0 * z / (z + (a2 + (1.0 - a2) * z * z).sqrt())
 }
 
-fn smith_g2(zo: f64, zi: f64, a2: f64) -> f64 {
+pub(super) fn smith_g2(zo: f64, zi: f64, a2: f64) -> f64 {
     let l = |z: f64| (a2 + (1.0 - a2) * z * z).sqrt();
     2.0 * zo * zi / (zo * l(zi) + zi * l(zo))
 }
@@ -421,13 +426,13 @@ fn glass_weight(m: &Material, wo: Vec3, wi: Vec3) -> Vec3 {
     w
 }
 
-fn close(a: Vec3, b: Vec3, rel: f32) -> bool {
+pub(super) fn close(a: Vec3, b: Vec3, rel: f32) -> bool {
     (a - b).abs().max_element() <= rel * a.abs().max(b.abs()).max_element().max(1e-6)
 }
 
 /// Runs the chi-square test over `cases`, `pdf` giving each case's expected density at the
 /// quadrature points; returns the failures.
-fn run_chi_square(
+pub(super) fn run_chi_square(
     check: &BsdfCheck,
     cases: &[Case],
     pdf: impl Fn(&BsdfCheck, &Case, &GpuMaterial, &[Vec3]) -> Vec<f64>,
@@ -471,15 +476,24 @@ fn run_chi_square(
 fn reflecting_lobes_sample_their_pdf() {
     let Some(ctx) = common::gpu() else { return };
     let check = BsdfCheck::new(ctx).unwrap();
-    let failures = run_chi_square(&check, &reflecting_cases(), |check, case, gpu, dirs| {
+    let failures = chi_square_against_eval(ctx, &check, &reflecting_cases());
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// [`run_chi_square`] with the density `eval_bsdf` reports.
+pub(super) fn chi_square_against_eval(
+    ctx: &lumagraph::render::GpuContext,
+    check: &BsdfCheck,
+    cases: &[Case],
+) -> Vec<String> {
+    run_chi_square(check, cases, |check, case, gpu, dirs| {
         check
             .eval(ctx, gpu, wo(case.theta_o), dirs)
             .unwrap()
             .iter()
             .map(|v| f64::from(v.pdf))
             .collect()
-    });
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    })
 }
 
 #[test]
@@ -501,26 +515,7 @@ fn sample_weights_are_f_cos_over_pdf() {
     let mut failures = Vec::new();
     let mut checked = 0;
     for case in reflecting_cases() {
-        let gpu = GpuMaterial::from(&case.material);
-        let wo = wo(case.theta_o);
-        let samples: Vec<_> = check
-            .sample(ctx, &gpu, wo, 4096, 3)
-            .unwrap()
-            .into_iter()
-            .filter(|s| s.valid)
-            .collect();
-        let dirs: Vec<Vec3> = samples.iter().map(|s| s.wi).collect();
-        let values = check.eval(ctx, &gpu, wo, &dirs).unwrap();
-        for (s, v) in samples.iter().zip(&values) {
-            checked += 1;
-            let want = v.f_cos / v.pdf;
-            if !(close(s.weight, want, 1e-3) && (s.pdf - v.pdf).abs() <= 1e-3 * v.pdf) {
-                failures.push(format!(
-                    "{}: wi {}: weight {} pdf {} vs f cos / pdf {want} pdf {}",
-                    case.name, s.wi, s.weight, s.pdf, v.pdf
-                ));
-            }
-        }
+        checked += weights_against_eval(ctx, &check, &case, &mut failures);
     }
     for case in glass_cases() {
         let gpu = GpuMaterial::from(&case.material);
@@ -542,6 +537,78 @@ fn sample_weights_are_f_cos_over_pdf() {
     eprintln!("{checked} sample weights checked");
     failures.truncate(10);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Checks that 4096 samples of `case` carry f·cos/pdf of `eval_bsdf` at their direction
+/// (relative 1e-3) and report its pdf; returns how many were checked.
+pub(super) fn weights_against_eval(
+    ctx: &lumagraph::render::GpuContext,
+    check: &BsdfCheck,
+    case: &Case,
+    failures: &mut Vec<String>,
+) -> usize {
+    let gpu = GpuMaterial::from(&case.material);
+    let wo = wo(case.theta_o);
+    let samples: Vec<_> = check
+        .sample(ctx, &gpu, wo, 4096, 3)
+        .unwrap()
+        .into_iter()
+        .filter(|s| s.valid)
+        .collect();
+    let dirs: Vec<Vec3> = samples.iter().map(|s| s.wi).collect();
+    let values = check.eval(ctx, &gpu, wo, &dirs).unwrap();
+    for (s, v) in samples.iter().zip(&values) {
+        let want = v.f_cos / v.pdf;
+        if !(close(s.weight, want, 1e-3) && (s.pdf - v.pdf).abs() <= 1e-3 * v.pdf) {
+            failures.push(format!(
+                "{}: wi {}: weight {} pdf {} vs f cos / pdf {want} pdf {}",
+                case.name, s.wi, s.weight, s.pdf, v.pdf
+            ));
+        }
+    }
+    samples.len()
+}
+
+/// The directional albedo of `m` at view cosine `mu`: the mean sample weight (red channel)
+/// of [`SAMPLES`] samples.
+pub(super) fn directional_albedo(
+    ctx: &lumagraph::render::GpuContext,
+    check: &BsdfCheck,
+    m: &Material,
+    mu: f32,
+) -> f64 {
+    let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+    let samples = check
+        .sample(ctx, &GpuMaterial::from(m), wo, SAMPLES, 11)
+        .unwrap();
+    samples
+        .iter()
+        .filter(|s| s.valid)
+        .map(|s| f64::from(s.weight.x))
+        .sum::<f64>()
+        / samples.len() as f64
+}
+
+/// Checks f(wo, wi) = f(wi, wo) (relative 2e-3, where f > 1e-6) at every direction of
+/// `wis`, naming failures by `name`.
+pub(super) fn reciprocity(
+    ctx: &lumagraph::render::GpuContext,
+    check: &BsdfCheck,
+    name: &str,
+    gpu: &GpuMaterial,
+    wo: Vec3,
+    wis: &[Vec3],
+    failures: &mut Vec<String>,
+) {
+    for (wi, v) in wis.iter().zip(check.eval(ctx, gpu, wo, wis).unwrap()) {
+        let f = v.f_cos / wi.z;
+        let f_swapped = v.f_cos_swapped / wo.z;
+        if f.max_element() > 1e-6 && !close(f, f_swapped, 2e-3) {
+            failures.push(format!(
+                "{name}: wi {wi}: f(wo, wi) {f} vs f(wi, wo) {f_swapped}"
+            ));
+        }
+    }
 }
 
 #[test]
@@ -566,16 +633,7 @@ fn reflecting_lobes_are_reciprocal() {
                 dir(z.acos(), std::f64::consts::TAU * rand()).as_vec3()
             })
             .collect();
-        for (wi, v) in wis.iter().zip(check.eval(ctx, &gpu, wo, &wis).unwrap()) {
-            let f = v.f_cos / wi.z;
-            let f_swapped = v.f_cos_swapped / wo.z;
-            if f.max_element() > 1e-6 && !close(f, f_swapped, 2e-3) {
-                failures.push(format!(
-                    "{}: wi {wi}: f(wo, wi) {f} vs f(wi, wo) {f_swapped}",
-                    case.name
-                ));
-            }
-        }
+        reciprocity(ctx, &check, &case.name, &gpu, wo, &wis, &mut failures);
     }
     failures.truncate(10);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
@@ -618,18 +676,7 @@ fn smooth_conductors_reflect_with_the_exact_fresnel() {
 fn white_materials_reflect_everything_at_every_angle() {
     let Some(ctx) = common::gpu() else { return };
     let check = BsdfCheck::new(ctx).unwrap();
-    let albedo = |m: &Material, mu: f32| {
-        let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
-        let samples = check
-            .sample(ctx, &GpuMaterial::from(m), wo, SAMPLES, 11)
-            .unwrap();
-        samples
-            .iter()
-            .filter(|s| s.valid)
-            .map(|s| f64::from(s.weight.x))
-            .sum::<f64>()
-            / samples.len() as f64
-    };
+    let albedo = |m: &Material, mu: f32| directional_albedo(ctx, &check, m, mu);
     let mut failures = Vec::new();
     for roughness in [0.0_f32, 0.3, 0.7] {
         for base in [1.0_f32, 0.6] {

@@ -8,6 +8,7 @@
 mod common;
 
 mod bsdf_lobes;
+mod layers;
 mod media;
 mod rough_diffuse;
 mod sampler;

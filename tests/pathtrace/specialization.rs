@@ -4,9 +4,9 @@
 //!
 //! Each scene is the Cornell box or the sphere furnace with every material drawn at random
 //! (metallic, transmission, specular and diffuse roughness each 0, 1 or between; roughness,
-//! IOR and colours between; opaque, alpha-masked or blended) and random textures given to
-//! some of them: metallic-roughness,
-//! transmission, specular and specular-colour textures whose channels are constant (0 or 255)
+//! IOR and colours between; a clear coat and a sheen on some; opaque, alpha-masked or
+//! blended) and random textures given to some of them: metallic-roughness,
+//! transmission, specular, specular-colour, clear coat and sheen textures whose channels are constant (0 or 255)
 //! or spread, so a factor of 1 or 0 can be lowered per texel, or not. The first scene holds
 //! the case that once rendered black: glass (transmission 1) with a metallic factor of 1
 //! that a metallic-roughness texture lowers to 0 over part of it. Both shaders traverse the
@@ -81,8 +81,8 @@ fn random_texture(rng: &mut Rng, name: String) -> Texture {
 
 /// `scene` with its materials drawn at random and textures given to some (reading either UV
 /// set, some through a transform); the triangles get two UV sets from their positions, and
-/// in half the scenes half of them random vertex colours. Each of metallic, transmission, specular and diffuse
-/// roughness is allowed in a scene with probability 0.6, else 0 in all its materials. `glass_case`: the first material is metallic 1, transmission 1
+/// in half the scenes half of them random vertex colours. Each of metallic, transmission, specular, diffuse
+/// roughness, clear coat and sheen is allowed in a scene with probability 0.6, else 0 in all its materials. `glass_case`: the first material is metallic 1, transmission 1
 /// with a metallic-roughness texture whose metallic (blue) channel spreads over [0, 255].
 fn randomize(scene: &mut Scene, rng: &mut Rng, glass_case: bool) {
     let colored = rng.chance(0.5);
@@ -124,7 +124,7 @@ fn randomize(scene: &mut Scene, rng: &mut Rng, glass_case: bool) {
     };
     // Which factors this scene's materials may set at all: a lobe no material can use is
     // what specialization leaves out.
-    let [metal, glass, specular, rough] = std::array::from_fn(|_| rng.chance(0.6));
+    let [metal, glass, specular, rough, coat, sheen] = std::array::from_fn(|_| rng.chance(0.6));
     for m in &mut scene.materials {
         if m.emission.max_element() > 0.0 {
             continue;
@@ -140,6 +140,18 @@ fn randomize(scene: &mut Scene, rng: &mut Rng, glass_case: bool) {
             0.0
         };
         m.ior = 1.2 + 0.6 * rng.f();
+        if coat && rng.chance(0.5) {
+            m.clearcoat = rng.factor();
+            m.clearcoat_roughness = rng.f();
+            m.textures.clearcoat = pick(rng, 0.3);
+            m.textures.clearcoat_roughness = pick(rng, 0.3);
+        }
+        if sheen && rng.chance(0.5) {
+            m.sheen_color = Vec3::new(rng.f(), rng.f(), rng.f());
+            m.sheen_roughness = rng.f();
+            m.textures.sheen_color = pick(rng, 0.3);
+            m.textures.sheen_roughness = pick(rng, 0.3);
+        }
         m.conductor = None;
         m.textures.metallic_roughness = pick(rng, 0.5);
         m.textures.transmission = pick(rng, 0.3);

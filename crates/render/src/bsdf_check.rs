@@ -59,7 +59,7 @@ impl BsdfCheck {
     /// When the shader does not compile.
     pub fn new(ctx: &GpuContext) -> Result<Self> {
         let kernel = Kernel::new(ctx, "pathtrace/bsdf_check.wgsl")?;
-        let ggx_table = crate::bsdf_tables::upload(ctx);
+        let ggx_table = crate::bsdf_tables::upload(ctx, true);
         Ok(Self { kernel, ggx_table })
     }
 

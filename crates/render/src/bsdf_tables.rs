@@ -8,6 +8,9 @@
 //! dielectric layer (its Lambertian base receives exactly `1 − E`) and the metal's
 //! Kulla–Conty multiple-scattering term (which needs `E` at F0 = 1 and its average).
 //!
+//! After them, the directional albedo `E_s(μ, r)` of glTF's sheen lobe at colour 1
+//! ([`sheen_albedo`], `shaders/pathtrace/sheen.wgsl`), which the layers below a sheen lose.
+//!
 //! Entries are estimated with stratified visible-normal sampling, in f64, exactly the
 //! estimator the shader's sampling uses, so the furnace balance holds to the table's
 //! accuracy; the averages integrate the table's own piecewise-linear interpolant exactly,
@@ -115,9 +118,100 @@ fn build() -> Vec<[f32; 2]> {
     out
 }
 
-/// The table in a storage buffer, as `shaders/pathtrace/bsdf.wgsl` reads it (`ggx_table`).
-pub fn upload(ctx: &crate::GpuContext) -> wgpu::Buffer {
-    crate::kernel::storage_buffer(ctx, "ggx albedo table", bytemuck::cast_slice(ggx_table()))
+/// Perceptual sheen roughness below this is taken as this (`SHEEN_ROUGHNESS_MIN` in
+/// `sheen.wgsl`).
+pub const SHEEN_ROUGHNESS_MIN: f64 = 0.07;
+
+/// glTF's sheen lobe (`sheen.wgsl`): `D · V · μ_i` at colour 1, for α = roughness², view
+/// cosine `mu_o` and `wi = (sin θ cos φ, sin θ sin φ, mu_i)` with `wo` in the xz-plane.
+pub fn sheen_f_cos(alpha: f64, mu_o: f64, mu_i: f64, phi: f64) -> f64 {
+    let wo = [(1.0 - mu_o * mu_o).max(0.0).sqrt(), 0.0, mu_o];
+    let s = (1.0 - mu_i * mu_i).max(0.0).sqrt();
+    let wi = [s * phi.cos(), s * phi.sin(), mu_i];
+    let h = normalize([wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]]);
+    let inv = 1.0 / alpha;
+    let d = (2.0 + inv) * (1.0 - h[2] * h[2]).max(0.0).powf(0.5 * inv) / (2.0 * PI);
+    let fit = |x: f64| {
+        let t = (1.0 - alpha) * (1.0 - alpha);
+        let mix = |a: f64, b: f64| a + (b - a) * t;
+        mix(21.5473, 25.3245) / (1.0 + mix(3.82987, 3.32435) * x.powf(mix(0.19823, 0.16801)))
+            + mix(-1.97760, -1.27393) * x
+            + mix(-4.32054, -4.85967)
+    };
+    let lambda = |mu: f64| {
+        if mu < 0.5 {
+            fit(mu).exp()
+        } else {
+            (2.0 * fit(0.5) - fit(1.0 - mu)).exp()
+        }
+    };
+    let v = (1.0 / ((1.0 + lambda(mu_o) + lambda(mu_i)) * 4.0 * mu_o * mu_i)).clamp(0.0, 1.0);
+    d * v * mu_i
+}
+
+/// `E_s` at view cosine `mu` and perceptual roughness `r`: `∫ sheen_f_cos dω_i` by the
+/// midpoint rule in `μ_i = t²` (dense towards grazing, where the lobe is) and `φ` (over
+/// half the circle: the lobe is symmetric about the plane of `wo`).
+pub fn sheen_albedo(mu: f64, r: f64) -> f64 {
+    const T: usize = 64;
+    const P: usize = 48;
+    let mu = mu.clamp(1e-3, 1.0);
+    let r = r.clamp(SHEEN_ROUGHNESS_MIN, 1.0);
+    let alpha = r * r;
+    let mut sum = 0.0;
+    for i in 0..T {
+        #[expect(clippy::cast_precision_loss, reason = "small counts")]
+        let t = (i as f64 + 0.5) / T as f64;
+        for j in 0..P {
+            #[expect(clippy::cast_precision_loss, reason = "small counts")]
+            let phi = PI * (j as f64 + 0.5) / P as f64;
+            sum += sheen_f_cos(alpha, mu, t * t, phi) * 2.0 * t;
+        }
+    }
+    #[expect(clippy::cast_precision_loss, reason = "small counts")]
+    let cell = (1.0 / T as f64) * (PI / P as f64);
+    // Both halves of the circle.
+    2.0 * sum * cell
+}
+
+fn build_sheen() -> Vec<[f32; 2]> {
+    let mut out = vec![[0.0_f32; 2]; N * N];
+    std::thread::scope(|s| {
+        let rows: Vec<_> = (0..N)
+            .map(|k| {
+                s.spawn(move || {
+                    (0..N)
+                        .map(|j| sheen_albedo(axis(j), axis(k)) as f32)
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        for (k, row) in rows.into_iter().enumerate() {
+            for (j, e) in row.join().unwrap_or_default().into_iter().enumerate() {
+                out[k * N + j] = [e, 0.0];
+            }
+        }
+    });
+    out
+}
+
+/// The sheen table as uploaded: `N × N` entries `(E_s, 0)` (roughness-major).
+pub fn sheen_table() -> &'static [[f32; 2]] {
+    static TABLE: LazyLock<Vec<[f32; 2]>> = LazyLock::new(build_sheen);
+    &TABLE
+}
+
+/// The tables in a storage buffer, as `shaders/pathtrace/bsdf.wgsl` reads them
+/// (`ggx_table`): the GGX tables, then the sheen table where `sheen` says some material has
+/// one (zeros, never read, where none has: it takes a moment to compute).
+pub fn upload(ctx: &crate::GpuContext, sheen: bool) -> wgpu::Buffer {
+    let mut data = ggx_table().to_vec();
+    if sheen {
+        data.extend_from_slice(sheen_table());
+    } else {
+        data.resize(data.len() + N * N, [0.0; 2]);
+    }
+    crate::kernel::storage_buffer(ctx, "ggx albedo table", bytemuck::cast_slice(&data))
 }
 
 /// The table as uploaded: `N × N` entries `(A, B)` (roughness-major), then `N` averages.

@@ -67,6 +67,12 @@ struct MaterialOut {
     specular: f32,
     specular_tint: f32,
     transmission: f32,
+    /// Clear coat weight and roughness (0: none).
+    clearcoat: f32,
+    clearcoat_roughness: f32,
+    /// Sheen colour (black: none) and roughness.
+    sheen_color: [f32; 3],
+    sheen_roughness: f32,
     ior: f32,
     two_sided: bool,
     eta: Option<[f32; 3]>,
@@ -215,6 +221,10 @@ fn material_out(m: &crate::scene::Material) -> MaterialOut {
         specular: m.specular,
         specular_tint: m.specular_tint,
         transmission: m.transmission,
+        clearcoat: m.clearcoat,
+        clearcoat_roughness: m.clearcoat_roughness,
+        sheen_color: m.sheen_color.to_array(),
+        sheen_roughness: m.sheen_roughness,
         ior: m.ior,
         two_sided: m.two_sided,
         eta: m.conductor.map(|c| c.eta.to_array()),

@@ -149,6 +149,17 @@ pub struct MaterialDesc {
     pub specular_tint: f32,
     /// Fraction of the dielectric lobe that is transmitted (glass), in [0, 1]. Default 0.
     pub transmission: f32,
+    /// Weight in [0, 1] of a clear coat on top (glTF `KHR_materials_clearcoat`): a
+    /// dielectric layer of ior 1.5 that reflects like a varnish and lets the rest through.
+    /// Default 0 (none).
+    pub clearcoat: f32,
+    /// Perceptual roughness of the clear coat in [0, 1]. Default 0 (a mirror).
+    pub clearcoat_roughness: f32,
+    /// Colour of a sheen under the clear coat (glTF `KHR_materials_sheen`: the velvet of
+    /// cloth at grazing angles), linear RGB. Default black (none).
+    pub sheen_color: V3,
+    /// Perceptual roughness of the sheen in [0, 1] (below 0.07 taken as 0.07). Default 0.
+    pub sheen_roughness: f32,
     /// Index of refraction. Default 1.5.
     pub ior: f32,
     /// Emission leaves both sides. Default false (front only).
@@ -229,6 +240,10 @@ impl Default for MaterialDesc {
             specular: 0.5,
             specular_tint: 0.0,
             transmission: 0.0,
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
+            sheen_color: [0.0; 3],
+            sheen_roughness: 0.0,
             ior: 1.5,
             two_sided: false,
             attenuation_color: None,

@@ -144,6 +144,12 @@ impl From<&Material> for GpuMaterial {
             tex_transmission_specular: tex16(m.textures.transmission)
                 | (tex16(m.textures.specular) << 16),
             tex_specular_color: tex16(m.textures.specular_color) | (0xFFFF << 16),
+            tex_coat: tex16(m.textures.clearcoat) | (tex16(m.textures.clearcoat_roughness) << 16),
+            tex_sheen: tex16(m.textures.sheen_color) | (tex16(m.textures.sheen_roughness) << 16),
+            sheen_color: m.sheen_color.to_array(),
+            sheen_roughness: m.sheen_roughness,
+            clearcoat: m.clearcoat,
+            clearcoat_roughness: m.clearcoat_roughness,
             eta,
             k,
             f_avg,

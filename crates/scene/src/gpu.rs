@@ -169,7 +169,7 @@ pub struct GpuSphere {
     pub pad1: u32,
 }
 
-/// A material, 160 bytes (ten vec4s). Texture ids index the scene's textures (see
+/// A material, 192 bytes (twelve vec4s). Texture ids index the scene's textures (see
 /// [`crate::texture::pack_atlas`]), 16 bits each, 0xFFFF = none; each texture multiplies
 /// its factor.
 #[repr(C)]
@@ -219,13 +219,15 @@ pub struct GpuMaterial {
     pub alpha_cutoff: f32,
     /// A conductor's extinction coefficient (offset 96).
     pub k: [f32; 3],
-    /// Padding (offset 108).
-    pub pad3: u32,
+    /// Clear coat texture (low 16 bits, R) and clear coat roughness texture (high 16 bits,
+    /// G) (offset 108).
+    pub tex_coat: u32,
     /// A conductor's cosine-weighted average Fresnel reflectance, for the metal lobe's
     /// multiple-scattering term (offset 112).
     pub f_avg: [f32; 3],
-    /// Padding (offset 124).
-    pub pad4: u32,
+    /// Sheen colour texture (low 16 bits, RGB sRGB) and sheen roughness texture (high 16
+    /// bits, A) (offset 124).
+    pub tex_sheen: u32,
     /// Absorption coefficient of the medium inside ([`MATERIAL_MEDIUM`]; offset 128).
     pub sigma_a: [f32; 3],
     /// Henyey–Greenstein asymmetry of the medium's phase function (offset 140).
@@ -234,6 +236,18 @@ pub struct GpuMaterial {
     pub sigma_s: [f32; 3],
     /// Padding (offset 156).
     pub pad5: u32,
+    /// Sheen colour, linear RGB; black: none (offset 160).
+    pub sheen_color: [f32; 3],
+    /// Sheen perceptual roughness (offset 172).
+    pub sheen_roughness: f32,
+    /// Clear coat weight; 0: none (offset 176).
+    pub clearcoat: f32,
+    /// Clear coat perceptual roughness (offset 180).
+    pub clearcoat_roughness: f32,
+    /// Padding (offset 184).
+    pub pad6: u32,
+    /// Padding (offset 188).
+    pub pad7: u32,
 }
 
 /// A triangle's texture coordinates, tangents and vertex colours, 112 bytes, same index as

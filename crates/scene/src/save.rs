@@ -265,6 +265,18 @@ fn material_value(m: &MaterialDesc) -> Val {
             given("specular", num(m.specular), &num(d.specular)),
             given("specular_tint", num(m.specular_tint), &num(d.specular_tint)),
             given("transmission", num(m.transmission), &num(d.transmission)),
+            given("clearcoat", num(m.clearcoat), &num(d.clearcoat)),
+            given(
+                "clearcoat_roughness",
+                num(m.clearcoat_roughness),
+                &num(d.clearcoat_roughness),
+            ),
+            given("sheen_color", vec3(m.sheen_color), &vec3(d.sheen_color)),
+            given(
+                "sheen_roughness",
+                num(m.sheen_roughness),
+                &num(d.sheen_roughness),
+            ),
             given("ior", num(m.ior), &num(d.ior)),
             given(
                 "two_sided",

@@ -27,6 +27,14 @@ pub struct MaterialTextures {
     pub specular: u32,
     /// `KHR_materials_specular` `specularColorTexture` (RGB, sRGB).
     pub specular_color: u32,
+    /// `KHR_materials_clearcoat` `clearcoatTexture` (R).
+    pub clearcoat: u32,
+    /// `KHR_materials_clearcoat` `clearcoatRoughnessTexture` (G).
+    pub clearcoat_roughness: u32,
+    /// `KHR_materials_sheen` `sheenColorTexture` (RGB, sRGB).
+    pub sheen_color: u32,
+    /// `KHR_materials_sheen` `sheenRoughnessTexture` (A).
+    pub sheen_roughness: u32,
 }
 
 impl Default for MaterialTextures {
@@ -39,6 +47,10 @@ impl Default for MaterialTextures {
             transmission: NO_TEXTURE,
             specular: NO_TEXTURE,
             specular_color: NO_TEXTURE,
+            clearcoat: NO_TEXTURE,
+            clearcoat_roughness: NO_TEXTURE,
+            sheen_color: NO_TEXTURE,
+            sheen_roughness: NO_TEXTURE,
         }
     }
 }
@@ -50,7 +62,7 @@ impl MaterialTextures {
     }
 
     /// Every slot, in declaration order.
-    pub fn all(&self) -> [u32; 7] {
+    pub fn all(&self) -> [u32; 11] {
         [
             self.base_color,
             self.metallic_roughness,
@@ -59,11 +71,15 @@ impl MaterialTextures {
             self.transmission,
             self.specular,
             self.specular_color,
+            self.clearcoat,
+            self.clearcoat_roughness,
+            self.sheen_color,
+            self.sheen_roughness,
         ]
     }
 
     /// Every slot, mutably, in declaration order.
-    pub fn all_mut(&mut self) -> [&mut u32; 7] {
+    pub fn all_mut(&mut self) -> [&mut u32; 11] {
         [
             &mut self.base_color,
             &mut self.metallic_roughness,
@@ -72,6 +88,10 @@ impl MaterialTextures {
             &mut self.transmission,
             &mut self.specular,
             &mut self.specular_color,
+            &mut self.clearcoat,
+            &mut self.clearcoat_roughness,
+            &mut self.sheen_color,
+            &mut self.sheen_roughness,
         ]
     }
 }
@@ -98,6 +118,16 @@ pub struct Material {
     pub specular_tint: f32,
     /// Transmitted fraction of the dielectric lobe.
     pub transmission: f32,
+    /// Weight in [0, 1] of a clear coat on top of the material (glTF
+    /// `KHR_materials_clearcoat`): a dielectric layer of ior 1.5; 0 none.
+    pub clearcoat: f32,
+    /// Perceptual roughness of the clear coat in [0, 1].
+    pub clearcoat_roughness: f32,
+    /// Colour of the sheen under the clear coat (glTF `KHR_materials_sheen`), linear RGB;
+    /// black none.
+    pub sheen_color: Vec3,
+    /// Perceptual roughness of the sheen in [0, 1].
+    pub sheen_roughness: f32,
     /// Index of refraction.
     pub ior: f32,
     /// Emission leaves both sides (default: front only).
@@ -188,6 +218,10 @@ impl Material {
             specular: 0.5,
             specular_tint: 0.0,
             transmission: 0.0,
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
+            sheen_color: Vec3::ZERO,
+            sheen_roughness: 0.0,
             ior: 1.5,
             two_sided: false,
             textures: MaterialTextures::default(),

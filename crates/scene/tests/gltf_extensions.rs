@@ -60,16 +60,16 @@ fn a_required_extension_not_read_is_an_error_located_in_the_gltf_file() {
     let text = gltf(
         r#"{"name": "paint"}"#,
         "",
-        r#""extensionsUsed": ["KHR_materials_clearcoat"],
-  "extensionsRequired": ["KHR_materials_clearcoat"],"#,
+        r#""extensionsUsed": ["KHR_materials_iridescence"],
+  "extensionsRequired": ["KHR_materials_iridescence"],"#,
     );
     let (_dir, path) = write("Car.gltf", &text);
     let e = import_mesh(&path, Mat4::IDENTITY).unwrap_err().to_string();
     println!("{e}");
     assert!(
-        e.contains("Car.gltf requires the extension KHR_materials_clearcoat")
+        e.contains("Car.gltf requires the extension KHR_materials_iridescence")
             && e.contains("extensionsRequired[0] (line 4, column 26 of its JSON)")
-            && e.contains("without their clear coat"),
+            && e.contains("without their thin-film iridescence"),
         "{e}"
     );
 }
@@ -105,8 +105,9 @@ fn extensions_and_attributes_not_read_are_warnings_naming_their_users() {
         r#"{"name": "velvet",
             "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1]},
             "extensions": {
-              "KHR_materials_sheen": {"sheenColorFactor": [1, 0, 0]},
-              "KHR_materials_clearcoat": {"clearcoatFactor": 1.0},
+              "KHR_materials_sheen": {"sheenColorFactor": [1, 0, 0], "sheenRoughnessFactor": 0.25},
+              "KHR_materials_clearcoat": {"clearcoatFactor": 0.75, "clearcoatRoughnessFactor": 0.5,
+                                          "clearcoatNormalTexture": {"index": 0}},
               "KHR_materials_specular": {"specularColorFactor": [1, 0.5, 0]}
             }}"#,
         r#", "COLOR_0": 0, "COLOR_1": 0"#,
@@ -116,9 +117,21 @@ fn extensions_and_attributes_not_read_are_warnings_naming_their_users() {
     let m = import_mesh(&path, Mat4::IDENTITY).unwrap();
     let w = m.report.warnings.join("\n");
     println!("{w}");
+    // Clear coat and sheen are read, all but the coat's normal texture.
+    let v = &m.materials[0];
+    assert_eq!(
+        (
+            v.clearcoat,
+            v.clearcoat_roughness,
+            v.sheen_color,
+            v.sheen_roughness
+        ),
+        (0.75, 0.5, glam::Vec3::X, 0.25)
+    );
+    assert!(!w.contains("KHR_materials_sheen"), "{w}");
+    assert!(!w.contains("KHR_materials_clearcoat"), "{w}");
     for want in [
-        "Velvet.gltf: KHR_materials_sheen is not read (used by \"velvet\"): materials render without their sheen",
-        "Velvet.gltf: KHR_materials_clearcoat is not read (used by \"velvet\"): materials render without their clear coat",
+        "material velvet: clearcoatNormalTexture is not read (the clear coat takes the base's shading normal)",
         "Velvet.gltf: KHR_materials_specular is read in part (used by \"velvet\"): the specular colour is reduced",
         "Velvet.gltf: KHR_materials_anisotropy is not read: materials render with isotropic roughness",
         "Velvet.gltf: the vertex attribute COLOR_1 is not read (1 primitives): only COLOR_0",

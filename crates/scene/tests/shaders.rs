@@ -106,13 +106,19 @@ fn material_layout() -> (&'static str, usize, Vec<(&'static str, usize)>) {
             eta,
             alpha_cutoff,
             k,
-            pad3,
+            tex_coat,
             f_avg,
-            pad4,
+            tex_sheen,
             sigma_a,
             phase_g,
             sigma_s,
-            pad5
+            pad5,
+            sheen_color,
+            sheen_roughness,
+            clearcoat,
+            clearcoat_roughness,
+            pad6,
+            pad7
         ]
     )
 }

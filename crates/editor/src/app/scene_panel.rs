@@ -634,6 +634,7 @@ fn material(ui: &mut Ui, name: &str, m: &mut MaterialDesc) {
                 ui.add(egui::Slider::new(&mut m.ior, 1.0..=3.0))
                     .labelled_by(l);
             });
+            layer_rows(ui, m);
             row(ui, "two-sided", "emission leaves both sides", |ui, _| {
                 ui.checkbox(&mut m.two_sided, "");
             });
@@ -646,4 +647,38 @@ fn material(ui: &mut Ui, name: &str, m: &mut MaterialDesc) {
                 },
             );
         });
+}
+
+/// The clear coat and sheen rows of [`material`]'s grid.
+fn layer_rows(ui: &mut Ui, m: &mut MaterialDesc) {
+    row(
+        ui,
+        "clear coat",
+        "weight of a varnish on top (ior 1.5)",
+        |ui, l| {
+            ui.add(egui::Slider::new(&mut m.clearcoat, 0.0..=1.0))
+                .labelled_by(l);
+        },
+    );
+    row(ui, "coat roughness", "0: a mirror", |ui, l| {
+        ui.add(egui::Slider::new(&mut m.clearcoat_roughness, 0.0..=1.0))
+            .labelled_by(l);
+    });
+    row(
+        ui,
+        "sheen",
+        "colour of a cloth sheen under the coat; black: none",
+        |ui, _| {
+            colour(ui, &mut m.sheen_color, 1.0);
+        },
+    );
+    row(
+        ui,
+        "sheen roughness",
+        "below 0.07 taken as 0.07",
+        |ui, l| {
+            ui.add(egui::Slider::new(&mut m.sheen_roughness, 0.0..=1.0))
+                .labelled_by(l);
+        },
+    );
 }

@@ -386,7 +386,7 @@ impl PathTrace {
             )?,
             None => crate::env_map::EnvMap::empty(ctx),
         };
-        let ggx_table = crate::bsdf_tables::upload(ctx);
+        let ggx_table = crate::bsdf_tables::upload(ctx, features.on(Feature::Sheen));
         // Outputs nothing reads are bound to 1x1 stand-ins (stores outside them are dropped).
         let one = lumagraph_graph::Extent::new(1, 1);
         let unused = [

@@ -227,10 +227,10 @@ fn table_fns(name: &str, ty: &str, types: &[&str], rows: &[Vec<String>]) -> Stri
 
 /// The WGSL types of [`materials_rows`]'s fields, in order (`Material` in
 /// `pathtrace/scene_types.wgsl`).
-const MATERIAL_TYPES: [&str; 26] = [
+const MATERIAL_TYPES: [&str; 32] = [
     "vec3f", "f32", "vec3f", "f32", "f32", "f32", "f32", "f32", "u32", "u32", "u32", "f32", "u32",
     "u32", "f32", "f32", "vec3f", "f32", "vec3f", "u32", "vec3f", "u32", "vec3f", "f32", "vec3f",
-    "u32",
+    "u32", "vec3f", "f32", "f32", "f32", "u32", "u32",
 ];
 
 /// Every material as WGSL literals, field by field.
@@ -259,12 +259,18 @@ fn materials_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
                 l.v3(m.eta),
                 l.f(m.alpha_cutoff),
                 l.v3(m.k),
-                u(0),
+                u(m.tex_coat),
                 l.v3(m.f_avg),
-                u(0),
+                u(m.tex_sheen),
                 l.v3(m.sigma_a),
                 l.f(m.phase_g),
                 l.v3(m.sigma_s),
+                u(0),
+                l.v3(m.sheen_color),
+                l.f(m.sheen_roughness),
+                l.f(m.clearcoat),
+                l.f(m.clearcoat_roughness),
+                u(0),
                 u(0),
             ]
         })

@@ -52,6 +52,10 @@ pub enum Feature {
     GlassLobe,
     /// The energy-preserving Oren–Nayar diffuse base.
     RoughDiffuse,
+    /// The clear coat over the lobes (`pathtrace/coat.wgsl`).
+    Coat,
+    /// The sheen under the clear coat (`pathtrace/sheen.wgsl`).
+    Sheen,
     /// Media inside shapes and index-matched boundaries.
     Media,
     /// The any-hit test of alpha-masked and blended materials, in every intersector.
@@ -75,7 +79,7 @@ pub enum Feature {
 
 impl Feature {
     /// Every feature, in the order `plan` lists them.
-    pub const ALL: [Self; 23] = [
+    pub const ALL: [Self; 25] = [
         Self::BvhTraversal,
         Self::WideBvh,
         Self::RayQueries,
@@ -90,6 +94,8 @@ impl Feature {
         Self::MetalLobe,
         Self::GlassLobe,
         Self::RoughDiffuse,
+        Self::Coat,
+        Self::Sheen,
         Self::Media,
         Self::Alpha,
         Self::FirstHitAovs,
@@ -118,6 +124,8 @@ impl Feature {
             Self::MetalLobe => "metal lobe",
             Self::GlassLobe => "glass lobe",
             Self::RoughDiffuse => "rough diffuse (EON)",
+            Self::Coat => "clear coat",
+            Self::Sheen => "sheen",
             Self::Media => "participating media",
             Self::Alpha => "alpha (mask, blend)",
             Self::FirstHitAovs => "first-hit AOVs",
@@ -151,6 +159,8 @@ impl Feature {
             Self::MetalLobe => "HAS_METAL",
             Self::GlassLobe => "HAS_GLASS",
             Self::RoughDiffuse => "HAS_ROUGH_DIFFUSE",
+            Self::Coat => "HAS_COAT",
+            Self::Sheen => "HAS_SHEEN",
             Self::Media => "HAS_MEDIA",
             Self::Alpha => "HAS_ALPHA",
             Self::FirstHitAovs => "WRITE_AOVS",
@@ -503,6 +513,43 @@ impl<'a> Facts<'a> {
         }
     }
 
+    /// A lobe or layer of the material model: needed where some material can produce it,
+    /// counting what its textures can do.
+    fn lobe(&self, f: Feature) -> Decision {
+        match f {
+            Feature::SpecularLobe => self.needed(
+                self.count(|r, _| {
+                    r.specular.max > 0.0 && r.metallic.min < 1.0 && r.transmission.min < 1.0
+                }),
+                "materials with specular > 0",
+            ),
+            Feature::MetalLobe => self.needed(
+                self.count(|r, _| r.metallic.max > 0.0),
+                "materials with metallic > 0",
+            ),
+            Feature::GlassLobe => self.needed(
+                self.count(|r, _| r.transmission.max > 0.0 && r.metallic.min < 1.0),
+                "materials with transmission > 0",
+            ),
+            Feature::RoughDiffuse => self.needed(
+                self.count(|r, m| {
+                    m.diffuse_roughness > 0.0 && r.metallic.min < 1.0 && r.transmission.min < 1.0
+                }),
+                "materials with diffuse_roughness > 0",
+            ),
+            // Textures multiply the factors: a factor of 0 is none at every texel.
+            Feature::Coat => self.needed(
+                self.count(|_, m| m.clearcoat > 0.0),
+                "materials with a clear coat",
+            ),
+            Feature::Sheen => self.needed(
+                self.count(|_, m| m.sheen_color.iter().any(|&c| c > 0.0)),
+                "materials with a sheen",
+            ),
+            _ => unreachable!("{f:?} is not a lobe"),
+        }
+    }
+
     fn decide(&self, f: Feature) -> Decision {
         let s = self.scene;
         match f {
@@ -542,26 +589,12 @@ impl<'a> Facts<'a> {
             }
             Feature::Triangles => self.needed(s.tri_positions.len(), "triangles"),
             Feature::Spheres => self.needed(s.spheres.len(), "spheres"),
-            Feature::SpecularLobe => self.needed(
-                self.count(|r, _| {
-                    r.specular.max > 0.0 && r.metallic.min < 1.0 && r.transmission.min < 1.0
-                }),
-                "materials with specular > 0",
-            ),
-            Feature::MetalLobe => self.needed(
-                self.count(|r, _| r.metallic.max > 0.0),
-                "materials with metallic > 0",
-            ),
-            Feature::GlassLobe => self.needed(
-                self.count(|r, _| r.transmission.max > 0.0 && r.metallic.min < 1.0),
-                "materials with transmission > 0",
-            ),
-            Feature::RoughDiffuse => self.needed(
-                self.count(|r, m| {
-                    m.diffuse_roughness > 0.0 && r.metallic.min < 1.0 && r.transmission.min < 1.0
-                }),
-                "materials with diffuse_roughness > 0",
-            ),
+            Feature::SpecularLobe
+            | Feature::MetalLobe
+            | Feature::GlassLobe
+            | Feature::RoughDiffuse
+            | Feature::Coat
+            | Feature::Sheen => self.lobe(f),
             Feature::Alpha => self.needed(
                 self.count(|r, m| {
                     (m.flags & MATERIAL_ALPHA_MASK != 0 && r.opacity.min < m.alpha_cutoff)

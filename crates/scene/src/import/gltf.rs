@@ -2,7 +2,9 @@
 //! perspective cameras, metallic-roughness materials with their base color,
 //! metallic-roughness, normal and emissive textures, `KHR_materials_emissive_strength`,
 //! `KHR_materials_ior`, `KHR_materials_transmission` and `KHR_materials_specular` (factors
-//! and textures), `KHR_materials_diffuse_roughness` (its factor), `alphaMode`, `alphaCutoff`
+//! and textures), `KHR_materials_clearcoat` and `KHR_materials_sheen` (factors and textures;
+//! not the coat's normal texture), `KHR_materials_diffuse_roughness` (its factor),
+//! `alphaMode`, `alphaCutoff`
 //! and the base colour factor's alpha (with the base colour texture's alpha: masks and
 //! blending, [`crate::scene::AlphaMode`]). Textures read `TEXCOORD_0` or `TEXCOORD_1` (their
 //! `texCoord`), through their `KHR_texture_transform` (offset, rotation, scale, `texCoord`
@@ -66,7 +68,7 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
     };
     for m in doc.materials() {
         decoder.material = material_name(&m);
-        let mat = material(&m, &mut decoder, &mut out.report.warnings)
+        let mat = material(doc, &m, &mut decoder, &mut out.report.warnings)
             .map_err(|e| e.about(format!("material \"{}\"", material_name(&m))))?;
         out.materials.push(mat);
     }
@@ -1022,7 +1024,106 @@ fn diffuse_roughness(m: &::gltf::Material<'_>, warnings: &mut Vec<String>) -> f3
         .map_or(0.0, |f| f.clamp(0.0, 1.0) as f32)
 }
 
+/// A factor of an extension's JSON, or `default`.
+#[expect(clippy::cast_possible_truncation, reason = "a factor read as JSON f64")]
+fn ext_factor(ext: &::gltf::json::Value, key: &str, default: f32) -> f32 {
+    ext.get(key)
+        .and_then(::gltf::json::Value::as_f64)
+        .map_or(default, |f| f as f32)
+}
+
+/// A texture info of an extension's JSON (`{"index", "texCoord", "extensions":
+/// {"KHR_texture_transform"}}`), decoded as the typed ones are; none where the key is absent
+/// or names no texture (a warning says so).
+fn ext_texture<'a>(
+    doc: &'a ::gltf::Document,
+    ext: &::gltf::json::Value,
+    key: &str,
+    dec: &mut Decoder<'a>,
+    warnings: &mut Vec<String>,
+) -> Result<u32, SceneError> {
+    let Some(info) = ext.get(key) else {
+        return Ok(NO_TEXTURE);
+    };
+    let texture = info
+        .get("index")
+        .and_then(::gltf::json::Value::as_u64)
+        .and_then(|i| doc.textures().nth(usize::try_from(i).ok()?));
+    let Some(texture) = texture else {
+        warnings.push(format!("{key} names no texture of the file: not read"));
+        return Ok(NO_TEXTURE);
+    };
+    let tex_coord = info
+        .get("texCoord")
+        .and_then(::gltf::json::Value::as_u64)
+        .map_or(0, |c| u32::try_from(c).unwrap_or(u32::MAX));
+    let transform = info
+        .get("extensions")
+        .and_then(|e| e.get("KHR_texture_transform"));
+    dec.texture(
+        Some(texture),
+        texture_transform(transform, tex_coord),
+        warnings,
+    )
+}
+
+/// `KHR_materials_clearcoat` and `KHR_materials_sheen` (from the raw extension JSON): the
+/// factors and their textures, into `out`. The coat takes the base's shading normal: its
+/// own normal texture is not read, and over a normal-mapped base it follows the base's
+/// bumps where glTF's would be smooth (a warning says either).
+fn layers<'a>(
+    doc: &'a ::gltf::Document,
+    m: &::gltf::Material<'a>,
+    out: &mut Material,
+    dec: &mut Decoder<'a>,
+    warnings: &mut Vec<String>,
+) -> Result<(), SceneError> {
+    if let Some(ext) = m.extension_value("KHR_materials_clearcoat") {
+        out.clearcoat = ext_factor(ext, "clearcoatFactor", 0.0).clamp(0.0, 1.0);
+        out.clearcoat_roughness = ext_factor(ext, "clearcoatRoughnessFactor", 0.0).clamp(0.0, 1.0);
+        out.textures.clearcoat = ext_texture(doc, ext, "clearcoatTexture", dec, warnings)?;
+        out.textures.clearcoat_roughness =
+            ext_texture(doc, ext, "clearcoatRoughnessTexture", dec, warnings)?;
+        if ext.get("clearcoatNormalTexture").is_some() && out.clearcoat > 0.0 {
+            warnings.push(format!(
+                "material {}: clearcoatNormalTexture is not read (the clear coat takes the \
+                 base's shading normal)",
+                material_name(m)
+            ));
+        } else if out.clearcoat > 0.0 && out.textures.normal != NO_TEXTURE {
+            warnings.push(format!(
+                "material {}: the clear coat follows the base's normal texture (glTF's coat \
+                 without a normal texture of its own is smooth)",
+                material_name(m)
+            ));
+        }
+    }
+    if let Some(ext) = m.extension_value("KHR_materials_sheen") {
+        let color = ext
+            .get("sheenColorFactor")
+            .and_then(::gltf::json::Value::as_array)
+            .map_or([0.0; 3], |a| {
+                [0, 1, 2].map(|i| {
+                    #[expect(
+                        clippy::cast_possible_truncation,
+                        reason = "a colour read as JSON f64"
+                    )]
+                    a.get(i)
+                        .and_then(::gltf::json::Value::as_f64)
+                        .map_or(0.0, |c| c.max(0.0) as f32)
+                })
+            });
+        out.sheen_color = Vec3::from(color);
+        out.sheen_roughness = ext_factor(ext, "sheenRoughnessFactor", 0.0).clamp(0.0, 1.0);
+        out.textures.sheen_color = ext_texture(doc, ext, "sheenColorTexture", dec, warnings)?;
+        out.textures.sheen_roughness =
+            ext_texture(doc, ext, "sheenRoughnessTexture", dec, warnings)?;
+    }
+    Ok(())
+}
+
 fn material<'a>(
+    doc: &'a ::gltf::Document,
     m: &::gltf::Material<'a>,
     dec: &mut Decoder<'a>,
     warnings: &mut Vec<String>,
@@ -1065,7 +1166,7 @@ fn material<'a>(
         || gltf_specular(ior, 1.0, [1.0; 3]),
         |s| gltf_specular(ior, s.specular_factor(), s.specular_color_factor()),
     );
-    Ok(Material {
+    let mut out = Material {
         name: material_name(m),
         base_color: Vec3::new(r, g, b),
         emission: Vec3::from(m.emissive_factor()) * strength,
@@ -1085,6 +1186,7 @@ fn material<'a>(
             transmission,
             specular: specular_tex,
             specular_color,
+            ..MaterialTextures::default()
         },
         normal_scale: normal_info.map_or(1.0, |n| n.scale()),
         conductor: None,
@@ -1109,5 +1211,8 @@ fn material<'a>(
             },
             ::gltf::material::AlphaMode::Blend => crate::scene::AlphaMode::Blend,
         },
-    })
+        ..Material::named("")
+    };
+    layers(doc, m, &mut out, dec, warnings)?;
+    Ok(out)
 }

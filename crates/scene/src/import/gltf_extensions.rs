@@ -14,10 +14,13 @@ use serde_json::Value;
 use crate::error::{ErrorKind, SceneError};
 
 /// Extensions read (in full, or with what is not read said where it is met: a light's
-/// `range`, which physical lights do not have, and `KHR_materials_diffuse_roughness`'s
-/// texture, warned about by the material reader).
+/// `range`, which physical lights do not have, `KHR_materials_diffuse_roughness`'s
+/// texture and `KHR_materials_clearcoat`'s normal texture, warned about by the material
+/// reader).
 const READ: &[&str] = &[
     "KHR_materials_emissive_strength",
+    "KHR_materials_clearcoat",
+    "KHR_materials_sheen",
     "KHR_materials_ior",
     "KHR_materials_transmission",
     "KHR_materials_diffuse_roughness",
@@ -43,14 +46,6 @@ const PARTLY_READ: &[(&str, &str)] = &[
 
 /// Extensions not read, with what a render of a file that uses them lacks.
 const NOT_READ: &[(&str, &str)] = &[
-    (
-        "KHR_materials_clearcoat",
-        "materials render without their clear coat",
-    ),
-    (
-        "KHR_materials_sheen",
-        "materials render without their sheen",
-    ),
     (
         "KHR_materials_iridescence",
         "materials render without their thin-film iridescence",
