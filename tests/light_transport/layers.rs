@@ -47,6 +47,14 @@ fn sheened(mut m: Material, color: Vec3, roughness: f32) -> Material {
     m
 }
 
+/// A base that reflects nothing: what is seen is the layer alone.
+fn black() -> Material {
+    material("black", |m| {
+        m.specular = 0.0;
+        m.base_color = Vec3::ZERO;
+    })
+}
+
 fn lambert(c: f32) -> Material {
     material(&format!("lambert {c}"), |m| {
         m.specular = 0.0;
@@ -178,10 +186,7 @@ fn spec_coat_albedo(roughness: f64, mu: f64) -> f64 {
 fn the_coat_and_the_sheen_follow_the_specification() {
     let Some(ctx) = common::gpu() else { return };
     let check = BsdfCheck::new(ctx).unwrap();
-    let black = material("black", |m| {
-        m.specular = 0.0;
-        m.base_color = Vec3::ZERO;
-    });
+    let black = black();
     let dirs = hemisphere(4096);
     let mut failures = Vec::new();
     for theta_o in [10.0, 45.0, 75.0] {
@@ -256,10 +261,7 @@ fn the_coat_and_the_sheen_follow_the_specification() {
 fn each_layer_alone_is_reciprocal() {
     let Some(ctx) = common::gpu() else { return };
     let check = BsdfCheck::new(ctx).unwrap();
-    let black = material("black", |m| {
-        m.specular = 0.0;
-        m.base_color = Vec3::ZERO;
-    });
+    let black = black();
     let dirs = hemisphere(4096);
     let mut failures = Vec::new();
     for m in [
