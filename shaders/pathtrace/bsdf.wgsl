@@ -130,16 +130,8 @@ fn metal_ss_prob(e_o: f32) -> f32 {
     return clamp(e_o, 0.25, 1.0);
 }
 
-struct LobeParams {
-    roughness: f32,
-    a2: f32,
-    is_smooth: bool,
-}
-
 fn lobe_params(m: Material) -> LobeParams {
-    let r = clamp(m.roughness, 0.0, 1.0);
-    let alpha = r * r;
-    return LobeParams(r, alpha * alpha, alpha < ALPHA_MIN);
+    return ggx_lobe(m.roughness);
 }
 
 // `metal_ss_prob`, or 1 where there is no multiple-scattering term to sample.
@@ -272,8 +264,10 @@ fn sample_glass(m: Material, lp: LobeParams, wo: vec3f, u: vec3f) -> BsdfSample 
     return BsdfSample(normalize(vec3f(wi.xy, wi.z * s)), weight, 0.0, true);
 }
 
-// A sample of the three lobes; its non-delta samples weighted by the whole BSDF
-// (`eval_bsdf`, layers included), as one-sample MIS over every lobe asks.
+// A sample of the three lobes. Its non-delta samples are weighted by the whole BSDF
+// (`eval_bsdf`, layers included), as one-sample MIS over every lobe asks, except where no
+// microfacet code is compiled in (!HAS_SPECULAR && !HAS_METAL): there they carry the
+// diffuse base's own weight, and `sample_bsdf` weights them again over the layers.
 fn sample_base(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     var out = BsdfSample(vec3f(0.0, 0.0, 1.0), vec3f(0.0), 0.0, false);
     let w = lobe_weights(m);
@@ -368,7 +362,7 @@ struct Layers {
 }
 
 fn layers(m: Material, mu_o: f32) -> Layers {
-    var l = Layers(CoatParams(0.0, 0.0, 0.0, true), 0.0, 1.0, 0.0);
+    var l = Layers(CoatParams(0.0, ggx_lobe(0.0)), 0.0, 1.0, 0.0);
     if HAS_COAT && m.clearcoat > 0.0 {
         l.coat = coat_params(m);
         l.p_coat = clamp(coat_albedo(l.coat, mu_o), 0.0, 1.0);
@@ -416,7 +410,7 @@ fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     var wi: vec3f;
     if u_lobe < l.p_coat {
         wi = coat_sample(l.coat, wo, u.xy);
-        if l.coat.is_smooth {
+        if l.coat.lobe.is_smooth {
             // The mirror reflects clearcoat F(mu_o), the probability of choosing it.
             return BsdfSample(wi, vec3f(1.0), 0.0, true);
         }
@@ -426,9 +420,10 @@ fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
             wi = sample_cosine(vec3f(0.0, 0.0, 1.0), u.xy);
         } else {
             let s = sample_base(m, wo, min((v - l.p_sheen) / max(1.0 - l.p_sheen, 1e-7), ONE_MINUS_EPSILON), u);
-            if !s.valid || s.pdf == 0.0 {
-                // A delta sample (mirror, glass) or none: the layers take from it exactly
-                // the probability of passing them.
+            // A delta sample (mirror, glass) or none: the layers take from it exactly the
+            // probability of passing them. With the microfacet code compiled in, every
+            // other sample of the lobes is already weighted by the whole BSDF.
+            if !s.valid || s.pdf == 0.0 || HAS_SPECULAR || HAS_METAL {
                 return s;
             }
             wi = s.wi;

@@ -12,44 +12,41 @@ const COAT_F0: f32 = 0.04;
 struct CoatParams {
     // `clearcoat` in [0, 1].
     weight: f32,
-    roughness: f32,
-    a2: f32,
-    is_smooth: bool,
+    lobe: LobeParams,
 }
 
 fn coat_params(m: Material) -> CoatParams {
-    let r = clamp(m.clearcoat_roughness, 0.0, 1.0);
-    let alpha = r * r;
-    return CoatParams(clamp(m.clearcoat, 0.0, 1.0), r, alpha * alpha, alpha < ALPHA_MIN);
+    return CoatParams(clamp(m.clearcoat, 0.0, 1.0), ggx_lobe(m.clearcoat_roughness));
 }
 
 // The coat's directional albedo (its weight included) at view cosine mu: what it reflects
 // and so takes from the layers below, and the probability of sampling it.
 fn coat_albedo(c: CoatParams, mu: f32) -> f32 {
-    if c.is_smooth {
+    if c.lobe.is_smooth {
         return c.weight * schlick(vec3f(COAT_F0), mu).x;
     }
-    return c.weight * lobe_albedo(vec3f(COAT_F0), ggx_albedo(mu, c.roughness)).x;
+    return c.weight * lobe_albedo(vec3f(COAT_F0), ggx_albedo(mu, c.lobe.roughness)).x;
 }
 
 // The rough coat's f * cos (weight included) and the density of its visible-normal
 // sampling; zero for a smooth coat (a delta lobe, reached by sampling only).
 fn coat_eval(c: CoatParams, wo: vec3f, wi: vec3f) -> BsdfEval {
-    if c.is_smooth {
+    let a2 = c.lobe.a2;
+    if c.lobe.is_smooth {
         return BsdfEval(vec3f(0.0), 0.0);
     }
     let h = normalize(wo + wi);
-    let d = ggx_d(h.z, c.a2);
+    let d = ggx_d(h.z, a2);
     let fresnel = schlick(vec3f(COAT_F0), dot(wo, h)).x;
-    let f_cos = c.weight * fresnel * d * smith_g2(wo.z, wi.z, c.a2) / (4.0 * wo.z);
-    return BsdfEval(vec3f(f_cos), smith_g1(wo.z, c.a2) * d / (4.0 * wo.z));
+    let f_cos = c.weight * fresnel * d * smith_g2(wo.z, wi.z, a2) / (4.0 * wo.z);
+    return BsdfEval(vec3f(f_cos), smith_g1(wo.z, a2) * d / (4.0 * wo.z));
 }
 
 // A direction reflected by the coat: the mirror direction, or one by visible normals.
 fn coat_sample(c: CoatParams, wo: vec3f, u: vec2f) -> vec3f {
-    if c.is_smooth {
+    if c.lobe.is_smooth {
         return vec3f(-wo.xy, wo.z);
     }
-    let mh = sample_vndf(wo, sqrt(c.a2), u);
+    let mh = sample_vndf(wo, sqrt(c.lobe.a2), u);
     return 2.0 * dot(wo, mh) * mh - wo;
 }

@@ -10,6 +10,20 @@
 const ALPHA_MIN: f32 = 1e-3;
 const GGX_TABLE_N: u32 = 32u;
 
+// A GGX lobe's roughness as its functions take it: perceptual roughness clamped to [0, 1],
+// alpha^2, and whether it is a perfect mirror or interface.
+struct LobeParams {
+    roughness: f32,
+    a2: f32,
+    is_smooth: bool,
+}
+
+fn ggx_lobe(roughness: f32) -> LobeParams {
+    let r = clamp(roughness, 0.0, 1.0);
+    let alpha = r * r;
+    return LobeParams(r, alpha * alpha, alpha < ALPHA_MIN);
+}
+
 // The N x N table starting at entry `first` of `ggx_table`, bilinearly interpolated at view
 // cosine mu (along a row) and roughness (down the rows).
 fn albedo_table(first: u32, mu: f32, roughness: f32) -> vec2f {

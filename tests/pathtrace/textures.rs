@@ -1264,18 +1264,7 @@ fn constant_transmission_and_specular_textures_render_like_factors() {
     let tr = [153, 0, 0, 255];
     let sp = [0, 0, 0, 77];
     let sc = [230, 180, 120, 255];
-    let mut left = Quad::at(-1.0, -1.0, 0);
-    left.size = 1.0;
-    let mut right = Quad::at(0.0, -1.0, 1);
-    right.size = 1.0;
-    let mut back_left = Quad::at(-1.0, 0.0, 0);
-    back_left.size = 1.0;
-    let mut back_right = Quad::at(0.0, 0.0, 1);
-    back_right.size = 1.0;
-    let mut light = Quad::at(-0.4, -0.4, 2);
-    light.size = 0.8;
-    light.z = 0.6;
-    let quads = vec![left, right, back_left, back_right, light];
+    let quads = two_materials_under_a_light();
     let base = r#""pbrMetallicRoughness":{"baseColorFactor":[0.8,0.6,0.5,1],"metallicFactor":0,"roughnessFactor":0.3}"#;
     let light_m = r#"{"emissiveFactor":[1,0.9,0.7],"extensions":{"KHR_materials_emissive_strength":{"emissiveStrength":4}},"doubleSided":true}"#;
     let textured = Gltf {
@@ -1323,16 +1312,30 @@ fn constant_transmission_and_specular_textures_render_like_factors() {
         ],
         quads,
     };
+    renders_like_factors(dir.path(), [&textured, &factors, &ignored], |f| {
+        // The factor scene has what the CPU expects.
+        let f0 = ((1.5_f32 - 1.0) / (1.5 + 1.0)).powi(2);
+        let want = 12.5 * f0 * u(sp[3]) * d[0];
+        assert!((f.materials[1].specular - want).abs() < 1e-6 * want);
+        assert_eq!(f.materials[0].transmission, 0.6);
+    });
+}
+
+/// The scenes of `textured`, `factors` and `ignored` (the textured materials without their
+/// textures), seen from above the floor at 32×32 with 4 spp: after `check` has looked at the
+/// factor scene, the textured render equals the factors' within 1e-4 relative per channel,
+/// and the one without textures differs by more than 1e-2.
+fn renders_like_factors(
+    dir: &Path,
+    [textured, factors, ignored]: [&Gltf; 3],
+    check: impl FnOnce(&GpuScene),
+) {
     let eye = Vec3::new(0.0, -2.5, 1.6);
-    let scene = |name, g| flat_scene(dir.path(), name, g, eye, (32, 32));
-    let t = scene("textured", &textured);
-    let f = scene("factors", &factors);
-    let n = scene("ignored", &ignored);
-    // The factor scene has what the CPU expects.
-    let f0 = ((1.5_f32 - 1.0) / (1.5 + 1.0)).powi(2);
-    let want = 12.5 * f0 * u(sp[3]) * d[0];
-    assert!((f.materials[1].specular - want).abs() < 1e-6 * want);
-    assert_eq!(f.materials[0].transmission, 0.6);
+    let scene = |name, g| flat_scene(dir, name, g, eye, (32, 32));
+    let t = scene("textured", textured);
+    let f = scene("factors", factors);
+    let n = scene("ignored", ignored);
+    check(&f);
     let (Some(t), Some(f), Some(n)) = (color(t, 4), color(f, 4), color(n, 4)) else {
         return;
     };
@@ -1345,6 +1348,93 @@ fn constant_transmission_and_specular_textures_render_like_factors() {
     assert!(sum > 10.0, "the image is lit");
     assert!(ignored_diff > 1e-2, "the textures change the image");
     assert!(worst < 1e-4, "{worst}");
+}
+
+/// A floor of four unit quads, materials 0 (left) and 1 (right), under a small emitter of
+/// material 2.
+fn two_materials_under_a_light() -> Vec<Quad> {
+    let unit = |x, y, m| {
+        let mut q = Quad::at(x, y, m);
+        q.size = 1.0;
+        q
+    };
+    let mut light = Quad::at(-0.4, -0.4, 2);
+    light.size = 0.8;
+    light.z = 0.6;
+    vec![
+        unit(-1.0, -1.0, 0),
+        unit(0.0, -1.0, 1),
+        unit(-1.0, 0.0, 0),
+        unit(0.0, 0.0, 1),
+        light,
+    ]
+}
+
+/// Constant clear coat and sheen textures render the image of the equivalent factors (same
+/// seed, 4 spp, 2 bounces), as the transmission and specular ones do: left, a clear coat of
+/// factor 1 and roughness factor 1 read from R 140 and G 90 of its two textures; right, a
+/// sheen of colour factor 1 times the sRGB texel (200, 120, 60) and roughness factor 1 times
+/// A 128. Allowed: 1e-4 relative per channel, as there; the same scene without the textures
+/// must differ by more than 1e-2.
+#[test]
+fn constant_clear_coat_and_sheen_textures_render_like_factors() {
+    let dir = temp();
+    let cc = [140, 90, 0, 255];
+    let sh = [200, 120, 60, 128];
+    let quads = two_materials_under_a_light();
+    let base = r#""pbrMetallicRoughness":{"baseColorFactor":[0.3,0.2,0.5,1],"metallicFactor":0,"roughnessFactor":0.6}"#;
+    let light_m = r#"{"emissiveFactor":[1,0.9,0.7],"extensions":{"KHR_materials_emissive_strength":{"emissiveStrength":4}},"doubleSided":true}"#;
+    let textured = Gltf {
+        images: vec![Img::constant(cc), Img::constant(sh)],
+        materials: vec![
+            format!(
+                r#"{{{base},"extensions":{{"KHR_materials_clearcoat":{{"clearcoatFactor":1,"clearcoatRoughnessFactor":1,"clearcoatTexture":{{"index":0}},"clearcoatRoughnessTexture":{{"index":0}}}}}}}}"#
+            ),
+            format!(
+                r#"{{{base},"extensions":{{"KHR_materials_sheen":{{"sheenColorFactor":[1,1,1],"sheenRoughnessFactor":1,"sheenColorTexture":{{"index":1}},"sheenRoughnessTexture":{{"index":1}}}}}}}}"#
+            ),
+            light_m.into(),
+        ],
+        quads: quads.clone(),
+    };
+    let u = |b: u8| f32::from(b) / 255.0;
+    let d = [sh[0], sh[1], sh[2]].map(|b| srgb_decode(u(b)));
+    let factors = Gltf {
+        images: Vec::new(),
+        materials: vec![
+            format!(
+                r#"{{{base},"extensions":{{"KHR_materials_clearcoat":{{"clearcoatFactor":{:?},"clearcoatRoughnessFactor":{:?}}}}}}}"#,
+                u(cc[0]),
+                u(cc[1])
+            ),
+            format!(
+                r#"{{{base},"extensions":{{"KHR_materials_sheen":{{"sheenColorFactor":[{:?},{:?},{:?}],"sheenRoughnessFactor":{:?}}}}}}}"#,
+                d[0],
+                d[1],
+                d[2],
+                u(sh[3])
+            ),
+            light_m.into(),
+        ],
+        quads: quads.clone(),
+    };
+    let ignored = Gltf {
+        images: Vec::new(),
+        materials: vec![
+            format!(
+                r#"{{{base},"extensions":{{"KHR_materials_clearcoat":{{"clearcoatFactor":1,"clearcoatRoughnessFactor":1}}}}}}"#
+            ),
+            format!(
+                r#"{{{base},"extensions":{{"KHR_materials_sheen":{{"sheenColorFactor":[1,1,1],"sheenRoughnessFactor":1}}}}}}"#
+            ),
+            light_m.into(),
+        ],
+        quads,
+    };
+    renders_like_factors(dir.path(), [&textured, &factors, &ignored], |f| {
+        assert_eq!(f.materials[0].clearcoat, u(cc[0]));
+        assert_eq!(f.materials[1].sheen_roughness, u(sh[3]));
+    });
 }
 
 /// A transmission texture whose left texel transmits (R = 255) and right one does not

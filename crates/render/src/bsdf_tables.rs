@@ -187,7 +187,8 @@ fn build_sheen() -> Vec<[f32; 2]> {
             })
             .collect();
         for (k, row) in rows.into_iter().enumerate() {
-            for (j, e) in row.join().unwrap_or_default().into_iter().enumerate() {
+            let row = row.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
+            for (j, e) in row.into_iter().enumerate() {
                 out[k * N + j] = [e, 0.0];
             }
         }

@@ -1037,6 +1037,7 @@ fn ext_factor(ext: &::gltf::json::Value, key: &str, default: f32) -> f32 {
 /// or names no texture (a warning says so).
 fn ext_texture<'a>(
     doc: &'a ::gltf::Document,
+    material: &str,
     ext: &::gltf::json::Value,
     key: &str,
     dec: &mut Decoder<'a>,
@@ -1050,7 +1051,9 @@ fn ext_texture<'a>(
         .and_then(::gltf::json::Value::as_u64)
         .and_then(|i| doc.textures().nth(usize::try_from(i).ok()?));
     let Some(texture) = texture else {
-        warnings.push(format!("{key} names no texture of the file: not read"));
+        warnings.push(format!(
+            "material {material}: {key} names no texture of the file: not read"
+        ));
         return Ok(NO_TEXTURE);
     };
     let tex_coord = info
@@ -1078,12 +1081,13 @@ fn layers<'a>(
     dec: &mut Decoder<'a>,
     warnings: &mut Vec<String>,
 ) -> Result<(), SceneError> {
+    let name = material_name(m);
     if let Some(ext) = m.extension_value("KHR_materials_clearcoat") {
         out.clearcoat = ext_factor(ext, "clearcoatFactor", 0.0).clamp(0.0, 1.0);
         out.clearcoat_roughness = ext_factor(ext, "clearcoatRoughnessFactor", 0.0).clamp(0.0, 1.0);
-        out.textures.clearcoat = ext_texture(doc, ext, "clearcoatTexture", dec, warnings)?;
+        out.textures.clearcoat = ext_texture(doc, &name, ext, "clearcoatTexture", dec, warnings)?;
         out.textures.clearcoat_roughness =
-            ext_texture(doc, ext, "clearcoatRoughnessTexture", dec, warnings)?;
+            ext_texture(doc, &name, ext, "clearcoatRoughnessTexture", dec, warnings)?;
         if ext.get("clearcoatNormalTexture").is_some() && out.clearcoat > 0.0 {
             warnings.push(format!(
                 "material {}: clearcoatNormalTexture is not read (the clear coat takes the \
@@ -1115,9 +1119,10 @@ fn layers<'a>(
             });
         out.sheen_color = Vec3::from(color);
         out.sheen_roughness = ext_factor(ext, "sheenRoughnessFactor", 0.0).clamp(0.0, 1.0);
-        out.textures.sheen_color = ext_texture(doc, ext, "sheenColorTexture", dec, warnings)?;
+        out.textures.sheen_color =
+            ext_texture(doc, &name, ext, "sheenColorTexture", dec, warnings)?;
         out.textures.sheen_roughness =
-            ext_texture(doc, ext, "sheenRoughnessTexture", dec, warnings)?;
+            ext_texture(doc, &name, ext, "sheenRoughnessTexture", dec, warnings)?;
     }
     Ok(())
 }
