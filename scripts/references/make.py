@@ -72,6 +72,9 @@ def bsdf(m):
     if m.get("clearcoat", 0.0) > 0.0 or max(m.get("sheen_color", [0.0])) > 0.0:
         raise Refused(f"material {m['name']}: clear coat and sheen (the glTF lobes) have no "
                       "Mitsuba equivalent (principled's are other models)")
+    if any(c != 1.0 for c in m.get("specular_color", [1.0, 1.0, 1.0])):
+        raise Refused(f"material {m['name']}: a specular colour (glTF's, on F0 only) has no "
+                      "Mitsuba equivalent")
     alpha = m["roughness"] ** 2
     smooth = alpha < ALPHA_MIN
     metallic, transmission, specular = m["metallic"], m["transmission"], m["specular"]

@@ -1,6 +1,7 @@
 // The material model: three lobes mixed by metallic and transmission.
 //   dielectric layer  (1 - metallic)(1 - transmission): GGX specular with Schlick Fresnel
-//                     (F0 = 0.08 specular, tinted by specular_tint) over a Lambertian base
+//                     (F0 = 0.08 specular, tinted by specular_tint, times specular_color;
+//                     `dielectric_fresnel`) over a Lambertian base
 //                     that receives exactly the energy the specular does not reflect, or
 //                     with diffuse_roughness > 0 an energy-preserving Oren-Nayar base (EON,
 //                     eon.wgsl, compiled in with HAS_ROUGH_DIFFUSE) weighted the same way;
@@ -94,10 +95,15 @@ fn lobe_weights(m: Material) -> vec3f {
     return vec3f((1.0 - metal) * (1.0 - t), metal, (1.0 - metal) * t);
 }
 
-fn dielectric_f0(m: Material) -> vec3f {
+// The dielectric specular's Fresnel: F0 = 0.08 specular, tinted towards the base colour by
+// specular_tint, then times specular_color and clamped to 1. F90 is taken from F0 before
+// specular_color, which (as glTF's KHR_materials_specular has it) colours normal incidence
+// only: the grazing reflection of a material with specular > 0 stays white.
+fn dielectric_fresnel(m: Material) -> Fresnel {
     let l = luminance(m.base_color);
     let tint = select(vec3f(1.0), m.base_color / l, l > 0.0);
-    return clamp(0.08 * m.specular, 0.0, 1.0) * mix(vec3f(1.0), tint, clamp(m.specular_tint, 0.0, 1.0));
+    let f0 = clamp(0.08 * m.specular, 0.0, 1.0) * mix(vec3f(1.0), tint, clamp(m.specular_tint, 0.0, 1.0));
+    return Fresnel(min(f0 * m.specular_color, vec3f(1.0)), schlick_f90(f0));
 }
 
 // Whether the dielectric layer's diffuse base is EON (else Lambertian).
@@ -116,9 +122,10 @@ fn layer_spec_prob(m: Material, es_o: vec3f) -> f32 {
     return clamp(s / max(s + d, 1e-6), 0.1, 0.9);
 }
 
-// `layer_spec_prob`, or 0 for a rough diffuse base with no specular (F0 = 0) at all.
-fn layer_spec_sample_prob(m: Material, f0: vec3f, es_o: vec3f) -> f32 {
-    if rough_diffuse(m) && all(f0 == vec3f(0.0)) {
+// `layer_spec_prob`, or 0 for a rough diffuse base with no specular at all (F90 = 0, which
+// makes F0 = 0 too).
+fn layer_spec_sample_prob(m: Material, f: Fresnel, es_o: vec3f) -> f32 {
+    if rough_diffuse(m) && f.f90 == 0.0 {
         return 0.0;
     }
     return layer_spec_prob(m, es_o);
@@ -173,10 +180,10 @@ fn eval_base(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
     let ti = ggx_albedo(wi.z, lp.roughness);
     let ta = ggx_albedo_avg(lp.roughness);
     if w.x > 0.0 {
-        let f0 = dielectric_f0(m);
-        let es_o = lobe_albedo(f0, to);
-        let es_i = lobe_albedo(f0, ti);
-        let es_avg = lobe_albedo(f0, ta);
+        let f = dielectric_fresnel(m);
+        let es_o = fresnel_albedo(f, to);
+        let es_i = fresnel_albedo(f, ti);
+        let es_avg = fresnel_albedo(f, ta);
         var diffuse = m.base_color * (1.0 - es_o) * (1.0 - es_i) / (PI * max(1.0 - es_avg, vec3f(1e-4))) * wi.z;
         var diffuse_pdf = cos_pdf;
         if rough_diffuse(m) {
@@ -186,8 +193,8 @@ fn eval_base(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
             diffuse = eon_f(m.base_color, r, wo, wi) * (1.0 - es_o) * (1.0 - es_i) / max(1.0 - es_avg, vec3f(1e-4)) * wi.z;
             diffuse_pdf = eon_pdf(wo, wi, r);
         }
-        let spec = g2_over * schlick(f0, dot(wo, h));
-        let ps = layer_spec_sample_prob(m, f0, es_o);
+        let spec = g2_over * fresnel_at(f, dot(wo, h));
+        let ps = layer_spec_sample_prob(m, f, es_o);
         out.f_cos += w.x * (diffuse + spec);
         out.pdf += w.x * (ps * vndf_pdf + (1.0 - ps) * diffuse_pdf);
     }
@@ -299,14 +306,14 @@ fn sample_base(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     let to = ggx_albedo(wo.z, lp.roughness);
     // Choose a sub-lobe: mirror-like (GGX or perfect mirror) or diffuse-like (cosine).
     var p_mirror: f32;
-    var fresnel_f0: vec3f;
+    // The dielectric layer's Fresnel (unused by the metal lobe).
+    var layer_fresnel: Fresnel;
     let v = (u_lobe - w.z) / max(1.0 - w.z, 1e-6);
     let layer = v * (w.x + w.y) < w.x;
     if layer {
-        fresnel_f0 = dielectric_f0(m);
-        p_mirror = w.x * layer_spec_sample_prob(m, fresnel_f0, lobe_albedo(fresnel_f0, to));
+        layer_fresnel = dielectric_fresnel(m);
+        p_mirror = w.x * layer_spec_sample_prob(m, layer_fresnel, fresnel_albedo(layer_fresnel, to));
     } else {
-        fresnel_f0 = m.base_color;
         p_mirror = w.y * metal_ss_sample_prob(m, lp, to.x + to.y);
     }
     let p_lobe = select(w.y, w.x, layer);
@@ -314,7 +321,7 @@ fn sample_base(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     if mirror && lp.is_smooth {
         // Perfect mirror: a delta lobe, weighted by its Fresnel over its probability.
         out.wi = vec3f(-wo.xy, wo.z);
-        let fresnel = select(metal_fresnel(m, wo.z), schlick(fresnel_f0, wo.z), layer);
+        let fresnel = select(metal_fresnel(m, wo.z), fresnel_at(layer_fresnel, wo.z), layer);
         out.weight = p_lobe * fresnel / p_mirror;
         out.valid = true;
         return out;

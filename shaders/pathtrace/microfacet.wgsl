@@ -87,15 +87,34 @@ fn schlick_f90(f0: vec3f) -> f32 {
     return clamp(50.0 * max(f0.x, max(f0.y, f0.z)), 0.0, 1.0);
 }
 
-fn schlick(f0: vec3f, c: f32) -> vec3f {
-    let m = clamp(1.0 - c, 0.0, 1.0);
-    let m2 = m * m;
-    return f0 + (schlick_f90(f0) - f0) * (m2 * m2 * m);
+// Schlick's Fresnel from its reflectance at normal (f0) and grazing (f90) incidence.
+struct Fresnel {
+    f0: vec3f,
+    f90: f32,
 }
 
-// Albedo of a GGX lobe with Fresnel `schlick(f0, .)` from the (A, B) table entry t.
+fn schlick_fresnel(f0: vec3f) -> Fresnel {
+    return Fresnel(f0, schlick_f90(f0));
+}
+
+fn fresnel_at(f: Fresnel, c: f32) -> vec3f {
+    let m = clamp(1.0 - c, 0.0, 1.0);
+    let m2 = m * m;
+    return f.f0 + (f.f90 - f.f0) * (m2 * m2 * m);
+}
+
+// Albedo of a GGX lobe with Fresnel `fresnel_at(f, .)` from the (A, B) table entry t (A
+// weights F0, B weights F90).
+fn fresnel_albedo(f: Fresnel, t: vec2f) -> vec3f {
+    return f.f0 * t.x + f.f90 * t.y;
+}
+
+fn schlick(f0: vec3f, c: f32) -> vec3f {
+    return fresnel_at(schlick_fresnel(f0), c);
+}
+
 fn lobe_albedo(f0: vec3f, t: vec2f) -> vec3f {
-    return f0 * t.x + schlick_f90(f0) * t.y;
+    return fresnel_albedo(schlick_fresnel(f0), t);
 }
 
 // f * cos(wi) of a lobe (or the whole non-delta BSDF) and the solid-angle pdf of its sampling.

@@ -87,7 +87,7 @@ struct Sphere {
     pad1: u32,
 }
 
-// Material, 160 bytes. Texture indices: 16 bits each, 0xffff = none; each texture
+// Material, 208 bytes. Texture indices: 16 bits each, 0xffff = none; each texture
 // multiplies its factor (see textures.wgsl).
 struct Material {
     base_color: vec3<f32>,
@@ -133,6 +133,10 @@ struct Material {
     clearcoat_roughness: f32,
     pad6: u32,
     pad7: u32,
+    // Colour of the dielectric specular at normal incidence: it multiplies F0 (clamped to
+    // 1), not the grazing reflectance (bsdf.wgsl's `dielectric_fresnel`).
+    specular_color: vec3<f32>,
+    pad8: u32,
 }
 
 // A triangle's tangents (xyz, w = handedness), UVs (two sets) and vertex colours (RGBA8, R in

@@ -115,8 +115,8 @@ fn textured_emission(m: Material, uv: vec4f) -> vec3f {
 // `m` with its textures and the vertex colour `color` applied at `uv`: base color x texture
 // (sRGB; alpha is the any-hit test's) x vertex colour, roughness x G and metallic x B of the
 // metallic-roughness texture, emission x texture (sRGB), transmission x R of the
-// transmission texture, specular x A of the specular texture x max channel of the specular
-// color texture (sRGB), clear coat x R and its roughness x G of their textures, sheen colour x
+// transmission texture, specular x A of the specular texture, specular colour x the specular
+// colour texture (sRGB), clear coat x R and its roughness x G of their textures, sheen colour x
 // its texture (sRGB) and sheen roughness x A of its texture.
 fn textured_material(m_in: Material, uv: vec4f, color: vec4f) -> Material {
     var m = m_in;
@@ -142,8 +142,7 @@ fn textured_material(m_in: Material, uv: vec4f, color: vec4f) -> Material {
     }
     let sc = tex_lo(m.tex_specular_color);
     if sc != NO_TEX {
-        let c = tex_sample(sc, uv, true).rgb;
-        m.specular *= max(c.x, max(c.y, c.z));
+        m.specular_color *= tex_sample(sc, uv, true).rgb;
     }
     let cc = tex_lo(m.tex_coat);
     if cc != NO_TEX {

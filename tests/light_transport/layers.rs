@@ -114,7 +114,7 @@ fn layer_sample_weights_are_f_cos_over_pdf() {
 }
 
 /// Random directions of the upper hemisphere (uniform), from a fixed xorshift stream.
-fn hemisphere(n: usize) -> Vec<Vec3> {
+pub(super) fn hemisphere(n: usize) -> Vec<Vec3> {
     let mut state = 0x2545_f491_u32;
     let mut rand = move || {
         state ^= state << 13;

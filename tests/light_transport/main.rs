@@ -12,5 +12,6 @@ mod layers;
 mod media;
 mod rough_diffuse;
 mod sampler;
+mod specular_color;
 mod stability;
 mod strategies;

@@ -377,6 +377,53 @@ fn simple_instancing_draws_every_instance() {
     }
 }
 
+/// The glTF model `rel` (under `assets/gltf-conformance/`) alone in a white sky (radiance 1
+/// from everywhere), seen from `eye` towards `target` with a 3° field of view.
+fn in_a_white_sky(
+    rel: &str,
+    eye: Vec3,
+    target: Vec3,
+    size: (u32, u32),
+    bounces: u32,
+    spp: u32,
+) -> Scene {
+    let dir = tempfile::tempdir().unwrap();
+    let model = common::repo(&format!("assets/gltf-conformance/{rel}"));
+    let text = format!(
+        "(version: 2,
+  camera: Perspective(position: ({:?}, {:?}, {:?}), target: ({:?}, {:?}, {:?}), up: (0.0, 1.0, 0.0), fov_y: 3.0),
+  shapes: [Mesh(name: \"m\", path: {model:?})],
+  environment: Constant((1.0, 1.0, 1.0)),
+  render: (width: {}, height: {}, max_bounces: {bounces}, spp: {spp}, seed: 3),
+)",
+        eye.x, eye.y, eye.z, target.x, target.y, target.z, size.0, size.1
+    );
+    let path = dir.path().join("scene.ron");
+    std::fs::write(&path, text).unwrap();
+    Scene::load(&path).unwrap()
+}
+
+/// Where `ray` meets a triangle of `gpu` (`hit`): the interpolated shading normal, the point,
+/// and whether the mirror ray from there leaves to the sky (meets nothing).
+fn mirror_to_sky(
+    gpu: &GpuScene,
+    ray: &lumagraph::scene::Ray,
+    hit: &lumagraph::scene::Hit,
+) -> (Vec3, Vec3, bool) {
+    let s = &gpu.tri_shading[hit.prim as usize];
+    let n = ((1.0 - hit.u - hit.v) * Vec3::from(s.n0)
+        + hit.u * Vec3::from(s.n1)
+        + hit.v * Vec3::from(s.n2))
+    .normalize();
+    let d = ray.dir.normalize();
+    let p = ray.origin + hit.t * ray.dir;
+    let bounce = lumagraph::scene::Ray {
+        origin: p + 1e-3 * n,
+        dir: d - 2.0 * d.dot(n) * n,
+    };
+    (n, p, intersect(gpu, &bounce).is_none())
+}
+
 /// `ClearCoatTest` (its README): each row holds a base material, the same under a clear coat
 /// ("Coated"), and a black material with the coat's settings ("Coating only"); the coated
 /// sample must show the reflections of both. In a white sky (radiance 1 everywhere; 4
@@ -395,19 +442,14 @@ fn simple_instancing_draws_every_instance() {
 #[test]
 fn clear_coat_test_reflects_the_sky_over_the_base() {
     let Some(ctx) = common::gpu() else { return };
-    let dir = tempfile::tempdir().unwrap();
-    let model = common::repo("assets/gltf-conformance/ClearCoatTest/ClearCoatTest.glb");
-    let text = format!(
-        "(version: 2,
-  camera: Perspective(position: (0.0, 5.25, 42.0), target: (0.0, 5.25, 0.0), up: (0.0, 1.0, 0.0), fov_y: 3.0),
-  shapes: [Mesh(name: \"m\", path: {model:?})],
-  environment: Constant((1.0, 1.0, 1.0)),
-  render: (width: 192, height: 64, max_bounces: 4, spp: 32, seed: 3),
-)"
+    let coated = in_a_white_sky(
+        "ClearCoatTest/ClearCoatTest.glb",
+        Vec3::new(0.0, 5.25, 42.0),
+        Vec3::new(0.0, 5.25, 0.0),
+        (192, 64),
+        4,
+        32,
     );
-    let path = dir.path().join("scene.ron");
-    std::fs::write(&path, text).unwrap();
-    let coated = Scene::load(&path).unwrap();
     let mut bare = coated.clone();
     for m in &mut bare.materials {
         m.clearcoat = 0.0;
@@ -430,27 +472,17 @@ fn clear_coat_test_reflects_the_sky_over_the_base() {
                 let Some(hit) = hit else {
                     break;
                 };
-                let s = &gpu.tri_shading[hit.prim as usize];
-                if coated.materials[s.material as usize].name != "m/Simple_Coated" {
+                let m = gpu.tri_shading[hit.prim as usize].material as usize;
+                if coated.materials[m].name != "m/Simple_Coated" {
                     break;
                 }
-                let n = ((1.0 - hit.u - hit.v) * Vec3::from(s.n0)
-                    + hit.u * Vec3::from(s.n1)
-                    + hit.v * Vec3::from(s.n2))
-                .normalize();
                 // Where the coat's mirror sees the model rather than the sky, it reflects
                 // less than F: such pixels are left out.
-                let d = ray.dir.normalize();
-                let r = d - 2.0 * d.dot(n) * n;
-                let p = ray.origin + hit.t * ray.dir;
-                let bounce = lumagraph::scene::Ray {
-                    origin: p + 1e-3 * n,
-                    dir: r,
-                };
-                if intersect(&gpu, &bounce).is_some() {
+                let (n, _, to_sky) = mirror_to_sky(&gpu, &ray, &hit);
+                if !to_sky {
                     break;
                 }
-                fs.push(f64::from(n.dot(-d)));
+                fs.push(f64::from(n.dot(-ray.dir.normalize())));
             }
             if fs.len() == 16 && fs.iter().all(|&mu| mu >= 0.5) {
                 let f = fs
@@ -480,4 +512,253 @@ fn clear_coat_test_reflects_the_sky_over_the_base() {
     assert!(pixels.len() > 500, "{} pixels", pixels.len());
     assert!(got.abs() < 5e-3, "residual {got}");
     assert!(control.abs() >= 5e-3, "the control passes too: {control}");
+}
+
+/// What `specular_test_colours_f0_and_keeps_white_rims` reads of one pixel wholly on one
+/// sphere whose mirror sees only the sky: the material (without the mesh's `m/` prefix),
+/// the sphere's column (0 to 4), the smallest view cosine over the pixel and the CPU's
+/// expected value per channel.
+struct SpecularPixel {
+    index: usize,
+    material: String,
+    column: i32,
+    mu_min: f64,
+    want: [f64; 3],
+}
+
+/// The pixels of `gpu` (`SpecularTest`) wholly on one sphere — their 4 × 4 footprint rays and
+/// their four corners meet it (the samples fall anywhere in the pixel, and a sphere's
+/// outline is convex) — whose mirror rays all leave to the sky, with glTF's F averaged
+/// over the footprint at the shading normal's view cosines.
+fn specular_pixels(scene: &Scene, gpu: &GpuScene) -> Vec<SpecularPixel> {
+    let (w, h) = (gpu.settings.width, gpu.settings.height);
+    let mut pixels = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].map(|(cx, cy)| {
+                let ray = common::image_ray(gpu, Vec2::new(x as f32 + cx, y as f32 + cy));
+                (ray, intersect(gpu, &ray))
+            });
+            let mut mus = Vec::new();
+            let mut name = None;
+            let mut column = 0;
+            for (ray, hit) in common::footprint(gpu, x, y).into_iter().chain(corners) {
+                let Some(hit) = hit else { break };
+                let m = &scene.materials[gpu.tri_shading[hit.prim as usize].material as usize].name;
+                if name.get_or_insert(m) != &m {
+                    break;
+                }
+                let (n, p, to_sky) = mirror_to_sky(gpu, &ray, &hit);
+                if !to_sky {
+                    break;
+                }
+                // Sphere columns at x = 0.325 − 0.44 + 0.11 k.
+                column = ((p.x + 0.115) / 0.11).round() as i32;
+                mus.push(f64::from(n.dot(-ray.dir.normalize())));
+            }
+            let Some(m) = name.filter(|_| mus.len() == 20) else {
+                continue;
+            };
+            let material = m.strip_prefix("m/").unwrap_or(m).to_owned();
+            if material == "LabelMat" {
+                continue;
+            }
+            // The footprint's F as glTF defines it for specularFactor 1 (rows 3, 5 and 7;
+            // rows 1 and 2 are held otherwise).
+            let color = scene
+                .materials
+                .iter()
+                .find(|x| &x.name == m)
+                .unwrap()
+                .specular_color;
+            mus.truncate(16);
+            let want = std::array::from_fn(|c| {
+                let f0 = (0.04 * f64::from(color[c])).min(1.0);
+                mus.iter()
+                    .map(|&mu| f0 + (1.0 - f0) * (1.0 - mu).clamp(0.0, 1.0).powi(5))
+                    .sum::<f64>()
+                    / 16.0
+            });
+            pixels.push(SpecularPixel {
+                index: (y * w + x) as usize,
+                material,
+                column,
+                mu_min: mus.iter().copied().fold(1.0, f64::min),
+                want,
+            });
+        }
+    }
+    pixels
+}
+
+/// Per channel: a mean and its standard error.
+type MeanAndError = [(f64, f64); 3];
+
+/// The mean of `values` per channel and its standard error.
+fn mean_and_error(values: &[[f64; 3]]) -> MeanAndError {
+    let n = values.len() as f64;
+    std::array::from_fn(|c| {
+        let mean = values.iter().map(|v| v[c]).sum::<f64>() / n;
+        let var = values.iter().map(|v| (v[c] - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        (mean, (var / n).sqrt())
+    })
+}
+
+/// For rows 3, 5 and 7 (the colour factors), per material and centre (μ ≥ 0.9) or rim (μ <
+/// 0.6): the mean of render − F per channel with its standard error, and the pixel count.
+fn specular_residuals(
+    pixels: &[SpecularPixel],
+    img: &Image,
+) -> Vec<((String, bool), MeanAndError, usize)> {
+    let mut groups: std::collections::BTreeMap<(String, bool), Vec<[f64; 3]>> =
+        std::collections::BTreeMap::new();
+    for p in pixels {
+        let factor_row = ["M3.", "M5.", "M7."]
+            .iter()
+            .any(|r| p.material.starts_with(r));
+        let centre = p.mu_min >= 0.9;
+        if !factor_row || (!centre && p.mu_min >= 0.6) {
+            continue;
+        }
+        groups
+            .entry((p.material.clone(), centre))
+            .or_default()
+            .push(std::array::from_fn(|c| {
+                f64::from(img.pixels[p.index][c]) - p.want[c]
+            }));
+    }
+    groups
+        .into_iter()
+        .map(|(k, r)| (k, mean_and_error(&r), r.len()))
+        .collect()
+}
+
+/// |mean| / (5 standard errors + 1e-4), the largest over the channels: at most 1 passes.
+fn specular_score(stats: &MeanAndError) -> f64 {
+    stats
+        .iter()
+        .map(|(mean, se)| mean.abs() / (5.0 * se + 1e-4))
+        .fold(0.0, f64::max)
+}
+
+/// `SpecularTest`: "rows [3 to 6] … should influence only the normal incidence (f0), not
+/// grazing incidence (f90). The centers of the spheres should darken on the left side of
+/// the row, but not the edges … The specular response at the edges of the spheres should
+/// remain white throughout"; row 1's leftmost sphere (specularFactor 0) "should appear
+/// perfectly black"; rows 2, 4 and 6 (textures) equal rows 1, 3 and 5 (factors); row 7's
+/// last sphere (specularColorFactor 25) is a mirror ball.
+///
+/// The spheres are black mirrors (base colour 0, roughness 0) in a white sky, 16 spp: a
+/// pixel wholly on one sphere whose mirror rays all leave to the sky ([`specular_pixels`])
+/// shows Schlick's F = F0 + (F90 − F0)(1 − μ)⁵ per channel, with glTF's F0 = min(0.04 ·
+/// specularColorFactor, 1) and F90 = 1 for rows 3, 5 and 7 (specularFactor 1). Held, per
+/// material and channel, over the centres (μ ≥ 0.9) and the rims (μ < 0.6) apart: the mean
+/// of render − F within 5 standard errors (of the pixels' spread) + 1e-4 (measured: at most
+/// 0.61 of that bound); row 1's first sphere exactly 0; each texture sphere's centre within
+/// 5 standard errors + 1e-4 of its factor sphere's (2 × 15 × 3 + 3 × 5 × 3 = 135
+/// comparisons at 5.7e-7 each: under 1e-4 overall). Two controls must fail: the colours
+/// dropped, and the colour reduced to its largest channel as a strength (which also lowers
+/// F90: the dark spheres' rims go dark).
+#[test]
+fn specular_test_colours_f0_and_keeps_white_rims() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = in_a_white_sky(
+        "SpecularTest/SpecularTest.glb",
+        Vec3::new(0.105, 0.0, 15.0),
+        Vec3::new(0.105, 0.0, 0.0),
+        (160, 224),
+        2,
+        16,
+    );
+    let color = |name: &str| {
+        let m = scene
+            .materials
+            .iter()
+            .find(|m| m.name == format!("m/{name}"));
+        m.unwrap().specular_color
+    };
+    // The importer's reading of the factors.
+    assert_eq!(
+        color("M5.3_yellowFac"),
+        Vec3::new(0.212_231, 0.212_231, 0.0)
+    );
+    assert_eq!(color("M7.5_HDR"), Vec3::splat(25.0));
+    let pixels = specular_pixels(&scene, &GpuScene::build(&scene).unwrap());
+    let render = |scene: &Scene| {
+        let gpu = Arc::new(GpuScene::build(scene).unwrap());
+        common::accumulate(ctx, &gpu, 8, 2, Resources::default())
+    };
+    let image = render(&scene);
+    let mut worst: f64 = 0.0;
+    for ((m, centre), stats, n) in specular_residuals(&pixels, &image) {
+        let part = if centre { "centre" } else { "rim" };
+        let [r, g, b] = stats.map(|(mean, se)| format!("{mean:+.1e} ± {se:.1e}"));
+        println!("{m} {part} ({n} pixels): render - F = {r}, {g}, {b}");
+        assert!(n >= 8, "{m} {part}: {n} pixels");
+        worst = worst.max(specular_score(&stats));
+    }
+    // The controls: the colours dropped, and the reading before the colour was kept (its
+    // largest channel scaled the strength, and with it F90).
+    let mut dropped = scene.clone();
+    for m in &mut dropped.materials {
+        m.specular_color = Vec3::ONE;
+        m.textures.specular_color = lumagraph::scene::NO_TEXTURE;
+    }
+    let mut reduced = dropped.clone();
+    for (m, c) in reduced.materials.iter_mut().zip(&scene.materials) {
+        m.specular *= c.specular_color.max_element();
+    }
+    let [dropped, reduced] = [&dropped, &reduced].map(|s| {
+        specular_residuals(&pixels, &render(s))
+            .iter()
+            .map(|(_, stats, _)| specular_score(stats))
+            .fold(0.0, f64::max)
+    });
+    println!(
+        "largest |render - F| / (5 standard errors + 1e-4): {worst:.2}; with the colours dropped: {dropped:.1}; reduced to a strength: {reduced:.1}"
+    );
+    assert!(worst <= 1.0, "{worst}");
+    assert!(dropped > 1.0, "the control passes too: {dropped}");
+    assert!(reduced > 1.0, "the control passes too: {reduced}");
+    // Row 1's first sphere: no specular at all.
+    let black: Vec<_> = pixels
+        .iter()
+        .filter(|p| p.material == "M1.1_specFac")
+        .collect();
+    assert!(black.len() > 50, "{}", black.len());
+    assert!(
+        black.iter().all(|p| image.pixels[p.index][..3] == [0.0; 3]),
+        "not black"
+    );
+    // The texture rows against their factor rows, sphere by sphere, at the centres.
+    let centre = |material: &str, column: i32| {
+        let px: Vec<[f64; 3]> = pixels
+            .iter()
+            .filter(|p| p.material.starts_with(material) && p.column == column && p.mu_min >= 0.9)
+            .map(|p| std::array::from_fn(|c| f64::from(image.pixels[p.index][c])))
+            .collect();
+        assert!(
+            px.len() >= 8,
+            "{material} column {column}: {} pixels",
+            px.len()
+        );
+        mean_and_error(&px)
+    };
+    for (texture, factors) in [("M2_", "M1."), ("M4_", "M3."), ("M6_", "M5.")] {
+        for k in 0..5 {
+            let factor = format!("{factors}{}_", k + 1);
+            let (t, f) = (centre(texture, k), centre(&factor, k));
+            for c in 0..3 {
+                let ((tm, ts), (fm, fs)) = (t[c], f[c]);
+                let bound = 5.0 * ts.hypot(fs) + 1e-4;
+                println!(
+                    "{texture} sphere {k}, channel {c}: {tm:.5} ± {ts:.1e}; {factor}: {fm:.5} ± {fs:.1e}"
+                );
+                assert!(
+                    (tm - fm).abs() <= bound,
+                    "{texture} sphere {k}, channel {c}: {tm} against {factor}'s {fm} (bound {bound:.1e})"
+                );
+            }
+        }
+    }
 }

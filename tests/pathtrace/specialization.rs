@@ -134,6 +134,10 @@ fn randomize(scene: &mut Scene, rng: &mut Rng, glass_case: bool) {
         m.metallic = if metal { rng.factor() } else { 0.0 };
         m.transmission = if glass { rng.factor() } else { 0.0 };
         m.specular = if specular { rng.factor() } else { 0.0 };
+        if specular && rng.chance(0.5) {
+            // Over 1 too: F0 clamps at 1.
+            m.specular_color = Vec3::new(rng.f(), rng.f(), rng.f()) * 2.0;
+        }
         m.diffuse_roughness = if rough && rng.chance(0.5) {
             rng.f()
         } else {

@@ -529,8 +529,9 @@ fn khr_transmission_ior_specular_and_emissive_strength_are_read() {
     assert_eq!(m.transmission, 0.7);
     assert_eq!(m.ior, 1.33);
     let f0 = ((1.33_f32 - 1.0) / (1.33 + 1.0)).powi(2);
-    let want = 12.5 * f0 * 0.5 * 0.8;
+    let want = 12.5 * f0 * 0.5;
     assert!((m.specular - want).abs() < 1e-6, "{} vs {want}", m.specular);
+    assert_eq!(m.specular_color, Vec3::new(0.2, 0.4, 0.8));
     assert_eq!(m.emission, Vec3::new(3.0, 1.5, 0.75));
     let t = m.textures;
     assert_eq!((t.transmission, t.specular, t.specular_color), (0, 0, 1));
@@ -1252,8 +1253,8 @@ fn constant_textures_render_like_factors() {
 
 /// Constant KHR transmission, specular and specular color textures render the image of the
 /// equivalent factors (same seed, 4 spp, 2 bounces): a floor of two quads, one transmitting
-/// (factor 1 × R 153 = 0.6), one with `specular` = 0.5 × A 77 × the largest decoded channel
-/// of the sRGB color (230, 180, 120), under an emitter. The factor scene's values are the CPU
+/// (factor 1 × R 153 = 0.6), one with `specular` = 0.5 × A 77 and `specular_color` the
+/// decoded sRGB color (230, 180, 120), under an emitter. The factor scene's values are the CPU
 /// decode of the same texels. Difference allowed: 1e-4 relative per channel, as for the
 /// metallic-roughness and emissive textures (f32 rounding of the GPU's unorm decode and
 /// products against the CPU's). The same scene with the textures left out differs by more
@@ -1315,8 +1316,9 @@ fn constant_transmission_and_specular_textures_render_like_factors() {
     renders_like_factors(dir.path(), [&textured, &factors, &ignored], |f| {
         // The factor scene has what the CPU expects.
         let f0 = ((1.5_f32 - 1.0) / (1.5 + 1.0)).powi(2);
-        let want = 12.5 * f0 * u(sp[3]) * d[0];
+        let want = 12.5 * f0 * u(sp[3]);
         assert!((f.materials[1].specular - want).abs() < 1e-6 * want);
+        assert_eq!(f.materials[1].specular_color, d);
         assert_eq!(f.materials[0].transmission, 0.6);
     });
 }

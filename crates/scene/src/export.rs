@@ -66,6 +66,8 @@ struct MaterialOut {
     metallic: f32,
     specular: f32,
     specular_tint: f32,
+    /// Colour of the dielectric specular at normal incidence (white: none).
+    specular_color: [f32; 3],
     transmission: f32,
     /// Clear coat weight and roughness (0: none).
     clearcoat: f32,
@@ -220,6 +222,7 @@ fn material_out(m: &crate::scene::Material) -> MaterialOut {
         metallic: m.metallic,
         specular: m.specular,
         specular_tint: m.specular_tint,
+        specular_color: m.specular_color.to_array(),
         transmission: m.transmission,
         clearcoat: m.clearcoat,
         clearcoat_roughness: m.clearcoat_roughness,

@@ -147,6 +147,10 @@ pub struct MaterialDesc {
     pub specular: f32,
     /// Tints the dielectric specular towards the base color, in [0, 1]. Default 0.
     pub specular_tint: f32,
+    /// Colour of the dielectric specular at normal incidence (glTF's
+    /// `specularColorFactor`), linear RGB, ≥ 0: it multiplies F0 (clamped to 1) and leaves
+    /// the grazing reflection white. Default white.
+    pub specular_color: V3,
     /// Fraction of the dielectric lobe that is transmitted (glass), in [0, 1]. Default 0.
     pub transmission: f32,
     /// Weight in [0, 1] of a clear coat on top (glTF `KHR_materials_clearcoat`): a
@@ -239,6 +243,7 @@ impl Default for MaterialDesc {
             multiscatter: true,
             specular: 0.5,
             specular_tint: 0.0,
+            specular_color: [1.0; 3],
             transmission: 0.0,
             clearcoat: 0.0,
             clearcoat_roughness: 0.0,

@@ -147,6 +147,7 @@ impl From<&Material> for GpuMaterial {
             tex_coat: tex16(m.textures.clearcoat) | (tex16(m.textures.clearcoat_roughness) << 16),
             tex_sheen: tex16(m.textures.sheen_color) | (tex16(m.textures.sheen_roughness) << 16),
             sheen_color: m.sheen_color.to_array(),
+            specular_color: m.specular_color.to_array(),
             sheen_roughness: m.sheen_roughness,
             clearcoat: m.clearcoat,
             clearcoat_roughness: m.clearcoat_roughness,

@@ -169,7 +169,7 @@ pub struct GpuSphere {
     pub pad1: u32,
 }
 
-/// A material, 192 bytes (twelve vec4s). Texture ids index the scene's textures (see
+/// A material, 208 bytes (thirteen vec4s). Texture ids index the scene's textures (see
 /// [`crate::texture::pack_atlas`]), 16 bits each, 0xFFFF = none; each texture multiplies
 /// its factor.
 #[repr(C)]
@@ -248,6 +248,11 @@ pub struct GpuMaterial {
     pub pad6: u32,
     /// Padding (offset 188).
     pub pad7: u32,
+    /// Colour of the dielectric specular at normal incidence: multiplies F0, not the
+    /// grazing reflectance (offset 192).
+    pub specular_color: [f32; 3],
+    /// Padding (offset 204).
+    pub pad8: u32,
 }
 
 /// A triangle's texture coordinates, tangents and vertex colours, 112 bytes, same index as

@@ -322,6 +322,7 @@ fn material_from_desc(name: &str, d: &MaterialDesc) -> Result<Material, SceneErr
         metallic: unit_range("metallic", metallic)?,
         specular: unit_range("specular", d.specular)?,
         specular_tint: unit_range("specular_tint", d.specular_tint)?,
+        specular_color: non_negative3("specular_color", d.specular_color)?,
         transmission: unit_range("transmission", d.transmission)?,
         clearcoat: unit_range("clearcoat", d.clearcoat)?,
         clearcoat_roughness: unit_range("clearcoat_roughness", d.clearcoat_roughness)?,

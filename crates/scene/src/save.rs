@@ -264,6 +264,11 @@ fn material_value(m: &MaterialDesc) -> Val {
             ),
             given("specular", num(m.specular), &num(d.specular)),
             given("specular_tint", num(m.specular_tint), &num(d.specular_tint)),
+            given(
+                "specular_color",
+                vec3(m.specular_color),
+                &vec3(d.specular_color),
+            ),
             given("transmission", num(m.transmission), &num(d.transmission)),
             given("clearcoat", num(m.clearcoat), &num(d.clearcoat)),
             given(

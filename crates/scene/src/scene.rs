@@ -116,6 +116,10 @@ pub struct Material {
     pub specular: f32,
     /// Tint of the dielectric specular towards the base color.
     pub specular_tint: f32,
+    /// Colour of the dielectric specular at normal incidence (glTF
+    /// `KHR_materials_specular`'s `specularColorFactor`), linear RGB: it multiplies F0 (the
+    /// product clamped to 1) and leaves the grazing reflectance as it is. White: none.
+    pub specular_color: Vec3,
     /// Transmitted fraction of the dielectric lobe.
     pub transmission: f32,
     /// Weight in [0, 1] of a clear coat on top of the material (glTF
@@ -217,6 +221,7 @@ impl Material {
             metallic: 0.0,
             specular: 0.5,
             specular_tint: 0.0,
+            specular_color: Vec3::ONE,
             transmission: 0.0,
             clearcoat: 0.0,
             clearcoat_roughness: 0.0,

@@ -108,16 +108,17 @@ fn extensions_and_attributes_not_read_are_warnings_naming_their_users() {
               "KHR_materials_sheen": {"sheenColorFactor": [1, 0, 0], "sheenRoughnessFactor": 0.25},
               "KHR_materials_clearcoat": {"clearcoatFactor": 0.75, "clearcoatRoughnessFactor": 0.5,
                                           "clearcoatNormalTexture": {"index": 0}},
-              "KHR_materials_specular": {"specularColorFactor": [1, 0.5, 0]}
+              "KHR_materials_specular": {"specularColorFactor": [1, 0.5, 0]},
+              "KHR_materials_volume": {"thicknessFactor": 0.1}
             }}"#,
         r#", "COLOR_0": 0, "COLOR_1": 0"#,
-        r#""extensionsUsed": ["KHR_materials_sheen", "KHR_materials_clearcoat", "KHR_materials_specular", "KHR_materials_anisotropy"],"#,
+        r#""extensionsUsed": ["KHR_materials_sheen", "KHR_materials_clearcoat", "KHR_materials_specular", "KHR_materials_volume", "KHR_materials_anisotropy"],"#,
     );
     let (_dir, path) = write("Velvet.gltf", &text);
     let m = import_mesh(&path, Mat4::IDENTITY).unwrap();
     let w = m.report.warnings.join("\n");
     println!("{w}");
-    // Clear coat and sheen are read, all but the coat's normal texture.
+    // Clear coat, sheen and specular colour are read, all but the coat's normal texture.
     let v = &m.materials[0];
     assert_eq!(
         (
@@ -128,11 +129,14 @@ fn extensions_and_attributes_not_read_are_warnings_naming_their_users() {
         ),
         (0.75, 0.5, glam::Vec3::X, 0.25)
     );
+    // The specular colour is read as it is.
+    assert_eq!(v.specular_color, glam::Vec3::new(1.0, 0.5, 0.0));
+    assert!(!w.contains("KHR_materials_specular"), "{w}");
     assert!(!w.contains("KHR_materials_sheen"), "{w}");
     assert!(!w.contains("KHR_materials_clearcoat"), "{w}");
     for want in [
         "material velvet: clearcoatNormalTexture is not read (the clear coat takes the base's shading normal)",
-        "Velvet.gltf: KHR_materials_specular is read in part (used by \"velvet\"): the specular colour is reduced",
+        "Velvet.gltf: KHR_materials_volume is read in part (used by \"velvet\"): the thickness is not used",
         "Velvet.gltf: KHR_materials_anisotropy is not read: materials render with isotropic roughness",
         "Velvet.gltf: the vertex attribute COLOR_1 is not read (1 primitives): only COLOR_0",
     ] {

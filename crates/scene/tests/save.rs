@@ -410,7 +410,7 @@ const CONDUCTORS: [&str; 3] = ["Au", "Cu", "q\"x"];
 fn random_material(rng: &mut common::Pcg, m: &mut MaterialDesc) {
     let d = MaterialDesc::default();
     for _ in 0..1 + rng.next_u32() % 3 {
-        match rng.next_u32() % 13 {
+        match rng.next_u32() % 16 {
             0 => m.base_color = vec3(rng, d.base_color),
             1 => m.emission = vec3(rng, d.emission),
             2 => m.roughness = float(rng, d.roughness),
@@ -423,6 +423,9 @@ fn random_material(rng: &mut common::Pcg, m: &mut MaterialDesc) {
             9 => m.specular_tint = float(rng, d.specular_tint),
             10 => m.transmission = float(rng, d.transmission),
             11 => m.ior = float(rng, d.ior),
+            12 => m.specular_color = vec3(rng, d.specular_color),
+            13 => m.clearcoat = float(rng, 1.0),
+            14 => m.sheen_color = vec3(rng, [0.5, 0.2, 0.1]),
             _ => m.two_sided = !m.two_sided,
         }
     }

@@ -118,7 +118,9 @@ fn material_layout() -> (&'static str, usize, Vec<(&'static str, usize)>) {
             clearcoat,
             clearcoat_roughness,
             pad6,
-            pad7
+            pad7,
+            specular_color,
+            pad8
         ]
     )
 }

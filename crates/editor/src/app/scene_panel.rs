@@ -623,6 +623,15 @@ fn material(ui: &mut Ui, name: &str, m: &mut MaterialDesc) {
             });
             row(
                 ui,
+                "specular colour",
+                "multiplies F0 (to at most 1), not the grazing reflection; white: none",
+                |ui, _| {
+                    // Up to 25: F0 = 0.04 × 25 = 1 at the default strength.
+                    colour(ui, &mut m.specular_color, 25.0);
+                },
+            );
+            row(
+                ui,
                 "transmission",
                 "transmitted fraction of the dielectric lobe",
                 |ui, l| {

@@ -227,10 +227,10 @@ fn table_fns(name: &str, ty: &str, types: &[&str], rows: &[Vec<String>]) -> Stri
 
 /// The WGSL types of [`materials_rows`]'s fields, in order (`Material` in
 /// `pathtrace/scene_types.wgsl`).
-const MATERIAL_TYPES: [&str; 32] = [
+const MATERIAL_TYPES: [&str; 34] = [
     "vec3f", "f32", "vec3f", "f32", "f32", "f32", "f32", "f32", "u32", "u32", "u32", "f32", "u32",
     "u32", "f32", "f32", "vec3f", "f32", "vec3f", "u32", "vec3f", "u32", "vec3f", "f32", "vec3f",
-    "u32", "vec3f", "f32", "f32", "f32", "u32", "u32",
+    "u32", "vec3f", "f32", "f32", "f32", "u32", "u32", "vec3f", "u32",
 ];
 
 /// Every material as WGSL literals, field by field.
@@ -271,6 +271,8 @@ fn materials_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
                 l.f(m.clearcoat),
                 l.f(m.clearcoat_roughness),
                 u(0),
+                u(0),
+                l.v3(m.specular_color),
                 u(0),
             ]
         })

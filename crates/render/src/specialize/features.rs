@@ -349,16 +349,9 @@ fn material_ranges(scene: &GpuScene, index: usize, m: &GpuMaterial) -> MaterialR
             Range::of(factor).times(a, b)
         }
     };
-    let mut specular = textured(m.specular, hi(m.tex_transmission_specular), 3);
-    let color = lo(m.tex_specular_color);
-    if color != 0xFFFF {
-        // The specular color texture multiplies by its largest channel (sRGB decoded, which
-        // keeps 0 and 1 and is monotonic): within [0, largest channel's largest texel].
-        let top = (0..3)
-            .map(|c| channel_range(scene, color, c).1)
-            .fold(0.0f32, f32::max);
-        specular = specular.times(0.0, top);
-    }
+    // The specular colour (factor and texture) colours F0 only: the grazing reflection of a
+    // material with specular > 0 is there whatever the colour.
+    let specular = textured(m.specular, hi(m.tex_transmission_specular), 3);
     let vertex_alpha =
         |i: usize| f32::from(scene.vertex_alpha_min.get(i).copied().unwrap_or(0)) / 255.0;
     MaterialRanges {

@@ -984,22 +984,19 @@ impl<'a> Decoder<'a> {
     }
 }
 
-/// `KHR_materials_specular` (and `KHR_materials_ior`) on the material model's dielectric
-/// specular: glTF's F0 is `((ior − 1)/(ior + 1))² · specularColor · specular` and ours
-/// `0.08 · specular`, so `specular = 12.5 · ((ior − 1)/(ior + 1))² · specularFactor ·
-/// max(specularColorFactor)`; the color's hue is not kept (`specular_tint` tints towards
-/// the base color only). With neither extension and ior 1.5 this is the default 0.5.
-pub fn gltf_specular(ior: f32, specular_factor: f32, specular_color: [f32; 3]) -> f32 {
+/// `KHR_materials_specular`'s strength (and `KHR_materials_ior`) on the material model's
+/// dielectric specular: glTF's F0 is `((ior − 1)/(ior + 1))² · specularColor ·
+/// specular` and ours `0.08 · specular · specular_color`, so `specular = 12.5 · ((ior −
+/// 1)/(ior + 1))² · specularFactor` and the colour goes to `specular_color` as it is. With
+/// neither extension and ior 1.5 this is the default 0.5.
+pub fn gltf_specular(ior: f32, specular_factor: f32) -> f32 {
     // Exactly 0.5 at the default ior, as before the extensions were read.
     let layer = if ior == 1.5 {
         0.5
     } else {
         12.5 * ((ior - 1.0) / (ior + 1.0)).powi(2)
     };
-    let color = specular_color[0]
-        .max(specular_color[1])
-        .max(specular_color[2]);
-    layer * specular_factor * color
+    layer * specular_factor
 }
 
 /// `KHR_materials_diffuse_roughness` (read from the raw extension JSON):
@@ -1151,7 +1148,7 @@ fn material<'a>(
     let specular_tex = tex(specular_ext
         .as_ref()
         .and_then(::gltf::material::Specular::specular_texture))?;
-    let specular_color = tex(specular_ext
+    let specular_color_tex = tex(specular_ext
         .as_ref()
         .and_then(::gltf::material::Specular::specular_color_texture))?;
     let normal_info = m.normal_texture();
@@ -1167,10 +1164,15 @@ fn material<'a>(
         None => NO_TEXTURE,
     };
     let ior = m.ior().unwrap_or(1.5);
-    let specular = specular_ext.as_ref().map_or_else(
-        || gltf_specular(ior, 1.0, [1.0; 3]),
-        |s| gltf_specular(ior, s.specular_factor(), s.specular_color_factor()),
+    let specular = gltf_specular(
+        ior,
+        specular_ext
+            .as_ref()
+            .map_or(1.0, ::gltf::material::Specular::specular_factor),
     );
+    let specular_color = specular_ext
+        .as_ref()
+        .map_or(Vec3::ONE, |s| Vec3::from(s.specular_color_factor()));
     let mut out = Material {
         name: material_name(m),
         base_color: Vec3::new(r, g, b),
@@ -1180,6 +1182,7 @@ fn material<'a>(
         metallic: pbr.metallic_factor(),
         specular,
         specular_tint: 0.0,
+        specular_color,
         transmission: transmission_ext.map_or(0.0, |t| t.transmission_factor()),
         ior,
         two_sided: m.double_sided(),
@@ -1190,7 +1193,7 @@ fn material<'a>(
             normal,
             transmission,
             specular: specular_tex,
-            specular_color,
+            specular_color: specular_color_tex,
             ..MaterialTextures::default()
         },
         normal_scale: normal_info.map_or(1.0, |n| n.scale()),

@@ -21,6 +21,7 @@ const READ: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_clearcoat",
     "KHR_materials_sheen",
+    "KHR_materials_specular",
     "KHR_materials_ior",
     "KHR_materials_transmission",
     "KHR_materials_diffuse_roughness",
@@ -33,16 +34,10 @@ const READ: &[&str] = &[
 const NOTHING_TO_RENDER: &[&str] = &["KHR_xmp", "KHR_xmp_json_ld"];
 
 /// Extensions read in part, with what is not read.
-const PARTLY_READ: &[(&str, &str)] = &[
-    (
-        "KHR_materials_specular",
-        "the specular colour is reduced to its largest channel (a strength)",
-    ),
-    (
-        "KHR_materials_volume",
-        "the thickness is not used: the mesh itself is the volume",
-    ),
-];
+const PARTLY_READ: &[(&str, &str)] = &[(
+    "KHR_materials_volume",
+    "the thickness is not used: the mesh itself is the volume",
+)];
 
 /// Extensions not read, with what a render of a file that uses them lacks.
 const NOT_READ: &[(&str, &str)] = &[
