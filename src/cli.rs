@@ -412,7 +412,9 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
         return Ok(done);
     }
     let left_out = plan.left_out.clone();
+    let built = std::time::Instant::now();
     let mut exec = Executor::with_library(&ctx, plan, &resources, args.library)?;
+    progressive::print_built(built);
     for (node, note) in exec.notes() {
         println!("{node}: {note}");
     }

@@ -86,6 +86,16 @@ pub(super) fn on_signal(then: &'static str) {
     }
 }
 
+/// Prints how long building the executor took since `start`: its pipelines (a CPU adapter
+/// spends seconds on each of the path tracer's; Mesa's shader cache does not keep them) and
+/// its nodes' uploads.
+pub(super) fn print_built(start: Instant) {
+    println!(
+        "pipelines and uploads: {:.0} ms",
+        start.elapsed().as_secs_f64() * 1e3
+    );
+}
+
 /// Warms `exec` up and prints how long it took: drivers compile pipelines at their first
 /// dispatch, and that is kept out of the timed frames.
 pub(super) fn warm_up(exec: &mut Executor) -> Result<()> {

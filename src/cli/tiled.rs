@@ -73,7 +73,9 @@ pub(super) fn render_if_needed(
     let window_plan = args
         .library
         .compile_window(graph, &[], Some(&scene.gpu), tiling.window)?;
+    let built = std::time::Instant::now();
     let mut exec = Executor::with_library(ctx, window_plan, resources, args.library)?;
+    super::progressive::print_built(built);
     for (node, note) in exec.notes() {
         println!("{node}: {note}");
     }
