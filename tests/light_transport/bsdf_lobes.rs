@@ -163,6 +163,17 @@ pub(super) fn wo(theta_o: f64) -> Vec3 {
     )
 }
 
+/// A fixed stream of numbers in [0, 1] (xorshift32), the same in every test that takes it.
+pub(super) fn uniform_stream() -> impl FnMut() -> f64 {
+    let mut state = 0x2545_f491_u32;
+    move || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        f64::from(state) / f64::from(u32::MAX)
+    }
+}
+
 pub(super) fn dir(theta: f64, phi: f64) -> DVec3 {
     DVec3::new(
         theta.sin() * phi.cos(),

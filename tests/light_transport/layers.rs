@@ -29,7 +29,7 @@ use lumagraph::scene::{GpuMaterial, Material};
 
 use super::bsdf_lobes::{
     Case, at_four_angles, chi_square_against_eval, dir, directional_albedo, ggx_d, gold, material,
-    reciprocity, smith_g2, weights_against_eval, wo,
+    reciprocity, smith_g2, uniform_stream, weights_against_eval, wo,
 };
 use crate::common;
 
@@ -115,13 +115,7 @@ fn layer_sample_weights_are_f_cos_over_pdf() {
 
 /// Random directions of the upper hemisphere (uniform), from a fixed xorshift stream.
 pub(super) fn hemisphere(n: usize) -> Vec<Vec3> {
-    let mut state = 0x2545_f491_u32;
-    let mut rand = move || {
-        state ^= state << 13;
-        state ^= state >> 17;
-        state ^= state << 5;
-        f64::from(state) / f64::from(u32::MAX)
-    };
+    let mut rand = uniform_stream();
     (0..n)
         .map(|_| dir(rand().acos(), std::f64::consts::TAU * rand()).as_vec3())
         .collect()

@@ -122,13 +122,7 @@ fn eon_material(rd: f32) -> Material {
 fn the_shader_evaluates_the_model() {
     let Some(ctx) = common::gpu() else { return };
     let check = BsdfCheck::new(ctx).unwrap();
-    let mut state = 0x2545_f491_u32;
-    let mut rand = move || {
-        state ^= state << 13;
-        state ^= state >> 17;
-        state ^= state << 5;
-        f64::from(state) / f64::from(u32::MAX)
-    };
+    let mut rand = super::bsdf_lobes::uniform_stream();
     let mut worst = (0.0_f64, String::new());
     for rd in [0.25_f32, 0.5, 1.0] {
         let m = eon_material(rd);

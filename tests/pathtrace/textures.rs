@@ -1265,55 +1265,28 @@ fn constant_transmission_and_specular_textures_render_like_factors() {
     let tr = [153, 0, 0, 255];
     let sp = [0, 0, 0, 77];
     let sc = [230, 180, 120, 255];
-    let quads = two_materials_under_a_light();
     let base = r#""pbrMetallicRoughness":{"baseColorFactor":[0.8,0.6,0.5,1],"metallicFactor":0,"roughnessFactor":0.3}"#;
-    let light_m = r#"{"emissiveFactor":[1,0.9,0.7],"extensions":{"KHR_materials_emissive_strength":{"emissiveStrength":4}},"doubleSided":true}"#;
-    let textured = Gltf {
-        images: vec![Img::constant(tr), Img::constant(sp), Img::constant(sc)],
-        materials: vec![
-            format!(
-                r#"{{{base},"extensions":{{"KHR_materials_transmission":{{"transmissionFactor":1,"transmissionTexture":{{"index":0}}}}}}}}"#
-            ),
-            format!(
-                r#"{{{base},"extensions":{{"KHR_materials_specular":{{"specularFactor":1,"specularColorFactor":[1,1,1],"specularTexture":{{"index":1}},"specularColorTexture":{{"index":2}}}}}}}}"#
-            ),
-            light_m.into(),
-        ],
-        quads: quads.clone(),
-    };
     let u = |b: u8| f32::from(b) / 255.0;
     let d = [sc[0], sc[1], sc[2]].map(|b| srgb_decode(u(b)));
-    let factors = Gltf {
-        images: Vec::new(),
-        materials: vec![
-            format!(
-                r#"{{{base},"extensions":{{"KHR_materials_transmission":{{"transmissionFactor":{:?}}}}}}}"#,
-                u(tr[0])
-            ),
-            format!(
-                r#"{{{base},"extensions":{{"KHR_materials_specular":{{"specularFactor":{:?},"specularColorFactor":[{:?},{:?},{:?}]}}}}}}"#,
-                u(sp[3]),
-                d[0],
-                d[1],
-                d[2]
-            ),
-            light_m.into(),
-        ],
-        quads: quads.clone(),
+    let transmission = Ways {
+        textured: r#"{"KHR_materials_transmission":{"transmissionFactor":1,"transmissionTexture":{"index":0}}}"#.into(),
+        factors: format!(r#"{{"KHR_materials_transmission":{{"transmissionFactor":{:?}}}}}"#, u(tr[0])),
+        ignored: r#"{"KHR_materials_transmission":{"transmissionFactor":1}}"#.into(),
     };
-    // The textured materials without their textures: transmission 1, specular 0.5.
-    let ignored = Gltf {
-        images: Vec::new(),
-        materials: vec![
-            format!(
-                r#"{{{base},"extensions":{{"KHR_materials_transmission":{{"transmissionFactor":1}}}}}}"#
-            ),
-            format!(r#"{{{base}}}"#),
-            light_m.into(),
-        ],
-        quads,
+    let specular = Ways {
+        textured: r#"{"KHR_materials_specular":{"specularFactor":1,"specularColorFactor":[1,1,1],"specularTexture":{"index":1},"specularColorTexture":{"index":2}}}"#.into(),
+        factors: format!(
+            r#"{{"KHR_materials_specular":{{"specularFactor":{:?},"specularColorFactor":[{:?},{:?},{:?}]}}}}"#,
+            u(sp[3]),
+            d[0],
+            d[1],
+            d[2]
+        ),
+        // Specular 0.5, white.
+        ignored: "{}".into(),
     };
-    renders_like_factors(dir.path(), [&textured, &factors, &ignored], |f| {
+    let images = vec![Img::constant(tr), Img::constant(sp), Img::constant(sc)];
+    renders_like_factors(dir.path(), base, images, &[transmission, specular], |f| {
         // The factor scene has what the CPU expects.
         let f0 = ((1.5_f32 - 1.0) / (1.5 + 1.0)).powi(2);
         let want = 12.5 * f0 * u(sp[3]);
@@ -1323,20 +1296,42 @@ fn constant_transmission_and_specular_textures_render_like_factors() {
     });
 }
 
-/// The scenes of `textured`, `factors` and `ignored` (the textured materials without their
-/// textures), seen from above the floor at 32×32 with 4 spp: after `check` has looked at the
-/// factor scene, the textured render equals the factors' within 1e-4 relative per channel,
-/// and the one without textures differs by more than 1e-2.
+/// One material of [`renders_like_factors`]'s floor, as the `extensions` object of a glTF
+/// material: with its textures, with the factors they equal, and with the textures left out.
+struct Ways {
+    textured: String,
+    factors: String,
+    ignored: String,
+}
+
+/// The floor of [`two_materials_under_a_light`], its two materials `base` (the
+/// `pbrMetallicRoughness` member) with the extensions of `ways` (textures from `images`),
+/// three times: textured, with the factors, and without the textures, seen from above at
+/// 32×32 with 4 spp. After `check` has looked at the factor scene, the textured render
+/// equals the factors' within 1e-4 relative per channel, and the one without textures
+/// differs by more than 1e-2.
 fn renders_like_factors(
     dir: &Path,
-    [textured, factors, ignored]: [&Gltf; 3],
+    base: &str,
+    images: Vec<Img>,
+    ways: &[Ways; 2],
     check: impl FnOnce(&GpuScene),
 ) {
+    let light = r#"{"emissiveFactor":[1,0.9,0.7],"extensions":{"KHR_materials_emissive_strength":{"emissiveStrength":4}},"doubleSided":true}"#;
+    let gltf = |images: Vec<Img>, ext: fn(&Ways) -> &String| Gltf {
+        images,
+        materials: vec![
+            format!(r#"{{{base},"extensions":{}}}"#, ext(&ways[0])),
+            format!(r#"{{{base},"extensions":{}}}"#, ext(&ways[1])),
+            light.into(),
+        ],
+        quads: two_materials_under_a_light(),
+    };
     let eye = Vec3::new(0.0, -2.5, 1.6);
-    let scene = |name, g| flat_scene(dir, name, g, eye, (32, 32));
-    let t = scene("textured", textured);
-    let f = scene("factors", factors);
-    let n = scene("ignored", ignored);
+    let scene = |name, g| flat_scene(dir, name, &g, eye, (32, 32));
+    let t = scene("textured", gltf(images, |w| &w.textured));
+    let f = scene("factors", gltf(Vec::new(), |w| &w.factors));
+    let n = scene("ignored", gltf(Vec::new(), |w| &w.ignored));
     check(&f);
     let (Some(t), Some(f), Some(n)) = (color(t, 4), color(f, 4), color(n, 4)) else {
         return;
@@ -1383,57 +1378,31 @@ fn constant_clear_coat_and_sheen_textures_render_like_factors() {
     let dir = temp();
     let cc = [140, 90, 0, 255];
     let sh = [200, 120, 60, 128];
-    let quads = two_materials_under_a_light();
     let base = r#""pbrMetallicRoughness":{"baseColorFactor":[0.3,0.2,0.5,1],"metallicFactor":0,"roughnessFactor":0.6}"#;
-    let light_m = r#"{"emissiveFactor":[1,0.9,0.7],"extensions":{"KHR_materials_emissive_strength":{"emissiveStrength":4}},"doubleSided":true}"#;
-    let textured = Gltf {
-        images: vec![Img::constant(cc), Img::constant(sh)],
-        materials: vec![
-            format!(
-                r#"{{{base},"extensions":{{"KHR_materials_clearcoat":{{"clearcoatFactor":1,"clearcoatRoughnessFactor":1,"clearcoatTexture":{{"index":0}},"clearcoatRoughnessTexture":{{"index":0}}}}}}}}"#
-            ),
-            format!(
-                r#"{{{base},"extensions":{{"KHR_materials_sheen":{{"sheenColorFactor":[1,1,1],"sheenRoughnessFactor":1,"sheenColorTexture":{{"index":1}},"sheenRoughnessTexture":{{"index":1}}}}}}}}"#
-            ),
-            light_m.into(),
-        ],
-        quads: quads.clone(),
-    };
     let u = |b: u8| f32::from(b) / 255.0;
     let d = [sh[0], sh[1], sh[2]].map(|b| srgb_decode(u(b)));
-    let factors = Gltf {
-        images: Vec::new(),
-        materials: vec![
-            format!(
-                r#"{{{base},"extensions":{{"KHR_materials_clearcoat":{{"clearcoatFactor":{:?},"clearcoatRoughnessFactor":{:?}}}}}}}"#,
-                u(cc[0]),
-                u(cc[1])
-            ),
-            format!(
-                r#"{{{base},"extensions":{{"KHR_materials_sheen":{{"sheenColorFactor":[{:?},{:?},{:?}],"sheenRoughnessFactor":{:?}}}}}}}"#,
-                d[0],
-                d[1],
-                d[2],
-                u(sh[3])
-            ),
-            light_m.into(),
-        ],
-        quads: quads.clone(),
+    let coat = Ways {
+        textured: r#"{"KHR_materials_clearcoat":{"clearcoatFactor":1,"clearcoatRoughnessFactor":1,"clearcoatTexture":{"index":0},"clearcoatRoughnessTexture":{"index":0}}}"#.into(),
+        factors: format!(
+            r#"{{"KHR_materials_clearcoat":{{"clearcoatFactor":{:?},"clearcoatRoughnessFactor":{:?}}}}}"#,
+            u(cc[0]),
+            u(cc[1])
+        ),
+        ignored: r#"{"KHR_materials_clearcoat":{"clearcoatFactor":1,"clearcoatRoughnessFactor":1}}"#.into(),
     };
-    let ignored = Gltf {
-        images: Vec::new(),
-        materials: vec![
-            format!(
-                r#"{{{base},"extensions":{{"KHR_materials_clearcoat":{{"clearcoatFactor":1,"clearcoatRoughnessFactor":1}}}}}}"#
-            ),
-            format!(
-                r#"{{{base},"extensions":{{"KHR_materials_sheen":{{"sheenColorFactor":[1,1,1],"sheenRoughnessFactor":1}}}}}}"#
-            ),
-            light_m.into(),
-        ],
-        quads,
+    let sheen = Ways {
+        textured: r#"{"KHR_materials_sheen":{"sheenColorFactor":[1,1,1],"sheenRoughnessFactor":1,"sheenColorTexture":{"index":1},"sheenRoughnessTexture":{"index":1}}}"#.into(),
+        factors: format!(
+            r#"{{"KHR_materials_sheen":{{"sheenColorFactor":[{:?},{:?},{:?}],"sheenRoughnessFactor":{:?}}}}}"#,
+            d[0],
+            d[1],
+            d[2],
+            u(sh[3])
+        ),
+        ignored: r#"{"KHR_materials_sheen":{"sheenColorFactor":[1,1,1],"sheenRoughnessFactor":1}}"#.into(),
     };
-    renders_like_factors(dir.path(), [&textured, &factors, &ignored], |f| {
+    let images = vec![Img::constant(cc), Img::constant(sh)];
+    renders_like_factors(dir.path(), base, images, &[coat, sheen], |f| {
         assert_eq!(f.materials[0].clearcoat, u(cc[0]));
         assert_eq!(f.materials[1].sheen_roughness, u(sh[3]));
     });
