@@ -271,19 +271,26 @@ fn sample_glass(m: Material, lp: LobeParams, wo: vec3f, u: vec3f) -> BsdfSample 
     return BsdfSample(normalize(vec3f(wi.xy, wi.z * s)), weight, 0.0, true);
 }
 
-// A sample of the three lobes. Its non-delta samples are weighted by the whole BSDF
-// (`eval_bsdf`, layers included), as one-sample MIS over every lobe asks, except where no
-// microfacet code is compiled in (!HAS_SPECULAR && !HAS_METAL): there they carry the
+// A sample of the three lobes. Its non-delta samples are to be weighted by the whole BSDF
+// (`eval_bsdf`, layers included), as one-sample MIS over every lobe asks: for these it
+// gives only the direction, with `eval` set, and `sample_bsdf` evaluates it (one call of
+// `eval_bsdf` in the code for every way of sampling: a driver inlines each call). Where no
+// microfacet code is compiled in (!HAS_SPECULAR && !HAS_METAL), the samples carry the
 // diffuse base's own weight, and `sample_bsdf` weights them again over the layers.
-fn sample_base(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
+struct BaseSample {
+    s: BsdfSample,
+    eval: bool,
+}
+
+fn sample_base(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BaseSample {
     var out = BsdfSample(vec3f(0.0, 0.0, 1.0), vec3f(0.0), 0.0, false);
     let w = lobe_weights(m);
     let lp = lobe_params(m);
     if HAS_GLASS && u_lobe < w.z {
-        return sample_glass(m, lp, wo, u);
+        return BaseSample(sample_glass(m, lp, wo, u), false);
     }
     if wo.z <= 0.0 {
-        return out;
+        return BaseSample(out, false);
     }
     if !HAS_SPECULAR && !HAS_METAL {
         if rough_diffuse(m) {
@@ -294,14 +301,14 @@ fn sample_base(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
             out.weight = eon_f(m.base_color, r, wo, wi) * (wi.z / pdf) * (w.x / max(1.0 - w.z, 1e-6));
             out.pdf = w.x * pdf;
             out.valid = wi.z > 0.0 && pdf > 0.0;
-            return out;
+            return BaseSample(out, false);
         }
         // Lambertian: f cos / pdf = base_color for the dielectric share of the material.
         out.wi = sample_cosine(vec3f(0.0, 0.0, 1.0), u.xy);
         out.weight = m.base_color * (w.x / max(1.0 - w.z, 1e-6));
         out.pdf = w.x * out.wi.z * INV_PI;
         out.valid = out.wi.z > 0.0;
-        return out;
+        return BaseSample(out, false);
     }
     let to = ggx_albedo(wo.z, lp.roughness);
     // Choose a sub-lobe: mirror-like (GGX or perfect mirror) or diffuse-like (cosine).
@@ -324,7 +331,7 @@ fn sample_base(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
         let fresnel = select(metal_fresnel(m, wo.z), fresnel_at(layer_fresnel, wo.z), layer);
         out.weight = p_lobe * fresnel / p_mirror;
         out.valid = true;
-        return out;
+        return BaseSample(out, false);
     }
     var wi: vec3f;
     if mirror {
@@ -335,7 +342,8 @@ fn sample_base(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     } else {
         wi = sample_cosine(vec3f(0.0, 0.0, 1.0), u.xy);
     }
-    return sampled_by_eval(m, wo, wi);
+    out.wi = wi;
+    return BaseSample(out, true);
 }
 
 // A non-delta sample towards wi: weighted by the whole BSDF's f * cos over its pdf
@@ -407,34 +415,42 @@ fn eval_bsdf(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
 // A sample of the whole BSDF: the coat, the sheen or the three lobes, chosen by u_lobe with
 // the layers' probabilities (`layers`), the rest of u_lobe choosing among the lobes.
 fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
-    if !(HAS_COAT || HAS_SHEEN) || wo.z <= 0.0 {
-        return sample_base(m, wo, u_lobe, u);
+    var l = Layers(CoatParams(0.0, ggx_lobe(0.0)), 0.0, 1.0, 0.0);
+    if (HAS_COAT || HAS_SHEEN) && !(wo.z <= 0.0) {
+        l = layers(m, wo.z);
     }
-    let l = layers(m, wo.z);
-    if l.p_coat == 0.0 && l.p_sheen == 0.0 {
-        return sample_base(m, wo, u_lobe, u);
-    }
+    let layered = l.p_coat != 0.0 || l.p_sheen != 0.0;
     var wi: vec3f;
-    if u_lobe < l.p_coat {
-        wi = coat_sample(l.coat, wo, u.xy);
-        if l.coat.lobe.is_smooth {
-            // The mirror reflects clearcoat F(mu_o), the probability of choosing it.
-            return BsdfSample(wi, vec3f(1.0), 0.0, true);
-        }
-    } else {
-        let v = (u_lobe - l.p_coat) / max(1.0 - l.p_coat, 1e-7);
-        if v < l.p_sheen {
-            wi = sample_cosine(vec3f(0.0, 0.0, 1.0), u.xy);
-        } else {
-            let s = sample_base(m, wo, min((v - l.p_sheen) / max(1.0 - l.p_sheen, 1e-7), ONE_MINUS_EPSILON), u);
-            // A delta sample (mirror, glass) or none: the layers take from it exactly the
-            // probability of passing them. With the microfacet code compiled in, every
-            // other sample of the lobes is already weighted by the whole BSDF.
-            if !s.valid || s.pdf == 0.0 || HAS_SPECULAR || HAS_METAL {
-                return s;
+    var u_base = u_lobe;
+    var base = true;
+    if layered {
+        if u_lobe < l.p_coat {
+            base = false;
+            wi = coat_sample(l.coat, wo, u.xy);
+            if l.coat.lobe.is_smooth {
+                // The mirror reflects clearcoat F(mu_o), the probability of choosing it.
+                return BsdfSample(wi, vec3f(1.0), 0.0, true);
             }
-            wi = s.wi;
+        } else {
+            let v = (u_lobe - l.p_coat) / max(1.0 - l.p_coat, 1e-7);
+            if v < l.p_sheen {
+                base = false;
+                wi = sample_cosine(vec3f(0.0, 0.0, 1.0), u.xy);
+            } else {
+                u_base = min((v - l.p_sheen) / max(1.0 - l.p_sheen, 1e-7), ONE_MINUS_EPSILON);
+            }
         }
+    }
+    if base {
+        let b = sample_base(m, wo, u_base, u);
+        // A delta sample (mirror, glass) or none: the layers take from it exactly the
+        // probability of passing them. With the microfacet code compiled in, every other
+        // sample of the lobes is weighted by the whole BSDF (`eval`); without, the diffuse
+        // base's sample is weighted again here only under layers.
+        if !b.eval && (!layered || !b.s.valid || b.s.pdf == 0.0 || HAS_SPECULAR || HAS_METAL) {
+            return b.s;
+        }
+        wi = b.s.wi;
     }
     return sampled_by_eval(m, wo, wi);
 }
