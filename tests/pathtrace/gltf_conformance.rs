@@ -18,17 +18,44 @@ use lumagraph::render::{Executor, Resources, compile};
 use lumagraph::scene::{GpuScene, Scene, UvTransform, intersect};
 
 /// A scene around the model `rel` (under `assets/gltf-conformance/`), looked at from +z,
-/// framed on its bounding box, `w`×`h` pixels.
+/// framed on its bounding box, `w`×`h` pixels, in a white sky, 1 bounce, 1 spp.
 fn scene(rel: &str, w: u32, h: u32) -> Scene {
+    framed(rel, (w, h), &Look::default())
+}
+
+/// The sky and the render settings of [`framed`].
+struct Look {
+    /// The constant environment's radiance.
+    sky: f32,
+    bounces: u32,
+    spp: u32,
+}
+
+impl Default for Look {
+    fn default() -> Self {
+        Self {
+            sky: 1.0,
+            bounces: 1,
+            spp: 1,
+        }
+    }
+}
+
+/// [`scene`] with the sky and settings of `look`.
+fn framed(rel: &str, (w, h): (u32, u32), look: &Look) -> Scene {
     let dir = tempfile::tempdir().unwrap();
     let model = common::repo(&format!("assets/gltf-conformance/{rel}"));
+    let view = |eye: Vec3, target: Vec3| View {
+        eye,
+        target,
+        w,
+        h,
+        look,
+    };
     let probe = write_scene(
         dir.path(),
         &model,
-        Vec3::new(0.0, 0.0, 10.0),
-        Vec3::ZERO,
-        w,
-        h,
+        &view(Vec3::new(0.0, 0.0, 10.0), Vec3::ZERO),
     );
     let s = Scene::load(&probe).unwrap();
     let (lo, hi) = s.triangles.iter().flat_map(|t| t.positions).fold(
@@ -40,25 +67,38 @@ fn scene(rel: &str, w: u32, h: u32) -> Scene {
     // fov_y 40°: the larger of the half-height and half-width (over the aspect) fills 90 %.
     let fit = half.y.max(half.x * h as f32 / w as f32) / 0.9;
     let eye = center + Vec3::new(0.0, 0.0, half.z + fit / 20f32.to_radians().tan());
-    Scene::load(&write_scene(dir.path(), &model, eye, center, w, h)).unwrap()
+    Scene::load(&write_scene(dir.path(), &model, &view(eye, center))).unwrap()
 }
 
-fn write_scene(
-    dir: &Path,
-    model: &Path,
+/// Where [`write_scene`] looks from, at what, and how.
+struct View<'a> {
     eye: Vec3,
     target: Vec3,
     w: u32,
     h: u32,
-) -> std::path::PathBuf {
+    look: &'a Look,
+}
+
+fn write_scene(dir: &Path, model: &Path, v: &View) -> std::path::PathBuf {
+    let (eye, target, sky) = (v.eye, v.target, v.look.sky);
     let text = format!(
         "(version: 2,
   camera: Perspective(position: ({:?}, {:?}, {:?}), target: ({:?}, {:?}, {:?}), up: (0.0, 1.0, 0.0), fov_y: 40.0),
   shapes: [Mesh(name: \"m\", path: {:?})],
-  environment: Constant((1.0, 1.0, 1.0)),
-  render: (width: {w}, height: {h}, max_bounces: 1, spp: 1, seed: 3),
+  environment: Constant(({sky:?}, {sky:?}, {sky:?})),
+  render: (width: {}, height: {}, max_bounces: {}, spp: {}, seed: 3),
 )",
-        eye.x, eye.y, eye.z, target.x, target.y, target.z, model.to_string_lossy()
+        eye.x,
+        eye.y,
+        eye.z,
+        target.x,
+        target.y,
+        target.z,
+        model.to_string_lossy(),
+        v.w,
+        v.h,
+        v.look.bounces,
+        v.look.spp
     );
     let path = dir.join("scene.ron");
     std::fs::write(&path, text).unwrap();
@@ -73,6 +113,34 @@ struct Render {
     material: Vec<Option<String>>,
     /// The index in [`Scene::triangles`] of the triangle met.
     triangle: Vec<Option<u32>>,
+}
+
+/// The CPU ray cast through each pixel's centre: the material met (without the mesh's `m/`
+/// prefix) and the index in [`Scene::triangles`] of the triangle met.
+fn cast(scene: &Scene, gpu: &GpuScene) -> (Vec<Option<String>>, Vec<Option<u32>>) {
+    let (w, h) = (gpu.settings.width, gpu.settings.height);
+    let hits: Vec<_> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let ray = common::image_ray(gpu, Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            intersect(gpu, &ray)
+        })
+        .collect();
+    let material = hits
+        .iter()
+        .map(|hit| {
+            hit.as_ref().map(|hit| {
+                let m = gpu.tri_shading[hit.prim as usize].material as usize;
+                let name = &scene.materials[m].name;
+                name.strip_prefix("m/").unwrap_or(name).to_owned()
+            })
+        })
+        .collect();
+    let triangle = hits
+        .iter()
+        .map(|hit| hit.as_ref().map(|hit| gpu.tri_source[hit.prim as usize]))
+        .collect();
+    (material, triangle)
 }
 
 impl Render {
@@ -93,30 +161,9 @@ impl Render {
         let mut exec = Executor::new(ctx, plan, &resources).unwrap();
         exec.run_frame().unwrap();
         let albedo = exec.read_port("pt.albedo").unwrap();
-        let (w, h) = (gpu.settings.width, gpu.settings.height);
-        let hits: Vec<_> = (0..h)
-            .flat_map(|y| (0..w).map(move |x| (x, y)))
-            .map(|(x, y)| {
-                let ray = common::image_ray(&gpu, Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                intersect(&gpu, &ray)
-            })
-            .collect();
-        let material = hits
-            .iter()
-            .map(|hit| {
-                hit.as_ref().map(|hit| {
-                    let m = gpu.tri_shading[hit.prim as usize].material as usize;
-                    let name = &scene.materials[m].name;
-                    name.strip_prefix("m/").unwrap_or(name).to_owned()
-                })
-            })
-            .collect();
-        let triangle = hits
-            .iter()
-            .map(|hit| hit.as_ref().map(|hit| gpu.tri_source[hit.prim as usize]))
-            .collect();
+        let (material, triangle) = cast(scene, &gpu);
         Some(Self {
-            w,
+            w: gpu.settings.width,
             albedo,
             material,
             triangle,
@@ -761,4 +808,192 @@ fn specular_test_colours_f0_and_keeps_white_rims() {
             }
         }
     }
+}
+
+/// The pixels of `gpu` wholly on material `name` (without the mesh's `m/` prefix): all 16
+/// rays of the pixel's footprint meet it (the CPU ray cast, alpha tests included).
+fn wholly_on(scene: &Scene, gpu: &GpuScene, name: &str) -> Vec<usize> {
+    let (w, h) = (gpu.settings.width, gpu.settings.height);
+    let full = format!("m/{name}");
+    (0..w * h)
+        .filter(|&i| {
+            common::footprint(gpu, i % w, i / w).iter().all(|(_, hit)| {
+                hit.as_ref().is_some_and(|hit| {
+                    let m = gpu.tri_shading[hit.prim as usize].material as usize;
+                    scene.materials[m].name == full
+                })
+            })
+        })
+        .map(|i| i as usize)
+        .collect()
+}
+
+/// The mean of `img` over `pixels`, per channel.
+fn mean_over(img: &Image, pixels: &[usize]) -> Vec3 {
+    let sum: Vec3 = pixels
+        .iter()
+        .map(|&i| Vec3::from_slice(&img.pixels[i][..3]))
+        .sum();
+    sum / pixels.len() as f32
+}
+
+/// `EmissiveStrengthTest`: "The basic emissive color of all the cubes is [0.1, 0.5, 0.9] …
+/// The cube on the far left has no emissive strength extension (1x), and each subsequent cube
+/// doubles the strength (2x, 4x, 8x, and 16x) … the ones on the right should emit
+/// substantially more light." In a black sky (1 bounce, 4 spp, 320 × 160), the mean radiance
+/// of each cube's front face over its strength is the colour within 1e-3 relative per
+/// channel: the face is black (base colour 0), and what it reflects of its neighbours is
+/// within rounding (measured: 2e-6). The negative control, the strengths dropped, is off by
+/// up to 94 %.
+#[test]
+fn emissive_strength_test_scales_each_cube() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = framed(
+        "EmissiveStrengthTest/EmissiveStrengthTest.glb",
+        (320, 160),
+        &Look {
+            sky: 0.0,
+            bounces: 1,
+            spp: 4,
+        },
+    );
+    assert!(
+        scene.report.warnings.is_empty(),
+        "{:?}",
+        scene.report.warnings
+    );
+    let gpu = Arc::new(GpuScene::build(&scene).unwrap());
+    let cubes: Vec<(f32, Vec<usize>)> = [1.0f32, 2.0, 4.0, 8.0, 16.0]
+        .into_iter()
+        .map(|k| (k, wholly_on(&scene, &gpu, &format!("Emit{k}"))))
+        .collect();
+    let worst = |scene: &Scene| {
+        let gpu = Arc::new(GpuScene::build(scene).unwrap());
+        let img = common::accumulate(ctx, &gpu, 4, 1, Resources::default());
+        let colour = Vec3::new(0.1, 0.5, 0.9);
+        let mut worst: f32 = 0.0;
+        for (k, pixels) in &cubes {
+            let per_strength = mean_over(&img, pixels) / *k;
+            println!(
+                "Emit{k} ({} pixels): mean / strength {per_strength}",
+                pixels.len()
+            );
+            worst = worst.max(((per_strength - colour) / colour).abs().max_element());
+        }
+        worst
+    };
+    for (k, pixels) in &cubes {
+        assert!(pixels.len() >= 100, "Emit{k}: {} pixels", pixels.len());
+    }
+    let got = worst(&scene);
+    let mut dropped = scene.clone();
+    for m in &mut dropped.materials {
+        if let Some(k) = m.name.strip_prefix("m/Emit") {
+            m.emission /= k.parse::<f32>().unwrap();
+        }
+    }
+    let control = worst(&dropped);
+    println!("largest relative error: {got:.2e}; with the strengths dropped: {control:.2}");
+    assert!(got <= 1e-3, "{got}");
+    assert!(control > 1e-3, "the control passes too: {control}");
+}
+
+/// What `alpha_blend_mode_test_cuts_and_blends_as_each_mode_says` measures of an albedo
+/// render of `AlphaBlendModeTest`: the pixels of the red X marks, and per panel (Blend,
+/// Cutoff 0.25, Cutoff default, Cutoff 0.75) the number of its pixels showing the texture's
+/// blue and green stripes over the Opaque panel's number, which alpha does not cut (the
+/// stripes are the same size on every panel).
+fn alpha_panels(scene: &Scene, panels: &[Option<String>]) -> Option<(usize, [f64; 4])> {
+    let r = Render::of(scene)?;
+    let stripe = |c: Vec3| c.z > c.x + 0.15 || c.y > c.x + 0.15;
+    let red = (0..panels.len())
+        .filter(|&i| {
+            let c = r.rgb(i);
+            c.x > 0.2 && c.y < 0.5 * c.x && c.z < 0.5 * c.x
+        })
+        .count();
+    let stripes = |name: &str| {
+        let on: Vec<usize> = (0..panels.len())
+            .filter(|&i| panels[i].as_deref() == Some(name))
+            .collect();
+        assert!(on.len() > 1000, "{name}: {} pixels", on.len());
+        on.iter().filter(|&&i| stripe(r.rgb(i))).count() as f64
+    };
+    let opaque = stripes("MatOpaque");
+    let shares = ["MatBlend", "MatCutoff25", "MatCutoffDefault", "MatCutoff75"]
+        .map(|name| stripes(name) / opaque);
+    Some((red, shares))
+}
+
+/// `AlphaBlendModeTest`: the Opaque panel ignores its texture's alpha; Blend blends it away
+/// ("green check marks and hidden red X's, that will show check marks only when the
+/// requested mode is correctly applied"); the three Mask panels cut "at the corresponding
+/// values" of the texture's linear alpha ramp: cutoffs 0.25, 0.5 (the default) and 0.75.
+/// In the albedo AOV (first hits through pixel centres, 480 × 200; a panel's pixels are those
+/// the CPU ray cast meets on it with every material opaque):
+/// - no pixel of a red X is seen (measured 0); two controls show one: every material opaque
+///   (the Blend panel's X: 15 pixels) and the Opaque panel cut at 0.5 (its X: 16);
+/// - the pixels of a panel showing its stripes, over the Opaque panel's, are 1 − cutoff for the
+///   Mask panels and the ramp's mean alpha, 0.5, for the Blend panel, within 0.06 (measured:
+///   0.508, 0.711, 0.516, 0.238; the 0.25 panel's stripes start a little above its ramp);
+///   the controls miss by over 0.2: every material opaque (0.95 to 0.98) and every cutoff
+///   the default (0.485 and 0.488 for 0.25 and 0.75).
+#[test]
+fn alpha_blend_mode_test_cuts_and_blends_as_each_mode_says() {
+    use lumagraph::scene::AlphaMode;
+    let scene = scene("AlphaBlendModeTest/AlphaBlendModeTest.glb", 480, 200);
+    assert!(
+        scene.report.warnings.is_empty(),
+        "{:?}",
+        scene.report.warnings
+    );
+    let with = |f: &dyn Fn(&str, &mut AlphaMode)| {
+        let mut s = scene.clone();
+        for m in &mut s.materials {
+            f(&m.name, &mut m.alpha_mode);
+        }
+        s
+    };
+    let opaque = with(&|_, a| *a = AlphaMode::Opaque);
+    let default = with(&|_, a| {
+        if let AlphaMode::Mask { cutoff } = a {
+            *cutoff = 0.5;
+        }
+    });
+    let cut_opaque = with(&|name, a| {
+        if name == "m/MatOpaque" {
+            *a = AlphaMode::Mask { cutoff: 0.5 };
+        }
+    });
+    let (panels, _) = cast(&opaque, &GpuScene::build(&opaque).unwrap());
+    let Some((red, shares)) = alpha_panels(&scene, &panels) else {
+        return;
+    };
+    let want = [0.5, 0.75, 0.5, 0.25];
+    let miss = |shares: [f64; 4]| {
+        shares
+            .iter()
+            .zip(want)
+            .map(|(s, w)| (s - w).abs())
+            .fold(0.0, f64::max)
+    };
+    let (red_opaque, shares_opaque) = alpha_panels(&opaque, &panels).unwrap();
+    let (_, shares_default) = alpha_panels(&default, &panels).unwrap();
+    let (red_cut, _) = alpha_panels(&cut_opaque, &panels).unwrap();
+    println!(
+        "red X pixels: {red} (every material opaque: {red_opaque}; the Opaque panel cut: {red_cut}); \
+         stripe shares {shares:.3?} (every material opaque: {shares_opaque:.3?}; every cutoff 0.5: {shares_default:.3?})"
+    );
+    assert_eq!(red, 0, "a red X is seen");
+    assert!(red_opaque >= 8, "the control passes too: {red_opaque}");
+    assert!(red_cut >= 8, "the control passes too: {red_cut}");
+    assert!(miss(shares) <= 0.06, "{shares:?}");
+    assert!(
+        miss(shares_opaque) > 0.06,
+        "the control passes too: {shares_opaque:?}"
+    );
+    assert!(
+        miss(shares_default) > 0.06,
+        "the control passes too: {shares_default:?}"
+    );
 }
