@@ -42,7 +42,7 @@ pub use flatten::{GpuScene, LIGHT_UNIFORM_SHARE, alias_table, light_selection, l
 pub use gpu::*;
 pub use load::transform_matrix;
 pub use scene::{
-    AlphaMode, Camera, LoadReport, LoadStats, Material, MaterialTextures, NO_TEXTURE,
+    AlphaMode, Camera, LoadReport, LoadStats, Material, MaterialTextures, Medium, NO_TEXTURE,
     PunctualLight, Scene, Sphere, Triangle, cube_quads, push_triangle, quad_triangles,
     rectangle_quad, transform_triangle,
 };
