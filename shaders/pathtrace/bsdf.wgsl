@@ -376,11 +376,15 @@ struct Layers {
     p_sheen: f32,
 }
 
-fn layers(m: Material, mu_o: f32) -> Layers {
+// The coat's albedo is taken at the view cosine to its own normal (`coat_normal`); it
+// reflects nothing from below its horizon.
+fn layers(m: Material, wo: vec3f) -> Layers {
+    let mu_o = wo.z;
     var l = Layers(CoatParams(0.0, ggx_lobe(0.0)), 0.0, 1.0, 0.0);
-    if HAS_COAT && m.clearcoat > 0.0 {
+    let mu_c = dot(wo, coat_normal);
+    if HAS_COAT && m.clearcoat > 0.0 && mu_c > 0.0 {
         l.coat = coat_params(m);
-        l.p_coat = clamp(coat_albedo(l.coat, mu_o), 0.0, 1.0);
+        l.p_coat = clamp(coat_albedo(l.coat, mu_c), 0.0, 1.0);
     }
     let sheen = max(m.sheen_color.x, max(m.sheen_color.y, m.sheen_color.z));
     if HAS_SHEEN && sheen > 0.0 {
@@ -399,13 +403,13 @@ fn eval_bsdf(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
     if !(HAS_COAT || HAS_SHEEN) || wo.z <= 0.0 || wi.z <= 0.0 {
         return out;
     }
-    let l = layers(m, wo.z);
+    let l = layers(m, wo);
     if l.p_sheen > 0.0 {
         out.f_cos = m.sheen_color * sheen_f_cos(l.sheen_alpha, wo, wi) + (1.0 - l.p_sheen) * out.f_cos;
         out.pdf = l.p_sheen * wi.z * INV_PI + (1.0 - l.p_sheen) * out.pdf;
     }
     if l.p_coat > 0.0 {
-        let c = coat_eval(l.coat, wo, wi);
+        let c = coat_eval(l.coat, to_coat(wo), to_coat(wi));
         out.f_cos = c.f_cos + (1.0 - l.p_coat) * out.f_cos;
         out.pdf = l.p_coat * c.pdf + (1.0 - l.p_coat) * out.pdf;
     }
@@ -417,7 +421,7 @@ fn eval_bsdf(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
 fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     var l = Layers(CoatParams(0.0, ggx_lobe(0.0)), 0.0, 1.0, 0.0);
     if (HAS_COAT || HAS_SHEEN) && !(wo.z <= 0.0) {
-        l = layers(m, wo.z);
+        l = layers(m, wo);
     }
     let layered = l.p_coat != 0.0 || l.p_sheen != 0.0;
     var wi: vec3f;
@@ -426,10 +430,17 @@ fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     if layered {
         if u_lobe < l.p_coat {
             base = false;
-            wi = coat_sample(l.coat, wo, u.xy);
+            let wc = coat_sample(l.coat, to_coat(wo), u.xy);
+            wi = from_coat(wc);
             if l.coat.lobe.is_smooth {
-                // The mirror reflects clearcoat F(mu_o), the probability of choosing it.
-                return BsdfSample(wi, vec3f(1.0), 0.0, true);
+                // The mirror reflects clearcoat F(mu_o), the probability of choosing it
+                // (lost where a tilted coat's mirror points into the surface).
+                return BsdfSample(wi, vec3f(1.0), 0.0, wi.z > 0.0);
+            }
+            if wc.z <= 0.0 {
+                // Below the coat's horizon, where its density is 0 (with a coat normal of
+                // its own, possibly above the base's).
+                return BsdfSample(vec3f(0.0, 0.0, 1.0), vec3f(0.0), 0.0, false);
             }
         } else {
             let v = (u_lobe - l.p_coat) / max(1.0 - l.p_coat, 1e-7);

@@ -15,6 +15,9 @@ struct Params {
     seed: u32,
     pad0: u32,
     pad1: u32,
+    // The clear coat's normal in the shading frame (`coat_normal`).
+    coat_n: vec3f,
+    pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -32,6 +35,7 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     let m = material[0];
+    coat_normal = params.coat_n;
     if params.mode == 0u {
         rng_init(i, 0u, params.seed);
         let u_lobe = rand();

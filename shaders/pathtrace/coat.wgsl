@@ -3,9 +3,37 @@
 // roughness, weighted by `clearcoat`. What the coat does not reflect reaches the layers below
 // (bsdf.wgsl's `eval_bsdf` scales them by 1 - clearcoat E_c(mu_o), E_c the coat's directional
 // albedo from the GGX tables: albedo scaling, as glTF's layering does with the view angle).
-// The coat shares the base's shading normal.
+// The coat has a normal of its own (`coat_normal`): glTF's coat is smooth where the base is
+// normal-mapped, or follows its own normal map. Its lobe and albedo are taken in its frame,
+// with its cosines; it reflects nothing towards or from below its own horizon.
 #import "pathtrace/scene_types.wgsl"
 #import "pathtrace/microfacet.wgsl"
+#import "common/sampling.wgsl"
+
+// The coat's normal at the point shaded, in the shading frame of the base (+z where it
+// shares the base's normal), set by whoever shades the point (`bounce_path`).
+var<private> coat_normal: vec3f = vec3f(0.0, 0.0, 1.0);
+
+// Whether the coat's normal is the base's: then its frame is the base's, exactly.
+fn coat_shares_normal() -> bool {
+    return all(coat_normal == vec3f(0.0, 0.0, 1.0));
+}
+
+// `w` (shading frame) in the coat's frame.
+fn to_coat(w: vec3f) -> vec3f {
+    if coat_shares_normal() {
+        return w;
+    }
+    return transpose(onb(coat_normal)) * w;
+}
+
+// `w` (coat frame) in the shading frame.
+fn from_coat(w: vec3f) -> vec3f {
+    if coat_shares_normal() {
+        return w;
+    }
+    return onb(coat_normal) * w;
+}
 
 const COAT_F0: f32 = 0.04;
 
@@ -28,11 +56,12 @@ fn coat_albedo(c: CoatParams, mu: f32) -> f32 {
     return c.weight * lobe_albedo(vec3f(COAT_F0), ggx_albedo(mu, c.lobe.roughness)).x;
 }
 
-// The rough coat's f * cos (weight included) and the density of its visible-normal
-// sampling; zero for a smooth coat (a delta lobe, reached by sampling only).
+// The rough coat's f * cos (weight included; its own cosine) and the density of its
+// visible-normal sampling, for directions in the coat's frame; zero for a smooth coat (a
+// delta lobe, reached by sampling only) and below the coat's horizon.
 fn coat_eval(c: CoatParams, wo: vec3f, wi: vec3f) -> BsdfEval {
     let a2 = c.lobe.a2;
-    if c.lobe.is_smooth {
+    if c.lobe.is_smooth || wo.z <= 0.0 || wi.z <= 0.0 {
         return BsdfEval(vec3f(0.0), 0.0);
     }
     let h = normalize(wo + wi);

@@ -139,6 +139,10 @@ fn bounce_path(p: ptr<function, PathState>, hit: Hit, may_miss: bool) -> u32 {
     let basis = onb(frame_n);
     let to_local = transpose(basis);
     let wo = to_local * -(*p).ray.dir;
+    coat_normal = vec3f(0.0, 0.0, 1.0);
+    if HAS_COAT && any(s.coat_n != s.ns) {
+        coat_normal = normalize(to_local * select(s.coat_n, -s.coat_n, flip));
+    }
     if wo.z > 0.0 {
         next_event(p, s, mat, on_sphere, ng, front || flip, to_local, wo, has_lights);
     }

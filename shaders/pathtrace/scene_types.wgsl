@@ -136,7 +136,7 @@ struct Material {
     // Colour of the dielectric specular at normal incidence: it multiplies F0 (clamped to
     // 1), not the grazing reflectance (bsdf.wgsl's `dielectric_fresnel`).
     specular_color: vec3<f32>,
-    pad8: u32,
+    clearcoat_normal_scale: f32,
 }
 
 // A triangle's tangents (xyz, w = handedness), UVs (two sets) and vertex colours (RGBA8, R in

@@ -15,6 +15,9 @@ struct Surface {
     ng: vec3f,
     // Shading normal, front side.
     ns: vec3f,
+    // The clear coat's normal, front side (HAS_COAT; else `ns`): the interpolated normal,
+    // or the coat's own normal map applied to it, not the base's normal map.
+    coat_n: vec3f,
     material: u32,
     light: u32,
     // Componentwise bound on the rounding error of `p` (triangles; 0 on spheres).
@@ -51,6 +54,7 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
         let sph = scene_sphere(hit.prim & ~PRIM_SPHERE);
         s.ng = normalize(s.p - sph.center);
         s.ns = s.ng;
+        s.coat_n = s.ns;
         s.material = sph.material;
         s.light = sph.light;
     } else {
@@ -72,7 +76,17 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
             let tc = tri_texcoords[hit.prim];
             s.uv = tri_uv(tc, hit.u, hit.v);
             s.color = tri_color(tc, hit.u, hit.v);
-            s.ns = normal_mapped(scene_material(sh.material), s.ns, s.ng, s.uv, tri_tangent(tc, hit.u, hit.v));
+            let m = scene_material(sh.material);
+            let tangent = tri_tangent(tc, hit.u, hit.v);
+            let interpolated = s.ns;
+            s.ns = normal_mapped(m, interpolated, s.ng, s.uv, tangent);
+            if HAS_COAT && m.clearcoat > 0.0 {
+                s.coat_n = normal_mapped_by(tex_hi(m.tex_specular_color), m.clearcoat_normal_scale, interpolated, s.ng, s.uv, tangent);
+            } else {
+                s.coat_n = s.ns;
+            }
+        } else {
+            s.coat_n = s.ns;
         }
     }
     return s;

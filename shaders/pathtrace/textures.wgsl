@@ -184,12 +184,17 @@ fn tex_slot_srgb(k: u32) -> bool {
 // is made orthogonal to ns and the bitangent is w * ns x tangent. Falls back to `ns` when the
 // result is degenerate or faces away from the geometric normal `ng` (front side).
 fn normal_mapped(m: Material, ns: vec3f, ng: vec3f, uv: vec4f, tangent: vec4f) -> vec3f {
-    let id = tex_hi(m.tex_emissive_normal);
+    return normal_mapped_by(tex_hi(m.tex_emissive_normal), m.normal_scale, ns, ng, uv, tangent);
+}
+
+// `normal_mapped` with the normal map `id` (none: NO_TEX) of scale `scale`: the base's, or
+// the clear coat's.
+fn normal_mapped_by(id: u32, scale: f32, ns: vec3f, ng: vec3f, uv: vec4f, tangent: vec4f) -> vec3f {
     if id == NO_TEX {
         return ns;
     }
     let t = tex_sample(id, uv, false).xyz * 2.0 - 1.0;
-    let tn = vec3f(t.xy * m.normal_scale, t.z);
+    let tn = vec3f(t.xy * scale, t.z);
     let tg = tangent.xyz - ns * dot(ns, tangent.xyz);
     if !(dot(tg, tg) > 0.0) {
         return ns;

@@ -149,6 +149,8 @@ fn randomize(scene: &mut Scene, rng: &mut Rng, glass_case: bool) {
             m.clearcoat_roughness = rng.f();
             m.textures.clearcoat = pick(rng, 0.3);
             m.textures.clearcoat_roughness = pick(rng, 0.3);
+            // The coat's own normal map (a random texture as a normal map).
+            m.textures.clearcoat_normal = pick(rng, 0.3);
         }
         if sheen && rng.chance(0.5) {
             m.sheen_color = Vec3::new(rng.f(), rng.f(), rng.f());

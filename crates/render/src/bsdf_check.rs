@@ -50,6 +50,9 @@ enum Job<'a> {
 pub struct BsdfCheck {
     kernel: Kernel,
     ggx_table: wgpu::Buffer,
+    /// The clear coat's normal in the shading frame (unit; +z, the default, where the coat
+    /// shares the base's normal), as the path tracer sets it per point shaded.
+    pub coat_normal: Vec3,
 }
 
 impl BsdfCheck {
@@ -60,7 +63,11 @@ impl BsdfCheck {
     pub fn new(ctx: &GpuContext) -> Result<Self> {
         let kernel = Kernel::new(ctx, "pathtrace/bsdf_check.wgsl")?;
         let ggx_table = crate::bsdf_tables::upload(ctx, true);
-        Ok(Self { kernel, ggx_table })
+        Ok(Self {
+            kernel,
+            ggx_table,
+            coat_normal: Vec3::Z,
+        })
     }
 
     fn run(
@@ -74,11 +81,12 @@ impl BsdfCheck {
             Job::Sample { count, seed } => (0, seed, &[][..], count),
             Job::Eval(dirs) => (1, 0, dirs, u32::try_from(dirs.len()).unwrap_or(u32::MAX)),
         };
-        let mut params = [0u32; 8];
+        let mut params = [0u32; 12];
         params[..3].copy_from_slice(&wo.to_array().map(f32::to_bits));
         params[3] = count;
         params[4] = mode;
         params[5] = seed;
+        params[8..11].copy_from_slice(&self.coat_normal.to_array().map(f32::to_bits));
         let params = uniform_buffer(ctx, "bsdf check params", bytemuck::cast_slice(&params));
         let material = storage_buffer(ctx, "bsdf check material", bytemuck::bytes_of(material));
         let dirs = if dirs.is_empty() {

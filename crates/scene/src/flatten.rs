@@ -143,11 +143,13 @@ impl From<&Material> for GpuMaterial {
             normal_scale: m.normal_scale,
             tex_transmission_specular: tex16(m.textures.transmission)
                 | (tex16(m.textures.specular) << 16),
-            tex_specular_color: tex16(m.textures.specular_color) | (0xFFFF << 16),
+            tex_specular_color: tex16(m.textures.specular_color)
+                | (tex16(m.textures.clearcoat_normal) << 16),
             tex_coat: tex16(m.textures.clearcoat) | (tex16(m.textures.clearcoat_roughness) << 16),
             tex_sheen: tex16(m.textures.sheen_color) | (tex16(m.textures.sheen_roughness) << 16),
             sheen_color: m.sheen_color.to_array(),
             specular_color: m.specular_color.to_array(),
+            clearcoat_normal_scale: m.clearcoat_normal_scale,
             sheen_roughness: m.sheen_roughness,
             clearcoat: m.clearcoat,
             clearcoat_roughness: m.clearcoat_roughness,

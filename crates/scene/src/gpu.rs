@@ -204,8 +204,8 @@ pub struct GpuMaterial {
     /// Transmission texture (low 16 bits, R) and specular texture (high 16 bits, A)
     /// (offset 64).
     pub tex_transmission_specular: u32,
-    /// Specular color texture (low 16 bits, RGB sRGB); the high 16 bits are 0xFFFF
-    /// (offset 68).
+    /// Specular color texture (low 16 bits, RGB sRGB) and the clear coat's normal texture
+    /// (high 16 bits) (offset 68).
     pub tex_specular_color: u32,
     /// Roughness of the diffuse base: 0 Lambertian, else energy-preserving Oren–Nayar
     /// (offset 72).
@@ -251,8 +251,8 @@ pub struct GpuMaterial {
     /// Colour of the dielectric specular at normal incidence: multiplies F0, not the
     /// grazing reflectance (offset 192).
     pub specular_color: [f32; 3],
-    /// Padding (offset 204).
-    pub pad8: u32,
+    /// glTF `clearcoatNormalTexture.scale` (offset 204).
+    pub clearcoat_normal_scale: f32,
 }
 
 /// A triangle's texture coordinates, tangents and vertex colours, 112 bytes, same index as

@@ -35,6 +35,9 @@ pub struct MaterialTextures {
     pub sheen_color: u32,
     /// `KHR_materials_sheen` `sheenRoughnessTexture` (A).
     pub sheen_roughness: u32,
+    /// `KHR_materials_clearcoat` `clearcoatNormalTexture` (the coat's own normal map, in the
+    /// base's tangent frame).
+    pub clearcoat_normal: u32,
 }
 
 impl Default for MaterialTextures {
@@ -51,6 +54,7 @@ impl Default for MaterialTextures {
             clearcoat_roughness: NO_TEXTURE,
             sheen_color: NO_TEXTURE,
             sheen_roughness: NO_TEXTURE,
+            clearcoat_normal: NO_TEXTURE,
         }
     }
 }
@@ -62,7 +66,7 @@ impl MaterialTextures {
     }
 
     /// Every slot, in declaration order.
-    pub fn all(&self) -> [u32; 11] {
+    pub fn all(&self) -> [u32; 12] {
         [
             self.base_color,
             self.metallic_roughness,
@@ -75,11 +79,12 @@ impl MaterialTextures {
             self.clearcoat_roughness,
             self.sheen_color,
             self.sheen_roughness,
+            self.clearcoat_normal,
         ]
     }
 
     /// Every slot, mutably, in declaration order.
-    pub fn all_mut(&mut self) -> [&mut u32; 11] {
+    pub fn all_mut(&mut self) -> [&mut u32; 12] {
         [
             &mut self.base_color,
             &mut self.metallic_roughness,
@@ -92,6 +97,7 @@ impl MaterialTextures {
             &mut self.clearcoat_roughness,
             &mut self.sheen_color,
             &mut self.sheen_roughness,
+            &mut self.clearcoat_normal,
         ]
     }
 }
@@ -141,6 +147,8 @@ pub struct Material {
     /// glTF `normalTexture.scale`: the tangent-space x and y of the normal map are scaled
     /// by it.
     pub normal_scale: f32,
+    /// The same for the clear coat's own normal map (`clearcoatNormalTexture.scale`).
+    pub clearcoat_normal_scale: f32,
     /// A conductor's complex index of refraction: the metal lobe's Fresnel is the exact
     /// conductor one instead of Schlick's on `base_color` (which then holds its
     /// normal-incidence reflectance, for albedo outputs).
@@ -231,6 +239,7 @@ impl Material {
             two_sided: false,
             textures: MaterialTextures::default(),
             normal_scale: 1.0,
+            clearcoat_normal_scale: 1.0,
             conductor: None,
             multiscatter: true,
             medium: None,

@@ -120,7 +120,7 @@ fn material_layout() -> (&'static str, usize, Vec<(&'static str, usize)>) {
             pad6,
             pad7,
             specular_color,
-            pad8
+            clearcoat_normal_scale
         ]
     )
 }

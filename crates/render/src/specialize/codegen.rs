@@ -230,7 +230,7 @@ fn table_fns(name: &str, ty: &str, types: &[&str], rows: &[Vec<String>]) -> Stri
 const MATERIAL_TYPES: [&str; 34] = [
     "vec3f", "f32", "vec3f", "f32", "f32", "f32", "f32", "f32", "u32", "u32", "u32", "f32", "u32",
     "u32", "f32", "f32", "vec3f", "f32", "vec3f", "u32", "vec3f", "u32", "vec3f", "f32", "vec3f",
-    "u32", "vec3f", "f32", "f32", "f32", "u32", "u32", "vec3f", "u32",
+    "u32", "vec3f", "f32", "f32", "f32", "u32", "u32", "vec3f", "f32",
 ];
 
 /// Every material as WGSL literals, field by field.
@@ -273,7 +273,7 @@ fn materials_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
                 u(0),
                 u(0),
                 l.v3(m.specular_color),
-                u(0),
+                l.f(m.clearcoat_normal_scale),
             ]
         })
         .collect()

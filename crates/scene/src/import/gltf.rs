@@ -2,8 +2,8 @@
 //! perspective cameras, metallic-roughness materials with their base color,
 //! metallic-roughness, normal and emissive textures, `KHR_materials_emissive_strength`,
 //! `KHR_materials_ior`, `KHR_materials_transmission` and `KHR_materials_specular` (factors
-//! and textures), `KHR_materials_clearcoat` and `KHR_materials_sheen` (factors and textures;
-//! not the coat's normal texture), `KHR_materials_diffuse_roughness` (its factor),
+//! and textures), `KHR_materials_clearcoat` and `KHR_materials_sheen` (factors and textures,
+//! the coat's own normal texture included), `KHR_materials_diffuse_roughness` (its factor),
 //! `alphaMode`, `alphaCutoff`
 //! and the base colour factor's alpha (with the base colour texture's alpha: masks and
 //! blending, [`crate::scene::AlphaMode`]). Textures read `TEXCOORD_0` or `TEXCOORD_1` (their
@@ -1085,19 +1085,15 @@ fn layers<'a>(
         out.textures.clearcoat = ext_texture(doc, &name, ext, "clearcoatTexture", dec, warnings)?;
         out.textures.clearcoat_roughness =
             ext_texture(doc, &name, ext, "clearcoatRoughnessTexture", dec, warnings)?;
-        if ext.get("clearcoatNormalTexture").is_some() && out.clearcoat > 0.0 {
-            warnings.push(format!(
-                "material {}: clearcoatNormalTexture is not read (the clear coat takes the \
-                 base's shading normal)",
-                material_name(m)
-            ));
-        } else if out.clearcoat > 0.0 && out.textures.normal != NO_TEXTURE {
-            warnings.push(format!(
-                "material {}: the clear coat follows the base's normal texture (glTF's coat \
-                 without a normal texture of its own is smooth)",
-                material_name(m)
-            ));
-        }
+        // The coat's own normal map; without one the coat is smooth (the interpolated
+        // normal), whatever the base's normal map does.
+        out.textures.clearcoat_normal =
+            ext_texture(doc, &name, ext, "clearcoatNormalTexture", dec, warnings)?;
+        out.clearcoat_normal_scale = ext
+            .get("clearcoatNormalTexture")
+            .and_then(|t| t.get("scale"))
+            .and_then(::gltf::json::Value::as_f64)
+            .map_or(1.0, |s| s as f32);
     }
     if let Some(ext) = m.extension_value("KHR_materials_sheen") {
         let color = ext

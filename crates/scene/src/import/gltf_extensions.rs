@@ -14,9 +14,8 @@ use serde_json::Value;
 use crate::error::{ErrorKind, SceneError};
 
 /// Extensions read (in full, or with what is not read said where it is met: a light's
-/// `range`, which physical lights do not have, `KHR_materials_diffuse_roughness`'s
-/// texture and `KHR_materials_clearcoat`'s normal texture, warned about by the material
-/// reader).
+/// `range`, which physical lights do not have, and `KHR_materials_diffuse_roughness`'s
+/// texture, warned about by the material reader).
 const READ: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_clearcoat",
