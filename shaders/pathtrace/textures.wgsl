@@ -52,15 +52,27 @@ fn tex_filter(d: vec4u, uv: vec2f, srgb: bool) -> vec4f {
     let f = floor(q);
     let t = q - f;
     let i = select(vec2i(f), vec2i(floor(p)), nearest);
-    var c: array<vec4f, 4>;
+    // The rows' mixes as the texels come (no array: a driver may keep one in memory, per
+    // lane): a = mix(c0, c1, t.x), b = mix(c2, c3, t.x).
+    var a = vec4f(0.0);
+    var b = vec4f(0.0);
     let n = select(4u, 1u, nearest);
     for (var k = 0u; k < n; k++) {
-        c[k] = tex_fetch(d, i.x + i32(k & 1u), i.y + i32(k >> 1u), srgb);
+        let c = tex_fetch(d, i.x + i32(k & 1u), i.y + i32(k >> 1u), srgb);
+        if k == 0u {
+            a = c;
+        } else if k == 1u {
+            a = mix(a, c, t.x);
+        } else if k == 2u {
+            b = c;
+        } else {
+            b = mix(b, c, t.x);
+        }
     }
     if nearest {
-        return c[0];
+        return a;
     }
-    return mix(mix(c[0], c[1], t.x), mix(c[2], c[3], t.x), t.y);
+    return mix(a, b, t.y);
 }
 
 // Where texture `d` is looked up for a point with coordinates `uvs`: its set, transformed.
