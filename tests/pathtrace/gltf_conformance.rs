@@ -1319,11 +1319,11 @@ fn attenuation_test_shades_each_column_alike() {
 /// `TransmissionRoughnessTest`: "With IOR = 1.0, light vectors do not change regardless of how
 /// strong the microfacet angles become … transmission will be sharp and non-blurred,
 /// regardless of the material's roughness"; with a higher IOR, rougher tiles blur what they
-/// transmit. Held (320 × 200, 6 bounces, 32 spp): the "1.0 - Air" row, whose roughness rises
+/// transmit. Held (320 × 200, 6 bounces, 16 spp): the "1.0 - Air" row, whose roughness rises
 /// along the row (its metallic-roughness texture), renders as the same row made smooth, to
-/// within a quarter of the noise (the mean |difference| per pixel and channel against that
-/// between two seeds of the render; measured: identical). The control is the same comparison
-/// on the 1.5 row's roughest quarter, which must differ by more than the noise (measured 1.33×).
+/// within a quarter of the noise ([`block_difference`] against that between two seeds of the
+/// render; measured: identical). The control is the same comparison on the 1.5 row's roughest
+/// quarter, which must differ by more than 1.3× the noise (measured 1.70×).
 #[test]
 fn transmission_roughness_test_keeps_air_sharp_at_any_roughness() {
     let Some(ctx) = common::gpu() else { return };
@@ -1346,13 +1346,14 @@ fn transmission_roughness_test_keeps_air_sharp_at_any_roughness() {
         }
         s
     };
-    let render = |s: &Scene, seed: u32| seeded(ctx, s, seed, 16, 2);
+    let render = |s: &Scene, seed: u32| seeded(ctx, s, seed, 16, 1);
     let a = render(&scene, 3);
     let again = render(&scene, 4);
     // The mean |x − y| per pixel and channel over `pixels`, against the noise: the same
     // between the two seeds.
     let versus_noise = |x: &Image, y: &Image, pixels: &[usize]| {
-        mean_abs_difference(x, y, pixels) / mean_abs_difference(&a, &again, pixels)
+        let w = gpu.settings.width;
+        block_difference(x, y, pixels, w) / block_difference(&a, &again, pixels, w)
     };
     let air = wholly_on(&scene, &gpu, "Mat_IOR_1.0");
     let glass = wholly_on(&scene, &gpu, "Mat_IOR_1.50");
@@ -1378,7 +1379,7 @@ fn transmission_roughness_test_keeps_air_sharp_at_any_roughness() {
         "air row against itself made smooth: {got:.3} of the noise; the 1.5 row's roughest quarter: {control:.2}"
     );
     assert!(got <= 0.25, "{got}");
-    assert!(control > 1.0, "the control passes too: {control}");
+    assert!(control > 1.3, "the control passes too: {control}");
 }
 
 /// The metallic value of the material at `hit` (its factor × the blue channel of its
