@@ -87,8 +87,8 @@ pub(super) fn on_signal(then: &'static str) {
 }
 
 /// Prints how long building the executor took since `start`: its pipelines (a CPU adapter
-/// spends seconds on each of the path tracer's; Mesa's shader cache does not keep them) and
-/// its nodes' uploads.
+/// spends seconds on each of the path tracer's, less where Mesa's shader cache holds part of
+/// the work from an earlier run) and its nodes' uploads.
 pub(super) fn print_built(start: Instant) {
     println!(
         "pipelines and uploads: {:.0} ms",
