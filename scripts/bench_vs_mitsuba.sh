@@ -1,11 +1,15 @@
 #!/usr/bin/env bash
 # lumagraph and Mitsuba 3 side by side, in one run on this machine: the Cornell box
 # (assets/cornell.ron) and the mesh benchmark scene (assets/bench/mesh_env.ron: an
-# 81 920-triangle mesh under an environment map). Prints both renderers' paths/s and their
-# ratio for each. Only a ratio taken in one run means something on a shared machine; the
-# load average is printed before and after.
+# 81 920-triangle mesh under an environment map), and with SPONZA set to a folder holding
+# the Crytek Sponza in glTF, that real scene as both renderers read it: its materials
+# reduced to diffuse base colour textures with their alpha cut-outs (`diffuse: true`; the
+# scene of tests/scenes/sponza_diffuse.ron at 256x160 with every texture), which Mitsuba
+# renders with `volpath` (shadow rays through the cut-outs). Prints both renderers' paths/s
+# and their ratio for each. Only a ratio taken in one run means something on a shared
+# machine; the load average is printed before and after.
 #
-#   scripts/bench_vs_mitsuba.sh [SPP]
+#   [SPONZA=path/to/Sponza] scripts/bench_vs_mitsuba.sh [SPP]
 #
 # It builds and runs target/release/lumagraph, or runs the binary LUMAGRAPH names (use a
 # release build: with host intersection, Rust code runs on the host between the kernel's
@@ -46,8 +50,24 @@ lg_m=$(specialized <<< "$out")
 out=$("$py" scripts/bench/mesh_env.py mitsuba assets/bench/blob.obj --spp "$spp" --runs 3)
 echo "$out"
 mi_m=$(paths <<< "$out")
+rows=("Cornell box:$lg_c:$mi_c" "mesh scene:$lg_m:$mi_m")
+if [ -n "${SPONZA:-}" ]; then
+    sponza=$(cd "$SPONZA" && pwd)
+    sed -e "s|../../assets/sponza-small/Sponza.gltf|$sponza/Sponza.gltf|" \
+        -e "s|../../assets/hdri/|$PWD/assets/hdri/|" \
+        -e "s|width: 128, height: 128|width: 256, height: 160|" \
+        tests/scenes/sponza_diffuse.ron > "$tmp/sponza.ron"
+    $lg_bin export "$tmp/sponza.ron" --out "$tmp/sponza" > /dev/null
+    out=$($lg_bin bench --scene "$tmp/sponza.ron" --spp "$spp" --runs 3)
+    echo "$out"
+    lg_s=$(specialized <<< "$out")
+    out=$("$py" scripts/bench/mitsuba_time.py "$tmp/sponza" --spp "$spp" --runs 3)
+    echo "$out"
+    mi_s=$(paths <<< "$out")
+    rows+=("Crytek Sponza (diffuse, cut-outs):$lg_s:$mi_s")
+fi
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
-for row in "Cornell box:$lg_c:$mi_c" "mesh scene:$lg_m:$mi_m"; do
+for row in "${rows[@]}"; do
     IFS=: read -r name lg mi <<< "$row"
     python3 -c "lg, mi = $lg, $mi; print(f'$name, $spp spp: lumagraph {lg:.3f} M paths/s, Mitsuba {mi:.3f} M paths/s: {lg / mi:.3f}x')"
 done

@@ -182,5 +182,6 @@ suite!(
     media_scattering,
     mesh_env,
     punctual_lights,
+    sponza_diffuse,
     thin_lens,
 );

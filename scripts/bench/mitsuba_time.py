@@ -4,8 +4,8 @@
     python mitsuba_time.py cornell_export [--spp 64] [--runs 3] [--variant llvm_ad_rgb]
 
 The scene is mapped onto Mitsuba plugins by scripts/references/make.py (`mitsuba_scene`, as
-the reference suite does: path integrator, max_depth = bounces + 1, rr_depth 5, box filter,
-independent sampler). Prints one JSON line: paths per second of the best of `--runs` timed
+the reference suite does: path integrator, or volpath for media and alpha cut-outs,
+max_depth = bounces + 1, rr_depth 5, box filter, independent sampler). Prints one JSON line: paths per second of the best of `--runs` timed
 renders after an untimed warm-up (kernel compilation).
 """
 import argparse

@@ -30,6 +30,21 @@ Materials map one to one or the scene is refused (never an approximation in sile
 Rough lobes need `multiscatter: false` to be the same model as Mitsuba's (which has no
 multiple-scattering compensation); a rough lobe with it on is flagged too.
 
+Textures: a diffuse material's base colour texture (white factor) becomes a `bitmap` (the
+exported sRGB PNG, its wrap mode and filter) for `reflectance`; its opacity (alpha `mask` or
+`blend`, exported as a linear grey PNG, 0 or 1 per texel for a mask) a `mask` BSDF around it
+(Mitsuba's mask is stochastic, so a mask's edge is cut between texels where lumagraph cuts at
+the filtered alpha: a sub-texel difference). Any other texture, a tinted textured base colour,
+vertex colours or a textured emission are refused. A two-sided material is wrapped in
+`twosided` (lumagraph's opaque surfaces are black from behind unless two-sided, as Mitsuba's).
+A scene with cut-outs renders with `volpath` (shadow rays cross the cut-outs, and crossing
+does not count as a bounce, as in lumagraph).
+
+A scene file elsewhere (a path ending in `.ron`) writes its reference into `--out`, e.g. the
+Crytek Sponza of docs/benchmarks.md:
+
+  .venv-mitsuba/bin/python scripts/references/make.py path/to/sponza_diffuse.ron --out out/sponza
+
 Media: a material's `medium` (or `attenuation_*`, exported as a medium of sigma_s 0) becomes
 the shape's `interior`, a `homogeneous` medium (sigma_t = sigma_a + sigma_s, albedo =
 sigma_s / sigma_t, `hg` phase function); an `index_matched` material becomes the `null`
@@ -62,10 +77,24 @@ def rgb(v):
     return {"type": "rgb", "value": [float(x) for x in v]}
 
 
-def bsdf(m):
+def bitmap(export_dir, t, raw):
+    """Mitsuba `bitmap` texture for an exported texture."""
+    if t["wrap"][0] != t["wrap"][1]:
+        raise Refused(f"texture {t['file']}: wrap modes {t['wrap']} differ along U and V "
+                      "(Mitsuba's bitmap has one)")
+    return {"type": "bitmap", "filename": os.path.join(export_dir, t["file"]),
+            "wrap_mode": t["wrap"][0], "filter_type": t["filter"], "raw": raw}
+
+
+def bsdf(m, export_dir="."):
     """Mitsuba BSDF dict for a lumagraph material, and notes on the mapping."""
     notes = []
-    if m["textured"]:
+    if m.get("other_textures"):
+        raise Refused(f"material {m['name']}: textures {m['other_textures']} have no mapping "
+                      "here (only a diffuse base colour texture and its opacity)")
+    if m.get("emission_textured") and max(m["emission"]) > 0:
+        raise Refused(f"material {m['name']}: a textured emission has no mapping here")
+    if m["textured"] and m.get("base_color_texture") is None:
         raise Refused(f"material {m['name']}: textured materials have no mapping here")
     if m.get("index_matched"):
         return {"type": "null"}, notes
@@ -92,7 +121,14 @@ def bsdf(m):
              "specular_transmittance": rgb(m["base_color"])}
         rough_lobe = not smooth
     elif metallic == 0.0 and transmission == 0.0 and specular == 0.0:
-        d = {"type": "diffuse", "reflectance": rgb(m["base_color"])}
+        reflectance = rgb(m["base_color"])
+        if m.get("base_color_texture"):
+            if any(c != 1.0 for c in m["base_color"]):
+                raise Refused(f"material {m['name']}: a base colour texture times a factor "
+                              f"{m['base_color']} (Mitsuba's bitmap has no factor)")
+            reflectance = bitmap(export_dir, m["base_color_texture"], raw=False)
+        d = {"type": "diffuse", "reflectance": reflectance}
+        return with_opacity(m, export_dir, two_sided(m, d)), notes
     elif metallic == 0.0 and transmission == 0.0 and m["specular_tint"] == 0.0 and LAYER == "principled":
         d = {"type": "principled", "base_color": rgb(m["base_color"]),
              "roughness": float(m["roughness"]), "specular": float(specular), "metallic": 0.0}
@@ -113,12 +149,45 @@ def bsdf(m):
     else:
         raise Refused(f"material {m['name']}: mixture metallic {metallic}, transmission "
                       f"{transmission} has no single Mitsuba plugin")
+    if m.get("base_color_texture"):
+        raise Refused(f"material {m['name']}: a base colour texture on a {d['type']} has no "
+                      "mapping here")
+    if m.get("alpha_mode", "opaque") != "opaque":
+        raise Refused(f"material {m['name']}: opacity on a {d['type']} has no mapping here")
     if not smooth and d["type"] != "diffuse":
         d["alpha"] = alpha
         d["distribution"] = "ggx"
     if rough_lobe and m["multiscatter"]:
         notes.append("model differs: multiple-scattering compensation on (Mitsuba has none)")
     return d, notes
+
+
+def two_sided(m, d):
+    """`d` shaded from both sides where the material is two-sided."""
+    return {"type": "twosided", "bsdf": d} if m.get("two_sided") else d
+
+
+def with_opacity(m, export_dir, d):
+    """`d` inside a `mask` BSDF where the material's opacity cuts or blends it."""
+    mode = m.get("alpha_mode", "opaque")
+    if mode == "opaque":
+        return d
+    if m.get("opacity_texture"):
+        opacity = bitmap(export_dir, m["opacity_texture"], raw=True)
+    elif mode == "mask":
+        opacity = 1.0 if m["opacity"] >= m["alpha_cutoff"] else 0.0
+    else:
+        opacity = m["opacity"]
+    return {"type": "mask", "opacity": opacity, "bsdf": d}
+
+
+def describe(b):
+    """A BSDF dict's plugin, with those it wraps: `mask(twosided(diffuse))`."""
+    return b["type"] + (f"({describe(b['bsdf'])})" if "bsdf" in b else "")
+
+
+def has_cutouts(s):
+    return any(m.get("alpha_mode", "opaque") != "opaque" for m in s["materials"])
 
 
 def medium(m):
@@ -160,15 +229,15 @@ def mitsuba_scene(export_dir, spp, seed):
         sensor["focus_distance"] = c["focus_distance"]
     has_media = any(m.get("medium") is not None for m in s["materials"])
     d = {"type": "scene",
-         "integrator": {"type": "volpath" if has_media else "path",
+         "integrator": {"type": "volpath" if has_media or has_cutouts(s) else "path",
                         "max_depth": r["max_bounces"] + 1, "rr_depth": 5},
          "sensor": sensor}
     plugins, notes = {}, []
     mats = s["materials"]
 
     def material(i):
-        b, n = bsdf(mats[i])
-        plugins[mats[i]["name"]] = b["type"]
+        b, n = bsdf(mats[i], export_dir)
+        plugins[mats[i]["name"]] = describe(b)
         notes.extend(f"{mats[i]['name']}: {x}" for x in n if x not in notes)
         return b
 
@@ -181,6 +250,8 @@ def mitsuba_scene(export_dir, spp, seed):
         return {"type": "area", "radiance": rgb(m["emission"])}
 
     for k, mesh in enumerate(s["meshes"]):
+        if mesh.get("vertex_colors"):
+            raise Refused(f"{mesh['file']}: vertex colours have no mapping here")
         shape = {"type": "obj", "filename": os.path.join(export_dir, mesh["file"]),
                  "face_normals": not mesh["smooth"], "bsdf": material(mesh["material"])}
         e = emitter(mesh["material"])
@@ -239,9 +310,13 @@ def render(d, spp, seed):
     return np.array(mi.render(scene, spp=spp, seed=seed), dtype=np.float64)[..., :3]
 
 
-def make(name, lumagraph, spp, chunk, seeds):
+def make(name, lumagraph, spp, chunk, seeds, out=OUT):
     import mitsuba as mi
-    src = os.path.join(SCENES, name + ".ron")
+    if name.endswith(".ron"):
+        src = os.path.abspath(name)
+        name = os.path.basename(name)[:-4]
+    else:
+        src = os.path.join(SCENES, name + ".ron")
     with tempfile.TemporaryDirectory() as tmp:
         subprocess.run([lumagraph, "export", src, "--out", tmp], check=True,
                        stdout=subprocess.DEVNULL)
@@ -263,12 +338,13 @@ def make(name, lumagraph, spp, chunk, seeds):
             t = time.time()
             img = render(d, 256, s)
             per_seed.append({"seed": s, "relmse": relmse(img, ref), "seconds": time.time() - t})
-    os.makedirs(OUT, exist_ok=True)
+    os.makedirs(out, exist_ok=True)
     bmp = mi.Bitmap(ref.astype(np.float32), pixel_format=mi.Bitmap.PixelFormat.RGB)
     bmp = bmp.convert(component_format=mi.Struct.Type.Float16)
-    bmp.write(os.path.join(OUT, name + ".exr"))
+    bmp.write(os.path.join(out, name + ".exr"))
+    scene = os.path.relpath(src, ROOT)
     meta = {
-        "scene": f"tests/scenes/{name}.ron",
+        "scene": scene if not scene.startswith("..") else os.path.basename(src),
         "renderer": f"Mitsuba {mi.__version__} ({mi.variant()}), integrator "
                     f"{d['integrator']['type']}, independent sampler, box filter",
         "spp": spp,
@@ -278,7 +354,7 @@ def make(name, lumagraph, spp, chunk, seeds):
         "mitsuba_relmse_256": {"mean": float(np.mean([p["relmse"] for p in per_seed])),
                                "per_seed": per_seed},
     }
-    with open(os.path.join(OUT, name + ".json"), "w") as f:
+    with open(os.path.join(out, name + ".json"), "w") as f:
         json.dump(meta, f, indent=1)
         f.write("\n")
     print(f"{name}: {spp} spp in {seconds:.0f} s, Mitsuba relMSE at 256 spp "
@@ -288,7 +364,9 @@ def make(name, lumagraph, spp, chunk, seeds):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("scenes", nargs="*", help="scene names in tests/scenes (default: all)")
+    p.add_argument("scenes", nargs="*",
+                   help="scene names in tests/scenes (default: all), or scene files (.ron)")
+    p.add_argument("--out", default=OUT, help="folder of the references written")
     p.add_argument("--lumagraph", default=os.path.join(ROOT, "target", "release", "lumagraph"))
     p.add_argument("--spp", type=int, default=16384, help="reference samples per pixel")
     p.add_argument("--chunk", type=int, default=1024, help="samples per Mitsuba render call")
@@ -304,7 +382,7 @@ def main():
     failed = []
     for name in names:
         try:
-            make(name, a.lumagraph, a.spp, a.chunk, a.seeds)
+            make(name, a.lumagraph, a.spp, a.chunk, a.seeds, a.out)
         except Refused as e:
             print(f"{name}: refused: {e}", file=sys.stderr)
             failed.append(name)

@@ -306,6 +306,12 @@ pub enum ShapeDesc {
         /// A scene material that replaces every material of the file.
         #[serde(default)]
         material: Option<String>,
+        /// Every material of the file reduced to a Lambertian diffuse of its base colour
+        /// (factor, texture and vertex colours), its opacity, alpha mode and emission kept and
+        /// every other lobe and texture left out: the scene as renderers that read only
+        /// those see it (`lumagraph export` and Mitsuba's `diffuse`, `bitmap` and `mask`).
+        #[serde(default)]
+        diffuse: bool,
         /// Emitted radiance, replacing the materials' own.
         #[serde(default)]
         emission: Option<V3>,

@@ -205,6 +205,39 @@ pub fn transform_matrix(t: &TransformDesc) -> Result<Mat4, SceneError> {
     Ok(m)
 }
 
+/// A `Mesh`'s `diffuse: true`: every material of the file as [`Material::as_diffuse`], and
+/// the textures none of them reads any more left out (they were decoded with the file, but
+/// take no place in the atlas).
+fn reduce_to_diffuse(mesh: &mut crate::import::ImportedMesh) {
+    use crate::scene::NO_TEXTURE;
+    for m in &mut mesh.materials {
+        *m = m.as_diffuse();
+    }
+    let mut index = vec![NO_TEXTURE; mesh.textures.len()];
+    for m in &mesh.materials {
+        for t in m.textures.all() {
+            if t != NO_TEXTURE {
+                index[t as usize] = 0;
+            }
+        }
+    }
+    let mut kept = Vec::new();
+    for (i, t) in std::mem::take(&mut mesh.textures).into_iter().enumerate() {
+        if index[i] != NO_TEXTURE {
+            index[i] = kept.len() as u32;
+            kept.push(t);
+        }
+    }
+    mesh.textures = kept;
+    for m in &mut mesh.materials {
+        for t in m.textures.all_mut() {
+            if *t != NO_TEXTURE {
+                *t = index[*t as usize];
+            }
+        }
+    }
+}
+
 /// The conductor a material description names or gives, if any.
 fn conductor_from_desc(d: &MaterialDesc) -> Result<Option<Conductor>, SceneError> {
     match (&d.conductor, d.eta, d.k) {
@@ -811,12 +844,16 @@ impl<'a> Builder<'a> {
                 path,
                 transform,
                 material,
+                diffuse,
                 ..
             } => {
                 let t = transform_matrix(transform)?;
                 let over = material.as_deref().map(|m| self.lookup(m)).transpose()?;
                 let full = self.base_dir.join(path);
-                let mesh = import_mesh(&full, t)?;
+                let mut mesh = import_mesh(&full, t)?;
+                if *diffuse {
+                    reduce_to_diffuse(&mut mesh);
+                }
                 let prefix = name.clone().unwrap_or_else(|| path.clone());
                 let mut ids = Vec::with_capacity(mesh.materials.len());
                 // The file's textures follow the scene's; its materials' indices move along

@@ -83,6 +83,22 @@ impl MaterialTextures {
         ]
     }
 
+    /// The slots' names, in declaration order (as [`Self::all`] gives them).
+    pub const NAMES: [&'static str; 12] = [
+        "base_color",
+        "metallic_roughness",
+        "emissive",
+        "normal",
+        "transmission",
+        "specular",
+        "specular_color",
+        "clearcoat",
+        "clearcoat_roughness",
+        "sheen_color",
+        "sheen_roughness",
+        "clearcoat_normal",
+    ];
+
     /// Every slot, mutably, in declaration order.
     pub fn all_mut(&mut self) -> [&mut u32; 12] {
         [
@@ -246,6 +262,27 @@ impl Material {
             index_matched: false,
             opacity: 1.0,
             alpha_mode: AlphaMode::Opaque,
+        }
+    }
+
+    /// The material reduced to a Lambertian diffuse of its base colour: the base colour
+    /// factor and texture, opacity, alpha mode, emission (factor and texture) and two-sidedness
+    /// kept, every other lobe, texture and medium left out (a `Mesh`'s `diffuse: true`).
+    #[must_use]
+    pub fn as_diffuse(&self) -> Self {
+        Self {
+            textures: MaterialTextures {
+                base_color: self.textures.base_color,
+                emissive: self.textures.emissive,
+                ..MaterialTextures::default()
+            },
+            specular: 0.0,
+            opacity: self.opacity,
+            alpha_mode: self.alpha_mode,
+            emission: self.emission,
+            two_sided: self.two_sided,
+            base_color: self.base_color,
+            ..Self::named(self.name.clone())
         }
     }
 

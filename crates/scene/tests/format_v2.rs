@@ -288,3 +288,127 @@ fn export_writes_the_resolved_scene() {
     assert!(written.iter().all(|p| Path::new(p).is_file()));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `AlphaBlendModeTest` as a `Mesh`, reduced to diffuse materials or not.
+fn alpha_blend_mode_test(diffuse: bool) -> Scene {
+    parse(&format!(
+        r#"(
+    version: 2,
+    camera: Perspective(position: (0, 1, 6), target: (0, 1, 0), fov_y: 40),
+    shapes: [Mesh(name: "m", path: "gltf-conformance/AlphaBlendModeTest/AlphaBlendModeTest.glb", diffuse: {diffuse})],
+    environment: Constant((1, 1, 1)),
+    render: (width: 64, height: 64, max_bounces: 4, spp: 1, seed: 0),
+)"#
+    ))
+    .unwrap()
+}
+
+#[test]
+fn diffuse_meshes_keep_only_their_base_colour_and_opacity() {
+    let full = alpha_blend_mode_test(false);
+    let reduced = alpha_blend_mode_test(true);
+    assert_eq!(full.materials.len(), reduced.materials.len());
+    // The control: the file's materials have textures besides the base colour's.
+    assert!(full.materials.iter().any(|m| {
+        m.textures.all()[1..]
+            .iter()
+            .any(|&t| t != lumagraph_scene::NO_TEXTURE)
+    }));
+    for (f, r) in full.materials.iter().zip(&reduced.materials) {
+        // The same image, at its own index: textures no material reads are left out.
+        let name = |s: &Scene, t: u32| s.textures.get(t as usize).map(|t| t.name.clone());
+        assert_eq!(
+            name(&reduced, r.textures.base_color),
+            name(&full, f.textures.base_color),
+            "{}",
+            f.name
+        );
+        assert!(
+            r.textures.all()[1..]
+                .iter()
+                .all(|&t| t == lumagraph_scene::NO_TEXTURE),
+            "{}",
+            f.name
+        );
+        assert_eq!(
+            (r.base_color, r.opacity, r.alpha_mode, r.two_sided),
+            (f.base_color, f.opacity, f.alpha_mode, f.two_sided)
+        );
+        assert_eq!((r.metallic, r.specular, r.transmission), (0.0, 0.0, 0.0));
+    }
+    assert!(reduced.textures.len() < full.textures.len());
+    for i in 0..reduced.textures.len() as u32 {
+        assert!(reduced.materials.iter().any(|m| m.textures.base_color == i));
+    }
+}
+
+#[test]
+fn export_writes_base_colour_textures_texture_coordinates_and_cut_outs() {
+    use lumagraph_scene::AlphaMode;
+    let s = alpha_blend_mode_test(true);
+    let g = GpuScene::build(&s).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    lumagraph_scene::export::export(&s, &g, dir.path()).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("scene.json")).unwrap())
+            .unwrap();
+    let materials = json["materials"].as_array().unwrap();
+    let mut masks = 0;
+    for (i, (m, out)) in s.materials.iter().zip(materials).enumerate() {
+        assert_eq!(out["other_textures"].as_array().unwrap().len(), 0);
+        let Some(t) = s.textures.get(m.textures.base_color as usize) else {
+            assert!(out["base_color_texture"].is_null());
+            continue;
+        };
+        // The base colour texture's RGB, byte for byte.
+        let file = out["base_color_texture"]["file"].as_str().unwrap();
+        let png = image::open(dir.path().join(file)).unwrap().to_rgb8();
+        assert_eq!((png.width(), png.height()), (t.width, t.height));
+        assert!(
+            png.pixels()
+                .zip(t.texels.iter())
+                .all(|(p, q)| p.0 == q[..3])
+        );
+        // A mask's opacity: cut out or not, texel by texel, as the path tracer tests it.
+        if let AlphaMode::Mask { cutoff } = m.alpha_mode {
+            masks += 1;
+            assert_eq!(out["alpha_mode"], "mask");
+            let file = out["opacity_texture"]["file"].as_str().unwrap();
+            let png = image::open(dir.path().join(file)).unwrap().to_luma8();
+            let (mut cut, mut kept) = (0, 0);
+            for (p, q) in png.pixels().zip(t.texels.iter()) {
+                let keep = f32::from(q[3]) / 255.0 * m.opacity >= cutoff;
+                assert_eq!(p.0[0], if keep { 255 } else { 0 }, "material {i}");
+                if keep { kept += 1 } else { cut += 1 }
+            }
+            assert!(cut > 0 && kept > 0, "material {i}: {cut} cut, {kept} kept");
+        }
+    }
+    assert!(masks > 0, "no mask material: the test checks nothing");
+    // Texture coordinates: OBJ's V up, the texture's transform applied; one per corner.
+    let mut checked = 0;
+    for mesh in json["meshes"].as_array().unwrap() {
+        if !mesh["uvs"].as_bool().unwrap() {
+            continue;
+        }
+        let obj = std::fs::read_to_string(dir.path().join(mesh["file"].as_str().unwrap())).unwrap();
+        let vt: Vec<[f32; 2]> = obj
+            .lines()
+            .filter_map(|l| l.strip_prefix("vt "))
+            .map(|l| {
+                let mut w = l.split(' ').map(|x| x.parse::<f32>().unwrap());
+                [w.next().unwrap(), w.next().unwrap()]
+            })
+            .collect();
+        let material = mesh["material"].as_u64().unwrap() as u32;
+        let first = s.triangles.iter().find(|t| t.material == material).unwrap();
+        let tex = &s.textures[s.materials[material as usize].textures.base_color as usize];
+        for (k, uv) in first.uvs.unwrap().iter().enumerate() {
+            let uv = tex.transform.apply(*uv);
+            assert_eq!(vt[k], [uv.x, 1.0 - uv.y]);
+        }
+        assert_eq!(vt.len(), 3 * mesh["triangles"].as_u64().unwrap() as usize);
+        checked += 1;
+    }
+    assert!(checked > 0);
+}
