@@ -23,7 +23,7 @@ mod tiled;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 use clap::{Parser, Subcommand};
@@ -99,6 +99,8 @@ enum Command {
         /// they are refused: docs/security.md).
         #[arg(long)]
         allow_outputs_outside: bool,
+        #[command(flatten)]
+        textures: TextureArgs,
     },
     /// Merge partial renders (`render --samples`) of one graph and scene into what a single
     /// render of all their samples writes: checks that they belong together, sums them
@@ -375,6 +377,78 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
     }))
 }
 
+/// `render --fit-textures` and `--texture-memory`: the scene's texture atlas against the
+/// device's largest 2D texture and array layers and the memory budget. Over them, the
+/// largest images are halved until they fit, each named in a warning, where `fit` asks;
+/// else a budget exceeded is an error here, and the device's limits are checked with the
+/// rest of the scene when it is uploaded (`scene_gpu::check_limits`).
+fn fit_textures(loaded: &mut LoadedScene, ctx: &GpuContext, args: TextureArgs) -> Result<()> {
+    use crate::scene::texture::AtlasLimits;
+    let (fit, budget_mib) = (args.fit_textures, args.texture_memory);
+    let l = ctx.device.limits();
+    let limits = AtlasLimits {
+        max_side: l.max_texture_dimension_2d,
+        max_pages: l.max_texture_array_layers,
+        max_bytes: budget_mib.map(|m| m.saturating_mul(1 << 20)),
+    };
+    let atlas = &loaded.gpu.atlas;
+    if limits.hold(atlas.page_size, atlas.pages) {
+        return Ok(());
+    }
+    let mib = |b: u64| b as f64 / f64::from(1 << 20);
+    let what = format!(
+        "scene textures: {} textures in {} pages of {}x{} texels ({:.1} MiB)",
+        loaded.scene.textures.len(),
+        atlas.pages,
+        atlas.page_size,
+        atlas.page_size,
+        mib(atlas.bytes())
+    );
+    if !fit {
+        if let Some(budget) = budget_mib
+            && atlas.bytes() > budget.saturating_mul(1 << 20)
+        {
+            anyhow::bail!(
+                "{what}: over the texture memory budget of {budget} MiB (--texture-memory); \
+                 pass --fit-textures to halve the largest textures until they fit"
+            );
+        }
+        return Ok(());
+    }
+    let gpu = Arc::get_mut(&mut loaded.gpu).context("the scene is already in use")?;
+    let Some(notes) = gpu.fit_textures(&loaded.scene.textures, limits) else {
+        anyhow::bail!(
+            "{what}: no downscaling fits them in {} pages of at most {}x{} texels{} on {}",
+            limits.max_pages,
+            limits.max_side,
+            limits.max_side,
+            budget_mib.map_or_else(String::new, |b| format!(" and {b} MiB")),
+            ctx.info.name
+        );
+    };
+    for n in &notes {
+        println!(
+            "scene warning: texture {} downscaled from {}x{} to {}x{} (--fit-textures)",
+            n.name, n.from.0, n.from.1, n.to.0, n.to.1
+        );
+    }
+    let atlas = &gpu.atlas;
+    println!(
+        "  {what}, over {} pages of at most {}x{}{} on {}: now {} pages of {}x{} ({:.1} MiB), {} images downscaled",
+        limits.max_pages,
+        limits.max_side,
+        limits.max_side,
+        budget_mib.map_or_else(String::new, |b| format!(" or {b} MiB")),
+        ctx.info.name,
+        atlas.pages,
+        atlas.page_size,
+        atlas.page_size,
+        mib(atlas.bytes()),
+        notes.len()
+    );
+    Ok(())
+}
+
 fn uses_scene(plan: &crate::graph::Plan) -> bool {
     plan.passes.iter().any(|p| p.kind.renders_scene)
 }
@@ -388,7 +462,7 @@ fn progressive_source(plan: &crate::graph::Plan) -> Option<&crate::graph::Pass> 
 
 fn render(args: &RenderArgs<'_>) -> Result<()> {
     let graph = load(args.graph, args.overrides)?;
-    let scene = load_scene(args.scene)?;
+    let mut scene = load_scene(args.scene)?;
     let plan = args
         .library
         .compile(&graph, &[], scene.as_ref().map(|s| &*s.gpu))?;
@@ -399,6 +473,9 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
     }
     let ctx = GpuContext::headless()?;
     println!("adapter: {}", ctx.describe());
+    if let (Some(s), true) = (scene.as_mut(), progressive) {
+        fit_textures(s, &ctx, args.textures)?;
+    }
     let resources = Resources {
         base_dir: graph.base_dir(),
         out_dir: args.out.to_owned(),
@@ -538,6 +615,22 @@ struct RenderArgs<'a> {
     tiles: Option<split::SampleRange>,
     /// `--allow-outputs-outside`.
     outputs_anywhere: bool,
+    /// `--fit-textures` and `--texture-memory`.
+    textures: TextureArgs,
+}
+
+/// How a render fits the scene's textures to the device (`render`'s options).
+#[derive(clap::Args, Clone, Copy, Debug)]
+struct TextureArgs {
+    /// Where the scene's textures exceed what the device holds (its largest 2D texture,
+    /// its array layers) or `--texture-memory`, halve the largest until they fit, with a
+    /// warning naming each (by default such a scene is refused with an error).
+    #[arg(long)]
+    fit_textures: bool,
+    /// The most memory the scene's textures may take, in MiB (all atlas pages; by default
+    /// what the device holds).
+    #[arg(long, value_name = "MIB")]
+    texture_memory: Option<u64>,
 }
 
 /// `lumagraph plan`: the plan, node-owned memory, and the shader features per pass.
@@ -644,23 +737,20 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             tiles,
             samples,
             allow_outputs_outside,
+            textures,
         } => render(&RenderArgs {
             library,
             graph: &graph,
             scene: scene.as_deref(),
             spp,
             overrides: &overrides,
-            checkpoints: progressive::Checkpoints {
-                path: checkpoint.unwrap_or_else(|| out.join("render.checkpoint")),
-                every: checkpoint_every.map(Duration::from_secs_f64),
-                resume,
-                key: 0,
-            },
+            checkpoints: progressive::Checkpoints::new(&out, checkpoint, checkpoint_every, resume),
             out: &out,
             tile,
             tiles,
             samples,
             outputs_anywhere: allow_outputs_outside,
+            textures,
         }),
         Command::Merge {
             partials,

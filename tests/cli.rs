@@ -1180,3 +1180,79 @@ fn bench_traversal_times_both_bvhs() {
     }
     assert!(out.contains("8-wide / binary: primary"), "{out}");
 }
+
+/// The reduced Crytek Sponza (24 textures of 128², 6 atlas pages of 256², 1.5 MiB) at 16×16
+/// with a texture memory budget of 1 MiB: refused with one error naming the textures, their
+/// size and the budget, nothing written; with `--fit-textures`, rendered, each image made
+/// smaller named in a warning and the atlas within the budget.
+#[test]
+fn textures_over_the_budget_are_refused_or_downscaled_when_asked() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("sponza.ron");
+    let described = std::fs::read_to_string(common::repo("tests/scenes/sponza_diffuse.ron"))
+        .unwrap()
+        .replace(
+            "../../assets/sponza-small/Sponza.gltf",
+            common::repo("assets/sponza-small/Sponza.gltf")
+                .to_str()
+                .unwrap(),
+        )
+        .replace(
+            "../../assets/hdri/venice_sunset_1k.hdr",
+            common::repo("assets/hdri/venice_sunset_1k.hdr")
+                .to_str()
+                .unwrap(),
+        )
+        .replace("width: 128, height: 128", "width: 16, height: 16");
+    std::fs::write(&scene, described).unwrap();
+    let out = dir.path().join("out");
+    let args = |more: &[&'static str]| {
+        let mut a = vec![
+            "render".to_owned(),
+            "graphs/pathtrace.ron".to_owned(),
+            "--scene".to_owned(),
+            scene.to_str().unwrap().to_owned(),
+            "--out".to_owned(),
+            out.to_str().unwrap().to_owned(),
+            "--spp".to_owned(),
+            "4".to_owned(),
+            "--texture-memory".to_owned(),
+            "1".to_owned(),
+        ];
+        a.extend(more.iter().map(|s| (*s).to_owned()));
+        a
+    };
+    let refused = args(&[]);
+    let o = lumagraph(&refused.iter().map(String::as_str).collect::<Vec<_>>());
+    let (stdout, stderr) = text(&o);
+    assert!(!o.status.success(), "{stdout}\n{stderr}");
+    assert!(
+        stderr.contains(
+            "error: scene textures: 24 textures in 6 pages of 256x256 texels (1.5 MiB): over the \
+             texture memory budget of 1 MiB (--texture-memory); pass --fit-textures"
+        ),
+        "{stderr}"
+    );
+    assert!(!out.exists() || common::is_empty_dir(&out));
+    let fitted = args(&["--fit-textures"]);
+    let o = lumagraph(&fitted.iter().map(String::as_str).collect::<Vec<_>>());
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stdout}\n{stderr}");
+    let warnings = stdout
+        .lines()
+        .filter(|l| {
+            l.starts_with("scene warning: texture ")
+                && l.contains(" downscaled from 128x128 to 64x64")
+        })
+        .count();
+    assert!(
+        stdout.contains(&format!(
+            "now 4 pages of 256x256 (1.0 MiB), {warnings} images downscaled"
+        )) && warnings > 0,
+        "{stdout}"
+    );
+    assert!(out.join("render.png").is_file());
+}

@@ -2,7 +2,7 @@
 //! bar, checkpoints every few seconds when asked, and on Ctrl-C (SIGINT) or SIGTERM the
 //! outputs of the samples so far plus a checkpoint to go on from (`--resume`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -26,6 +26,24 @@ pub(super) struct Checkpoints {
     pub resume: Option<PathBuf>,
     /// What is rendered ([`key`]).
     pub key: u64,
+}
+
+impl Checkpoints {
+    /// `render`'s `--checkpoint` (default `OUT/render.checkpoint`), `--checkpoint-every`
+    /// and `--resume`; the key is set when the render knows it.
+    pub(super) fn new(
+        out: &Path,
+        path: Option<PathBuf>,
+        every: Option<f64>,
+        resume: Option<PathBuf>,
+    ) -> Self {
+        Self {
+            path: path.unwrap_or_else(|| out.join("render.checkpoint")),
+            every: every.map(Duration::from_secs_f64),
+            resume,
+            key: 0,
+        }
+    }
 }
 
 /// The render's key: lumagraph's version, the graph as run (overrides applied, without

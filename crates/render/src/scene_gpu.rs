@@ -150,7 +150,8 @@ pub fn check_limits(scene: &GpuScene, limits: &wgpu::Limits, adapter: &str) -> R
                 format!(
                     "a page must hold the largest texture whole, and {} texels is over the \
                      adapter's largest 2D texture side of {} (max_texture_dimension_2d); scale the \
-                     largest textures down to at most {} texels",
+                     largest textures down to at most {} texels (`render --fit-textures` halves \
+                     them)",
                     atlas.page_size,
                     limits.max_texture_dimension_2d,
                     limits.max_texture_dimension_2d
@@ -162,7 +163,8 @@ pub fn check_limits(scene: &GpuScene, limits: &wgpu::Limits, adapter: &str) -> R
                 what,
                 format!(
                     "{} pages, over the adapter's {} array layers (max_texture_array_layers); \
-                     use fewer or smaller textures",
+                     use fewer or smaller textures (`render --fit-textures` halves the largest \
+                     until they fit)",
                     atlas.pages, limits.max_texture_array_layers
                 ),
             ));

@@ -371,6 +371,23 @@ impl GpuScene {
         Ok((built, bvh))
     }
 
+    /// The texture atlas made again from `textures` (the scene's, from which it was built)
+    /// with the largest images halved until it fits `limits`
+    /// ([`crate::texture::fit_textures`]); what was made smaller, empty when it fitted
+    /// already. `None` when even 1×1 images do not fit; the atlas is then unchanged.
+    pub fn fit_textures(
+        &mut self,
+        textures: &[crate::texture::Texture],
+        limits: crate::texture::AtlasLimits,
+    ) -> Option<Vec<crate::texture::Downscaled>> {
+        if limits.hold(self.atlas.page_size, self.atlas.pages) {
+            return Some(Vec::new());
+        }
+        let (fitted, notes) = crate::texture::fit_textures(textures, limits)?;
+        self.atlas = crate::texture::pack_atlas(&fitted);
+        Some(notes)
+    }
+
     /// Flattens `scene`.
     ///
     /// # Errors

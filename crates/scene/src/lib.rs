@@ -46,5 +46,8 @@ pub use scene::{
     PunctualLight, Scene, Sphere, Triangle, cube_quads, push_triangle, quad_triangles,
     rectangle_quad, transform_triangle,
 };
-pub use texture::{TexelRange, Texture, TextureAtlas, UvTransform, Wrap, pack_atlas};
+pub use texture::{
+    AtlasLimits, Downscaled, TexelRange, Texture, TextureAtlas, UvTransform, Wrap, fit_textures,
+    pack_atlas,
+};
 pub use traverse::{Hit, Ray, intersect, intersect_within, occluded};

@@ -144,6 +144,39 @@ pub struct TexelRange {
 }
 
 impl Texture {
+    /// The image at half the size (odd sides rounded up, the last row or column then
+    /// averaged with itself): each texel the mean of the 2×2 it covers, byte by byte in the
+    /// stored encoding (sRGB for colours, so a high-contrast edge comes out slightly darker
+    /// than a linear mean would make it).
+    #[must_use]
+    pub fn halved(&self) -> Self {
+        let (w, h) = (self.width.div_ceil(2), self.height.div_ceil(2));
+        let at = |x: u32, y: u32| {
+            self.texels[(y.min(self.height - 1) * self.width + x.min(self.width - 1)) as usize]
+        };
+        let mut texels = Vec::with_capacity(w as usize * h as usize);
+        for y in 0..h {
+            for x in 0..w {
+                let q = [
+                    at(2 * x, 2 * y),
+                    at(2 * x + 1, 2 * y),
+                    at(2 * x, 2 * y + 1),
+                    at(2 * x + 1, 2 * y + 1),
+                ];
+                texels.push(std::array::from_fn(|c| {
+                    let sum: u32 = q.iter().map(|p| u32::from(p[c])).sum();
+                    u8::try_from((sum + 2) / 4).unwrap_or(u8::MAX)
+                }));
+            }
+        }
+        Self {
+            width: w,
+            height: h,
+            texels: texels.into(),
+            ..self.clone()
+        }
+    }
+
     /// The range of each channel over every texel (bilinear filtering stays within it).
     pub fn range(&self) -> TexelRange {
         let mut r = TexelRange {
@@ -347,17 +380,9 @@ impl TextureAtlas {
     }
 }
 
-/// The smallest page side: pages of tiny textures are not made smaller than this.
-pub const ATLAS_MIN_PAGE: u32 = 256;
-
-/// Places the images of `textures` in pages of one size (shelf packing, tallest first:
-/// images whose sides are powers of two fill pages without gaps) and copies their texels
-/// there; textures sharing an image ([`Texture::texels`], the same [`Arc`]) share its place.
-pub fn pack_atlas(all: &[Texture]) -> TextureAtlas {
-    if all.is_empty() {
-        return TextureAtlas::default();
-    }
-    // One entry per image: the first texture showing it.
+/// One entry per image: for each texture the index of its image, and the first texture
+/// showing each image (textures sharing [`Texture::texels`], the same [`Arc`], share it).
+fn images(all: &[Texture]) -> (Vec<usize>, Vec<&Texture>) {
     let mut image_of = Vec::with_capacity(all.len());
     let mut first: std::collections::HashMap<*const [u8; 4], usize> =
         std::collections::HashMap::new();
@@ -369,37 +394,172 @@ pub fn pack_atlas(all: &[Texture]) -> TextureAtlas {
         });
         image_of.push(at);
     }
-    let side = textures
-        .iter()
-        .map(|t| t.width.max(t.height))
-        .max()
-        .unwrap_or(1);
+    (image_of, textures)
+}
+
+/// Where images of the given sizes go in an atlas.
+struct AtlasLayout {
+    /// The page side.
+    page: u32,
+    /// Pages used.
+    pages: u32,
+    /// Per image: x, y and page.
+    place: Vec<(u32, u32, u32)>,
+}
+
+/// Shelf packing of images of `sizes` (width, height) in pages of one size, tallest first.
+fn atlas_layout(sizes: &[(u32, u32)]) -> AtlasLayout {
+    let side = sizes.iter().map(|&(w, h)| w.max(h)).max().unwrap_or(1);
     let page = side.next_power_of_two().max(ATLAS_MIN_PAGE);
-    let mut order: Vec<usize> = (0..textures.len()).collect();
+    let mut order: Vec<usize> = (0..sizes.len()).collect();
     order.sort_by_key(|&i| {
         (
-            std::cmp::Reverse(textures[i].height),
-            std::cmp::Reverse(textures[i].width),
+            std::cmp::Reverse(sizes[i].1),
+            std::cmp::Reverse(sizes[i].0),
             i,
         )
     });
     // Shelves: rows of textures left to right; a new shelf under the last, a new page when
     // the page is full.
     let (mut p, mut x, mut y, mut shelf) = (0u32, 0u32, 0u32, 0u32);
-    let mut place = vec![(0u32, 0u32, 0u32); textures.len()];
+    let mut place = vec![(0u32, 0u32, 0u32); sizes.len()];
     for &i in &order {
-        let t = &textures[i];
-        if x + t.width > page {
+        let (w, h) = sizes[i];
+        if x + w > page {
             (x, y, shelf) = (0, y + shelf, 0);
         }
-        if y + t.height > page {
+        if y + h > page {
             (p, x, y, shelf) = (p + 1, 0, 0, 0);
         }
         place[i] = (x, y, p);
-        x += t.width;
-        shelf = shelf.max(t.height);
+        x += w;
+        shelf = shelf.max(h);
     }
-    let pages = p + 1;
+    AtlasLayout {
+        page,
+        pages: p + 1,
+        place,
+    }
+}
+
+/// What an atlas may use: its page side and page count (a device's largest 2D texture and
+/// array layers) and, if given, its bytes of texels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AtlasLimits {
+    /// The largest page side, in texels.
+    pub max_side: u32,
+    /// The most pages.
+    pub max_pages: u32,
+    /// The most bytes of texels in all pages (a memory budget), if any.
+    pub max_bytes: Option<u64>,
+}
+
+impl AtlasLimits {
+    /// Whether an atlas of `pages` pages of `page`² texels fits.
+    pub fn hold(&self, page: u32, pages: u32) -> bool {
+        let bytes = 4 * u64::from(page) * u64::from(page) * u64::from(pages);
+        page <= self.max_side
+            && pages <= self.max_pages
+            && self.max_bytes.is_none_or(|b| bytes <= b)
+    }
+}
+
+/// An image made smaller to fit an atlas's limits ([`fit_textures`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Downscaled {
+    /// The first texture showing the image ([`Texture::name`]).
+    pub name: String,
+    /// Its size before, width and height.
+    pub from: (u32, u32),
+    /// And after.
+    pub to: (u32, u32),
+}
+
+/// The textures with their images halved, largest first, until their atlas fits `limits`
+/// (each image halved at most until it is 1×1), and what was made smaller; `None` when even
+/// then they do not fit. Textures that share an image share its smaller one.
+pub fn fit_textures(
+    all: &[Texture],
+    limits: AtlasLimits,
+) -> Option<(Vec<Texture>, Vec<Downscaled>)> {
+    let (image_of, textures) = images(all);
+    let mut sizes: Vec<(u32, u32)> = textures.iter().map(|t| (t.width, t.height)).collect();
+    loop {
+        let layout = atlas_layout(&sizes);
+        if limits.hold(layout.page, layout.pages) {
+            break;
+        }
+        // Halve every image wider than a page may be, else the one with the most texels.
+        let too_wide: Vec<usize> = (0..sizes.len())
+            .filter(|&i| sizes[i].0.max(sizes[i].1) > limits.max_side)
+            .collect();
+        let halve = if too_wide.is_empty() {
+            let i = (0..sizes.len()).max_by_key(|&i| {
+                (
+                    u64::from(sizes[i].0) * u64::from(sizes[i].1),
+                    std::cmp::Reverse(i),
+                )
+            })?;
+            vec![i]
+        } else {
+            too_wide
+        };
+        for i in halve {
+            let (w, h) = sizes[i];
+            if (w, h) == (1, 1) {
+                return None;
+            }
+            sizes[i] = (w.div_ceil(2), h.div_ceil(2));
+        }
+    }
+    let mut notes = Vec::new();
+    let smaller: Vec<Option<Arc<[[u8; 4]]>>> = textures
+        .iter()
+        .zip(&sizes)
+        .map(|(t, &size)| {
+            if size == (t.width, t.height) {
+                return None;
+            }
+            notes.push(Downscaled {
+                name: t.name.clone(),
+                from: (t.width, t.height),
+                to: size,
+            });
+            let mut img = (*t).clone();
+            while (img.width, img.height) != size {
+                img = img.halved();
+            }
+            Some(img.texels)
+        })
+        .collect();
+    let out = all
+        .iter()
+        .zip(&image_of)
+        .map(|(t, &i)| {
+            let mut t = t.clone();
+            if let Some(texels) = &smaller[i] {
+                (t.width, t.height) = sizes[i];
+                t.texels = Arc::clone(texels);
+            }
+            t
+        })
+        .collect();
+    Some((out, notes))
+}
+
+/// The smallest page side: pages of tiny textures are not made smaller than this.
+pub const ATLAS_MIN_PAGE: u32 = 256;
+
+/// Places the images of `textures` in pages of one size (shelf packing, tallest first:
+/// images whose sides are powers of two fill pages without gaps) and copies their texels
+/// there; textures sharing an image ([`Texture::texels`], the same [`Arc`]) share its place.
+pub fn pack_atlas(all: &[Texture]) -> TextureAtlas {
+    if all.is_empty() {
+        return TextureAtlas::default();
+    }
+    let (image_of, textures) = images(all);
+    let sizes: Vec<(u32, u32)> = textures.iter().map(|t| (t.width, t.height)).collect();
+    let AtlasLayout { page, pages, place } = atlas_layout(&sizes);
     let page_texels = page as usize * page as usize;
     let mut texels = vec![0u32; page_texels * pages as usize];
     for (t, &(x, y, p)) in textures.iter().zip(&place) {

@@ -130,3 +130,86 @@ fn textures_sharing_an_image_share_its_place() {
     // Scaled (2, 4); rotated by 90° with the spec's matrix [cos sin; -sin cos]: (4, -2).
     assert!((p - glam::Vec2::new(4.5, -1.75)).length() < 1e-6, "{p}");
 }
+
+/// Textures of 1024², 512² (shared by two textures), 300×200 and 64²: 3 pages of 1024².
+fn to_fit() -> Vec<Texture> {
+    let mut all = vec![texture(0, 1024, 1024), texture(1, 512, 512)];
+    all.push(Texture {
+        name: "t1 again".to_owned(),
+        transform: UvTransform::khr([0.5, 0.0], 0.0, [2.0, 2.0]),
+        ..all[1].clone()
+    });
+    all.push(texture(3, 300, 200));
+    all.push(texture(4, 64, 64));
+    all
+}
+
+#[test]
+fn fitting_halves_the_largest_images_until_the_atlas_fits() {
+    use lumagraph_scene::{AtlasLimits, fit_textures};
+    let all = to_fit();
+    let before = pack_atlas(&all);
+    assert_eq!((before.page_size, before.pages), (1024, 2));
+    let limits = |max_side, max_pages, max_bytes| AtlasLimits {
+        max_side,
+        max_pages,
+        max_bytes,
+    };
+    // Fits already: nothing changes.
+    let (same, notes) = fit_textures(&all, limits(1024, 2, None)).unwrap();
+    assert!(notes.is_empty());
+    assert_eq!(pack_atlas(&same).texels, before.texels);
+    // One page: the 1024² image halved, then the largest again until one page holds all.
+    let (fitted, notes) = fit_textures(&all, limits(16384, 1, None)).unwrap();
+    let after = pack_atlas(&fitted);
+    assert_eq!(after.pages, 1);
+    assert_eq!(notes[0].name, "t0");
+    assert_eq!(notes[0].from, (1024, 1024));
+    assert!(notes[0].to.0 < 1024);
+    assert!(
+        notes.iter().all(|n| n.name != "t4"),
+        "the smallest image stays: {notes:?}"
+    );
+    // Two textures that shared an image share its smaller one, each with its own transform.
+    assert!(std::sync::Arc::ptr_eq(&fitted[1].texels, &fitted[2].texels));
+    assert_eq!(fitted[1].width, fitted[2].width);
+    assert_eq!(fitted[2].transform, all[2].transform);
+    // A largest side: every image wider is halved until it is not.
+    let (fitted, _) = fit_textures(&all, limits(256, 64, None)).unwrap();
+    assert_eq!(
+        fitted
+            .iter()
+            .map(|t| (t.width, t.height))
+            .collect::<Vec<_>>(),
+        [(256, 256), (256, 256), (256, 256), (150, 100), (64, 64)]
+    );
+    // A byte budget: one page of 256² is the least an atlas takes.
+    let (fitted, _) = fit_textures(&all, limits(16384, 64, Some(4 * 256 * 256))).unwrap();
+    let after = pack_atlas(&fitted);
+    assert_eq!((after.page_size, after.pages), (256, 1));
+    assert!(fit_textures(&all, limits(16384, 64, Some(4 * 256 * 256 - 1))).is_none());
+}
+
+#[test]
+fn a_halved_image_averages_each_two_by_two_block() {
+    let t = Texture {
+        texels: vec![
+            [0, 10, 255, 255],
+            [4, 10, 255, 0],
+            [9, 30, 0, 255],
+            [8, 10, 255, 255],
+            [3, 50, 0, 0],
+            [100, 200, 0, 255],
+        ]
+        .into(),
+        width: 3,
+        height: 2,
+        ..texture(0, 1, 1)
+    };
+    let h = t.halved();
+    assert_eq!((h.width, h.height), (2, 1));
+    // (0 + 4 + 8 + 3) / 4 = 3.75 -> 4; the odd column averaged with itself.
+    assert_eq!(h.texels[0], [4, 20, 191, 128]);
+    assert_eq!(h.texels[1], [55, 115, 0, 255]);
+    assert_eq!((h.wrap, h.nearest, h.uv_set), (t.wrap, t.nearest, t.uv_set));
+}
