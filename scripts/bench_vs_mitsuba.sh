@@ -58,7 +58,7 @@ if [ -n "${SPONZA:-}" ]; then
         -e "s|width: 128, height: 128|width: 256, height: 160|" \
         tests/scenes/sponza_diffuse.ron > "$tmp/sponza.ron"
     $lg_bin export "$tmp/sponza.ron" --out "$tmp/sponza" > /dev/null
-    out=$($lg_bin bench --scene "$tmp/sponza.ron" --spp "$spp" --runs 3)
+    out=$($lg_bin bench --scene "$tmp/sponza.ron" --spp "$spp" --runs 3 --specialized-only)
     echo "$out"
     lg_s=$(specialized <<< "$out")
     out=$("$py" scripts/bench/mitsuba_time.py "$tmp/sponza" --spp "$spp" --runs 3)

@@ -432,17 +432,65 @@ impl Kernel {
                 cache: None,
             })
         };
-        let pipeline = create("main");
-        let entries: Vec<_> = entry_points
-            .iter()
-            .map(|e| ((*e).to_owned(), create(e)))
+        // The entry points' pipelines on as many threads as there are cores: a driver
+        // compiles the whole program for each (over a second each on a CPU adapter for the
+        // path tracer's host intersection steps), and nothing orders them. No more threads
+        // than cores: each compilation holds hundreds of MiB while it runs. Error scopes are
+        // per thread.
+        let names: Vec<&str> = std::iter::once("main")
+            .chain(entry_points.iter().copied())
             .collect();
-        if let Some(e) = pollster::block_on(scope.pop()) {
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let threads = std::thread::available_parallelism()
+            .map_or(1, std::num::NonZero::get)
+            .min(names.len());
+        let mut made: Vec<(usize, wgpu::ComputePipeline, Option<wgpu::Error>)> =
+            std::thread::scope(|s| {
+                let workers: Vec<_> = (0..threads)
+                    .map(|_| {
+                        s.spawn(|| {
+                            let mut out = Vec::new();
+                            loop {
+                                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                                let Some(&e) = names.get(i) else { break out };
+                                let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+                                let p = create(e);
+                                out.push((i, p, pollster::block_on(scope.pop())));
+                            }
+                        })
+                    })
+                    .collect();
+                workers
+                    .into_iter()
+                    .flat_map(|t| {
+                        t.join()
+                            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+                    })
+                    .collect()
+            });
+        made.sort_by_key(|m| m.0);
+        let mut first_error = pollster::block_on(scope.pop());
+        let mut pipelines = Vec::with_capacity(made.len());
+        for (_, p, e) in made {
+            first_error = first_error.or(e);
+            pipelines.push(p);
+        }
+        if let Some(e) = first_error {
             return Err(RenderError::Shader {
                 name: label.to_owned(),
                 message: e.to_string(),
             });
         }
+        let mut pipelines = pipelines.into_iter();
+        let pipeline = pipelines.next().ok_or_else(|| RenderError::Shader {
+            name: label.to_owned(),
+            message: "no pipeline was made".to_owned(),
+        })?;
+        let entries: Vec<_> = entry_points
+            .iter()
+            .map(|e| (*e).to_owned())
+            .zip(pipelines)
+            .collect();
         Ok(Self {
             label: label.to_owned(),
             pipeline,
