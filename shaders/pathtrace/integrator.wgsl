@@ -86,18 +86,40 @@ fn path_step_from(hit: Hit, may_miss: bool) -> bool {
     return ended;
 }
 
+// `path_step_from` for a ray that hit nothing, without the code of a surface's bounce (which
+// a compiler would otherwise build for the host's step of misses, `wave_misses`, and throw
+// away only after all the work: seconds on llvmpipe).
+fn path_step_missed() -> bool {
+    var p = path;
+    var next = bounce_through(&p, Hit(NO_HIT, F32_MAX, 0.0, 0.0));
+    if next == BOUNCE_GOES_ON {
+        add_escaped(&p);
+        next = PATH_ENDS;
+    }
+    p.bounce += 1u;
+    path = p;
+    return next == PATH_ENDS;
+}
+
+// The start of every bounce: the ray counted, and the medium it travels in, which may end the
+// bounce (scattered, absorbed) before the ray reaches `hit`.
+fn bounce_through(p: ptr<function, PathState>, hit: Hit) -> u32 {
+    ray_count += 1u;
+    if HAS_MEDIA && medium_id != NO_MEDIUM {
+        return through_medium(p, hit, HAS_LIGHTS && frame.header.num_lights > 0u);
+    }
+    return BOUNCE_GOES_ON;
+}
+
 // One bounce of path `p`, whose ray's closest hit is `hit`: through the medium the ray
 // travels in, then out of the scene, across an index-matched boundary, or at a surface
 // (emission found, next-event estimation, the BSDF's next direction).
 fn bounce_path(p: ptr<function, PathState>, hit: Hit, may_miss: bool) -> u32 {
-    ray_count += 1u;
-    let has_lights = HAS_LIGHTS && frame.header.num_lights > 0u;
-    if HAS_MEDIA && medium_id != NO_MEDIUM {
-        let next = through_medium(p, hit, has_lights);
-        if next != BOUNCE_GOES_ON {
-            return next;
-        }
+    let through = bounce_through(p, hit);
+    if through != BOUNCE_GOES_ON {
+        return through;
     }
+    let has_lights = HAS_LIGHTS && frame.header.num_lights > 0u;
     if may_miss && hit.prim == NO_HIT {
         add_escaped(p);
         return PATH_ENDS;

@@ -114,101 +114,123 @@ fn wave_list_at() -> u32 {
     return WAVE_LIST_AT * wave_slots();
 }
 
-// One step of the paths of window slot `slot`, the `j`-th of the step (see above).
-fn wave_step(slot: u32, j: u32, kind: u32) {
-    let at = vec2u(slot % frame.window.z, slot / frame.window.z);
-    let w = frame.settings.width;
-    let h = frame.settings.height;
-    let pixel = at + frame.window.xy;
-    let n = frame.samples_per_frame;
-    let slots = wave_slots();
-    let pixel_index = pixel.y * w + pixel.x;
-    let end = frame.chunk_first + frame.chunk_count;
-    var flags = 0u;
-    var i = frame.chunk_first;
-    var sum = vec3f(0.0);
-    var dropped = 0u;
+// A slot's state through a step: what `wave_load` reads, the step moves on and
+// `wave_store` writes.
+struct WaveSlot {
+    // The window slot, and its sections of `wave` (see `save_slot`).
+    slot: u32,
+    b: u32,
+    c: u32,
+    pixel: vec2u,
+    pixel_index: u32,
+    flags: u32,
+    // The sample being traced, the pixel's sum and its dropped samples.
+    i: u32,
+    sum: vec3f,
+    dropped: u32,
     // Whether the sum or the sample moved on (a path ended): [6] and [7] are saved.
-    var moved = true;
+    moved: bool,
+    // The path ended (before the step, or by it).
+    ended: bool,
+    // The host's `WaveHit` of the slot's ray.
+    hit: vec4u,
+}
+
+// The state of window slot `slot`, the `j`-th of the step (see above), into the path
+// globals: a new path for a `WAVE_KIND_START` step, else the path in flight, with the answer
+// to its shadow ray added.
+fn wave_load(slot: u32, j: u32, kind: u32) -> WaveSlot {
+    let at = vec2u(slot % frame.window.z, slot / frame.window.z);
+    let pixel = at + frame.window.xy;
+    let slots = wave_slots();
+    var s = WaveSlot(slot, 0u, 0u, pixel, pixel.y * frame.settings.width + pixel.x, 0u, frame.chunk_first, vec3f(0.0), 0u, true, false, vec4u(0u));
     host_shadow.pending = false;
     host_shadow.contribution = vec3f(0.0);
     // The slot's state: what every step moves, then the rest (see `save_slot`).
-    let b = WAVE_HOT_VEC4S * (slot - frame.wave_base);
-    let c = WAVE_HOT_VEC4S * slots + WAVE_COLD_VEC4S * (slot - frame.wave_base);
+    s.b = WAVE_HOT_VEC4S * (slot - frame.wave_base);
+    s.c = WAVE_HOT_VEC4S * slots + WAVE_COLD_VEC4S * (slot - frame.wave_base);
     if kind == WAVE_KIND_START {
-        sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler, n, frame.replicates);
+        sampler_init(s.pixel_index, frame.sample_offset + s.i, frame.settings.seed, frame.sampler, frame.samples_per_frame, frame.replicates);
         start_path(pixel);
-    } else {
-        moved = false;
-        let s0 = wave[b];
-        let s1 = wave[b + 1u];
-        let s2 = wave[b + 2u];
-        // No origin: a hit's point comes from its triangle's barycentrics.
-        path.ray = Ray(vec3f(0.0), bitcast<vec3f>(s0.xyz));
-        path.bsdf_pdf = bitcast<f32>(s0.w);
-        path.throughput = bitcast<vec3f>(s1.xyz);
-        rng_state = s1.w;
-        path.radiance = bitcast<vec3f>(s2.xyz);
-        path.bounce = s2.w & SLOT_BOUNCE_MASK;
-        flags = s2.w >> SLOT_FLAGS_SHIFT;
-        if HAS_LIGHTS || HAS_MEDIA {
-            let s3 = wave[c];
-            path.prev_p = bitcast<vec3f>(s3.xyz);
-            path.crossings = s3.w;
-        }
-        sampler_sobol = frame.sampler == SAMPLER_SOBOL;
-        // The `WaveHit` of this slot's ray; the sign bit of its `t` answers the shadow ray.
-        let hv = wave[WAVE_HITS_AT * slots + j];
-        let shadow_out = (flags & SLOT_SHADOW) != 0u;
-        if shadow_out || path.bounce == 0u {
-            let s4 = wave[c + 1u];
-            sampler_index = s4.w;
-            if shadow_out && (hv.x >> 31u) == 0u {
-                path.radiance += bitcast<vec3f>(s4.xyz);
-            }
-        }
-        if path.bounce == 0u {
-            sampler_seed = wave[c + 2u].w;
-        }
-        var ended = (flags & SLOT_ENDED) != 0u;
-        flags = 0u;
-        if !ended {
-            if kind == WAVE_KIND_MISS {
-                ended = path_step_from(Hit(NO_HIT, F32_MAX, 0.0, 0.0), true);
-            } else {
-                let t = bitcast<f32>(hv.x & 0x7fffffffu);
-                ended = path_step_from(Hit(hv.w, t, bitcast<f32>(hv.y), bitcast<f32>(hv.z)), false);
-            }
-        }
-        if ended && (host_shadow.pending || kind == WAVE_KIND_HIT) {
-            // The path's last shadow ray is still to be answered; or the path ended at a
-            // surface, and the next step's `wave_misses` adds its sample and starts the next
-            // one (so `wave_hits` carries none of that code).
-            flags = SLOT_ENDED;
-        } else if ended {
-            moved = true;
-            let s5 = wave[c + 2u];
-            sum = bitcast<vec3f>(s5.xyz);
-            sampler_seed = s5.w;
-            i = wave[c + 3u].x;
-            dropped = wave[c + 3u].y;
-            add_sample(path.radiance, &sum, &dropped);
-            i++;
-            if i >= end {
-                flags = SLOT_DONE;
-                chunk_sums[slot] = vec4f(sum, 0.0);
-                if dropped > 0u {
-                    atomicAdd(&stats[0], dropped);
-                }
-            } else {
-                sampler_init(pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler, n, frame.replicates);
-                start_path(pixel);
-            }
+        return s;
+    }
+    s.moved = false;
+    let s0 = wave[s.b];
+    let s1 = wave[s.b + 1u];
+    let s2 = wave[s.b + 2u];
+    // No origin: a hit's point comes from its triangle's barycentrics.
+    path.ray = Ray(vec3f(0.0), bitcast<vec3f>(s0.xyz));
+    path.bsdf_pdf = bitcast<f32>(s0.w);
+    path.throughput = bitcast<vec3f>(s1.xyz);
+    rng_state = s1.w;
+    path.radiance = bitcast<vec3f>(s2.xyz);
+    path.bounce = s2.w & SLOT_BOUNCE_MASK;
+    let flags = s2.w >> SLOT_FLAGS_SHIFT;
+    if HAS_LIGHTS || HAS_MEDIA {
+        let s3 = wave[s.c];
+        path.prev_p = bitcast<vec3f>(s3.xyz);
+        path.crossings = s3.w;
+    }
+    sampler_sobol = frame.sampler == SAMPLER_SOBOL;
+    // The `WaveHit` of this slot's ray; the sign bit of its `t` answers the shadow ray.
+    s.hit = wave[WAVE_HITS_AT * slots + j];
+    let shadow_out = (flags & SLOT_SHADOW) != 0u;
+    if shadow_out || path.bounce == 0u {
+        let s4 = wave[s.c + 1u];
+        sampler_index = s4.w;
+        if shadow_out && (s.hit.x >> 31u) == 0u {
+            path.radiance += bitcast<vec3f>(s4.xyz);
         }
     }
-    // The slot's `WaveRays`, written word by word (fewer stores where a ray is absent). The
-    // rays leave from one point (`leave`): the next ray's origin is the shadow ray's.
+    if path.bounce == 0u {
+        sampler_seed = wave[s.c + 2u].w;
+    }
+    s.ended = (flags & SLOT_ENDED) != 0u;
+    return s;
+}
+
+// After a step of a `kind` other than `WAVE_KIND_START`: a path that ended adds its sample
+// and the slot starts the next one, or is done; or it waits, flagged, for the next step to
+// do so.
+fn wave_settle(s: ptr<function, WaveSlot>, kind: u32) {
+    (*s).flags = 0u;
+    if (*s).ended && (host_shadow.pending || kind == WAVE_KIND_HIT) {
+        // The path's last shadow ray is still to be answered; or the path ended at a
+        // surface, and the next step's `wave_misses` adds its sample and starts the next
+        // one (so `wave_hits` carries none of that code).
+        (*s).flags = SLOT_ENDED;
+    } else if (*s).ended {
+        (*s).moved = true;
+        let s5 = wave[(*s).c + 2u];
+        var sum = bitcast<vec3f>(s5.xyz);
+        var dropped = wave[(*s).c + 3u].y;
+        sampler_seed = s5.w;
+        var i = wave[(*s).c + 3u].x;
+        add_sample(path.radiance, &sum, &dropped);
+        i++;
+        if i >= frame.chunk_first + frame.chunk_count {
+            (*s).flags = SLOT_DONE;
+            chunk_sums[(*s).slot] = vec4f(sum, 0.0);
+            if dropped > 0u {
+                atomicAdd(&stats[0], dropped);
+            }
+        } else {
+            sampler_init((*s).pixel_index, frame.sample_offset + i, frame.settings.seed, frame.sampler, frame.samples_per_frame, frame.replicates);
+            start_path((*s).pixel);
+        }
+        (*s).i = i;
+        (*s).sum = sum;
+        (*s).dropped = dropped;
+    }
+}
+// The rays of the slot's step, the `j`-th: its `WaveRays`, written word by word (fewer
+// stores where a ray is absent), and where the wavefront traces them, how they leave their
+// surface; then the slot's state.
+fn wave_store(s: WaveSlot, j: u32) {
+    let slots = wave_slots();
+    // The rays leave from one point (`leave`): the next ray's origin is the shadow ray's.
     let r = WAVE_RAYS_AT * slots + WAVE_RAYS_VEC4S * j;
+    var flags = s.flags;
     let next = flags == 0u;
     if next || host_shadow.pending {
         let origin = select(host_shadow.ray.origin, path.ray.origin, next);
@@ -239,54 +261,110 @@ fn wave_step(slot: u32, j: u32, kind: u32) {
         wave[l] = vec4u(bitcast<vec3u>(origin_n), skip_prim);
         wave[l + 1u] = vec4u(bitcast<vec3u>(origin_err), select(0u, 1u, other_side));
     }
-    save_slot(b, c, flags, moved, i, sum, dropped);
+    save_slot(s.b, s.c, flags, s.moved, s.i, s.sum, s.dropped);
 }
 
-// The steps of host intersection, one entry point per kind of step, each compiled on its
-// own: llvmpipe runs the code behind every `if`, taken or not, so a step that started paths,
-// shaded misses and shaded hits in one kernel paid for all three at every slot. The host
-// lists a step's slots whose ray missed (or that only await a shadow ray) first, then those
-// whose ray hit (`frame.wave_split` of them first), and dispatches `wave_misses` over the
-// first and `wave_hits` over the others; `wave_start` starts the batch's first paths.
+// The steps of host intersection and of the wavefront, one entry point per kind of step,
+// each compiled on its own: llvmpipe runs the code behind every `if`, taken or not, so a
+// step that started paths, shaded misses and shaded hits in one kernel paid for all three at
+// every slot. The host lists a step's slots whose ray missed (or that only await a shadow
+// ray) first, then those whose ray hit (`frame.wave_split` of them first), and dispatches
+// `wave_misses` over the first and `wave_hits` over the others; `wave_start` starts the
+// batch's first paths. Each kind has its own step function, and no entry point calls another
+// kind's: a driver builds all the code an entry point can reach before it leaves out what a
+// constant rules out, and the path step's surface code reached from all three cost over a
+// second of compilation each on llvmpipe (`wave_start` took 1.2 s, 8 ms without it).
 const WAVE_KIND_START: u32 = 0u;
 const WAVE_KIND_MISS: u32 = 1u;
 const WAVE_KIND_HIT: u32 = 2u;
 
-// A 1D dispatch: each invocation takes the listed slots of its kind one `threads` apart:
-// llvmpipe pays a fixed cost per invocation, as much as a step of a path when the kernel is
-// this large, so an invocation per slot would pay it for every step.
-fn wave_run(kind: u32, group: u32, groups: u32, lane: u32) {
-    if WAVEFRONT {
-        wavefront_run(kind, group * 64u + lane, lane);
-        return;
+// A step starting slot `slot`'s first path (the `j`-th slot of the step).
+fn wave_step_start(slot: u32, j: u32) {
+    let s = wave_load(slot, j, WAVE_KIND_START);
+    wave_store(s, j);
+}
+
+// A step of a path whose ray missed (or that awaits only its shadow ray's answer).
+fn wave_step_miss(slot: u32, j: u32) {
+    var s = wave_load(slot, j, WAVE_KIND_MISS);
+    if !s.ended {
+        s.ended = path_step_missed();
     }
+    wave_settle(&s, WAVE_KIND_MISS);
+    wave_store(s, j);
+}
+
+// A step of a path whose ray hit a surface.
+fn wave_step_hit(slot: u32, j: u32) {
+    var s = wave_load(slot, j, WAVE_KIND_HIT);
+    if !s.ended {
+        let t = bitcast<f32>(s.hit.x & 0x7fffffffu);
+        s.ended = path_step_from(Hit(s.hit.w, t, bitcast<f32>(s.hit.y), bitcast<f32>(s.hit.z)), false);
+    }
+    wave_settle(&s, WAVE_KIND_HIT);
+    wave_store(s, j);
+}
+
+// The positions of the host's list a kind's dispatch takes, as (first, end, stride): each
+// invocation takes the listed slots of its kind one `threads` apart. A 1D dispatch: llvmpipe
+// pays a fixed cost per invocation, as much as a step of a path when the kernel is this
+// large, so an invocation per slot would pay it for every step.
+fn wave_range(kind: u32, group: u32, groups: u32, lane: u32) -> vec3u {
     let threads = groups * 64u;
     let count = wave_word(wave_list_at(), 0u);
     let first = select(0u, frame.wave_split, kind == WAVE_KIND_HIT);
     let end = select(count, min(frame.wave_split, count), kind == WAVE_KIND_MISS);
-    for (var j = first + group * 64u + lane; j < end; j += threads) {
-        wave_step(wave_word(wave_list_at(), 1u + j), j, kind);
-    }
+    return vec3u(first + group * 64u + lane, end, threads);
 }
 
 @compute @workgroup_size(8, 8)
 fn wave_start(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) groups: vec3u, @builtin(local_invocation_index) lane: u32) {
     if WAVES {
-        wave_run(WAVE_KIND_START, group.x, groups.x, lane);
+        if WAVEFRONT {
+            let at = wavefront_slot(WAVE_KIND_START, group.x * 64u + lane, lane);
+            if at.x != NO_SLOT {
+                wave_step_start(at.x, at.y);
+            }
+            return;
+        }
+        let r = wave_range(WAVE_KIND_START, group.x, groups.x, lane);
+        for (var j = r.x; j < r.y; j += r.z) {
+            wave_step_start(wave_word(wave_list_at(), 1u + j), j);
+        }
     }
 }
 
 @compute @workgroup_size(8, 8)
 fn wave_misses(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) groups: vec3u, @builtin(local_invocation_index) lane: u32) {
     if WAVES {
-        wave_run(WAVE_KIND_MISS, group.x, groups.x, lane);
+        if WAVEFRONT {
+            let at = wavefront_slot(WAVE_KIND_MISS, group.x * 64u + lane, lane);
+            if at.x != NO_SLOT {
+                wave_step_miss(at.x, at.y);
+            }
+            return;
+        }
+        let r = wave_range(WAVE_KIND_MISS, group.x, groups.x, lane);
+        for (var j = r.x; j < r.y; j += r.z) {
+            wave_step_miss(wave_word(wave_list_at(), 1u + j), j);
+        }
     }
 }
 
 @compute @workgroup_size(8, 8)
 fn wave_hits(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) groups: vec3u, @builtin(local_invocation_index) lane: u32) {
     if WAVES {
-        wave_run(WAVE_KIND_HIT, group.x, groups.x, lane);
+        if WAVEFRONT {
+            let at = wavefront_slot(WAVE_KIND_HIT, group.x * 64u + lane, lane);
+            if at.x != NO_SLOT {
+                wave_step_hit(at.x, at.y);
+            }
+            return;
+        }
+        let r = wave_range(WAVE_KIND_HIT, group.x, groups.x, lane);
+        for (var j = r.x; j < r.y; j += r.z) {
+            wave_step_hit(wave_word(wave_list_at(), 1u + j), j);
+        }
     }
 }
 
@@ -316,9 +394,13 @@ fn wavefront_load_counts(list: u32, lane: u32) {
     workgroupBarrier();
 }
 
+// No slot for the invocation (`wavefront_slot`).
+const NO_SLOT: u32 = 0xffffffffu;
+
 // A step of the wavefront: invocation `i` of a dispatch over the batch's slots takes the
-// i-th slot of its kind in the step's list (misses from its start, hits from its end).
-fn wavefront_run(kind: u32, i: u32, lane: u32) {
+// i-th slot of its kind in the step's list (misses from its start, hits from its end); its
+// slot and position in the list, or `NO_SLOT`.
+fn wavefront_slot(kind: u32, i: u32, lane: u32) -> vec2u {
     let slots = wave_slots();
     let list = frame.wave_list;
     wavefront_load_counts(list, lane);
@@ -334,11 +416,12 @@ fn wavefront_run(kind: u32, i: u32, lane: u32) {
     if kind == WAVE_KIND_HIT {
         if i < hits {
             let j = slots - hits + i;
-            wave_step(wave_word(wavefront_list_at(list), j), j, kind);
+            return vec2u(wave_word(wavefront_list_at(list), j), j);
         }
     } else if i < misses {
-        wave_step(wave_word(wavefront_list_at(list), i), i, kind);
+        return vec2u(wave_word(wavefront_list_at(list), i), i);
     }
+    return vec2u(NO_SLOT, 0u);
 }
 
 // What `wavefront_trace` found for a position of the step's list: the slot, the hit of its
