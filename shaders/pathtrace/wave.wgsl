@@ -305,11 +305,18 @@ fn wave_step_hit(slot: u32, j: u32) {
     wave_store(s, j);
 }
 
-// The positions of the host's list a kind's dispatch takes, as (first, end, stride): each
-// invocation takes the listed slots of its kind one `threads` apart. A 1D dispatch: llvmpipe
-// pays a fixed cost per invocation, as much as a step of a path when the kernel is this
-// large, so an invocation per slot would pay it for every step.
+// The positions of the step's list a kind's dispatch takes, as (first, end, stride).
+// Host intersection: each invocation takes the listed slots of its kind one `threads` apart
+// (a 1D dispatch: llvmpipe pays a fixed cost per invocation, as much as a step of a path
+// when the kernel is this large, so an invocation per slot would pay it for every step).
+// The wavefront: invocation `i` of a dispatch over the batch's slots takes the i-th slot of
+// its kind (misses from the list's start, hits from its end), if there is one.
 fn wave_range(kind: u32, group: u32, groups: u32, lane: u32) -> vec3u {
+    if WAVEFRONT {
+        let i = group * 64u + lane;
+        let j = wavefront_position(kind, i, lane);
+        return vec3u(j, select(j, j + 1u, j != NO_SLOT), 1u);
+    }
     let threads = groups * 64u;
     let count = wave_word(wave_list_at(), 0u);
     let first = select(0u, frame.wave_split, kind == WAVE_KIND_HIT);
@@ -317,19 +324,20 @@ fn wave_range(kind: u32, group: u32, groups: u32, lane: u32) -> vec3u {
     return vec3u(first + group * 64u + lane, end, threads);
 }
 
+// The slot at position `j` of the step's list.
+fn wave_listed(j: u32) -> u32 {
+    if WAVEFRONT {
+        return wave_word(wavefront_list_at(frame.wave_list), j);
+    }
+    return wave_word(wave_list_at(), 1u + j);
+}
+
 @compute @workgroup_size(8, 8)
 fn wave_start(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) groups: vec3u, @builtin(local_invocation_index) lane: u32) {
     if WAVES {
-        if WAVEFRONT {
-            let at = wavefront_slot(WAVE_KIND_START, group.x * 64u + lane, lane);
-            if at.x != NO_SLOT {
-                wave_step_start(at.x, at.y);
-            }
-            return;
-        }
         let r = wave_range(WAVE_KIND_START, group.x, groups.x, lane);
         for (var j = r.x; j < r.y; j += r.z) {
-            wave_step_start(wave_word(wave_list_at(), 1u + j), j);
+            wave_step_start(wave_listed(j), j);
         }
     }
 }
@@ -337,16 +345,9 @@ fn wave_start(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) grou
 @compute @workgroup_size(8, 8)
 fn wave_misses(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) groups: vec3u, @builtin(local_invocation_index) lane: u32) {
     if WAVES {
-        if WAVEFRONT {
-            let at = wavefront_slot(WAVE_KIND_MISS, group.x * 64u + lane, lane);
-            if at.x != NO_SLOT {
-                wave_step_miss(at.x, at.y);
-            }
-            return;
-        }
         let r = wave_range(WAVE_KIND_MISS, group.x, groups.x, lane);
         for (var j = r.x; j < r.y; j += r.z) {
-            wave_step_miss(wave_word(wave_list_at(), 1u + j), j);
+            wave_step_miss(wave_listed(j), j);
         }
     }
 }
@@ -354,16 +355,9 @@ fn wave_misses(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) gro
 @compute @workgroup_size(8, 8)
 fn wave_hits(@builtin(workgroup_id) group: vec3u, @builtin(num_workgroups) groups: vec3u, @builtin(local_invocation_index) lane: u32) {
     if WAVES {
-        if WAVEFRONT {
-            let at = wavefront_slot(WAVE_KIND_HIT, group.x * 64u + lane, lane);
-            if at.x != NO_SLOT {
-                wave_step_hit(at.x, at.y);
-            }
-            return;
-        }
         let r = wave_range(WAVE_KIND_HIT, group.x, groups.x, lane);
         for (var j = r.x; j < r.y; j += r.z) {
-            wave_step_hit(wave_word(wave_list_at(), 1u + j), j);
+            wave_step_hit(wave_listed(j), j);
         }
     }
 }
@@ -394,13 +388,12 @@ fn wavefront_load_counts(list: u32, lane: u32) {
     workgroupBarrier();
 }
 
-// No slot for the invocation (`wavefront_slot`).
+// No position of the list for the invocation (`wavefront_position`).
 const NO_SLOT: u32 = 0xffffffffu;
 
-// A step of the wavefront: invocation `i` of a dispatch over the batch's slots takes the
-// i-th slot of its kind in the step's list (misses from its start, hits from its end); its
-// slot and position in the list, or `NO_SLOT`.
-fn wavefront_slot(kind: u32, i: u32, lane: u32) -> vec2u {
+// The position in the step's list of the i-th slot of kind `kind` (misses from the list's
+// start, hits from its end), or `NO_SLOT`.
+fn wavefront_position(kind: u32, i: u32, lane: u32) -> u32 {
     let slots = wave_slots();
     let list = frame.wave_list;
     wavefront_load_counts(list, lane);
@@ -415,13 +408,12 @@ fn wavefront_slot(kind: u32, i: u32, lane: u32) -> vec2u {
     let hits = wave_counts[1];
     if kind == WAVE_KIND_HIT {
         if i < hits {
-            let j = slots - hits + i;
-            return vec2u(wave_word(wavefront_list_at(list), j), j);
+            return slots - hits + i;
         }
     } else if i < misses {
-        return vec2u(wave_word(wavefront_list_at(list), i), i);
+        return i;
     }
-    return vec2u(NO_SLOT, 0u);
+    return NO_SLOT;
 }
 
 // What `wavefront_trace` found for a position of the step's list: the slot, the hit of its
