@@ -176,22 +176,41 @@ fn main(
         }
     }
     if WAVES {
-        if frame.wave == WAVE_FINISH {
-            let slot = id.y * frame.window.z + id.x;
-            if all(id < frame.window.zw) {
-                let n = f32(max(frame.samples_per_frame, 1u));
-                textureStore(output, id, vec4f(chunk_sums[slot].xyz / n, 1.0));
-            }
-            first_hit_aovs(id);
-            return;
-        }
-        // The steps are the entry points below.
+        // Paths traced in steps are finished by `wave_finish`, their steps are `wave.wgsl`'s.
         return;
     }
     if trace {
         trace_pixel(at);
     }
     first_hit_aovs(id);
+}
+
+// The finish of a frame traced in steps (WAVES, with `frame.wave` WAVE_FINISH): the pixels'
+// means from `chunk_sums`, and the first-hit AOVs. An entry point of its own, which reaches
+// none of the megakernel's code: such a shader does not build `main` at all (a driver builds
+// all the code an entry point can reach, a constant's `if` or not).
+@compute @workgroup_size(8, 8)
+fn wave_finish(
+    @builtin(workgroup_id) group: vec3u,
+    @builtin(num_workgroups) groups: vec3u,
+    @builtin(local_invocation_id) local: vec3u,
+) {
+    var tile = group.xy;
+    if SPREAD_WORKGROUPS {
+        tile.y = spread_row(group.y, groups.y);
+    }
+    let id = tile * 8u + local.xy;
+    if ADAPTIVE && all(id < frame.window.zw) && adaptive_stopped[id.y * frame.window.z + id.x] != 0u {
+        textureStore(output, id, vec4f(0.0));
+    }
+    if WAVES && frame.wave == WAVE_FINISH {
+        let slot = id.y * frame.window.z + id.x;
+        if all(id < frame.window.zw) {
+            let n = f32(max(frame.samples_per_frame, 1u));
+            textureStore(output, id, vec4f(chunk_sums[slot].xyz / n, 1.0));
+        }
+        first_hit_aovs(id);
+    }
 }
 
 // Adds a path's radiance `l` to `sum`, clamped (`firefly_clamp`), or counts it in `dropped`

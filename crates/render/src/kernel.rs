@@ -354,13 +354,16 @@ impl Kernel {
     /// # Errors
     /// When the shader does not compile or declares bindings kernels do not support.
     pub fn from_source(ctx: &GpuContext, label: &str, source: &str) -> Result<Self> {
-        Self::with_entries(ctx, label, source, &[])
+        Self::with_entries(ctx, label, source, "main", &[])
     }
 
-    /// [`Kernel::from_source`] with a pipeline for each of the further entry points
-    /// `entry_points` too, chosen with [`PassBuilder::entry`]: a driver compiles each entry point
-    /// on its own, with only the code it reaches (llvmpipe runs the code behind every `if`,
-    /// taken or not, so a smaller entry point runs faster).
+    /// [`Kernel::from_source`] with entry point `main` as the kernel's own pipeline (a shader
+    /// whose `main` would not run names another, and `main` is then not built), and a pipeline
+    /// for each of the further entry points `entry_points` too, chosen with
+    /// [`PassBuilder::entry`]: a driver compiles each entry point on its own, with only the code
+    /// it reaches (llvmpipe runs the code behind every `if`, taken or not, so a smaller entry
+    /// point runs faster; and it builds all the code an entry point reaches before it leaves
+    /// out what a constant rules out, so a smaller entry point also compiles faster).
     ///
     /// # Errors
     /// As [`Kernel::from_source`], and when an entry point is missing.
@@ -368,20 +371,25 @@ impl Kernel {
         ctx: &GpuContext,
         label: &str,
         source: &str,
+        main: &str,
         entry_points: &[&str],
     ) -> Result<Self> {
-        if let Some(kernel) = ctx.kernels.get(source, entry_points) {
+        let names: Vec<&str> = std::iter::once(main)
+            .chain(entry_points.iter().copied())
+            .collect();
+        if let Some(kernel) = ctx.kernels.get(source, &names) {
             return Ok(Self {
                 label: label.to_owned(),
                 ..kernel
             });
         }
-        let kernel = Self::compile(ctx, label, source, entry_points)?;
-        ctx.kernels.put(source, entry_points, &kernel);
+        let kernel = Self::compile(ctx, label, source, &names)?;
+        ctx.kernels.put(source, &names, &kernel);
         Ok(kernel)
     }
 
-    fn compile(ctx: &GpuContext, label: &str, source: &str, entry_points: &[&str]) -> Result<Self> {
+    /// `names[0]` is the kernel's own pipeline, the others its further entry points.
+    fn compile(ctx: &GpuContext, label: &str, source: &str, names: &[&str]) -> Result<Self> {
         let (bindings, workgroup) = reflect(label, source)?;
         let device = &ctx.device;
         if bindings
@@ -437,9 +445,6 @@ impl Kernel {
         // path tracer's host intersection steps), and nothing orders them. No more threads
         // than cores: each compilation holds hundreds of MiB while it runs. Error scopes are
         // per thread.
-        let names: Vec<&str> = std::iter::once("main")
-            .chain(entry_points.iter().copied())
-            .collect();
         let next = std::sync::atomic::AtomicUsize::new(0);
         let threads = std::thread::available_parallelism()
             .map_or(1, std::num::NonZero::get)
@@ -486,7 +491,7 @@ impl Kernel {
             name: label.to_owned(),
             message: "no pipeline was made".to_owned(),
         })?;
-        let entries: Vec<_> = entry_points
+        let entries: Vec<_> = names[1..]
             .iter()
             .map(|e| (*e).to_owned())
             .zip(pipelines)

@@ -372,12 +372,8 @@ impl PathTrace {
         let wavefront = features
             .on(Feature::Wavefront)
             .then(|| crate::wavefront::Wavefront::new(ctx));
-        let kernel = Kernel::with_entries(
-            ctx,
-            "pathtrace/pathtrace.wgsl",
-            &source,
-            entry_points(&features),
-        )?;
+        let (main, entries) = entry_points(&features);
+        let kernel = Kernel::with_entries(ctx, "pathtrace/pathtrace.wgsl", &source, main, entries)?;
         let env = match &scene.environment_map {
             Some(path) => crate::env_map::EnvMap::load(
                 ctx,
@@ -705,14 +701,16 @@ const WAVE_ENTRIES: [&str; 3] = ["wave_start", "wave_misses", "wave_hits"];
 /// The wavefront's: the steps, and the tracing between them ([`crate::wavefront`]).
 const WAVEFRONT_ENTRIES: [&str; 4] = ["wave_start", "wave_misses", "wave_hits", "wave_trace"];
 
-/// The entry points beside `main` that a shader of `features` runs.
-fn entry_points(features: &Features) -> &'static [&'static str] {
+/// The entry points a shader of `features` runs: the kernel's own (`main`, the megakernel;
+/// or `wave_finish` for paths traced in steps, whose `main` is then not built), and the
+/// others.
+fn entry_points(features: &Features) -> (&'static str, &'static [&'static str]) {
     if features.on(Feature::Wavefront) {
-        &WAVEFRONT_ENTRIES
+        ("wave_finish", &WAVEFRONT_ENTRIES)
     } else if features.on(Feature::HostRays) {
-        &WAVE_ENTRIES
+        ("wave_finish", &WAVE_ENTRIES)
     } else {
-        &[]
+        ("main", &[])
     }
 }
 
