@@ -434,11 +434,11 @@ fn fit_textures(loaded: &mut LoadedScene, ctx: &GpuContext, args: TextureArgs) -
     }
     let atlas = &gpu.atlas;
     println!(
-        "  {what}, over {} pages of at most {}x{}{} on {}: now {} pages of {}x{} ({:.1} MiB), {} images downscaled",
+        "  {what}, over what fits ({} pages of at most {}x{}{} on {}): now {} pages of {}x{} ({:.1} MiB), {} images downscaled",
         limits.max_pages,
         limits.max_side,
         limits.max_side,
-        budget_mib.map_or_else(String::new, |b| format!(" or {b} MiB")),
+        budget_mib.map_or_else(String::new, |b| format!(", {b} MiB in all")),
         ctx.info.name,
         atlas.pages,
         atlas.page_size,

@@ -144,6 +144,24 @@ fn spread_row(row: u32, rows: u32) -> u32 {
     return (row * stride) % rows;
 }
 
+// The tile a workgroup takes: its own, or with SPREAD_WORKGROUPS (CPU adapters) the rows of
+// tiles spread over the image, which is the same work in another order (the images are
+// bit-identical).
+fn workgroup_tile(group: vec3u, groups: vec3u) -> vec2u {
+    var tile = group.xy;
+    if SPREAD_WORKGROUPS {
+        tile.y = spread_row(group.y, groups.y);
+    }
+    return tile;
+}
+
+// With ADAPTIVE: a pixel adaptive sampling stopped takes no samples and outputs alpha 0.
+fn clear_stopped(id: vec2u) {
+    if ADAPTIVE && all(id < frame.window.zw) && adaptive_stopped[id.y * frame.window.z + id.x] != 0u {
+        textureStore(output, id, vec4f(0.0));
+    }
+}
+
 @compute @workgroup_size(8, 8)
 fn main(
     @builtin(workgroup_id) group: vec3u,
@@ -151,23 +169,15 @@ fn main(
     @builtin(local_invocation_id) local: vec3u,
     @builtin(local_invocation_index) lane: u32,
 ) {
-    // The tile this workgroup traces: the workgroup's own, or with SPREAD_WORKGROUPS (CPU
-    // adapters) the rows of tiles spread over the image, which is the same work in another
-    // order (the images are bit-identical).
-    var tile = group.xy;
-    if SPREAD_WORKGROUPS {
-        tile.y = spread_row(group.y, groups.y);
-    }
+    let tile = workgroup_tile(group, groups);
     let id = tile * 8u + local.xy;
     var at = id;
     var trace = true;
     if ADAPTIVE {
-        // A pixel adaptive sampling stopped takes no samples and outputs alpha 0. The pixels
-        // still sampling are traced by the first invocations, in the order the adaptive pass
-        // listed them (workgroup by workgroup), so whole workgroups at the end idle.
-        if all(id < frame.window.zw) && adaptive_stopped[id.y * frame.window.z + id.x] != 0u {
-            textureStore(output, id, vec4f(0.0));
-        }
+        // The pixels still sampling are traced by the first invocations, in the order the
+        // adaptive pass listed them (workgroup by workgroup), so whole workgroups at the end
+        // idle.
+        clear_stopped(id);
         let k = (tile.y * groups.x + tile.x) * 64u + lane;
         trace = k < adaptive_active[0];
         if trace {
@@ -195,14 +205,8 @@ fn wave_finish(
     @builtin(num_workgroups) groups: vec3u,
     @builtin(local_invocation_id) local: vec3u,
 ) {
-    var tile = group.xy;
-    if SPREAD_WORKGROUPS {
-        tile.y = spread_row(group.y, groups.y);
-    }
-    let id = tile * 8u + local.xy;
-    if ADAPTIVE && all(id < frame.window.zw) && adaptive_stopped[id.y * frame.window.z + id.x] != 0u {
-        textureStore(output, id, vec4f(0.0));
-    }
+    let id = workgroup_tile(group, groups) * 8u + local.xy;
+    clear_stopped(id);
     if WAVES && frame.wave == WAVE_FINISH {
         let slot = id.y * frame.window.z + id.x;
         if all(id < frame.window.zw) {
