@@ -338,14 +338,27 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
     let (gpu, bvh_time) = GpuScene::build_timed(&scene)?;
     let layout = built.elapsed();
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    let instanced = if gpu.instances.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " (of which {} stored once for {} instances of {} meshes, placing {} triangles)",
+            gpu.tri_positions.len() - gpu.tri_source.len(),
+            gpu.instances.len(),
+            scene.instanced.len(),
+            gpu.instanced_triangles
+        )
+    };
     println!(
-        "scene {}: {} triangles, {} spheres, {} lights, {} textures, {} BVH nodes ({:.0} ms)",
+        "scene {}: {} triangles{instanced}, {} spheres, {} lights, {} textures, {} BVH nodes, \
+         {:.1} MiB of geometry ({:.0} ms)",
         path.display(),
         gpu.tri_positions.len(),
         gpu.spheres.len(),
         gpu.lights.len(),
         scene.textures.len(),
         gpu.bvh_nodes.len(),
+        gpu.geometry_bytes() as f64 / f64::from(1 << 20),
         ms(start.elapsed())
     );
     let d = scene.stats.decode;

@@ -63,6 +63,19 @@ struct VertexIn {
     @location(7) color: vec4f,
 }
 
+// The instance a vertex is drawn for (a `GpuInstance`, pathtrace/instances.wgsl): its
+// object-to-world and world-to-object rows and (root, index, flags, pad); the identity for
+// the scene's own triangles and spheres.
+struct InstanceIn {
+    @location(8) world_x: vec4f,
+    @location(9) world_y: vec4f,
+    @location(10) world_z: vec4f,
+    @location(11) object_x: vec4f,
+    @location(12) object_y: vec4f,
+    @location(13) object_z: vec4f,
+    @location(14) info: vec4u,
+}
+
 struct VertexOut {
     @builtin(position) clip: vec4f,
     @location(0) world: vec3f,
@@ -76,8 +89,22 @@ struct VertexOut {
 }
 
 @vertex
-fn vs_main(v: VertexIn) -> VertexOut {
-    let d = v.position - cam.position;
+fn vs_main(v: VertexIn, i: InstanceIn) -> VertexOut {
+    // Placed as the path tracer places an instance's triangle (instances.wgsl): points and
+    // tangents by the object-to-world rows, normals by the world-to-object ones transposed,
+    // the front side turned where the instance mirrors. Exact for the identity.
+    let position = vec3f(dot(i.world_x.xyz, v.position) + i.world_x.w, dot(i.world_y.xyz, v.position) + i.world_y.w, dot(i.world_z.xyz, v.position) + i.world_z.w);
+    let to_world = mat3x3f(i.world_x.xyz, i.world_y.xyz, i.world_z.xyz);
+    let normal_of = mat3x3f(i.object_x.xyz, i.object_y.xyz, i.object_z.xyz);
+    let turn = select(1.0, -1.0, (i.info.z & INSTANCE_MIRROR) != 0u);
+    // The identity has no mesh root: the scene's own geometry is drawn as it was.
+    let placed = i.info.x != 0u;
+    var sphere = v.sphere;
+    if placed && v.sphere.w <= 0.0 {
+        // A triangle's unit geometric normal.
+        sphere = vec4f(turn * normalize(normal_of * v.sphere.xyz), 0.0);
+    }
+    let d = position - cam.position;
     let z = dot(d, cam.forward);
     var out: VertexOut;
     // NDC of the whole image, then of the window: x' = x W / w + (W - 2 left) / w - 1 and
@@ -93,12 +120,12 @@ fn vs_main(v: VertexIn) -> VertexOut {
         dot(d, cam.up) / cam.tan_half_fov,
     );
     out.clip = vec4f(xy * scale + z * shift, NEAR, z);
-    out.world = v.position;
-    out.normal = v.normal;
+    out.world = position;
+    out.normal = normal_of * v.normal;
     out.albedo = v.albedo;
-    out.sphere = v.sphere;
+    out.sphere = sphere;
     out.uv = v.uv;
-    out.tangent = v.tangent;
+    out.tangent = vec4f(v.tangent.xyz * to_world, turn * v.tangent.w);
     out.material = v.material;
     out.color = v.color;
     return out;

@@ -1,5 +1,5 @@
 // From its includer: the bindings `bvh_nodes`, `tri_positions` and `spheres`, the constants
-// `HAS_TRIANGLES`, `HAS_SPHERES` and `HAS_ALPHA`, and the any-hit tests `triangle_hit_counts`
+// `HAS_TRIANGLES`, `HAS_SPHERES`, `HAS_ALPHA` and `HAS_INSTANCES`, and the any-hit tests `triangle_hit_counts`
 // and `sphere_hit_counts` (in the path tracer options.wgsl and alpha.wgsl; raycast.wgsl
 // declares its own).
 #import "pathtrace/primitives.wgsl"
@@ -26,34 +26,76 @@
 const BVH_END: u32 = 0xffffffffu;
 
 // Closest hit (any_hit false) or first hit found (any_hit true) with 0 < t < t_max.
+// With instanced meshes (HAS_INSTANCES) the walk has two levels: a leaf of instances walks
+// each instance's mesh BVH in turn, its boxes tested with the ray in the mesh's space (`at`),
+// then goes on past the leaf (`resume`); a mesh BVH ends with BVH_END as the top level does.
 fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
-    var hit = Hit(NO_HIT, t_max, 0.0, 0.0);
-    let inv_dir = safe_inverse(ray.dir);
+    var hit = Hit(NO_HIT, t_max, 0.0, 0.0, NO_INSTANCE);
+    // The ray the boxes are tested with: the world's, or the walked instance's.
+    var at = InstanceRay(ray.origin, safe_inverse(ray.dir), 0u, 0.0, 0u);
     // Bit a set where the direction's component on axis a is negative: such rays visit the
     // second child of a node split on a first.
     let octant = select(0u, 1u, ray.dir.x < 0.0) | select(0u, 2u, ray.dir.y < 0.0) | select(0u, 4u, ray.dir.z < 0.0);
+    at.octant = octant;
+    // The instance walked (its slot) or NO_INSTANCE, the slot after its leaf's last one, and
+    // the top-level node after that leaf.
+    var inst = NO_INSTANCE;
+    var inst_end = 0u;
+    var resume = 0u;
     var node_index = 0u;
     loop {
         if (node_index == BVH_END) {
-            break;
+            if (!HAS_INSTANCES || inst == NO_INSTANCE) {
+                break;
+            }
+            // The instance's mesh is done: the leaf's next instance, or back to the top.
+            inst = inst + 2u;
+            if (inst == inst_end) {
+                inst = NO_INSTANCE;
+                at = InstanceRay(ray.origin, safe_inverse(ray.dir), octant, 0.0, 0u);
+                node_index = resume;
+            } else {
+                at = instance_ray(inst, ray);
+                node_index = at.root;
+            }
+            continue;
         }
         let lo = bvh_nodes[node_index * 4u];
         let hi = bvh_nodes[node_index * 4u + 1u];
-        if (ray_aabb(ray.origin, inv_dir, bitcast<vec3<f32>>(lo.xyz), bitcast<vec3<f32>>(hi.xyz), hit.t)) {
+        var box_lo = bitcast<vec3<f32>>(lo.xyz);
+        var box_hi = bitcast<vec3<f32>>(hi.xyz);
+        if (HAS_INSTANCES) {
+            box_lo = box_lo - at.pad;
+            box_hi = box_hi + at.pad;
+        }
+        if (ray_aabb(at.origin, at.inv_dir, box_lo, box_hi, hit.t)) {
             let count = hi.w >> NODE_COUNT_SHIFT;
             if (count == 0u) {
                 // Inner node: on to the near child (the first one is adjacent, the second at
                 // `index`).
                 let axis = hi.w & 3u;
-                node_index = select(node_index + 1u, lo.w, ((octant >> axis) & 1u) == 1u);
+                node_index = select(node_index + 1u, lo.w, ((at.octant >> axis) & 1u) == 1u);
                 continue;
             }
             let first = lo.w;
+            if (HAS_INSTANCES && (hi.w & NODE_INSTANCES) != 0u) {
+                inst = first;
+                inst_end = first + 2u * count;
+                resume = bvh_nodes[node_index * 4u + 2u + (octant >> 2u)][octant & 3u];
+                at = instance_ray(inst, ray);
+                node_index = at.root;
+                continue;
+            }
             if (HAS_TRIANGLES && (!HAS_SPHERES || (hi.w & NODE_SPHERES) == 0u)) {
                 for (var i = first; i < first + count; i = i + 1u) {
-                    let r = candidate_triangle(i, ray, hit.t);
+                    var r: vec4<f32>;
+                    if (HAS_INSTANCES && inst != NO_INSTANCE) {
+                        r = candidate_instance_triangle(i, inst, ray, hit.t);
+                    } else {
+                        r = candidate_triangle(i, ray, hit.t);
+                    }
                     if (r.x != 0.0) {
-                        hit = Hit(i, r.y, r.z, r.w);
+                        hit = Hit(i, r.y, r.z, r.w, inst);
                         if (any_hit) {
                             return hit;
                         }
@@ -63,7 +105,7 @@ fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                 for (var i = first; i < first + count; i = i + 1u) {
                     let t = candidate_sphere(i, ray, hit.t);
                     if (t > 0.0) {
-                        hit = Hit(i | PRIM_SPHERE, t, 0.0, 0.0);
+                        hit = Hit(i | PRIM_SPHERE, t, 0.0, 0.0, NO_INSTANCE);
                         if (any_hit) {
                             return hit;
                         }
@@ -72,7 +114,7 @@ fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
             }
         }
         // A leaf, or a box missed: past this subtree.
-        node_index = bvh_nodes[node_index * 4u + 2u + (octant >> 2u)][octant & 3u];
+        node_index = bvh_nodes[node_index * 4u + 2u + (at.octant >> 2u)][at.octant & 3u];
     }
     return hit;
 }

@@ -1,10 +1,12 @@
 #import "pathtrace/primitives.wgsl"
+#import "pathtrace/instances.wgsl"
 
 // A candidate primitive tested as every intersector tests the primitives it finds (the BVH's
 // leaves, the wide BVH's, the device's ray-query candidates): the exact ray/primitive test,
 // the rules for rays leaving a surface (`skip_prim`, the origin's error, primitives.wgsl) and
 // the any-hit test of alpha-masked and blended materials (alpha.wgsl).
-// From its includer: the bindings `tri_positions` and `spheres`, the constant `HAS_ALPHA`,
+// From its includer: the bindings `tri_positions`, `spheres` and (instances.wgsl)
+// `bvh_nodes`, the constant `HAS_ALPHA`,
 // and the any-hit tests `triangle_hit_counts` and `sphere_hit_counts`.
 
 // Triangle `i`: vec4(1, t, u, v) where it counts as a hit with 0 < t < t_max, else x = 0.
@@ -20,6 +22,22 @@ fn candidate_triangle_at(i: u32, v0: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>, fl
     // The any-hit test only for triangles whose material needs it (the flag rides in the
     // record just read).
     if (r.x != 0.0 && i != skip_prim && (!HAS_ALPHA || (flags & TRI_ALPHA) == 0u || triangle_hit_counts(i, r.z, r.w, ray))) {
+        return r;
+    }
+    return vec4<f32>(0.0);
+}
+
+// Triangle `i` of the mesh of the instance at `slot` (instances.wgsl), tested in world space
+// as a copy of it would be: the same front side (corners 1 and 2 swapped where the instance
+// mirrors, u and v swapped back), the same rules for rays leaving it (the instance counts:
+// the triangle left is `skip_prim` in instance `skip_inst`).
+fn candidate_instance_triangle(i: u32, slot: u32, ray: Ray, t_max: f32) -> vec4<f32> {
+    let tri = tri_positions[i];
+    let w = place_triangle(slot, tri);
+    let mirror = instance_mirrors(slot);
+    var r = intersect_triangle(ray.origin, ray.dir, w.v0, select(w.e1, w.e2, mirror), select(w.e2, w.e1, mirror), t_max);
+    r = select(r, r.xywz, mirror);
+    if (r.x != 0.0 && (i != skip_prim || slot != skip_inst) && (!HAS_ALPHA || (tri.flags & TRI_ALPHA) == 0u || triangle_hit_counts(i, r.z, r.w, ray))) {
         return r;
     }
     return vec4<f32>(0.0);

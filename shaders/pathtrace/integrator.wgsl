@@ -91,7 +91,7 @@ fn path_step_from(hit: Hit, may_miss: bool) -> bool {
 // away only after all the work: seconds on llvmpipe).
 fn path_step_missed() -> bool {
     var p = path;
-    var next = bounce_through(&p, Hit(NO_HIT, F32_MAX, 0.0, 0.0));
+    var next = bounce_through(&p, Hit(NO_HIT, F32_MAX, 0.0, 0.0, NO_INSTANCE));
     if next == BOUNCE_GOES_ON {
         add_escaped(&p);
         next = PATH_ENDS;
@@ -130,6 +130,7 @@ fn bounce_path(p: ptr<function, PathState>, hit: Hit, may_miss: bool) -> u32 {
     // sphere is met again only by a ray going into it, at its far side.
     let on_sphere = is_sphere(hit.prim);
     skip_prim = hit.prim;
+    skip_inst = hit.inst;
     var mat = scene_material(s.material);
     if HAS_TEXTURES {
         mat = textured_material(mat, s.uv, s.color);

@@ -57,9 +57,10 @@ fn hg_sample(dir: vec3f, g: f32, u: vec2f) -> vec3f {
 // Transmittance along a shadow ray from its origin (in `medium`) to `t_max`: Beer-Lambert
 // through the media it travels in, across index-matched boundaries; 0 when anything else is
 // in the way. The ray's origin state (`skip_prim`, `origin_*`) is the caller's, as for
-// `occluded`; `skip_prim` is restored on return. The caller counts the first ray.
+// `occluded`; `skip_prim` and `skip_inst` are restored on return. The caller counts the first ray.
 fn shadow_transmittance(shadow: Ray, t_max: f32, medium: u32) -> vec3f {
     let saved_skip = skip_prim;
+    let saved_inst = skip_inst;
     var ray = shadow;
     var left = t_max;
     var current = medium;
@@ -84,12 +85,14 @@ fn shadow_transmittance(shadow: Ray, t_max: f32, medium: u32) -> vec3f {
         }
         current = medium_after(s.material, m, s.ng, ray.dir, current);
         skip_prim = hit.prim;
+        skip_inst = hit.inst;
         let side = select(-s.ng, s.ng, dot(s.ng, ray.dir) > 0.0);
         ray = Ray(leave(s, is_sphere(hit.prim), side, ray.dir), ray.dir);
         left -= t;
         ray_count += 1u;
     }
     skip_prim = saved_skip;
+    skip_inst = saved_inst;
     return tr;
 }
 

@@ -44,6 +44,9 @@ const HAS_SHEEN: bool = true;
 // compiled in.
 const HAS_MEDIA: bool = true;
 
+// The scene has instanced meshes: the BVH walk has two levels (bvh.wgsl, instances.wgsl).
+const HAS_INSTANCES: bool = true;
+
 // Some material is alpha-masked or blended (and can be seen through): every intersector
 // runs the any-hit test of alpha.wgsl.
 const HAS_ALPHA: bool = true;

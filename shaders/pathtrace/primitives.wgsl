@@ -12,6 +12,9 @@ const F32_MAX: f32 = 3.40282347e38;
 // offset of the origin; for triangles the origin's error only has to clear coplanar
 // neighbours (below). A ray entering a sphere (`skip_inward`) meets it at its far side.
 var<private> skip_prim: u32 = NO_HIT;
+// The instance of the triangle left (a hit's `inst`): a triangle of an instanced mesh is one
+// surface per instance.
+var<private> skip_inst: u32 = NO_INSTANCE;
 var<private> skip_inward: bool = false;
 // For rays leaving a triangle (camera rays and rays leaving a sphere have 0 for both): the
 // unit normal of the triangle left, and a componentwise bound on the rounding error of the

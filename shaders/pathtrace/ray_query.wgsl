@@ -28,7 +28,7 @@
 
 // Closest hit (any_hit false) or first hit found (any_hit true) with 0 < t < t_max.
 fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
-    var hit = Hit(NO_HIT, t_max, 0.0, 0.0);
+    var hit = Hit(NO_HIT, t_max, 0.0, 0.0, NO_INSTANCE);
     var rq: ray_query;
     // The device's range must be finite and not below its t_min (a shadow ray's may be
     // neither); the exact tests keep `t_max` itself.
@@ -40,7 +40,7 @@ fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
         if (HAS_TRIANGLES && c.instance_custom_data == ACCEL_TRIANGLES) {
             let r = candidate_triangle(i, ray, hit.t);
             if (r.x != 0.0) {
-                hit = Hit(i, r.y, r.z, r.w);
+                hit = Hit(i, r.y, r.z, r.w, NO_INSTANCE);
                 // A hit at a concave corner may come at t <= 0 (primitives.wgsl); the device
                 // takes none below its t_min of 0.
                 // (Bound by a `let`: naga 30 rejects an expression in the call itself.)
@@ -53,7 +53,7 @@ fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
         } else if (HAS_SPHERES && c.instance_custom_data == ACCEL_SPHERES) {
             let t = candidate_sphere(i, ray, hit.t);
             if (t > 0.0) {
-                hit = Hit(i | PRIM_SPHERE, t, 0.0, 0.0);
+                hit = Hit(i | PRIM_SPHERE, t, 0.0, 0.0, NO_INSTANCE);
                 rayQueryGenerateIntersection(&rq, t);
                 if (any_hit) {
                     rayQueryTerminate(&rq);

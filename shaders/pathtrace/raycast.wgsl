@@ -27,6 +27,7 @@ struct Params {
 const HAS_TRIANGLES: bool = true;
 const HAS_SPHERES: bool = true;
 const HAS_ALPHA: bool = false;
+const HAS_INSTANCES: bool = true;
 
 fn triangle_hit_counts(prim: u32, u: f32, v: f32, ray: Ray) -> bool {
     return true;

@@ -6,6 +6,8 @@
 const PRIM_SPHERE: u32 = 0x80000000u;
 // A hit's `prim` when nothing was hit.
 const NO_HIT: u32 = 0xffffffffu;
+// A hit's `inst` off instanced meshes.
+const NO_INSTANCE: u32 = 0xffffffffu;
 // `light` of a primitive that does not emit.
 const NO_LIGHT: u32 = 0xffffffffu;
 
@@ -41,9 +43,13 @@ const FEATURE_LIGHTS: u32 = 16u;
 const FEATURE_METAL: u32 = 32u;
 const FEATURE_MEDIA: u32 = 64u;
 const FEATURE_ALPHA: u32 = 128u;
+const FEATURE_INSTANCES: u32 = 256u;
+// An instance's flags: its transform mirrors (a negative determinant).
+const INSTANCE_MIRROR: u32 = 1u;
 
 // BVH node, 32 bytes. Depth-first order: an inner node's first child is the next node.
-//   bits 0-1: split axis (inner); bit 2: leaf kind (1 = spheres, 0 = triangles);
+//   bits 0-1: split axis (inner); leaf kind: bit 0 instances (NODE_INSTANCES), bit 2 spheres,
+//   neither triangles;
 //   bits 3-31: primitive count (0 = inner node).
 //   index: inner = second child's node index; leaf = first primitive in its kind's array.
 struct BvhNode {
@@ -54,6 +60,7 @@ struct BvhNode {
 }
 
 const NODE_SPHERES: u32 = 4u;
+const NODE_INSTANCES: u32 = 1u;
 const NODE_COUNT_SHIFT: u32 = 3u;
 
 // Triangle intersection data, 48 bytes: corner 0 and the edges to corners 1 and 2.
@@ -233,9 +240,12 @@ struct Ray {
 
 // prim: triangle index, or sphere index | PRIM_SPHERE, or NO_HIT.
 // u, v: barycentric weights of corners 1 and 2 (0 for spheres).
+// inst: the instance whose mesh the triangle is of (its node slot in `bvh_nodes`,
+// instances.wgsl), or NO_INSTANCE for the scene's own primitives.
 struct Hit {
     prim: u32,
     t: f32,
     u: f32,
     v: f32,
+    inst: u32,
 }

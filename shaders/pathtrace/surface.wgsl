@@ -8,6 +8,7 @@
 #import "pathtrace/intersect.wgsl"
 #import "pathtrace/scene_data.wgsl"
 #import "pathtrace/textures.wgsl"
+#import "pathtrace/instances.wgsl"
 
 struct Surface {
     p: vec3f,
@@ -60,12 +61,24 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
     } else {
         let tri = scene_tri_positions(hit.prim);
         let sh = scene_tri_shading(hit.prim);
+        // A triangle of an instanced mesh: in world space as its test saw it
+        // (instances.wgsl), its front side that of a copy (a mirroring instance's turned).
+        let placed = HAS_INSTANCES && hit.inst != NO_INSTANCE;
+        var w = PlacedTriangle(tri.v0, tri.e1, tri.e2);
+        var turn = 1.0;
+        if placed {
+            w = place_triangle(hit.inst, tri);
+            turn = select(1.0, -1.0, instance_mirrors(hit.inst));
+        }
         // Position from the barycentrics: more accurate than origin + t * dir far away.
-        s.p = tri.v0 + hit.u * tri.e1 + hit.v * tri.e2;
-        s.err = barycentric_err(tri.v0, tri.e1, tri.e2, hit.u, hit.v);
-        s.ng = normalize(cross(tri.e1, tri.e2));
+        s.p = w.v0 + hit.u * w.e1 + hit.v * w.e2;
+        s.err = barycentric_err(w.v0, w.e1, w.e2, hit.u, hit.v);
+        s.ng = turn * normalize(cross(w.e1, w.e2));
         if (sh.flags & TRI_VERTEX_NORMALS) != 0u {
-            let n = (1.0 - hit.u - hit.v) * sh.n0 + hit.u * sh.n1 + hit.v * sh.n2;
+            var n = (1.0 - hit.u - hit.v) * sh.n0 + hit.u * sh.n1 + hit.v * sh.n2;
+            if placed {
+                n = instance_normal(hit.inst, n);
+            }
             s.ns = select(s.ng, normalize(n), dot(n, n) > 0.0);
         } else {
             s.ns = s.ng;
@@ -77,7 +90,10 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
             s.uv = tri_uv(tc, hit.u, hit.v);
             s.color = tri_color(tc, hit.u, hit.v);
             let m = scene_material(sh.material);
-            let tangent = tri_tangent(tc, hit.u, hit.v);
+            var tangent = tri_tangent(tc, hit.u, hit.v);
+            if placed {
+                tangent = vec4f(instance_apply(hit.inst, 0u, tangent.xyz, 0.0), turn * tangent.w);
+            }
             let interpolated = s.ns;
             s.ns = normal_mapped(m, interpolated, s.ng, s.uv, tangent);
             if HAS_COAT && m.clearcoat > 0.0 {
@@ -96,6 +112,7 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
 // primitive skipped, no origin error.
 fn leave_no_surface() {
     skip_prim = NO_HIT;
+    skip_inst = NO_INSTANCE;
     origin_n = vec3f(0.0);
     origin_err = vec3f(0.0);
     origin_off = 0.0;

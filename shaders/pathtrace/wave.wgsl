@@ -299,7 +299,7 @@ fn wave_step_hit(slot: u32, j: u32) {
     var s = wave_load(slot, j, WAVE_KIND_HIT);
     if !s.ended {
         let t = bitcast<f32>(s.hit.x & 0x7fffffffu);
-        s.ended = path_step_from(Hit(s.hit.w, t, bitcast<f32>(s.hit.y), bitcast<f32>(s.hit.z)), false);
+        s.ended = path_step_from(Hit(s.hit.w, t, bitcast<f32>(s.hit.y), bitcast<f32>(s.hit.z), NO_INSTANCE), false);
     }
     wave_settle(&s, WAVE_KIND_HIT);
     wave_store(s, j);
@@ -465,7 +465,7 @@ fn wavefront_trace(j: u32) -> Traced {
             occluded_bit = 0x80000000u;
         }
     }
-    var hit = Hit(NO_HIT, F32_MAX, 0.0, 0.0);
+    var hit = Hit(NO_HIT, F32_MAX, 0.0, 0.0, NO_INSTANCE);
     if has_next {
         origin_n = n;
         origin_slab = next_near;

@@ -56,7 +56,7 @@ fn wide_children(first: u32, info: u32, lx: u32, hx: u32, ly: u32, hy: u32, lz: 
 
 // Closest hit (any_hit false) or first hit found (any_hit true) with 0 < t < t_max.
 fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
-    var hit = Hit(NO_HIT, t_max, 0.0, 0.0);
+    var hit = Hit(NO_HIT, t_max, 0.0, 0.0, NO_INSTANCE);
     let inv_dir = safe_inverse(ray.dir);
     // The octant, inverted as the builder orders children (x 4, y 2, z 1; set where the
     // component is >= 0).
@@ -84,7 +84,7 @@ fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                 let r2 = bvh_nodes[at + 2u];
                 let r = candidate_triangle_at(p, bitcast<vec3<f32>>(r0.xyz), bitcast<vec3<f32>>(r1.xyz), bitcast<vec3<f32>>(r2.xyz), r0.w, ray, hit.t);
                 if (r.x != 0.0) {
-                    hit = Hit(p, r.y, r.z, r.w);
+                    hit = Hit(p, r.y, r.z, r.w, NO_INSTANCE);
                     if (any_hit) {
                         return hit;
                     }
@@ -92,7 +92,7 @@ fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
             } else if (HAS_SPHERES) {
                 let t = candidate_sphere_at(p & ~PRIM_SPHERE, bitcast<vec3<f32>>(r0.xyz), bitcast<f32>(r0.w), ray, hit.t);
                 if (t > 0.0) {
-                    hit = Hit(p, t, 0.0, 0.0);
+                    hit = Hit(p, t, 0.0, 0.0, NO_INSTANCE);
                     if (any_hit) {
                         return hit;
                     }

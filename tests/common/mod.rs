@@ -730,3 +730,23 @@ pub fn ply_bytes(format: &str) -> Vec<u8> {
     }
     out
 }
+
+/// PCG32 from a raw state, so random rays are the same on every run.
+pub struct Pcg(pub u64);
+
+impl Pcg {
+    /// Uniform in [0, 1).
+    pub fn next(&mut self) -> f32 {
+        let old = self.0;
+        self.0 = old
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        let x = (((old >> 18) ^ old) >> 27) as u32;
+        (x.rotate_right((old >> 59) as u32) >> 8) as f32 / (1u32 << 24) as f32
+    }
+
+    /// Uniform in [lo, hi).
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.next()
+    }
+}

@@ -26,26 +26,8 @@ const SCENE: &str = r#"(
     render: (width: 8, height: 8),
 )"#;
 
-/// PCG32, so the rays are the same on every run.
-struct Pcg(u64);
-
-impl Pcg {
-    fn next(&mut self) -> f32 {
-        let old = self.0;
-        self.0 = old
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        let x = (((old >> 18) ^ old) >> 27) as u32;
-        (x.rotate_right((old >> 59) as u32) >> 8) as f32 / (1u32 << 24) as f32
-    }
-
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.next()
-    }
-}
-
 fn random_rays(n: usize) -> Vec<RayQuery> {
-    let mut rng = Pcg(0x853c_49e6_748f_ea9b);
+    let mut rng = common::Pcg(0x853c_49e6_748f_ea9b);
     (0..n)
         .map(|_| {
             let origin = [

@@ -12,6 +12,7 @@ mod bvh_gpu;
 mod gbuffer;
 mod gltf_conformance;
 mod images;
+mod instancing;
 mod ray_query;
 mod shaders;
 mod specialization;

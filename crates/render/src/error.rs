@@ -68,6 +68,10 @@ pub enum RenderError {
         /// Why, as the driver says.
         reason: String,
     },
+    /// The scene asks for what a node cannot do yet (the message says what, and the way
+    /// around it).
+    #[error("{0}")]
+    Unsupported(String),
     /// A node kind has no GPU implementation in this build.
     #[error("node kind {0} has no implementation")]
     Unimplemented(String),

@@ -33,6 +33,7 @@ struct GpuHit {
     t: f32,
     u: f32,
     v: f32,
+    inst: u32,
 }
 
 /// A ray-query kernel bound to one scene's buffers.
@@ -163,6 +164,7 @@ impl Raycaster {
                 t: h.t,
                 u: h.u,
                 v: h.v,
+                inst: h.inst,
             })
             .collect())
     }

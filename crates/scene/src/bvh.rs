@@ -10,13 +10,23 @@
 //! | field | inner node | leaf |
 //! |---|---|---|
 //! | `aabb_min`, `aabb_max` | bounds of the subtree | bounds of its primitives |
-//! | `index` | second child's node index | first primitive, in its kind's array |
-//! | `bits` bits 0–1 | split axis (0 x, 1 y, 2 z) | 0 |
+//! | `index` | second child's node index | first primitive, in its kind's array (instances: the node slot of the first, see below) |
+//! | `bits` bits 0–1 | split axis (0 x, 1 y, 2 z) | bit 0: kind instances ([`NODE_INSTANCES`]) |
 //! | `bits` bit 2 | 0 | kind: 0 triangles (`tri_positions`), 1 spheres (`spheres`) |
 //! | `bits` bits 3–31 | 0 (this is what makes it inner) | primitive count ≥ 1 |
 //!
-//! A leaf holds one kind only: when obvhs puts triangles and spheres in one leaf, it is
-//! split into an inner node over two leaves. Triangles and spheres are **reordered** so
+//! A leaf holds one kind only: when obvhs puts several kinds in one leaf, it is split into
+//! inner nodes over one leaf per kind.
+//!
+//! # Instances (two levels)
+//! A scene with instanced meshes has one BVH per mesh (the bottom level: over its triangles
+//! in its own space, stored once) after the top-level one, whose leaves may hold instances.
+//! Each instance ([`crate::gpu::GpuInstance`]: its transforms and its mesh's root) takes two
+//! node slots after the last node, and an instance leaf's `index` is the slot of its first
+//! instance (the next at `index + 2`). A ray meeting an instance leaf walks each instance's
+//! bottom-level BVH with the ray in the mesh's space, then goes on past the leaf; a
+//! bottom-level BVH's skip links end with [`BVH_END`] as the top level's do, which is where
+//! the walk leaves the instance. Triangles and spheres are **reordered** so
 //! that every leaf's primitives are contiguous in their array: no index indirection, one
 //! load fewer per primitive. [`crate::GpuScene::tri_source`] maps back to the scene order.
 //!
@@ -58,6 +68,8 @@ pub const BVH_OCTANTS: usize = 8;
 
 /// `bits` bit: the leaf holds spheres.
 pub const NODE_SPHERES: u32 = 4;
+/// `bits` bit: the leaf holds instances.
+pub const NODE_INSTANCES: u32 = 1;
 /// `bits` shift of the primitive count.
 pub const NODE_COUNT_SHIFT: u32 = 3;
 
@@ -88,6 +100,9 @@ pub(crate) struct FlatBvh {
     pub tri_order: Vec<u32>,
     /// New sphere order, likewise.
     pub sphere_order: Vec<u32>,
+    /// New instance order, likewise; an instance leaf's `index` is its first instance in
+    /// this order until [`crate::GpuScene`] makes it a node slot.
+    pub instance_order: Vec<u32>,
     /// For each node and ray octant, the node after its subtree in that octant's visit
     /// order, or [`BVH_END`] (see the module docs).
     pub skips: Vec<[u32; BVH_OCTANTS]>,
@@ -124,15 +139,22 @@ pub fn skip_links(nodes: &[GpuBvhNode]) -> Vec<[u32; BVH_OCTANTS]> {
     skips
 }
 
-/// Builds and flattens the BVH over `tri_boxes` (primitives `0..n`) and `sphere_boxes`
-/// (primitives `n..`).
+/// Builds and flattens the BVH over `tri_boxes` (primitives `0..n`), `sphere_boxes`
+/// (primitives `n..`) and `instance_boxes` (after the spheres).
 pub(crate) fn build(
     tri_boxes: &[Aabb],
     sphere_boxes: &[Aabb],
+    instance_boxes: &[Aabb],
     options: &BvhOptions,
 ) -> Result<FlatBvh, SceneError> {
     let n_tris = tri_boxes.len() as u32;
-    let boxes: Vec<Aabb> = tri_boxes.iter().chain(sphere_boxes).copied().collect();
+    let n_spheres = sphere_boxes.len() as u32;
+    let boxes: Vec<Aabb> = tri_boxes
+        .iter()
+        .chain(sphere_boxes)
+        .chain(instance_boxes)
+        .copied()
+        .collect();
     let mut flat = FlatBvh::default();
     if boxes.is_empty() {
         return Ok(flat);
@@ -147,6 +169,7 @@ pub(crate) fn build(
         bvh: &bvh,
         boxes: &boxes,
         n_tris,
+        n_spheres,
         out: &mut flat,
     };
     f.node(0, 0)?;
@@ -158,6 +181,7 @@ struct Flattener<'a> {
     bvh: &'a Bvh2,
     boxes: &'a [Aabb],
     n_tris: u32,
+    n_spheres: u32,
     out: &'a mut FlatBvh,
 }
 
@@ -186,25 +210,24 @@ impl Flattener<'_> {
         if n.is_leaf() {
             let first = n.first_index as usize;
             let prims = &self.bvh.primitive_indices[first..first + n.prim_count as usize];
-            let (tris, spheres): (Vec<u32>, Vec<u32>) =
-                prims.iter().partition(|&&p| p < self.n_tris);
-            if tris.is_empty() || spheres.is_empty() {
-                self.out.nodes[at] = self.leaf(&tris, &spheres);
-            } else {
-                Self::too_deep(depth + 1)?;
-                self.out.depth = self.out.depth.max(depth + 1);
-                let left = self.leaf(&tris, &[]);
-                self.out.nodes.push(left);
-                let right_at = self.out.nodes.len() as u32;
-                let right = self.leaf(&[], &spheres);
-                self.out.nodes.push(right);
-                self.out.nodes[at] = GpuBvhNode {
-                    aabb_min: to3(n.aabb().min),
-                    index: right_at,
-                    aabb_max: to3(n.aabb().max),
-                    bits: 0,
+            let mut kinds: [Vec<u32>; 3] = Default::default();
+            for &p in prims {
+                let kind = if p < self.n_tris {
+                    0
+                } else if p < self.n_tris + self.n_spheres {
+                    1
+                } else {
+                    2
                 };
+                kinds[kind].push(p);
             }
+            let groups: Vec<(usize, Vec<u32>)> = kinds
+                .into_iter()
+                .enumerate()
+                .filter(|(_, g)| !g.is_empty())
+                .collect();
+            self.out.nodes.pop();
+            self.kinds(&groups, depth)?;
             return Ok(at as u32);
         }
         let (mut a, mut b) = (n.first_index as usize, n.first_index as usize + 1);
@@ -232,28 +255,61 @@ impl Flattener<'_> {
         Ok(at as u32)
     }
 
-    /// A leaf over `tris` or `spheres` (one of them empty), appending them to the orders.
-    fn leaf(&mut self, tris: &[u32], spheres: &[u32]) -> GpuBvhNode {
+    /// One leaf per kind of `groups` (kind 0 triangles, 1 spheres, 2 instances), under a
+    /// chain of inner nodes where there are several; returns the first node's index.
+    fn kinds(&mut self, groups: &[(usize, Vec<u32>)], depth: usize) -> Result<u32, SceneError> {
+        Self::too_deep(depth)?;
+        self.out.depth = self.out.depth.max(depth);
+        let at = self.out.nodes.len();
+        let [(kind, prims), rest @ ..] = groups else {
+            unreachable!("a leaf has primitives");
+        };
+        if rest.is_empty() {
+            let leaf = self.leaf(*kind, prims);
+            self.out.nodes.push(leaf);
+            return Ok(at as u32);
+        }
+        self.out.nodes.push(GpuBvhNode::default());
+        let first = self.leaf(*kind, prims);
+        self.out.nodes.push(first);
+        let right = self.kinds(rest, depth + 1)?;
         let mut aabb = Aabb::empty();
-        for &p in tris.iter().chain(spheres) {
+        for (_, g) in groups {
+            for &p in g {
+                aabb = aabb.union(&self.boxes[p as usize]);
+            }
+        }
+        self.out.nodes[at] = GpuBvhNode {
+            aabb_min: to3(aabb.min),
+            index: right,
+            aabb_max: to3(aabb.max),
+            bits: 0,
+        };
+        Ok(at as u32)
+    }
+
+    /// A leaf over `prims`, all of `kind`, appending them to that kind's order.
+    fn leaf(&mut self, kind: usize, prims: &[u32]) -> GpuBvhNode {
+        let mut aabb = Aabb::empty();
+        for &p in prims {
             aabb = aabb.union(&self.boxes[p as usize]);
         }
-        let (index, count, kind) = if spheres.is_empty() {
-            let first = self.out.tri_order.len() as u32;
-            self.out.tri_order.extend_from_slice(tris);
-            (first, tris.len() as u32, 0)
-        } else {
-            let first = self.out.sphere_order.len() as u32;
-            self.out
-                .sphere_order
-                .extend(spheres.iter().map(|&p| p - self.n_tris));
-            (first, spheres.len() as u32, NODE_SPHERES)
+        let (order, offset, bits) = match kind {
+            0 => (&mut self.out.tri_order, 0, 0),
+            1 => (&mut self.out.sphere_order, self.n_tris, NODE_SPHERES),
+            _ => (
+                &mut self.out.instance_order,
+                self.n_tris + self.n_spheres,
+                NODE_INSTANCES,
+            ),
         };
+        let index = order.len() as u32;
+        order.extend(prims.iter().map(|&p| p - offset));
         GpuBvhNode {
             aabb_min: to3(aabb.min),
             index,
             aabb_max: to3(aabb.max),
-            bits: (count << NODE_COUNT_SHIFT) | kind,
+            bits: ((prims.len() as u32) << NODE_COUNT_SHIFT) | bits,
         }
     }
 }

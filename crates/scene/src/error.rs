@@ -92,6 +92,14 @@ pub enum ErrorKind {
     /// More primitives than the GPU layout can index.
     #[error("too many primitives ({0}); the GPU layout indexes at most 2^28")]
     TooManyPrimitives(usize),
+    /// Copies of instanced meshes over [`crate::scene::MAX_INSTANCED_TRIANGLES`].
+    #[error(
+        "copying instanced meshes would store {} triangles, over lumagraph's {} (the largest: \
+         \"{}\", {} instances of {} triangles); keep them instances (`instancing: On` in the \
+         scene file, or `Auto`) or place fewer",
+        .0.total, .0.max, .0.mesh, .0.instances, .0.triangles
+    )]
+    TooManyInstancedTriangles(Box<InstancedCopies>),
     /// A scene file could not be written.
     #[error("cannot write scene file: {source}")]
     Write {
@@ -192,4 +200,19 @@ impl std::error::Error for SceneError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         std::error::Error::source(&self.kind)
     }
+}
+
+/// What [`ErrorKind::TooManyInstancedTriangles`] names.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct InstancedCopies {
+    /// The mesh with the most copied triangles.
+    pub mesh: String,
+    /// Its instances.
+    pub instances: usize,
+    /// Its triangles.
+    pub triangles: usize,
+    /// Triangles all copies would store.
+    pub total: u64,
+    /// The limit.
+    pub max: u64,
 }

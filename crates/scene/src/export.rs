@@ -494,11 +494,21 @@ fn environment_out(env: &Environment) -> EnvironmentOut {
 
 /// Writes `scene` (flattened as `gpu`, for the resolved camera) into `dir`: `scene.json`,
 /// `mesh_<material>[_smooth][_uv].obj`, `texture_<texture>.png` and `opacity_<material>.png`
-/// files. Returns the files written.
+/// files. Returns the files written. Instanced meshes are written as copies.
 ///
 /// # Errors
-/// When `dir` cannot be created or a file cannot be written.
+/// When `dir` cannot be created or a file cannot be written, or the copies of instanced
+/// meshes would exceed [`crate::MAX_INSTANCED_TRIANGLES`].
 pub fn export(scene: &Scene, gpu: &GpuScene, dir: &Path) -> Result<Vec<PathBuf>, SceneError> {
+    let flat;
+    let scene = if scene.instanced.is_empty() {
+        scene
+    } else {
+        let mut copy = scene.clone();
+        copy.apply_instancing(crate::Instancing::Off)?;
+        flat = copy;
+        &flat
+    };
     std::fs::create_dir_all(dir).map_err(|source| {
         SceneError::new(ErrorKind::Io {
             what: "export folder",

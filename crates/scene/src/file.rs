@@ -61,6 +61,10 @@ pub struct SceneFile {
     pub environment: Environment,
     /// Image size and sampling.
     pub render: RenderSettings,
+    /// Whether meshes placed several times (a `Mesh` with `instances`, a glTF mesh used by
+    /// several nodes or with `EXT_mesh_gpu_instancing`) are stored once or copied.
+    #[serde(default)]
+    pub instancing: crate::scene::Instancing,
 }
 
 /// Where the camera comes from.
@@ -318,6 +322,10 @@ pub enum ShapeDesc {
         /// Emission leaves both sides.
         #[serde(default)]
         two_sided: bool,
+        /// Places of the whole file (each after `transform`): the file is read once and
+        /// its meshes are instances, one per entry (see `instancing`). Empty: placed once.
+        #[serde(default)]
+        instances: Vec<TransformDesc>,
     },
     /// An analytic sphere.
     Sphere {

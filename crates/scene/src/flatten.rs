@@ -67,6 +67,19 @@ pub struct GpuScene {
     pub tri_source: Vec<u32>,
     /// For each GPU sphere, its index in [`Scene::spheres`] (CPU side only).
     pub sphere_source: Vec<u32>,
+    /// The instances of the scene's instanced meshes, in top-level BVH order (uploaded in
+    /// `bvh_nodes` after the nodes, two node slots each: see [`crate::bvh`]). Their meshes'
+    /// triangles follow the scene's own ones (the first `tri_source.len()`) in
+    /// `tri_positions`, in their meshes' own space.
+    pub instances: Vec<crate::gpu::GpuInstance>,
+    /// For each instance, its mesh in [`Scene::instanced`] (CPU side only).
+    pub instance_mesh: Vec<u32>,
+    /// For each instanced mesh, its first triangle in `tri_positions` and its triangle count
+    /// (CPU side only: the G-buffer draws each mesh once per instance).
+    pub mesh_triangles: Vec<[u32; 2]>,
+    /// Triangles the instances place (each instance's mesh counted once per instance;
+    /// CPU side only, for what `render` prints).
+    pub instanced_triangles: u64,
     /// The environment map's file, when the environment is a map (CPU side only: the
     /// renderer loads it and builds its sampling tables).
     pub environment_map: Option<std::path::PathBuf>,
@@ -346,11 +359,39 @@ impl GpuScene {
                 skips: [crate::bvh::BVH_END; crate::bvh::BVH_OCTANTS],
             }];
         }
-        self.bvh_nodes
+        let mut records: Vec<GpuBvhRecord> = self
+            .bvh_nodes
             .iter()
             .zip(&self.bvh_skips)
             .map(|(&node, &skips)| GpuBvhRecord { node, skips })
-            .collect()
+            .collect();
+        records.extend(
+            self.instances
+                .iter()
+                .flat_map(|i| bytemuck::cast::<_, [GpuBvhRecord; 2]>(*i)),
+        );
+        records
+    }
+
+    /// Bytes of the geometry's GPU buffers: BVH records (with the instances), triangles
+    /// (positions, shading data, texture coordinates) and spheres.
+    pub fn geometry_bytes(&self) -> u64 {
+        let size = |n: usize, each: usize| (n * each) as u64;
+        size(
+            self.bvh_nodes.len() + 2 * self.instances.len(),
+            std::mem::size_of::<GpuBvhRecord>(),
+        ) + size(self.tri_positions.len(), std::mem::size_of::<GpuTriangle>())
+            + size(self.tri_shading.len(), std::mem::size_of::<GpuTriShading>())
+            + size(
+                self.tri_texcoords.len(),
+                std::mem::size_of::<GpuTriTexcoords>(),
+            )
+            + size(self.spheres.len(), std::mem::size_of::<GpuSphere>())
+    }
+
+    /// Instance `k` of a leaf whose `index` is `slot` (its first instance's node slot).
+    pub fn instance_at(&self, slot: u32, k: u32) -> &crate::gpu::GpuInstance {
+        &self.instances[(slot as usize - self.bvh_nodes.len()) / 2 + k as usize]
     }
 
     /// Flattens `scene` with the default BVH options.
@@ -402,7 +443,8 @@ impl GpuScene {
         options: &BvhOptions,
         bvh_time: &mut std::time::Duration,
     ) -> Result<Self, SceneError> {
-        let total = scene.triangles.len() + scene.spheres.len();
+        let unique: usize = scene.instanced.iter().map(|m| m.triangles.len()).sum();
+        let total = scene.triangles.len() + unique + scene.spheres.len();
         if total >= 1 << 28 {
             return Err(SceneError::new(ErrorKind::TooManyPrimitives(total)));
         }
@@ -412,11 +454,7 @@ impl GpuScene {
                 message: "the scene has no triangle or sphere".to_owned(),
             }));
         }
-        let tri_boxes: Vec<Aabb> = scene
-            .triangles
-            .iter()
-            .map(|t| Aabb::from_points(&t.positions.map(Vec3A::from)))
-            .collect();
+        let tri_boxes: Vec<Aabb> = scene.triangles.iter().map(triangle_box).collect();
         let sphere_boxes: Vec<Aabb> = scene
             .spheres
             .iter()
@@ -425,8 +463,35 @@ impl GpuScene {
                 Aabb::new(c - s.radius, c + s.radius)
             })
             .collect();
+        // Each instance's box: its mesh's box, transformed.
+        let mesh_boxes: Vec<Aabb> = scene
+            .instanced
+            .iter()
+            .map(|m| {
+                m.triangles
+                    .iter()
+                    .fold(Aabb::empty(), |b, t| b.union(&triangle_box(t)))
+            })
+            .collect();
+        let mut placed = Vec::new();
+        let mut instance_boxes = Vec::new();
+        for (mesh, m) in scene.instanced.iter().enumerate() {
+            for t in &m.transforms {
+                placed.push((mesh as u32, *t));
+                instance_boxes.push(transformed_box(&mesh_boxes[mesh], t));
+            }
+        }
         let bvh_started = std::time::Instant::now();
-        let flat = bvh::build(&tri_boxes, &sphere_boxes, options)?;
+        let flat = bvh::build(&tri_boxes, &sphere_boxes, &instance_boxes, options)?;
+        // One BVH per mesh, in its own space.
+        let meshes: Vec<bvh::FlatBvh> = scene
+            .instanced
+            .iter()
+            .map(|m| {
+                let boxes: Vec<Aabb> = m.triangles.iter().map(triangle_box).collect();
+                bvh::build(&boxes, &[], &[], options)
+            })
+            .collect::<Result<_, _>>()?;
         *bvh_time = bvh_started.elapsed();
 
         let mut out = Self {
@@ -452,7 +517,11 @@ impl GpuScene {
                 .collect();
         }
         out.vertex_alpha_min = vec![u8::MAX; scene.materials.len()];
-        for t in &scene.triangles {
+        for t in scene
+            .triangles
+            .iter()
+            .chain(scene.instanced.iter().flat_map(|m| &m.triangles))
+        {
             if let (Some(c), Some(min)) =
                 (t.colors, out.vertex_alpha_min.get_mut(t.material as usize))
             {
@@ -460,8 +529,11 @@ impl GpuScene {
             }
         }
         let mut weights = Vec::new();
-        out.push_triangles(scene, textured, &mut weights);
+        let order = std::mem::take(&mut out.tri_source);
+        out.push_triangles(scene, &scene.triangles, &order, textured, &mut weights);
+        out.tri_source = order;
         out.push_spheres(scene, &mut weights);
+        let depth = out.push_instances(scene, meshes, &placed, &flat.instance_order, textured);
         let radius = out.bvh_nodes.first().map_or(1.0, |root| {
             0.5 * (Vec3::from(root.aabb_max) - Vec3::from(root.aabb_min)).length()
         });
@@ -471,18 +543,105 @@ impl GpuScene {
             out.lights.push(light);
         }
         out.light_alias = alias_table(&light_selection(&weights));
-        out.header = header(scene, &out, flat.depth, weights.iter().sum());
+        out.header = header(scene, &out, flat.depth.max(depth), weights.iter().sum());
         out.settings = settings(scene);
         out.camera = out.camera_for(&scene.camera);
         Ok(out)
     }
 
-    /// Appends the triangles in BVH order: intersection data, shading data, texture
-    /// coordinates (when `textured`), and a light for each emissive one (its power pushed
-    /// to `weights`).
-    fn push_triangles(&mut self, scene: &Scene, textured: bool, weights: &mut Vec<f32>) {
-        for (i, &src) in self.tri_source.iter().enumerate() {
-            let t = &scene.triangles[src as usize];
+    /// Appends each instanced mesh's BVH after the nodes (its indices moved to where it
+    /// lands) and its triangles after the triangles, then the instances in top-level order,
+    /// and makes the top level's instance leaves point at their first instance's node slot;
+    /// returns the deepest mesh BVH's depth.
+    fn push_instances(
+        &mut self,
+        scene: &Scene,
+        meshes: Vec<bvh::FlatBvh>,
+        placed: &[(u32, glam::Mat4)],
+        order: &[u32],
+        textured: bool,
+    ) -> usize {
+        let mut roots = Vec::with_capacity(meshes.len());
+        let mut depth = 0;
+        for (m, flat) in scene.instanced.iter().zip(meshes) {
+            let node_base = self.bvh_nodes.len() as u32;
+            let tri_base = self.tri_positions.len() as u32;
+            roots.push(node_base);
+            depth = depth.max(flat.depth);
+            self.bvh_nodes.extend(flat.nodes.iter().map(|n| GpuBvhNode {
+                index: n.index
+                    + if n.bits >> bvh::NODE_COUNT_SHIFT == 0 {
+                        node_base
+                    } else {
+                        tri_base
+                    },
+                ..*n
+            }));
+            self.bvh_skips.extend(
+                flat.skips
+                    .iter()
+                    .map(|s| s.map(|k| if k == bvh::BVH_END { k } else { k + node_base })),
+            );
+            // Instanced meshes never emit (`Scene::apply_instancing` copies those that do).
+            self.push_triangles(
+                scene,
+                &m.triangles,
+                &flat.tri_order,
+                textured,
+                &mut Vec::new(),
+            );
+            self.mesh_triangles
+                .push([tri_base, m.triangles.len() as u32]);
+            self.instanced_triangles += m.copies();
+        }
+        let first_slot = self.bvh_nodes.len() as u32;
+        for n in &mut self.bvh_nodes[..roots.first().map_or(0, |&r| r as usize)] {
+            if n.bits >> bvh::NODE_COUNT_SHIFT != 0 && n.bits & bvh::NODE_INSTANCES != 0 {
+                n.index = first_slot + 2 * n.index;
+            }
+        }
+        for (k, &i) in order.iter().enumerate() {
+            let (mesh, to_world) = placed[i as usize];
+            let to_object = to_world.as_dmat4().inverse().as_mat4();
+            let rows = |m: glam::Mat4| {
+                let t = m.transpose();
+                [
+                    t.x_axis.to_array(),
+                    t.y_axis.to_array(),
+                    t.z_axis.to_array(),
+                ]
+            };
+            self.instances.push(crate::gpu::GpuInstance {
+                to_world: rows(to_world),
+                to_object: rows(to_object),
+                root: roots[mesh as usize],
+                index: k as u32,
+                flags: if to_world.determinant() < 0.0 {
+                    crate::gpu::INSTANCE_MIRROR
+                } else {
+                    0
+                },
+                pad: [0; 5],
+            });
+            self.instance_mesh.push(mesh);
+        }
+        depth
+    }
+
+    /// Appends `triangles` in the order `order` (BVH order): intersection data, shading
+    /// data, texture coordinates (when `textured`), and a light for each emissive one (its
+    /// power pushed to `weights`).
+    fn push_triangles(
+        &mut self,
+        scene: &Scene,
+        triangles: &[crate::scene::Triangle],
+        order: &[u32],
+        textured: bool,
+        weights: &mut Vec<f32>,
+    ) {
+        for &src in order {
+            let i = self.tri_positions.len();
+            let t = &triangles[src as usize];
             let [p0, p1, p2] = t.positions;
             let (e1, e2) = (p1 - p0, p2 - p0);
             let alpha =
@@ -598,6 +757,26 @@ impl GpuScene {
     }
 }
 
+fn triangle_box(t: &crate::scene::Triangle) -> Aabb {
+    Aabb::from_points(&t.positions.map(Vec3A::from))
+}
+
+/// The box around `b`'s corners moved by `m`.
+fn transformed_box(b: &Aabb, m: &glam::Mat4) -> Aabb {
+    let mut out = Aabb::empty();
+    for k in 0..8 {
+        let corner = Vec3A::new(
+            if k & 1 == 0 { b.min.x } else { b.max.x },
+            if k & 2 == 0 { b.min.y } else { b.max.y },
+            if k & 4 == 0 { b.min.z } else { b.max.z },
+        );
+        out = out.union(&Aabb::from_points(&[Vec3A::from(
+            m.transform_point3(corner.into()),
+        )]));
+    }
+    out
+}
+
 /// Refuses more textures than the GPU layout can index and materials that use a texture
 /// the scene does not have.
 /// Whether the shader reads per-triangle attributes beyond normals: some material has a
@@ -605,7 +784,11 @@ impl GpuScene {
 /// [`FEATURE_TEXTURES`]).
 fn surface_attributes(scene: &Scene) -> bool {
     scene.materials.iter().any(|m| m.textures.any())
-        || scene.triangles.iter().any(|t| t.colors.is_some())
+        || scene
+            .triangles
+            .iter()
+            .chain(scene.instanced.iter().flat_map(|m| &m.triangles))
+            .any(|t| t.colors.is_some())
 }
 
 fn check_textures(scene: &Scene) -> Result<(), SceneError> {
@@ -665,6 +848,9 @@ fn header(scene: &Scene, g: &GpuScene, depth: usize, total_power: f32) -> GpuHea
         .any(|m| m.medium.is_some() || m.index_matched)
     {
         features |= FEATURE_MEDIA;
+    }
+    if !g.instances.is_empty() {
+        features |= crate::gpu::FEATURE_INSTANCES;
     }
     let lit = match &scene.environment {
         Environment::Constant(c) => c.iter().any(|&x| x > 0.0),

@@ -97,10 +97,40 @@ pub struct GpuBvhNode {
     pub index: u32,
     /// Box maximum corner (offset 16).
     pub aabb_max: [f32; 3],
-    /// Bits 0–1 split axis (inner), bit 2 leaf kind (1 = spheres), bits 3–31 primitive
-    /// count (0 = inner node) (offset 28).
+    /// Bits 0–1 split axis (inner), leaf kind (bit 0: instances, bit 2: spheres, neither:
+    /// triangles), bits 3–31 primitive count (0 = inner node) (offset 28).
     pub bits: u32,
 }
+
+/// An instance of an instanced mesh as the traversal reads it, 128 bytes: two
+/// [`GpuBvhRecord`] slots in the `bvh_nodes` buffer, after the last node (a top-level leaf of
+/// instances holds the slot of its first one; see [`crate::bvh`]).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuInstance {
+    /// Object to world, the matrix's first three rows (offset 0).
+    pub to_world: [[f32; 4]; 3],
+    /// World to object, likewise (offset 48).
+    pub to_object: [[f32; 4]; 3],
+    /// Its mesh's BVH root node (offset 96).
+    pub root: u32,
+    /// Its index in [`crate::GpuScene::instances`] (offset 100).
+    pub index: u32,
+    /// [`INSTANCE_MIRROR`] (offset 104).
+    pub flags: u32,
+    /// Padding to two node records (offset 108).
+    pub pad: [u32; 5],
+}
+
+/// A hit's instance off instanced meshes (the scene's own primitives).
+pub const NO_INSTANCE: u32 = u32::MAX;
+
+/// [`GpuInstance::flags`]: the transform mirrors (a negative determinant); its triangles'
+/// corners 1 and 2 are swapped, as in a copy ([`crate::transform_triangle`]).
+pub const INSTANCE_MIRROR: u32 = 1;
+
+/// [`GpuHeader::features`]: the scene has instanced meshes (a two-level BVH).
+pub const FEATURE_INSTANCES: u32 = 256;
 
 /// A BVH node as the GPU reads it, 64 bytes: the node, then its skip links for the 8 ray
 /// octants (see [`crate::bvh`]), so the link a ray needs is in the node's cache line.

@@ -36,13 +36,14 @@ pub mod texture;
 pub mod traverse;
 
 pub use bvh::{BVH_END, BVH_MAX_DEPTH, BvhOptions};
-pub use error::{ErrorKind, Pos, SceneError};
+pub use error::{ErrorKind, InstancedCopies, Pos, SceneError};
 pub use file::{Environment, LightDesc, RenderSettings, VERSION};
 pub use flatten::{GpuScene, LIGHT_UNIFORM_SHARE, alias_table, light_selection, luminance};
 pub use gpu::*;
 pub use load::transform_matrix;
 pub use scene::{
-    AlphaMode, Camera, LoadReport, LoadStats, Material, MaterialTextures, Medium, NO_TEXTURE,
+    AUTO_FLATTEN_MAX_TRIANGLES, AlphaMode, Camera, InstancedMesh, Instancing, LoadReport,
+    LoadStats, MAX_INSTANCED_TRIANGLES, Material, MaterialTextures, Medium, NO_TEXTURE,
     PunctualLight, Scene, Sphere, Triangle, cube_quads, push_triangle, quad_triangles,
     rectangle_quad, transform_triangle,
 };

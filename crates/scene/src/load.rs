@@ -205,6 +205,26 @@ pub fn transform_matrix(t: &TransformDesc) -> Result<Mat4, SceneError> {
     Ok(m)
 }
 
+/// A `Mesh`'s `instances`: everything the file holds becomes instances placed at each of
+/// `places` (after the file's own transform and node hierarchy): its flat triangles one
+/// instanced mesh, its own instanced meshes (a glTF mesh used by several nodes) placed at
+/// every combination.
+fn place_instances(mesh: &mut crate::import::ImportedMesh, places: &[Mat4], name: &str) {
+    for m in &mut mesh.instanced {
+        m.transforms = places
+            .iter()
+            .flat_map(|p| m.transforms.iter().map(move |t| *p * *t))
+            .collect();
+    }
+    if !mesh.triangles.is_empty() {
+        mesh.instanced.push(crate::scene::InstancedMesh {
+            name: name.to_owned(),
+            triangles: std::mem::take(&mut mesh.triangles),
+            transforms: places.to_vec(),
+        });
+    }
+}
+
 /// A `Mesh`'s `diffuse: true`: every material of the file as [`Material::as_diffuse`], and
 /// the textures none of them reads any more left out (they were decoded with the file, but
 /// take no place in the atlas).
@@ -513,6 +533,7 @@ impl Scene {
         } else {
             Builder::new(text, base_dir).build(file)?
         };
+        scene.apply_instancing(file.instancing)?;
         scene.stats.total = started.elapsed();
         Ok(scene)
     }
@@ -553,6 +574,7 @@ struct Builder<'a> {
     /// (base material, emission bits, two-sided) → derived emissive material.
     derived: HashMap<(u32, [u32; 3], bool), u32>,
     scene_triangles: Vec<crate::scene::Triangle>,
+    instanced: Vec<crate::scene::InstancedMesh>,
     spheres: Vec<Sphere>,
     lights: Vec<PunctualLight>,
     textures: Vec<crate::texture::Texture>,
@@ -593,6 +615,7 @@ impl<'a> Builder<'a> {
             by_name: HashMap::new(),
             derived: HashMap::new(),
             scene_triangles: Vec::new(),
+            instanced: Vec::new(),
             spheres: Vec::new(),
             lights: Vec::new(),
             textures: Vec::new(),
@@ -722,6 +745,7 @@ impl<'a> Builder<'a> {
             camera,
             materials: self.materials,
             triangles: self.scene_triangles,
+            instanced: self.instanced,
             spheres: self.spheres,
             lights: self.lights,
             textures: self.textures,
@@ -845,56 +869,113 @@ impl<'a> Builder<'a> {
                 transform,
                 material,
                 diffuse,
+                instances,
                 ..
-            } => {
-                let t = transform_matrix(transform)?;
-                let over = material.as_deref().map(|m| self.lookup(m)).transpose()?;
-                let full = self.base_dir.join(path);
-                let mut mesh = import_mesh(&full, t)?;
-                if *diffuse {
-                    reduce_to_diffuse(&mut mesh);
-                }
-                let prefix = name.clone().unwrap_or_else(|| path.clone());
-                let mut ids = Vec::with_capacity(mesh.materials.len());
-                // The file's textures follow the scene's; its materials' indices move along
-                // (an override material has none, so the file's textures are not kept).
-                let first_texture = self.textures.len() as u32;
-                if over.is_none() {
-                    self.textures.extend(mesh.textures);
-                }
-                for mut m in mesh.materials {
-                    let id = if let Some(o) = over {
-                        o
-                    } else {
-                        for t in m.textures.all_mut() {
-                            if *t != crate::scene::NO_TEXTURE {
-                                *t += first_texture;
-                            }
-                        }
-                        self.materials.push(Material {
-                            name: format!("{prefix}/{}", m.name),
-                            ..m
-                        });
-                        self.materials.len() as u32 - 1
-                    };
-                    ids.push(self.emissive(id, emission, two_sided)?);
-                }
-                self.scene_triangles
-                    .extend(mesh.triangles.into_iter().map(|mut t| {
-                        t.material = ids[t.material as usize];
-                        // An override material replaces the file's look, vertex colours too.
-                        if over.is_some() {
-                            t.colors = None;
-                        }
-                        t
-                    }));
-                self.report.merge(mesh.report);
-                self.decode.add(&mesh.decode);
-                self.lights.extend(mesh.lights);
-                if let Some(n) = name {
-                    self.mesh_cameras.insert(n.clone(), mesh.cameras);
-                }
+            } => self.mesh(
+                name.as_ref(),
+                path,
+                transform,
+                material.as_deref(),
+                *diffuse,
+                instances,
+                emission,
+                two_sided,
+            )?,
+        }
+        Ok(())
+    }
+
+    /// A `Mesh` shape: the file imported (once, for all its `instances`), its materials
+    /// and textures added after the scene's, its triangles and instanced meshes kept.
+    #[allow(clippy::too_many_arguments)]
+    fn mesh(
+        &mut self,
+        name: Option<&String>,
+        path: &String,
+        transform: &TransformDesc,
+        material: Option<&str>,
+        diffuse: bool,
+        instances: &[TransformDesc],
+        emission: Option<V3>,
+        two_sided: bool,
+    ) -> Result<(), SceneError> {
+        let t = transform_matrix(transform)?;
+        let places = instances
+            .iter()
+            .map(transform_matrix)
+            .collect::<Result<Vec<_>, _>>()?;
+        let over = material.map(|m| self.lookup(m)).transpose()?;
+        let full = self.base_dir.join(path);
+        let mut mesh = import_mesh(&full, t)?;
+        if diffuse {
+            reduce_to_diffuse(&mut mesh);
+        }
+        let prefix = name.cloned().unwrap_or_else(|| path.clone());
+        if !places.is_empty() {
+            if !mesh.lights.is_empty() {
+                return Err(bad(
+                    "instances",
+                    format!(
+                        "the file has {} light(s), which lumagraph places once, not per \
+                             instance; give them in the scene file's `lights`",
+                        mesh.lights.len()
+                    ),
+                ));
             }
+            place_instances(&mut mesh, &places, &prefix);
+        }
+        let mut ids = Vec::with_capacity(mesh.materials.len());
+        // The file's textures follow the scene's; its materials' indices move along
+        // (an override material has none, so the file's textures are not kept).
+        let first_texture = self.textures.len() as u32;
+        if over.is_none() {
+            self.textures.extend(mesh.textures);
+        }
+        for mut m in mesh.materials {
+            let id = if let Some(o) = over {
+                o
+            } else {
+                for t in m.textures.all_mut() {
+                    if *t != crate::scene::NO_TEXTURE {
+                        *t += first_texture;
+                    }
+                }
+                self.materials.push(Material {
+                    name: format!("{prefix}/{}", m.name),
+                    ..m
+                });
+                self.materials.len() as u32 - 1
+            };
+            ids.push(self.emissive(id, emission, two_sided)?);
+        }
+        let remap = |mut t: crate::scene::Triangle| {
+            t.material = ids[t.material as usize];
+            // An override material replaces the file's look, vertex colours too.
+            if over.is_some() {
+                t.colors = None;
+            }
+            t
+        };
+        self.scene_triangles
+            .extend(mesh.triangles.into_iter().map(remap));
+        for mut m in mesh.instanced {
+            m.triangles = m.triangles.into_iter().map(remap).collect();
+            // Media need their boundaries in world space (and `check_medium`):
+            // such meshes are copied here.
+            if m.triangles.iter().any(|t| {
+                let mat = &self.materials[t.material as usize];
+                mat.medium.is_some() || mat.index_matched
+            }) {
+                crate::scene::copy_instances(&[m], &mut self.scene_triangles, &mut self.report)?;
+            } else {
+                self.instanced.push(m);
+            }
+        }
+        self.report.merge(mesh.report);
+        self.decode.add(&mesh.decode);
+        self.lights.extend(mesh.lights);
+        if let Some(n) = name {
+            self.mesh_cameras.insert(n.clone(), mesh.cameras);
         }
         Ok(())
     }

@@ -7,9 +7,12 @@
 
 use glam::Vec3;
 
-use crate::bvh::{BVH_END, NODE_COUNT_SHIFT, NODE_SPHERES};
+use crate::bvh::{BVH_END, NODE_COUNT_SHIFT, NODE_INSTANCES, NODE_SPHERES};
 use crate::flatten::GpuScene;
-use crate::gpu::{MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, NO_HIT, PRIM_SPHERE};
+use crate::gpu::{
+    GpuInstance, INSTANCE_MIRROR, MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, NO_HIT, NO_INSTANCE,
+    PRIM_SPHERE,
+};
 
 /// A ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,6 +34,9 @@ pub struct Hit {
     pub u: f32,
     /// Barycentric weight of corner 2 (triangles; 0 for spheres).
     pub v: f32,
+    /// The instance whose mesh the triangle is of (its first node slot, see
+    /// [`GpuScene::instance_at`]), or [`NO_INSTANCE`] for the scene's own primitives.
+    pub inst: u32,
 }
 
 impl Hit {
@@ -222,31 +228,227 @@ pub fn occluded(scene: &GpuScene, ray: &Ray, t_max: f32) -> bool {
     traverse::<true>(scene, ray, t_max).is_some()
 }
 
+/// Boxes of a mesh's BVH are tested with the ray moved into the mesh's space: they grow by
+/// this much of the coordinates involved (`INSTANCE_PAD` in `pathtrace/instances.wgsl`).
+const INSTANCE_PAD: f32 = 9.536_743e-7;
+
+/// The rows `first..first + 3` of `inst` (0: object to world, 3: world to object) applied
+/// to point `p` (`w` 1) or vector (`w` 0).
+fn instance_apply(inst: &GpuInstance, first: usize, p: Vec3, w: f32) -> Vec3 {
+    let row = |r: usize| {
+        let x = if r < 3 {
+            inst.to_world[r]
+        } else {
+            inst.to_object[r - 3]
+        };
+        Vec3::new(x[0], x[1], x[2]).dot(p) + w * x[3]
+    };
+    Vec3::new(row(first), row(first + 1), row(first + 2))
+}
+
+/// A triangle of `inst`'s mesh in world space: corner 0 and the edges to corners 1 and 2
+/// (`place_triangle`).
+pub fn place_triangle(inst: &GpuInstance, tri: &crate::gpu::GpuTriangle) -> (Vec3, Vec3, Vec3) {
+    (
+        instance_apply(inst, 0, v3(tri.v0), 1.0),
+        instance_apply(inst, 0, v3(tri.e1), 0.0),
+        instance_apply(inst, 0, v3(tri.e2), 0.0),
+    )
+}
+
+/// A normal of `inst`'s mesh in world space, not normalized (`instance_normal`).
+pub fn instance_normal(inst: &GpuInstance, n: Vec3) -> Vec3 {
+    let row = |r: usize| {
+        Vec3::new(
+            inst.to_object[r][0],
+            inst.to_object[r][1],
+            inst.to_object[r][2],
+        )
+    };
+    n.x * row(0) + n.y * row(1) + n.z * row(2)
+}
+
+/// The ray the boxes of a level are tested with (`InstanceRay`).
+#[derive(Clone, Copy)]
+struct BoxRay {
+    origin: Vec3,
+    inv_dir: Vec3,
+    octant: u32,
+    pad: f32,
+    root: u32,
+}
+
+fn max3(v: Vec3) -> f32 {
+    v.x.max(v.y).max(v.z)
+}
+
+fn octant_of(d: Vec3) -> u32 {
+    u32::from(d.x < 0.0) | (u32::from(d.y < 0.0) << 1) | (u32::from(d.z < 0.0) << 2)
+}
+
+/// `ray` in the space of `inst`'s mesh (`instance_ray`).
+fn instance_ray(scene: &GpuScene, inst: &GpuInstance, ray: &Ray) -> BoxRay {
+    let origin = instance_apply(inst, 3, ray.origin, 1.0);
+    let dir = instance_apply(inst, 3, ray.dir, 0.0);
+    let root = inst.root;
+    let o = ray.origin.abs();
+    let term = |r: [f32; 4]| Vec3::new(r[0], r[1], r[2]).abs().dot(o) + r[3].abs();
+    let terms = Vec3::new(
+        term(inst.to_object[0]),
+        term(inst.to_object[1]),
+        term(inst.to_object[2]),
+    );
+    let node = scene.bvh_nodes[root as usize];
+    let extent = max3(v3(node.aabb_min).abs().max(v3(node.aabb_max).abs()));
+    let pad = INSTANCE_PAD * (max3(terms) + max3(origin.abs()) + extent);
+    BoxRay {
+        origin,
+        inv_dir: safe_inverse(dir),
+        octant: octant_of(dir),
+        pad,
+        root,
+    }
+}
+
+/// Triangle `i` of `inst`'s mesh, tested in world space as a copy of it would be (corners 1
+/// and 2 swapped where the instance mirrors, u and v swapped back):
+/// `candidate_instance_triangle`.
+fn instance_triangle_hit(
+    scene: &GpuScene,
+    inst: &GpuInstance,
+    i: u32,
+    ray: &Ray,
+    t_max: f32,
+) -> Option<(f32, f32, f32)> {
+    let tri = &scene.tri_positions[i as usize];
+    let (v0, e1, e2) = place_triangle(inst, tri);
+    let mirror = inst.flags & INSTANCE_MIRROR != 0;
+    let (a, b) = if mirror { (e2, e1) } else { (e1, e2) };
+    intersect_triangle(ray.origin, ray.dir, v0, a, b, t_max)
+        .map(|(t, u, v)| if mirror { (t, v, u) } else { (t, u, v) })
+}
+
+/// The tests of a leaf's triangles (of the instance `inst`, or the scene's own where it is
+/// [`NO_INSTANCE`]) or spheres, narrowing `hit`; `true` where `ANY` and one counts.
+fn leaf_hits<const ANY: bool>(
+    scene: &GpuScene,
+    node: crate::gpu::GpuBvhNode,
+    inst: u32,
+    ray: &Ray,
+    alpha: bool,
+    hit: &mut Hit,
+) -> bool {
+    let (first, count) = (node.index, node.bits >> NODE_COUNT_SHIFT);
+    let slot = |s: u32| scene.instance_at(s, 0);
+    if node.bits & NODE_SPHERES == 0 {
+        for i in first..first + count {
+            let tri = scene.tri_positions[i as usize];
+            let r = if inst == NO_INSTANCE {
+                intersect_triangle(
+                    ray.origin,
+                    ray.dir,
+                    v3(tri.v0),
+                    v3(tri.e1),
+                    v3(tri.e2),
+                    hit.t,
+                )
+            } else {
+                instance_triangle_hit(scene, slot(inst), i, ray, hit.t)
+            };
+            if let Some((t, u, v)) = r
+                && (!alpha
+                    || tri.flags & crate::gpu::TRI_ALPHA == 0
+                    || triangle_hit_counts(scene, i, u, v, ray))
+            {
+                *hit = Hit {
+                    prim: i,
+                    t,
+                    u,
+                    v,
+                    inst,
+                };
+                if ANY {
+                    return true;
+                }
+            }
+        }
+    } else {
+        for i in first..first + count {
+            let s = scene.spheres[i as usize];
+            if let Some(t) = intersect_sphere(ray.origin, ray.dir, v3(s.center), s.radius, hit.t)
+                && (!alpha || sphere_hit_counts(scene, i, ray))
+            {
+                *hit = Hit {
+                    prim: i | PRIM_SPHERE,
+                    t,
+                    u: 0.0,
+                    v: 0.0,
+                    inst: NO_INSTANCE,
+                };
+                if ANY {
+                    return true;
+                }
+            }
+        }
+    }
+    false
+}
+
 fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
     let mut hit = Hit {
         prim: NO_HIT,
         t: t_max,
         u: 0.0,
         v: 0.0,
+        inst: NO_INSTANCE,
     };
     if scene.bvh_nodes.is_empty() {
         return None;
     }
     let alpha = scene.header.features & crate::gpu::FEATURE_ALPHA != 0;
-    let inv_dir = safe_inverse(ray.dir);
     // Bit `a` set where the direction's component on axis `a` is negative: such rays visit
     // the second child of a node split on `a` first.
-    let octant = u32::from(ray.dir.x < 0.0)
-        | (u32::from(ray.dir.y < 0.0) << 1)
-        | (u32::from(ray.dir.z < 0.0) << 2);
+    let octant = octant_of(ray.dir);
+    let world = BoxRay {
+        origin: ray.origin,
+        inv_dir: safe_inverse(ray.dir),
+        octant,
+        pad: 0.0,
+        root: 0,
+    };
+    // The ray the boxes are tested with: the world's, or the walked instance's.
+    let mut at = world;
+    // The instance walked (its slot) or NO_INSTANCE, the slot after its leaf's last one,
+    // and the top-level node after that leaf.
+    let mut inst = NO_INSTANCE;
+    let mut inst_end = 0u32;
+    let mut resume = 0u32;
     let mut node_index = 0u32;
-    while node_index != BVH_END {
+    let slot = |s: u32| scene.instance_at(s, 0);
+    loop {
+        if node_index == BVH_END {
+            if inst == NO_INSTANCE {
+                break;
+            }
+            // The instance's mesh is done: the leaf's next instance, or back to the top.
+            inst += 2;
+            if inst == inst_end {
+                inst = NO_INSTANCE;
+                at = world;
+                node_index = resume;
+            } else {
+                at = instance_ray(scene, slot(inst), ray);
+                node_index = at.root;
+            }
+            continue;
+        }
         let node = scene.bvh_nodes[node_index as usize];
+        let pad = Vec3::splat(at.pad);
         if ray_aabb(
-            ray.origin,
-            inv_dir,
-            v3(node.aabb_min),
-            v3(node.aabb_max),
+            at.origin,
+            at.inv_dir,
+            v3(node.aabb_min) - pad,
+            v3(node.aabb_max) + pad,
             hit.t,
         ) {
             let count = node.bits >> NODE_COUNT_SHIFT;
@@ -254,7 +456,7 @@ fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
                 // Inner node: on to the near child (the first one is adjacent, the second at
                 // `index`).
                 let axis = node.bits & 3;
-                node_index = if (octant >> axis) & 1 == 1 {
+                node_index = if (at.octant >> axis) & 1 == 1 {
                     node.index
                 } else {
                     node_index + 1
@@ -262,48 +464,20 @@ fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
                 continue;
             }
             let first = node.index;
-            if node.bits & NODE_SPHERES == 0 {
-                for i in first..first + count {
-                    let tri = scene.tri_positions[i as usize];
-                    if let Some((t, u, v)) = intersect_triangle(
-                        ray.origin,
-                        ray.dir,
-                        v3(tri.v0),
-                        v3(tri.e1),
-                        v3(tri.e2),
-                        hit.t,
-                    ) && (!alpha
-                        || tri.flags & crate::gpu::TRI_ALPHA == 0
-                        || triangle_hit_counts(scene, i, u, v, ray))
-                    {
-                        hit = Hit { prim: i, t, u, v };
-                        if ANY {
-                            return Some(hit);
-                        }
-                    }
-                }
-            } else {
-                for i in first..first + count {
-                    let s = scene.spheres[i as usize];
-                    if let Some(t) =
-                        intersect_sphere(ray.origin, ray.dir, v3(s.center), s.radius, hit.t)
-                        && (!alpha || sphere_hit_counts(scene, i, ray))
-                    {
-                        hit = Hit {
-                            prim: i | PRIM_SPHERE,
-                            t,
-                            u: 0.0,
-                            v: 0.0,
-                        };
-                        if ANY {
-                            return Some(hit);
-                        }
-                    }
-                }
+            if node.bits & NODE_INSTANCES != 0 {
+                inst = first;
+                inst_end = first + 2 * count;
+                resume = scene.bvh_skips[node_index as usize][octant as usize];
+                at = instance_ray(scene, slot(inst), ray);
+                node_index = at.root;
+                continue;
+            }
+            if leaf_hits::<ANY>(scene, node, inst, ray, alpha, &mut hit) {
+                return Some(hit);
             }
         }
         // A leaf, or a box missed: past this subtree.
-        node_index = scene.bvh_skips[node_index as usize][octant as usize];
+        node_index = scene.bvh_skips[node_index as usize][at.octant as usize];
     }
     (hit.prim != NO_HIT).then_some(hit)
 }
@@ -329,6 +503,7 @@ pub fn intersect_brute_force(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
                 t,
                 u,
                 v,
+                inst: NO_INSTANCE,
             });
         }
     }
@@ -340,6 +515,7 @@ pub fn intersect_brute_force(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
                 t,
                 u: 0.0,
                 v: 0.0,
+                inst: NO_INSTANCE,
             });
         }
     }

@@ -48,6 +48,7 @@ fn sphere_grid_scene() -> Scene {
         },
         materials,
         triangles: mesh.triangles,
+        instanced: Vec::new(),
         lights: Vec::new(),
         textures: Vec::new(),
         spheres,
@@ -175,7 +176,13 @@ impl Reference {
                 );
                 if let Some((t, u, v)) = r {
                     t_max = t;
-                    best = Some(Hit { prim: i, t, u, v });
+                    best = Some(Hit {
+                        prim: i,
+                        t,
+                        u,
+                        v,
+                        inst: lumagraph_scene::NO_INSTANCE,
+                    });
                 }
             }
         }
@@ -194,6 +201,7 @@ impl Reference {
                     t,
                     u: 0.0,
                     v: 0.0,
+                    inst: lumagraph_scene::NO_INSTANCE,
                 });
             }
         }

@@ -150,7 +150,7 @@ fn extensions_and_attributes_not_read_are_warnings_naming_their_users() {
 /// rotation and scale applied before the node's own transform (glTF's order); the file
 /// requires the extension, and it loads.
 #[test]
-fn gpu_instancing_places_a_copy_at_each_instance() {
+fn gpu_instancing_places_the_mesh_at_each_instance() {
     let corners: [f32; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
     let translations: [f32; 9] = [10.0, 0.0, 0.0, 0.0, 5.0, 0.0, 0.0, 0.0, 0.0];
     let h = std::f32::consts::FRAC_1_SQRT_2;
@@ -191,7 +191,15 @@ fn gpu_instancing_places_a_copy_at_each_instance() {
     let (_dir, path) = write("Instanced.gltf", &text);
     let m = import_mesh(&path, Mat4::IDENTITY).unwrap();
     assert!(m.report.warnings.is_empty(), "{:?}", m.report.warnings);
-    let got: Vec<[glam::Vec3; 3]> = m.triangles.iter().map(|t| t.positions).collect();
+    // The mesh is stored once, with a transform per instance.
+    assert!(m.triangles.is_empty());
+    assert_eq!(m.instanced.len(), 1);
+    assert_eq!(m.instanced[0].triangles.len(), 1);
+    let got: Vec<[glam::Vec3; 3]> = m.instanced[0]
+        .transforms
+        .iter()
+        .map(|t| lumagraph_scene::transform_triangle(t, &m.instanced[0].triangles[0]).positions)
+        .collect();
     let v = |x: f32, y: f32, z: f32| glam::Vec3::new(x, y, z);
     let want = [
         [v(10.0, 0.0, 1.0), v(11.0, 0.0, 1.0), v(10.0, 1.0, 1.0)],

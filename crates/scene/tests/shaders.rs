@@ -33,6 +33,7 @@ const STUB: &str = r#"
 const HAS_TRIANGLES: bool = true;
 const HAS_SPHERES: bool = true;
 const HAS_ALPHA: bool = false;
+const HAS_INSTANCES: bool = true;
 fn triangle_hit_counts(prim: u32, u: f32, v: f32, ray: Ray) -> bool { return true; }
 fn sphere_hit_counts(i: u32, ray: Ray) -> bool { return true; }
 @group(0) @binding(0) var<storage, read> bvh_nodes: array<vec4<u32>>;
@@ -224,6 +225,22 @@ fn wgsl_layouts_match_rust() {
     }
 }
 
+/// `pathtrace/instances.wgsl` reads an instance as vec4s of `bvh_nodes`: rows 0-2
+/// `to_world`, 3-5 `to_object`, 6 (root, index, flags); two node records in all.
+#[test]
+fn instance_records_are_where_instances_wgsl_reads_them() {
+    use lumagraph_scene::{GpuBvhRecord, GpuInstance};
+    assert_eq!(size_of::<GpuInstance>(), 2 * size_of::<GpuBvhRecord>());
+    assert_eq!(offset_of!(GpuInstance, to_world), 0);
+    assert_eq!(offset_of!(GpuInstance, to_object), 3 * 16);
+    assert_eq!(offset_of!(GpuInstance, root), 6 * 16);
+    assert_eq!(offset_of!(GpuInstance, index), 6 * 16 + 4);
+    assert_eq!(offset_of!(GpuInstance, flags), 6 * 16 + 8);
+    let src = std::fs::read_to_string(common::shaders().join("pathtrace/instances.wgsl")).unwrap();
+    assert!(src.contains("return bvh_nodes[slot * 4u + 6u];"));
+    assert!(src.contains("const INSTANCE_PAD: f32 = 9.536743e-7;"));
+}
+
 #[test]
 fn wgsl_constants_match_rust() {
     let src = std::fs::read_to_string(common::shaders().join("pathtrace/bvh.wgsl")).unwrap();
@@ -236,6 +253,10 @@ fn wgsl_constants_match_rust() {
         ("NO_HIT", lumagraph_scene::NO_HIT),
         ("NO_LIGHT", lumagraph_scene::NO_LIGHT),
         ("NODE_SPHERES", lumagraph_scene::bvh::NODE_SPHERES),
+        ("NODE_INSTANCES", lumagraph_scene::bvh::NODE_INSTANCES),
+        ("NO_INSTANCE", lumagraph_scene::NO_INSTANCE),
+        ("INSTANCE_MIRROR", lumagraph_scene::INSTANCE_MIRROR),
+        ("FEATURE_INSTANCES", lumagraph_scene::FEATURE_INSTANCES),
         ("NODE_COUNT_SHIFT", lumagraph_scene::bvh::NODE_COUNT_SHIFT),
         ("LIGHT_SPHERE", lumagraph_scene::LIGHT_SPHERE),
         ("LIGHT_TWO_SIDED", lumagraph_scene::LIGHT_TWO_SIDED),

@@ -1,6 +1,10 @@
 //! `GBuffer`: a raster pass (vertex + fragment, depth-tested) from the path tracer's camera,
 //! writing first-hit albedo, shading normal and distance along the ray.
 //!
+//! Instanced meshes are drawn once per instance: each mesh's triangles (in its own space)
+//! are one range of the vertex buffer, drawn with its instances' transforms from a second,
+//! per-instance buffer (`GpuInstance` records, an identity first for everything else).
+//!
 //! The scene's triangles go to one non-indexed vertex buffer with their corner normals and
 //! material color (and, with textures, UV, tangent and material id: the fragment shader
 //! applies the base color texture and the normal map as the path tracer does); each sphere becomes a UV sphere circumscribing the true one, and the
@@ -12,7 +16,7 @@
 //! every attachment of a render pass must have the same size.
 
 use lumagraph_graph::{Extent, Pass, TexFormat};
-use lumagraph_scene::{FEATURE_TEXTURES, GpuScene, TRI_VERTEX_NORMALS};
+use lumagraph_scene::{FEATURE_TEXTURES, GpuInstance, GpuScene, TRI_VERTEX_NORMALS};
 use wgpu::util::DeviceExt as _;
 
 use crate::context::GpuContext;
@@ -48,7 +52,8 @@ pub(crate) struct GBuffer {
     camera_now: lumagraph_scene::GpuCamera,
     pipeline: wgpu::RenderPipeline,
     bind_group: wgpu::BindGroup,
-    vertices: Option<(wgpu::Buffer, u32)>,
+    /// The vertex buffer, the per-instance buffer, and the draws over them.
+    vertices: Option<(wgpu::Buffer, wgpu::Buffer, Vec<Draw>)>,
     segments: u32,
     /// Depth attachment and stand-ins for unread outputs, at the pass's size.
     targets: Option<(Extent, wgpu::TextureView, [Option<PooledTexture>; 3])>,
@@ -197,6 +202,11 @@ fn pipeline(
         0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x4,
         4 => Float32x4, 5 => Float32x4, 6 => Uint32, 7 => Float32x4
     ];
+    // A `GpuInstance`: its transforms' rows and (root, index, flags, pad).
+    let instance_attributes = wgpu::vertex_attr_array![
+        8 => Float32x4, 9 => Float32x4, 10 => Float32x4,
+        11 => Float32x4, 12 => Float32x4, 13 => Float32x4, 14 => Uint32x4
+    ];
     let target = |format| {
         Some(wgpu::ColorTargetState {
             format: wgpu_format(format),
@@ -211,11 +221,18 @@ fn pipeline(
             module: &module,
             entry_point: Some("vs_main"),
             compilation_options: wgpu::PipelineCompilationOptions::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: (VERTEX_FLOATS * 4) as u64,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &attributes,
-            })],
+            buffers: &[
+                Some(wgpu::VertexBufferLayout {
+                    array_stride: (VERTEX_FLOATS * 4) as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &attributes,
+                }),
+                Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<GpuInstance>() as u64,
+                    step_mode: wgpu::VertexStepMode::Instance,
+                    attributes: &instance_attributes,
+                }),
+            ],
         },
         // No culling: the path tracer sees back faces too.
         primitive: wgpu::PrimitiveState::default(),
@@ -332,8 +349,66 @@ struct Tex {
     color: [f32; 4],
 }
 
-/// The vertex data of every triangle and tessellated sphere, `VERTEX_FLOATS` per vertex.
-pub(crate) fn vertices(scene: &GpuScene, segments: u32) -> Vec<f32> {
+/// One draw: a range of vertices, drawn once per instance of a range of the per-instance
+/// buffer.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Draw {
+    pub vertices: std::ops::Range<u32>,
+    pub instances: std::ops::Range<u32>,
+}
+
+/// The per-instance records: the identity (for the scene's own triangles and spheres), then
+/// the instances grouped by mesh; and the draws: the scene's own triangles and tessellated
+/// spheres once, then each instanced mesh's triangles once per instance of it.
+pub(crate) fn draws(scene: &GpuScene, segments: u32) -> (Vec<f32>, Vec<GpuInstance>, Vec<Draw>) {
+    let identity = GpuInstance {
+        to_world: [
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+        ],
+        to_object: [
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+        ],
+        ..GpuInstance::default()
+    };
+    let own = scene.tri_source.len();
+    let mut data = vertices(scene, 0..own, segments.max(1));
+    let floats = |d: &Vec<f32>| (d.len() / VERTEX_FLOATS) as u32;
+    let mut draws = vec![Draw {
+        vertices: 0..floats(&data),
+        instances: 0..1,
+    }];
+    let mut instances = vec![identity];
+    for (mesh, &[first, count]) in scene.mesh_triangles.iter().enumerate() {
+        let start = floats(&data);
+        data.extend(vertices(scene, first as usize..(first + count) as usize, 0));
+        let at = instances.len() as u32;
+        instances.extend(
+            scene
+                .instances
+                .iter()
+                .zip(&scene.instance_mesh)
+                .filter(|(_, m)| **m as usize == mesh)
+                .map(|(i, _)| *i),
+        );
+        draws.push(Draw {
+            vertices: start..floats(&data),
+            instances: at..instances.len() as u32,
+        });
+    }
+    (data, instances, draws)
+}
+
+/// The vertex data of the triangles `triangles` (indices in `tri_positions`) and, where
+/// `segments` is not 0, every tessellated sphere, `VERTEX_FLOATS` per vertex.
+pub(crate) fn vertices(
+    scene: &GpuScene,
+    triangles: std::ops::Range<usize>,
+    segments: u32,
+) -> Vec<f32> {
     let albedo = |m: u32| {
         scene
             .materials
@@ -357,12 +432,8 @@ pub(crate) fn vertices(scene: &GpuScene, segments: u32) -> Vec<f32> {
         material,
         color: [1.0; 4],
     };
-    for (i, (t, sh)) in scene
-        .tri_positions
-        .iter()
-        .zip(&scene.tri_shading)
-        .enumerate()
-    {
+    for i in triangles {
+        let (t, sh) = (&scene.tri_positions[i], &scene.tri_shading[i]);
         let corners = [t.v0, add(t.v0, t.e1), add(t.v0, t.e2)];
         let ng = normalize(cross(t.e1, t.e2));
         let normals = if sh.flags & TRI_VERTEX_NORMALS != 0 {
@@ -391,6 +462,9 @@ pub(crate) fn vertices(scene: &GpuScene, segments: u32) -> Vec<f32> {
             });
             push(corners[k], normals[k], a, [ng[0], ng[1], ng[2], 0.0], tex);
         }
+    }
+    if segments == 0 {
+        return out;
     }
     // UV spheres: `segments` around, `segments / 2` from pole to pole, with corners pushed
     // out by 1/cos(step) so the faces enclose the true sphere.
@@ -434,9 +508,16 @@ impl NodeExec for GBuffer {
     fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
         let segments = u32::try_from(pass.params.int("sphere_segments")).unwrap_or(48);
         if self.vertices.is_none() || segments != self.segments {
-            let data = vertices(&self.scene, segments);
-            let count = u32::try_from(data.len() / VERTEX_FLOATS)
+            let (data, instances, draws) = draws(&self.scene, segments);
+            u32::try_from(data.len() / VERTEX_FLOATS)
                 .map_err(|_| RenderError::Gpu("too many G-buffer vertices".into()))?;
+            let instances = ctx
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("gbuffer instances"),
+                    contents: bytemuck::cast_slice(&instances),
+                    usage: wgpu::BufferUsages::VERTEX,
+                });
             let buffer = ctx
                 .device
                 .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -448,7 +529,7 @@ impl NodeExec for GBuffer {
                     }),
                     usage: wgpu::BufferUsages::VERTEX,
                 });
-            self.vertices = Some((buffer, count));
+            self.vertices = Some((buffer, instances, draws));
             self.segments = segments;
         }
         Ok(())
@@ -545,11 +626,14 @@ impl NodeExec for GBuffer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if let Some((buffer, count)) = &self.vertices {
+        if let Some((buffer, instances, draws)) = &self.vertices {
             rpass.set_pipeline(&self.pipeline);
             rpass.set_bind_group(0, &self.bind_group, &[]);
             rpass.set_vertex_buffer(0, buffer.slice(..));
-            rpass.draw(0..*count, 0..1);
+            rpass.set_vertex_buffer(1, instances.slice(..));
+            for d in draws {
+                rpass.draw(d.vertices.clone(), d.instances.clone());
+            }
         }
         Ok(())
     }

@@ -88,7 +88,7 @@ pub fn inline_intersection(scene: &GpuScene, alpha: bool) -> Option<String> {
         };
         let _ = writeln!(
             closest,
-            "    r = intersect_triangle(ray.origin, ray.dir, {args}, hit.t);\n    if (r.x != 0.0 && skip_prim != {a}u{test}) {{ hit = Hit({a}u, r.y, r.z, r.w); }}"
+            "    r = intersect_triangle(ray.origin, ray.dir, {args}, hit.t);\n    if (r.x != 0.0 && skip_prim != {a}u{test}) {{ hit = Hit({a}u, r.y, r.z, r.w, NO_INSTANCE); }}"
         );
         let _ = writeln!(
             any,
@@ -104,7 +104,7 @@ pub fn inline_intersection(scene: &GpuScene, alpha: bool) -> Option<String> {
                 // its barycentrics are (u + v, -u).
                 let _ = writeln!(
                     closest,
-                    "    r = intersect_parallelogram(ray.origin, ray.dir, {args}, hit.t);\n    if (r.x != 0.0 && skip_prim != {a}u && skip_prim != {b}u) {{ let second = r.z < 0.0; hit = Hit(select({a}u, {b}u, second), r.y, select(r.z, r.z + r.w, second), select(r.w, -r.z, second)); }}"
+                    "    r = intersect_parallelogram(ray.origin, ray.dir, {args}, hit.t);\n    if (r.x != 0.0 && skip_prim != {a}u && skip_prim != {b}u) {{ let second = r.z < 0.0; hit = Hit(select({a}u, {b}u, second), r.y, select(r.z, r.z + r.w, second), select(r.w, -r.z, second), NO_INSTANCE); }}"
                 );
                 let _ = writeln!(
                     any,
@@ -127,7 +127,7 @@ pub fn inline_intersection(scene: &GpuScene, alpha: bool) -> Option<String> {
         };
         let _ = writeln!(
             closest,
-            "    t = intersect_sphere_from({i}u | PRIM_SPHERE, ray.origin, ray.dir, {args}, hit.t);\n    if (t > 0.0{test}) {{ hit = Hit({i}u | PRIM_SPHERE, t, 0.0, 0.0); }}"
+            "    t = intersect_sphere_from({i}u | PRIM_SPHERE, ray.origin, ray.dir, {args}, hit.t);\n    if (t > 0.0{test}) {{ hit = Hit({i}u | PRIM_SPHERE, t, 0.0, 0.0, NO_INSTANCE); }}"
         );
         let _ = writeln!(
             any,
@@ -140,7 +140,7 @@ pub fn inline_intersection(scene: &GpuScene, alpha: bool) -> Option<String> {
 #import \"pathtrace/primitives.wgsl\"
 
 fn intersect_scene_within(ray: Ray, t_max: f32) -> Hit {{
-    var hit = Hit(NO_HIT, t_max, 0.0, 0.0);
+    var hit = Hit(NO_HIT, t_max, 0.0, 0.0, NO_INSTANCE);
     var r: vec4<f32>;
     var t: f32;
 {closest}    return hit;

@@ -60,6 +60,8 @@ pub enum Feature {
     Media,
     /// The any-hit test of alpha-masked and blended materials, in every intersector.
     Alpha,
+    /// Instanced meshes: the WGSL BVH walk has two levels (`pathtrace/instances.wgsl`).
+    Instances,
     /// First-hit albedo, normal and depth.
     FirstHitAovs,
     /// Adaptive sampling's statistics and skipping.
@@ -79,7 +81,7 @@ pub enum Feature {
 
 impl Feature {
     /// Every feature, in the order `plan` lists them.
-    pub const ALL: [Self; 25] = [
+    pub const ALL: [Self; 26] = [
         Self::BvhTraversal,
         Self::WideBvh,
         Self::RayQueries,
@@ -98,6 +100,7 @@ impl Feature {
         Self::Sheen,
         Self::Media,
         Self::Alpha,
+        Self::Instances,
         Self::FirstHitAovs,
         Self::Adaptive,
         Self::Textures,
@@ -128,6 +131,7 @@ impl Feature {
             Self::Sheen => "sheen",
             Self::Media => "participating media",
             Self::Alpha => "alpha (mask, blend)",
+            Self::Instances => "instanced meshes (two-level BVH)",
             Self::FirstHitAovs => "first-hit AOVs",
             Self::Adaptive => "adaptive sampling",
             Self::Textures => "material textures",
@@ -163,6 +167,7 @@ impl Feature {
             Self::Sheen => "HAS_SHEEN",
             Self::Media => "HAS_MEDIA",
             Self::Alpha => "HAS_ALPHA",
+            Self::Instances => "HAS_INSTANCES",
             Self::FirstHitAovs => "WRITE_AOVS",
             Self::Adaptive => "ADAPTIVE",
             Self::Textures => "HAS_TEXTURES",
@@ -402,9 +407,12 @@ struct Facts<'a> {
 impl<'a> Facts<'a> {
     fn new(scene: &'a GpuScene, options: PathTraceOptions) -> Self {
         let prims = scene.tri_positions.len() + scene.spheres.len();
+        let instanced = !scene.instances.is_empty();
         // Why the device's ray queries cannot trace this scene, if they cannot.
         let no_ray_queries = if !options.specialize {
             Some("general shader: WGSL BVH".to_owned())
+        } else if instanced {
+            Some(super::INSTANCES_REASON.to_owned())
         } else {
             match options.ray_query_limit {
                 None => Some(if crate::context::ray_queries_turned_off() {
@@ -418,14 +426,18 @@ impl<'a> Facts<'a> {
         // The intersector asked for where it can trace the scene; else the adapter decides.
         let asked = match options.intersector {
             Intersector::RayQueries if no_ray_queries.is_some() => Intersector::Auto,
-            Intersector::Inline if !options.specialize || prims > INLINE_MAX_PRIMITIVES => {
+            Intersector::Inline
+                if !options.specialize || prims > INLINE_MAX_PRIMITIVES || instanced =>
+            {
                 Intersector::Auto
             }
+            Intersector::WideBvh if instanced => Intersector::Auto,
             asked => asked,
         };
         let inline_for = |asked| {
             options.specialize
                 && prims <= INLINE_MAX_PRIMITIVES
+                && !instanced
                 && match asked {
                     Intersector::Auto => options.cpu_adapter,
                     Intersector::Inline => true,
@@ -595,6 +607,7 @@ impl<'a> Facts<'a> {
                 }),
                 "materials that can be cut out (alpha mask) or seen through (alpha blend)",
             ),
+            Feature::Instances => self.needed(s.instances.len(), "instances"),
             Feature::Media => self.needed(
                 self.count(|_, m| m.flags & (MATERIAL_MEDIUM | MATERIAL_INDEX_MATCHED) != 0),
                 "materials with a medium inside or an index-matched boundary",
@@ -654,6 +667,8 @@ impl<'a> Facts<'a> {
         let o = self.options;
         if !self.bvh().included || self.host.included {
             decision(false, "the BVH is not traversed in WGSL")
+        } else if !self.scene.instances.is_empty() {
+            decision(false, super::INSTANCES_REASON)
         } else if !o.specialize {
             decision(false, "general shader: the binary BVH")
         } else {

@@ -308,6 +308,8 @@ fn steps_cannot_trace(scene: &GpuScene, options: PathTraceOptions) -> Option<Str
     });
     if scene.tri_positions.is_empty() || !scene.spheres.is_empty() {
         Some("spheres or no triangles: the steps shade triangle hits only".to_owned())
+    } else if !scene.instances.is_empty() {
+        Some(INSTANCES_REASON.to_owned())
     } else if media {
         Some("participating media: shadow rays cross boundaries in WGSL".to_owned())
     } else if options.adaptive {
@@ -321,6 +323,11 @@ fn steps_cannot_trace(scene: &GpuScene, options: PathTraceOptions) -> Option<Str
         None
     }
 }
+
+/// Why only the binary WGSL BVH traces a scene with instanced meshes: the others (inline
+/// code, the 8-wide BVH, ray queries, the host and the wavefront's step records) take flat
+/// scenes only so far.
+pub const INSTANCES_REASON: &str = "instanced meshes: the binary WGSL BVH walks the two levels (the other intersectors take flat scenes only)";
 
 /// Whether the host intersects the rays (`HOST_RAYS`), and why (not).
 fn host_rays_decision(

@@ -13,8 +13,10 @@
 //! texture's own coordinates).
 //!
 //! `EXT_mesh_gpu_instancing` places a node's mesh at each of its instances (translation,
-//! rotation, scale from float accessors): the instances are copies of the mesh, each
-//! instance's triangles stored ([`MAX_INSTANCED_TRIANGLES`] at most).
+//! rotation, scale from float accessors). A mesh placed more than once (by instancing, or by
+//! several nodes) is returned once, in its own space, with a transform per placement
+//! ([`ImportedMesh::instanced`]); the scene's `instancing` decides whether it stays so or is
+//! copied.
 //!
 //! `KHR_lights_punctual` lights become [`PunctualLight`]s, converted as Blender's importer
 //! does in its default ("Standard") mode: a point or spot light's intensity in candela
@@ -83,6 +85,7 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
         threads,
     };
     let mut default_material = None;
+    let mut placed: Vec<(::gltf::Mesh<'_>, Vec<Mat4>)> = Vec::new();
 
     let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
         out.report
@@ -127,38 +130,93 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
                 Some(locals) => locals.iter().map(|l| world * *l).collect(),
                 None => vec![world],
             };
-            for prim in mesh.primitives() {
-                if prim.mode() != ::gltf::mesh::Mode::Triangles {
-                    out.report.warnings.push(format!(
-                        "mesh {} primitive {}: mode {:?} skipped (only triangles)",
-                        mesh.index(),
-                        prim.index(),
-                        prim.mode()
-                    ));
-                    continue;
-                }
-                let material = if let Some(i) = prim.material().index() {
-                    i
-                } else {
-                    *default_material.get_or_insert_with(|| {
-                        out.materials.push(Material::named("default"));
-                        out.materials.len() - 1
-                    })
-                };
-                check_attributes(&prim, &buffers).map_err(|e| {
-                    SceneError::new(ErrorKind::GltfData(format!(
-                        "mesh {} primitive {}: {e}",
-                        mesh.index(),
-                        prim.index()
-                    )))
-                })?;
-                read_primitive(&prim, &buffers, &worlds, material as u32, &mut out);
-            }
+            placed.push((mesh, worlds));
         }
         let children: Vec<_> = node.children().collect();
         stack.extend(children.into_iter().rev().map(|c| (c, world)));
     }
+    place_meshes(placed, &buffers, &mut default_material, &mut out)?;
     Ok(out)
+}
+
+/// Reads the meshes the nodes place (each with its placements, in node order): a mesh placed
+/// once in world space, in node order; one placed several times (by several nodes, or by
+/// instancing) once, in its own space, as an instanced mesh.
+fn place_meshes(
+    placed: Vec<(::gltf::Mesh<'_>, Vec<Mat4>)>,
+    buffers: &[::gltf::buffer::Data],
+    default_material: &mut Option<usize>,
+    out: &mut ImportedMesh,
+) -> Result<(), SceneError> {
+    // A mesh placed once is stored in world space, in node order; one placed several times
+    // (by several nodes, or by instancing) is stored once, in its own space.
+    let mut uses: HashMap<usize, usize> = HashMap::new();
+    for (mesh, worlds) in &placed {
+        *uses.entry(mesh.index()).or_default() += worlds.len();
+    }
+    let mut instanced_at: HashMap<usize, usize> = HashMap::new();
+    for (mesh, worlds) in placed {
+        if uses[&mesh.index()] <= 1 {
+            read_mesh(&mesh, buffers, &worlds, default_material, out)?;
+            continue;
+        }
+        if let Some(&k) = instanced_at.get(&mesh.index()) {
+            out.instanced[k].transforms.extend(worlds);
+            continue;
+        }
+        let before = out.triangles.len();
+        read_mesh(&mesh, buffers, &[Mat4::IDENTITY], default_material, out)?;
+        let triangles = out.triangles.split_off(before);
+        instanced_at.insert(mesh.index(), out.instanced.len());
+        out.instanced.push(crate::scene::InstancedMesh {
+            name: format!(
+                "mesh {} ({})",
+                mesh.index(),
+                mesh.name().unwrap_or("unnamed")
+            ),
+            triangles,
+            transforms: worlds,
+        });
+    }
+    Ok(())
+}
+
+/// Reads every triangle primitive of `mesh` placed at each of `worlds` into `out`.
+fn read_mesh(
+    mesh: &::gltf::Mesh<'_>,
+    buffers: &[::gltf::buffer::Data],
+    worlds: &[Mat4],
+    default_material: &mut Option<usize>,
+    out: &mut ImportedMesh,
+) -> Result<(), SceneError> {
+    for prim in mesh.primitives() {
+        if prim.mode() != ::gltf::mesh::Mode::Triangles {
+            out.report.warnings.push(format!(
+                "mesh {} primitive {}: mode {:?} skipped (only triangles)",
+                mesh.index(),
+                prim.index(),
+                prim.mode()
+            ));
+            continue;
+        }
+        let material = if let Some(i) = prim.material().index() {
+            i
+        } else {
+            *default_material.get_or_insert_with(|| {
+                out.materials.push(Material::named("default"));
+                out.materials.len() - 1
+            })
+        };
+        check_attributes(&prim, buffers).map_err(|e| {
+            SceneError::new(ErrorKind::GltfData(format!(
+                "mesh {} primitive {}: {e}",
+                mesh.index(),
+                prim.index()
+            )))
+        })?;
+        read_primitive(&prim, buffers, worlds, material as u32, out);
+    }
+    Ok(())
 }
 
 /// Reads and validates a `.gltf` or `.glb` file, as `gltf::Gltf::open` does, checking first
@@ -502,19 +560,13 @@ fn punctual_light(
     })
 }
 
-/// The most triangles instancing may make: instances are copies (each instance's
-/// triangles are stored), so a file instancing a large mesh many times gets an error naming
-/// the node rather than exhausting memory.
-pub const MAX_INSTANCED_TRIANGLES: u64 = 50_000_000;
-
 /// The instance transforms of a node with `EXT_mesh_gpu_instancing` (relative to the
 /// node): translation, rotation (a unit quaternion) and scale per instance, from float
 /// accessors; `None` without the extension.
 ///
 /// # Errors
 /// [`ErrorKind::GltfData`] naming the node, where an accessor is missing, not of floats, or
-/// of another count than the others, or where the copies would exceed
-/// [`MAX_INSTANCED_TRIANGLES`].
+/// of another count than the others.
 fn instances(
     doc: &::gltf::Document,
     node: &::gltf::Node<'_>,
@@ -569,25 +621,6 @@ fn instances(
     if counts.iter().any(|&c| c != n) {
         return Err(fail(format!(
             "its attributes have different counts {counts:?}"
-        )));
-    }
-    let triangles: u64 = node
-        .mesh()
-        .map(|m| {
-            m.primitives()
-                .map(|p| {
-                    p.indices()
-                        .or_else(|| p.get(&::gltf::Semantic::Positions))
-                        .map_or(0, |a| a.count() as u64 / 3)
-                })
-                .sum()
-        })
-        .unwrap_or(0);
-    if triangles.saturating_mul(n as u64) > MAX_INSTANCED_TRIANGLES {
-        return Err(fail(format!(
-            "{n} instances of {triangles} triangles would be stored as {} triangles, over \
-             lumagraph's {MAX_INSTANCED_TRIANGLES} (instances are copies)",
-            triangles.saturating_mul(n as u64)
         )));
     }
     Ok(Some(

@@ -1,7 +1,8 @@
 //! Mesh import: glTF 2.0 ([`gltf`]), OBJ + MTL ([`obj`]) and PLY ([`ply`]).
 //!
 //! An importer returns world-space triangles (the file's node hierarchy and the caller's
-//! transform applied), its materials with indices local to the file, its cameras and its
+//! transform applied) and the meshes it places several times (stored once, with a transform
+//! per placement), its materials with indices local to the file, its cameras and its
 //! lights.
 //! Broken triangles (NaN or infinite corners, zero area) are dropped and counted in the
 //! [`LoadReport`], never a panic.
@@ -23,6 +24,9 @@ use crate::scene::{Camera, LoadReport, Material, PunctualLight, Triangle};
 pub struct ImportedMesh {
     /// Triangles; `material` indexes [`ImportedMesh::materials`].
     pub triangles: Vec<Triangle>,
+    /// Meshes placed several times (glTF: a mesh used by several nodes, or with
+    /// `EXT_mesh_gpu_instancing`), their triangles in object space; `material` as above.
+    pub instanced: Vec<crate::scene::InstancedMesh>,
     /// The file's materials (plus a default one when some triangles had none).
     pub materials: Vec<Material>,
     /// The textures the materials use, decoded; `Material::textures` index this.

@@ -1,0 +1,343 @@
+//! Instanced meshes through the GPU: the two-level walk of `pathtrace/bvh.wgsl` against the
+//! CPU mirror's, ray by ray; the path tracer's image of an instanced scene against the same
+//! scene with its instances copied; and a scene of 1000 instances of a 100 352-triangle
+//! mesh, whose copies (100 M triangles) no intersector could hold.
+
+use crate::common;
+
+use std::sync::Arc;
+
+use glam::Vec3;
+use lumagraph::graph::ParamValue;
+use lumagraph::render::raycast::{RayQuery, Raycaster};
+use lumagraph::render::specialize::{Feature, Intersector};
+use lumagraph::render::{Executor, Resources, SceneBuffers, compile};
+use lumagraph::scene::{GpuScene, NO_HIT, Ray, Scene, intersect_within};
+
+/// The sphere grid (55 200 triangles, 25 metal-rough materials) placed 6 times (moved,
+/// turned, scaled unevenly, mirrored), a sphere, and a floor and an area light of the
+/// scene's own.
+fn scene_text(instancing: &str) -> String {
+    format!(
+        r#"(
+    version: 2,
+    camera: Perspective(position: (0, 2, 26), target: (0, 0, 0), up: (0, 1, 0), fov_y: 45),
+    materials: {{ "grey": (base_color: (0.5, 0.5, 0.5)), "light": (base_color: (0, 0, 0)) }},
+    shapes: [
+        Mesh(name: "grid", path: "SphereGrids/SphereGrid_MetalRough.gltf", instances: [
+            (),
+            (translate: (7, 0, 0)),
+            (translate: (-7, 1, 0), rotate: [(axis: (0, 1, 0), degrees: 30)]),
+            (translate: (0, 7, -3), scale: (1, 2, 0.5)),
+            (translate: (0, -7, 2), scale: (-1, 1, 1)),
+            (matrix: [[0, -1, 0, 3], [1, 0, 0, -3], [0, 0, 1, 4], [0, 0, 0, 1]]),
+        ]),
+        Sphere(center: (6, 6, 3), radius: 1.5, material: "grey"),
+        Quad(corners: [(-20, -12, -8), (20, -12, -8), (20, -12, 12), (-20, -12, 12)], material: "grey"),
+        Quad(corners: [(-4, 14, -2), (-4, 14, 2), (4, 14, 2), (4, 14, -2)], material: "light",
+             emission: (20, 20, 20)),
+    ],
+    environment: Constant((0.2, 0.2, 0.25)),
+    render: (width: 8, height: 8, max_bounces: 6),
+    instancing: {instancing},
+)"#
+    )
+}
+
+fn gpu_scene(instancing: &str) -> GpuScene {
+    GpuScene::build(&Scene::from_ron(&scene_text(instancing), &common::repo("assets")).unwrap())
+        .unwrap()
+}
+
+/// 50 000 random rays, half aimed at the instances.
+fn rays(n: usize) -> Vec<RayQuery> {
+    let mut rng = common::Pcg(0x9e37_79b9_7f4a_7c15);
+    (0..n)
+        .map(|k| {
+            let origin = Vec3::new(
+                rng.range(-15.0, 15.0),
+                rng.range(-15.0, 15.0),
+                rng.range(-10.0, 20.0),
+            );
+            let spread = if k % 2 == 0 { 9.0 } else { 30.0 };
+            let target = Vec3::new(
+                rng.range(-spread, spread),
+                rng.range(-spread, spread),
+                rng.range(-3.0, 3.0),
+            );
+            RayQuery {
+                origin: origin.to_array(),
+                t_max: if k % 3 == 0 { 20.0 } else { f32::MAX },
+                dir: (target - origin).normalize().to_array(),
+                pad: 0,
+            }
+        })
+        .collect()
+}
+
+/// The GPU's two-level walk against the mirror's on 50 000 rays: every ray hits or misses
+/// alike, at the same distance (1e-5 relative), on the same triangle of the same instance
+/// except at ties (another primitive at the same distance), which stay rare.
+#[test]
+fn the_gpu_walks_instances_as_the_mirror_does() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = gpu_scene("On");
+    assert_eq!(scene.instances.len(), 6);
+    let buffers = SceneBuffers::upload(ctx, &scene).unwrap();
+    let queries = rays(50_000);
+    let gpu = Raycaster::new(ctx)
+        .unwrap()
+        .cast(ctx, &buffers, &queries)
+        .unwrap();
+    let (mut hits, mut in_instances, mut ties) = (0, 0, 0);
+    for (q, g) in queries.iter().zip(&gpu) {
+        let ray = Ray {
+            origin: q.origin.into(),
+            dir: q.dir.into(),
+        };
+        match intersect_within(&scene, &ray, q.t_max) {
+            None => assert_eq!(
+                g.prim, NO_HIT,
+                "the mirror misses, the GPU hits {g:?}: {q:?}"
+            ),
+            Some(c) => {
+                assert_ne!(
+                    g.prim, NO_HIT,
+                    "the mirror hits {c:?}, the GPU misses: {q:?}"
+                );
+                let rel = (g.t - c.t).abs() / c.t;
+                assert!(rel <= 1e-5, "GPU {g:?} mirror {c:?}: {q:?}");
+                if (g.prim, g.inst) == (c.prim, c.inst) {
+                    hits += 1;
+                    in_instances += usize::from(c.inst != lumagraph::scene::NO_INSTANCE);
+                } else {
+                    ties += 1;
+                }
+            }
+        }
+    }
+    println!("{hits} hits agree ({in_instances} in instances), {ties} ties");
+    assert!(
+        in_instances > 10_000,
+        "too few instance hits: {in_instances}"
+    );
+    assert!(ties * 1000 < hits, "{ties} ties in {hits} hits");
+}
+
+/// `scene` rendered at 64×64, `spp` samples, through the binary BVH as a GPU adapter runs
+/// it: color, albedo, normal and depth, and whether the two-level walk was compiled in.
+fn render(
+    scene: GpuScene,
+    spp: u32,
+    seed: u32,
+) -> Option<(Vec<lumagraph::render::cpu::Image>, bool)> {
+    let ctx = common::gpu()?;
+    let mut scene = scene;
+    (scene.settings.width, scene.settings.height) = (64, 64);
+    scene.settings.seed = seed;
+    let scene = Arc::new(scene);
+    let ports = ["acc.color", "pt.albedo", "pt.normal", "pt.depth"];
+    let outputs: Vec<String> = ports.iter().map(|p| (*p).to_owned()).collect();
+    let graph = common::progressive_graph(&[("samples_per_frame", ParamValue::Int(4))]);
+    let plan = compile(&graph, &outputs, Some(&scene)).unwrap();
+    let resources = Resources {
+        scene: Some(scene),
+        as_gpu_adapter: true,
+        intersector: Intersector::BinaryBvh,
+        ..Resources::default()
+    };
+    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let features = exec.shader_features("pt").unwrap().clone();
+    println!("{}", features.summary());
+    exec.run_frames(spp.div_ceil(4), true).unwrap();
+    let images = ports.iter().map(|p| exec.read_port(p).unwrap()).collect();
+    Some((images, features.on(Feature::Instances)))
+}
+
+/// The mean of each 8×8 block's color, summed over the channels.
+fn block_means(image: &lumagraph::render::cpu::Image) -> Vec<f64> {
+    let (w, h) = (image.width as usize, image.height as usize);
+    let mut out = vec![0.0; (w / 8) * (h / 8)];
+    for y in 0..h {
+        for x in 0..w {
+            let p = image.pixels[y * w + x];
+            out[(y / 8) * (w / 8) + x / 8] += f64::from(p[0] + p[1] + p[2]) / 64.0;
+        }
+    }
+    out
+}
+
+/// The instanced scene and its copies, 64×64 at 64 spp through the binary BVH: the
+/// first-hit depth agrees to 1e-4 relative where the same surface is hit (all but edge
+/// pixels, where a ray may meet the neighbour of the triangle the other met), and the 8×8
+/// block means of the color differ by no more than the same scene rendered with another seed
+/// differs from itself (the same random numbers follow the same paths, so the difference is
+/// far below that noise).
+#[test]
+fn instanced_and_copied_scenes_render_alike() {
+    let Some((inst, on)) = render(gpu_scene("On"), 64, 1) else {
+        return;
+    };
+    assert!(on, "the two-level walk is compiled in for instances");
+    let (flat, on) = render(gpu_scene("Off"), 64, 1).unwrap();
+    assert!(!on, "and left out without them");
+    let (noise, _) = render(gpu_scene("Off"), 64, 2).unwrap();
+    let depth_far = common::differing(&inst[3], &flat[3], Some(1e-4));
+    println!("depth: {depth_far} of 4096 pixels beyond 1e-4 relative");
+    assert!(depth_far <= 16, "{depth_far} depth pixels differ");
+    let (a, b, n) = (
+        block_means(&inst[0]),
+        block_means(&flat[0]),
+        block_means(&noise[0]),
+    );
+    let worst = |x: &[f64], y: &[f64]| {
+        x.iter()
+            .zip(y)
+            .map(|(p, q)| (p - q).abs() / q.abs().max(1e-3))
+            .fold(0.0, f64::max)
+    };
+    let (between, seeds) = (worst(&a, &b), worst(&n, &b));
+    println!(
+        "8x8 block means: instanced against copied {between:.2e} relative at worst; another \
+         seed {seeds:.2e}"
+    );
+    assert!(b.iter().sum::<f64>() > 1.0, "black");
+    assert!(
+        between < 0.25 * seeds,
+        "{between} against the noise {seeds}"
+    );
+}
+
+/// A mesh of `2 n²` triangles: a wavy square of side 1 in the xy plane, written as a binary
+/// PLY.
+fn wavy_ply(n: usize) -> Vec<u8> {
+    let mut out = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\n\
+         property float y\nproperty float z\nelement face {}\n\
+         property list uchar int vertex_indices\nend_header\n",
+        (n + 1) * (n + 1),
+        2 * n * n
+    )
+    .into_bytes();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f32 / n as f32 - 0.5, j as f32 / n as f32 - 0.5);
+            let z = 0.05 * (12.0 * x).sin() * (9.0 * y).cos();
+            for c in [x, y, z] {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+    }
+    let at = |i: usize, j: usize| (j * (n + 1) + i) as i32;
+    for j in 0..n {
+        for i in 0..n {
+            for tri in [
+                [at(i, j), at(i + 1, j), at(i + 1, j + 1)],
+                [at(i, j), at(i + 1, j + 1), at(i, j + 1)],
+            ] {
+                out.push(3);
+                for v in tri {
+                    out.extend_from_slice(&v.to_le_bytes());
+                }
+            }
+        }
+    }
+    out
+}
+
+/// 1000 instances (a 10×10×10 lattice) of a 100 352-triangle mesh: loaded as instances
+/// (`instancing: Auto`: the copies would be 100 M triangles), its GPU geometry stated
+/// against what the copies would take, traced by the default choice of intersector (the
+/// binary BVH: the only one that walks instances), and its first hits where the mirror
+/// finds them.
+#[test]
+fn a_thousand_instances_of_a_100k_triangle_mesh() {
+    let Some(ctx) = common::gpu() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("wavy.ply"), wavy_ply(224)).unwrap();
+    let places: Vec<String> = (0..1000)
+        .map(|k| {
+            let (x, y, z) = (k % 10, (k / 10) % 10, k / 100);
+            format!(
+                "(translate: ({}, {}, {}), rotate: [(axis: (0, 1, 0), degrees: {})])",
+                2 * x,
+                2 * y,
+                -2 * z,
+                7 * k
+            )
+        })
+        .collect();
+    let text = format!(
+        "(version: 2,
+  camera: Perspective(position: (9, 9, 14), target: (9, 9, -9), up: (0, 1, 0), fov_y: 60),
+  materials: {{ \"grey\": (base_color: (0.6, 0.6, 0.6)) }},
+  shapes: [Mesh(path: \"wavy.ply\", material: \"grey\", instances: [{}])],
+  environment: Constant((1, 1, 1)),
+  render: (width: 48, height: 48, max_bounces: 3),
+)",
+        places.join(", ")
+    );
+    let path = dir.path().join("lattice.ron");
+    std::fs::write(&path, text).unwrap();
+    let started = std::time::Instant::now();
+    let scene = Scene::load(&path).unwrap();
+    assert_eq!(scene.instanced.len(), 1);
+    assert_eq!(scene.instanced[0].triangles.len(), 100_352);
+    let gpu = GpuScene::build(&scene).unwrap();
+    let load = started.elapsed();
+    assert_eq!(gpu.instances.len(), 1000);
+    assert_eq!(gpu.instanced_triangles, 100_352_000);
+    // The copies' geometry, from the bytes a flat triangle takes (its records and its share
+    // of the BVH's, here as in the mesh's own BVH).
+    let per_triangle = (gpu.geometry_bytes() as f64) / gpu.tri_positions.len() as f64;
+    let copies = per_triangle * gpu.instanced_triangles as f64;
+    println!(
+        "1000 instances of 100 352 triangles: loaded and laid out in {:.2} s, {:.1} MiB of GPU \
+         geometry; copied, about {:.1} GiB ({per_triangle:.0} bytes a triangle)",
+        load.as_secs_f64(),
+        gpu.geometry_bytes() as f64 / f64::from(1 << 20),
+        copies / f64::from(1 << 30)
+    );
+    assert!(gpu.geometry_bytes() < 64 << 20);
+
+    let scene = Arc::new(gpu);
+    let outputs = vec!["acc.color".to_owned(), "pt.depth".to_owned()];
+    let graph = common::progressive_graph(&[("samples_per_frame", ParamValue::Int(4))]);
+    let plan = compile(&graph, &outputs, Some(&scene)).unwrap();
+    let resources = Resources {
+        scene: Some(scene.clone()),
+        ..Resources::default()
+    };
+    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let features = exec.shader_features("pt").unwrap().clone();
+    println!("{}", features.summary());
+    assert!(features.on(Feature::Instances) && features.on(Feature::BvhTraversal));
+    let started = std::time::Instant::now();
+    exec.run_frames(1, true).unwrap();
+    println!(
+        "48x48, 4 spp, 3 bounces: {:.2} s",
+        started.elapsed().as_secs_f64()
+    );
+    let depth = exec.read_port("pt.depth").unwrap();
+    let color = exec.read_port("acc.color").unwrap();
+    assert!(color.pixels.iter().all(|p| p.iter().all(|c| c.is_finite())));
+    // The depth AOV is the distance along each pixel-centre ray, the mirror's to 1e-4.
+    let (mut hit, mut checked) = (0, 0);
+    for y in (0..48).step_by(3) {
+        for x in (0..48).step_by(3) {
+            let ray = common::image_ray(&scene, glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let want = lumagraph::scene::intersect(&scene, &ray).map_or(0.0, |h| h.t);
+            let got = depth.pixels[y * 48 + x][0];
+            checked += 1;
+            if want > 0.0 {
+                hit += 1;
+            }
+            assert!(
+                (got - want).abs() <= 1e-4 * want.max(1.0),
+                "pixel ({x}, {y}): depth {got}, the mirror {want}"
+            );
+        }
+    }
+    println!("{hit} of {checked} pixel-centre rays hit, at the mirror's depth");
+    assert!(hit > checked / 2, "{hit} of {checked}");
+}
