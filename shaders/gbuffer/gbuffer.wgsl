@@ -64,7 +64,7 @@ struct VertexIn {
 }
 
 // The instance a vertex is drawn for (a `GpuInstance`, pathtrace/instances.wgsl): its
-// object-to-world and world-to-object rows and (root, index, flags, pad); the identity for
+// object-to-world and world-to-object rows and (root, flags, pad_scale, pad_base); the identity for
 // the scene's own triangles and spheres.
 struct InstanceIn {
     @location(8) world_x: vec4f,
@@ -96,7 +96,7 @@ fn vs_main(v: VertexIn, i: InstanceIn) -> VertexOut {
     let position = vec3f(dot(i.world_x.xyz, v.position) + i.world_x.w, dot(i.world_y.xyz, v.position) + i.world_y.w, dot(i.world_z.xyz, v.position) + i.world_z.w);
     let to_world = mat3x3f(i.world_x.xyz, i.world_y.xyz, i.world_z.xyz);
     let normal_of = mat3x3f(i.object_x.xyz, i.object_y.xyz, i.object_z.xyz);
-    let turn = select(1.0, -1.0, (i.info.z & INSTANCE_MIRROR) != 0u);
+    let turn = select(1.0, -1.0, (i.info.y & INSTANCE_MIRROR) != 0u);
     // The identity has no mesh root: the scene's own geometry is drawn as it was.
     let placed = i.info.x != 0u;
     var sphere = v.sphere;

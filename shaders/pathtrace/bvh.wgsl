@@ -32,11 +32,11 @@ const BVH_END: u32 = 0xffffffffu;
 fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
     var hit = Hit(NO_HIT, t_max, 0.0, 0.0, NO_INSTANCE);
     // The ray the boxes are tested with: the world's, or the walked instance's.
-    var at = InstanceRay(ray.origin, safe_inverse(ray.dir), 0u, 0.0, 0u);
     // Bit a set where the direction's component on axis a is negative: such rays visit the
     // second child of a node split on a first.
     let octant = select(0u, 1u, ray.dir.x < 0.0) | select(0u, 2u, ray.dir.y < 0.0) | select(0u, 4u, ray.dir.z < 0.0);
-    at.octant = octant;
+    let world = world_ray(ray, octant);
+    var at = world;
     // The instance walked (its slot) or NO_INSTANCE, the slot after its leaf's last one, and
     // the top-level node after that leaf.
     var inst = NO_INSTANCE;
@@ -44,77 +44,85 @@ fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
     var resume = 0u;
     var node_index = 0u;
     loop {
+        // Whether this step enters instance `inst`: decided on both paths below and done
+        // once, at the end (llvmpipe runs an if's body whether or not a lane needs it, so
+        // the entry, with its loads, is written once).
+        var enter = false;
         if (node_index == BVH_END) {
             if (!HAS_INSTANCES || inst == NO_INSTANCE) {
                 break;
             }
             // The instance's mesh is done: the leaf's next instance, or back to the top.
             inst = inst + 2u;
-            if (inst == inst_end) {
+            enter = inst != inst_end;
+            if (!enter) {
                 inst = NO_INSTANCE;
-                at = InstanceRay(ray.origin, safe_inverse(ray.dir), octant, 0.0, 0u);
+                at = world;
                 node_index = resume;
-            } else {
-                at = instance_ray(inst, ray);
-                node_index = at.root;
-            }
-            continue;
-        }
-        let lo = bvh_nodes[node_index * 4u];
-        let hi = bvh_nodes[node_index * 4u + 1u];
-        var box_lo = bitcast<vec3<f32>>(lo.xyz);
-        var box_hi = bitcast<vec3<f32>>(hi.xyz);
-        if (HAS_INSTANCES) {
-            box_lo = box_lo - at.pad;
-            box_hi = box_hi + at.pad;
-        }
-        if (ray_aabb(at.origin, at.inv_dir, box_lo, box_hi, hit.t)) {
-            let count = hi.w >> NODE_COUNT_SHIFT;
-            if (count == 0u) {
-                // Inner node: on to the near child (the first one is adjacent, the second at
-                // `index`).
-                let axis = hi.w & 3u;
-                node_index = select(node_index + 1u, lo.w, ((at.octant >> axis) & 1u) == 1u);
                 continue;
             }
-            let first = lo.w;
-            if (HAS_INSTANCES && (hi.w & NODE_INSTANCES) != 0u) {
-                inst = first;
-                inst_end = first + 2u * count;
-                resume = bvh_nodes[node_index * 4u + 2u + (octant >> 2u)][octant & 3u];
-                at = instance_ray(inst, ray);
-                node_index = at.root;
-                continue;
+        } else {
+            let lo = bvh_nodes[node_index * 4u];
+            let hi = bvh_nodes[node_index * 4u + 1u];
+            var box_lo = bitcast<vec3<f32>>(lo.xyz);
+            var box_hi = bitcast<vec3<f32>>(hi.xyz);
+            if (HAS_INSTANCES) {
+                box_lo = box_lo - at.pad;
+                box_hi = box_hi + at.pad;
             }
-            if (HAS_TRIANGLES && (!HAS_SPHERES || (hi.w & NODE_SPHERES) == 0u)) {
-                for (var i = first; i < first + count; i = i + 1u) {
-                    var r: vec4<f32>;
-                    if (HAS_INSTANCES && inst != NO_INSTANCE) {
-                        r = candidate_instance_triangle(i, inst, ray, hit.t);
-                    } else {
-                        r = candidate_triangle(i, ray, hit.t);
+            if (ray_aabb(at.origin, at.inv_dir, box_lo, box_hi, hit.t)) {
+                let count = hi.w >> NODE_COUNT_SHIFT;
+                if (count == 0u) {
+                    // Inner node: on to the near child (the first one is adjacent, the second
+                    // at `index`).
+                    let axis = hi.w & 3u;
+                    node_index = select(node_index + 1u, lo.w, ((at.octant >> axis) & 1u) == 1u);
+                    continue;
+                }
+                let first = lo.w;
+                if (HAS_INSTANCES && (hi.w & NODE_INSTANCES) != 0u) {
+                    inst = first;
+                    inst_end = first + 2u * count;
+                    resume = bvh_nodes[node_index * 4u + 2u + (octant >> 2u)][octant & 3u];
+                    enter = true;
+                } else if (HAS_TRIANGLES && (!HAS_SPHERES || (hi.w & NODE_SPHERES) == 0u)) {
+                    for (var i = first; i < first + count; i = i + 1u) {
+                        // The scene's own triangles through the same test, placed by the
+                        // identity.
+                        var r: vec4<f32>;
+                        if (HAS_INSTANCES) {
+                            r = candidate_instance_triangle(i, inst, at.placed, ray, hit.t);
+                        } else {
+                            r = candidate_triangle(i, ray, hit.t);
+                        }
+                        if (r.x != 0.0) {
+                            hit = Hit(i, r.y, r.z, r.w, inst);
+                            if (any_hit) {
+                                return hit;
+                            }
+                        }
                     }
-                    if (r.x != 0.0) {
-                        hit = Hit(i, r.y, r.z, r.w, inst);
-                        if (any_hit) {
-                            return hit;
+                } else if (HAS_SPHERES) {
+                    for (var i = first; i < first + count; i = i + 1u) {
+                        let t = candidate_sphere(i, ray, hit.t);
+                        if (t > 0.0) {
+                            hit = Hit(i | PRIM_SPHERE, t, 0.0, 0.0, NO_INSTANCE);
+                            if (any_hit) {
+                                return hit;
+                            }
                         }
                     }
                 }
-            } else if (HAS_SPHERES) {
-                for (var i = first; i < first + count; i = i + 1u) {
-                    let t = candidate_sphere(i, ray, hit.t);
-                    if (t > 0.0) {
-                        hit = Hit(i | PRIM_SPHERE, t, 0.0, 0.0, NO_INSTANCE);
-                        if (any_hit) {
-                            return hit;
-                        }
-                    }
-                }
+            }
+            if (!enter) {
+                // A leaf, or a box missed: past this subtree.
+                node_index = bvh_nodes[node_index * 4u + 2u + (at.octant >> 2u)][at.octant & 3u];
+                continue;
             }
         }
-        // A leaf, or a box missed: past this subtree.
-        node_index = bvh_nodes[node_index * 4u + 2u + (at.octant >> 2u)][at.octant & 3u];
+        // Into instance `inst`: its mesh's BVH, the ray in its space.
+        at = instance_ray(inst, ray);
+        node_index = at.root;
     }
     return hit;
 }

@@ -27,14 +27,15 @@ fn candidate_triangle_at(i: u32, v0: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>, fl
     return vec4<f32>(0.0);
 }
 
-// Triangle `i` of the mesh of the instance at `slot` (instances.wgsl), tested in world space
+// Triangle `i` of the mesh of the instance at `slot` (instances.wgsl), placed by `placed`
+// (`instance_placement(slot)`, read once per instance), tested in world space
 // as a copy of it would be: the same front side (corners 1 and 2 swapped where the instance
 // mirrors, u and v swapped back), the same rules for rays leaving it (the instance counts:
 // the triangle left is `skip_prim` in instance `skip_inst`).
-fn candidate_instance_triangle(i: u32, slot: u32, ray: Ray, t_max: f32) -> vec4<f32> {
+fn candidate_instance_triangle(i: u32, slot: u32, placed: Placement, ray: Ray, t_max: f32) -> vec4<f32> {
     let tri = tri_positions[i];
-    let w = place_triangle(slot, tri);
-    let mirror = instance_mirrors(slot);
+    let w = place_with(placed, tri);
+    let mirror = placed.mirror;
     var r = intersect_triangle(ray.origin, ray.dir, w.v0, select(w.e1, w.e2, mirror), select(w.e2, w.e1, mirror), t_max);
     r = select(r, r.xywz, mirror);
     if (r.x != 0.0 && (i != skip_prim || slot != skip_inst) && (!HAS_ALPHA || (tri.flags & TRI_ALPHA) == 0u || triangle_hit_counts(i, r.z, r.w, ray))) {

@@ -611,17 +611,30 @@ impl GpuScene {
                     t.z_axis.to_array(),
                 ]
             };
+            let object = rows(to_object);
+            let pad_scale = object
+                .iter()
+                .map(|r| r[0].abs() + r[1].abs() + r[2].abs())
+                .fold(0.0f32, f32::max);
+            let root = &self.bvh_nodes[roots[mesh as usize] as usize];
+            let extent = Vec3::from(root.aabb_min)
+                .abs()
+                .max(Vec3::from(root.aabb_max).abs())
+                .max_element();
+            let translation = object.iter().map(|r| r[3].abs()).fold(0.0f32, f32::max);
             self.instances.push(crate::gpu::GpuInstance {
                 to_world: rows(to_world),
-                to_object: rows(to_object),
+                to_object: object,
                 root: roots[mesh as usize],
-                index: k as u32,
                 flags: if to_world.determinant() < 0.0 {
                     crate::gpu::INSTANCE_MIRROR
                 } else {
                     0
                 },
-                pad: [0; 5],
+                pad_scale,
+                pad_base: translation + extent,
+                index: k as u32,
+                pad: [0; 3],
             });
             self.instance_mesh.push(mesh);
         }

@@ -114,12 +114,20 @@ pub struct GpuInstance {
     pub to_object: [[f32; 4]; 3],
     /// Its mesh's BVH root node (offset 96).
     pub root: u32,
-    /// Its index in [`crate::GpuScene::instances`] (offset 100).
-    pub index: u32,
-    /// [`INSTANCE_MIRROR`] (offset 104).
+    /// [`INSTANCE_MIRROR`] (offset 100).
     pub flags: u32,
-    /// Padding to two node records (offset 108).
-    pub pad: [u32; 5],
+    /// How much a ray's origin coordinates weigh in the rounding error of the moved ray
+    /// (the largest row sum of |`to_object`|'s 3×3 part; offset 104): the boxes of its
+    /// mesh grow by `INSTANCE_PAD` × (this × the origin's largest coordinate + `pad_base` +
+    /// the moved origin's largest coordinate) (`instance_ray` in `pathtrace/instances.wgsl`).
+    pub pad_scale: f32,
+    /// The rest of that bound: `to_object`'s largest translation and the mesh's largest
+    /// coordinate (offset 108).
+    pub pad_base: f32,
+    /// Its index in [`crate::GpuScene::instances`] (offset 112).
+    pub index: u32,
+    /// Padding to two node records (offset 116).
+    pub pad: [u32; 3],
 }
 
 /// A hit's instance off instanced meshes (the scene's own primitives).

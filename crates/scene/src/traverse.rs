@@ -287,26 +287,19 @@ fn octant_of(d: Vec3) -> u32 {
 }
 
 /// `ray` in the space of `inst`'s mesh (`instance_ray`).
-fn instance_ray(scene: &GpuScene, inst: &GpuInstance, ray: &Ray) -> BoxRay {
+fn instance_ray(inst: &GpuInstance, ray: &Ray) -> BoxRay {
     let origin = instance_apply(inst, 3, ray.origin, 1.0);
     let dir = instance_apply(inst, 3, ray.dir, 0.0);
-    let root = inst.root;
-    let o = ray.origin.abs();
-    let term = |r: [f32; 4]| Vec3::new(r[0], r[1], r[2]).abs().dot(o) + r[3].abs();
-    let terms = Vec3::new(
-        term(inst.to_object[0]),
-        term(inst.to_object[1]),
-        term(inst.to_object[2]),
-    );
-    let node = scene.bvh_nodes[root as usize];
-    let extent = max3(v3(node.aabb_min).abs().max(v3(node.aabb_max).abs()));
-    let pad = INSTANCE_PAD * (max3(terms) + max3(origin.abs()) + extent);
+    // The moved origin's terms (bounded by the largest row sum times the origin's largest
+    // coordinate, plus the translation), the moved origin and the mesh's extent.
+    let pad = INSTANCE_PAD
+        * (inst.pad_scale * max3(ray.origin.abs()) + inst.pad_base + max3(origin.abs()));
     BoxRay {
         origin,
         inv_dir: safe_inverse(dir),
         octant: octant_of(dir),
         pad,
-        root,
+        root: inst.root,
     }
 }
 
@@ -437,7 +430,7 @@ fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
                 at = world;
                 node_index = resume;
             } else {
-                at = instance_ray(scene, slot(inst), ray);
+                at = instance_ray(slot(inst), ray);
                 node_index = at.root;
             }
             continue;
@@ -468,7 +461,7 @@ fn traverse<const ANY: bool>(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
                 inst = first;
                 inst_end = first + 2 * count;
                 resume = scene.bvh_skips[node_index as usize][octant as usize];
-                at = instance_ray(scene, slot(inst), ray);
+                at = instance_ray(slot(inst), ray);
                 node_index = at.root;
                 continue;
             }

@@ -226,7 +226,8 @@ fn wgsl_layouts_match_rust() {
 }
 
 /// `pathtrace/instances.wgsl` reads an instance as vec4s of `bvh_nodes`: rows 0-2
-/// `to_world`, 3-5 `to_object`, 6 (root, index, flags); two node records in all.
+/// `to_world`, 3-5 `to_object`, 6 (root, flags, pad_scale, pad_base), 7 (index); two node
+/// records in all.
 #[test]
 fn instance_records_are_where_instances_wgsl_reads_them() {
     use lumagraph_scene::{GpuBvhRecord, GpuInstance};
@@ -234,8 +235,10 @@ fn instance_records_are_where_instances_wgsl_reads_them() {
     assert_eq!(offset_of!(GpuInstance, to_world), 0);
     assert_eq!(offset_of!(GpuInstance, to_object), 3 * 16);
     assert_eq!(offset_of!(GpuInstance, root), 6 * 16);
-    assert_eq!(offset_of!(GpuInstance, index), 6 * 16 + 4);
-    assert_eq!(offset_of!(GpuInstance, flags), 6 * 16 + 8);
+    assert_eq!(offset_of!(GpuInstance, flags), 6 * 16 + 4);
+    assert_eq!(offset_of!(GpuInstance, pad_scale), 6 * 16 + 8);
+    assert_eq!(offset_of!(GpuInstance, pad_base), 6 * 16 + 12);
+    assert_eq!(offset_of!(GpuInstance, index), 7 * 16);
     let src = std::fs::read_to_string(common::shaders().join("pathtrace/instances.wgsl")).unwrap();
     assert!(src.contains("return bvh_nodes[slot * 4u + 6u];"));
     assert!(src.contains("const INSTANCE_PAD: f32 = 9.536743e-7;"));

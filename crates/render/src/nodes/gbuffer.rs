@@ -202,7 +202,7 @@ fn pipeline(
         0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x4,
         4 => Float32x4, 5 => Float32x4, 6 => Uint32, 7 => Float32x4
     ];
-    // A `GpuInstance`: its transforms' rows and (root, index, flags, pad).
+    // A `GpuInstance`: its transforms' rows and (root, flags, pad_scale, pad_base).
     let instance_attributes = wgpu::vertex_attr_array![
         8 => Float32x4, 9 => Float32x4, 10 => Float32x4,
         11 => Float32x4, 12 => Float32x4, 13 => Float32x4, 14 => Uint32x4
