@@ -226,7 +226,7 @@ fn wgsl_layouts_match_rust() {
 }
 
 /// `pathtrace/instances.wgsl` reads an instance as vec4s of `bvh_nodes`: rows 0-2
-/// `to_world`, 3-5 `to_object`, 6 (root, flags, pad_scale, pad_base), 7 (index); two node
+/// `to_world`, 3-5 `to_object`, 6 (`root`, `flags`, `pad_scale`, `pad_base`), 7 (`index`); two node
 /// records in all.
 #[test]
 fn instance_records_are_where_instances_wgsl_reads_them() {
