@@ -72,12 +72,28 @@ fn mib(bytes: u64) -> String {
 /// [`RenderError::TooLarge`] naming the first part that does not fit, its size and the
 /// limit, and what to do.
 pub fn check_limits(scene: &GpuScene, limits: &wgpu::Limits, adapter: &str) -> Result<()> {
+    check_parts(scene, limits, adapter, true)
+}
+
+/// [`check_limits`], leaving out the binary BVH's records where `binary_bvh` is false (an
+/// intersector that does not walk them: the host's, the 8-wide BVH's own buffer, ray
+/// queries, inline code).
+fn check_parts(
+    scene: &GpuScene,
+    limits: &wgpu::Limits,
+    adapter: &str,
+    binary_bvh: bool,
+) -> Result<()> {
     let too_large = |what: String, message: String| RenderError::TooLarge {
         what: format!("scene part {what}"),
         adapter: adapter.to_owned(),
         message,
     };
-    let records = scene.bvh_records();
+    let records = if binary_bvh {
+        scene.bvh_records()
+    } else {
+        Vec::new()
+    };
     let binding = limits
         .max_storage_buffer_binding_size
         .min(limits.max_buffer_size);
@@ -234,7 +250,19 @@ impl SceneBuffers {
     /// # Errors
     /// [`RenderError::TooLarge`] where a part does not fit ([`check_limits`]).
     pub fn upload(ctx: &GpuContext, scene: &GpuScene) -> Result<Self> {
-        check_limits(scene, &ctx.device.limits(), &ctx.info.name)?;
+        Self::upload_for(ctx, scene, true)
+    }
+
+    /// [`SceneBuffers::upload`], with a one-record stand-in for the binary BVH's records
+    /// where `binary_bvh` is false (its intersector does not walk them), so a scene whose
+    /// binary BVH is over the device's largest binding still renders through the host or
+    /// the 8-wide BVH.
+    ///
+    /// # Errors
+    /// As [`SceneBuffers::upload`], the binary BVH left out of the check where it is not
+    /// uploaded.
+    pub fn upload_for(ctx: &GpuContext, scene: &GpuScene, binary_bvh: bool) -> Result<Self> {
+        check_parts(scene, &ctx.device.limits(), &ctx.info.name, binary_bvh)?;
         // A runtime-sized array binding holds at least one element: white, for the general
         // shader, which reads the vertex colour of every triangle.
         let one = [lumagraph_scene::GpuTriTexcoords {
@@ -246,7 +274,11 @@ impl SceneBuffers {
         } else {
             &scene.tri_texcoords[..]
         };
-        let records = scene.bvh_records();
+        let records = if binary_bvh {
+            scene.bvh_records()
+        } else {
+            GpuScene::default().bvh_records()
+        };
         let parts: [(&str, &[u8]); 9] = [
             ("bvh_nodes", bytemuck::cast_slice(&records)),
             ("tri_positions", bytemuck::cast_slice(&scene.tri_positions)),

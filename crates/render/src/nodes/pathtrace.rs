@@ -392,7 +392,13 @@ impl PathTrace {
             create(ctx, "unused depth", TexFormat::R32Float, one),
             create(ctx, "unused samples", TexFormat::Rgba32Float, one),
         ];
-        let buffers = SceneBuffers::upload(ctx, &scene)?;
+        // The binary BVH's records only where the binary BVH is walked: not by the 8-wide
+        // BVH (its own buffer is bound), nor by host intersection unless the first-hit AOVs
+        // are written (`first_hit_aovs` traces in WGSL), nor inline or by ray queries.
+        let binary_bvh = features.on(Feature::BvhTraversal)
+            && !features.on(Feature::WideBvh)
+            && !(features.on(Feature::HostRays) && !features.on(Feature::FirstHitAovs));
+        let buffers = SceneBuffers::upload_for(ctx, &scene, binary_bvh)?;
         let frame = uniform_buffer(
             ctx,
             "pathtrace frame",
