@@ -397,7 +397,7 @@ impl PathTrace {
         // are written (`first_hit_aovs` traces in WGSL), nor inline or by ray queries.
         let binary_bvh = features.on(Feature::BvhTraversal)
             && !features.on(Feature::WideBvh)
-            && !(features.on(Feature::HostRays) && !features.on(Feature::FirstHitAovs));
+            && (!features.on(Feature::HostRays) || features.on(Feature::FirstHitAovs));
         let buffers = SceneBuffers::upload_for(ctx, &scene, binary_bvh)?;
         let frame = uniform_buffer(
             ctx,
