@@ -85,6 +85,9 @@ fn scene_digest(s: &GpuScene) -> String {
         .write(&s.vertex_alpha_min)
         .write(cast_slice(&s.tri_source))
         .write(cast_slice(&s.sphere_source))
+        .write(cast_slice(&s.instances))
+        .write(cast_slice(&s.instance_mesh))
+        .write(cast_slice(&s.mesh_triangles))
         .write(format!("{:?}", s.environment_map).as_bytes());
     format!("{:016x}", h.finish())
 }
@@ -286,4 +289,33 @@ fn report_speed(exec: &mut Executor, wall: Duration, before: (u64, u64)) -> Resu
         get("dropped_samples")
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The key of a render's checkpoint follows the instances: a moved instance (its mesh
+    /// and everything else the same) is another scene.
+    #[test]
+    fn the_scene_key_follows_the_instances() {
+        let text = |x: f32| {
+            format!(
+                "(version: 2, camera: Perspective(position: (0, 0, 9), target: (0, 0, 0), fov_y: 40),
+                  materials: {{ \"m\": () }},
+                  shapes: [Mesh(path: \"CornellBox/CornellBox.gltf\", material: \"m\",
+                                instances: [(), (translate: ({x}, 0, 0))])],
+                  render: (width: 8, height: 8), instancing: On)"
+            )
+        };
+        let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
+        let digest = |x: f32| {
+            let scene = crate::scene::Scene::from_ron(&text(x), &assets).unwrap();
+            let gpu = GpuScene::build(&scene).unwrap();
+            assert_eq!(gpu.instances.len(), 2);
+            scene_digest(&gpu)
+        };
+        assert_eq!(digest(3.0), digest(3.0));
+        assert_ne!(digest(3.0), digest(3.5));
+    }
 }

@@ -341,3 +341,56 @@ fn a_thousand_instances_of_a_100k_triangle_mesh() {
     println!("{hit} of {checked} pixel-centre rays hit, at the mirror's depth");
     assert!(hit > checked / 2, "{hit} of {checked}");
 }
+
+/// The intersectors that take flat scenes only refuse an instanced one by name, and the path
+/// tracer's choice sends it to the binary BVH whatever is asked, saying why: it is never
+/// traced as its object-space meshes laid flat.
+#[test]
+fn flat_only_intersectors_refuse_instances_and_the_choice_says_why() {
+    use lumagraph::render::specialize::{Features, PathTraceOptions, Schedule};
+    let scene = gpu_scene("On");
+    let e = lumagraph::render::wide_bvh::WideBvh::build(&scene).unwrap_err();
+    assert!(
+        e.contains("the 8-wide BVH takes flat scenes only, and this one has 6 instances"),
+        "{e}"
+    );
+    let e = lumagraph::render::accel::unsupported(&scene, u32::MAX).unwrap();
+    assert!(e.contains("ray queries takes flat scenes only"), "{e}");
+    for (cpu_adapter, intersector) in [
+        (true, Intersector::Auto),
+        (true, Intersector::WideBvh),
+        (true, Intersector::Host),
+        (true, Intersector::Inline),
+        (false, Intersector::RayQueries),
+    ] {
+        let options = PathTraceOptions {
+            specialize: true,
+            cpu_adapter,
+            host_rays: true,
+            ray_query_limit: Some(u32::MAX),
+            intersector,
+            schedule: Schedule::Wavefront,
+            ..PathTraceOptions::default()
+        };
+        let f = Features::decide(&scene, options);
+        assert!(
+            f.on(Feature::Instances) && f.on(Feature::BvhTraversal),
+            "{intersector:?}"
+        );
+        for other in [
+            Feature::WideBvh,
+            Feature::RayQueries,
+            Feature::InlineIntersection,
+            Feature::HostRays,
+            Feature::Wavefront,
+        ] {
+            assert!(!f.on(other), "{intersector:?}: {other:?} is on");
+        }
+        assert!(
+            f.reason(Feature::WideBvh).contains("instanced meshes")
+                || f.reason(Feature::RayQueries).contains("instanced meshes"),
+            "{intersector:?}: {}",
+            f.summary()
+        );
+    }
+}

@@ -32,7 +32,9 @@ pub struct SceneAccel {
 pub fn unsupported(scene: &GpuScene, most: u32) -> Option<String> {
     let most = u64::from(most);
     let over = |n: usize| n as u64 > most;
-    if over(scene.tri_positions.len()) || over(scene.spheres.len()) {
+    if !scene.instances.is_empty() {
+        Some(crate::embree::flat_only("ray queries", scene))
+    } else if over(scene.tri_positions.len()) || over(scene.spheres.len()) {
         Some(format!(
             "{} triangles and {} spheres: the device holds at most {most} primitives in one \
              acceleration structure",

@@ -100,6 +100,9 @@ impl WideBvh {
     /// # Errors
     /// A message when the tree is deeper than the traversal's stack ([`WIDE_BVH_STACK`]).
     pub fn build(scene: &GpuScene) -> Result<Self, String> {
+        if !scene.instances.is_empty() {
+            return Err(crate::embree::flat_only("the 8-wide BVH", scene));
+        }
         let (tri_boxes, sphere_boxes) = primitive_boxes(scene);
         let n_tris = u32::try_from(tri_boxes.len()).map_err(|_| "too many triangles")?;
         let boxes: Vec<Aabb> = tri_boxes

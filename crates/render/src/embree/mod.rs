@@ -43,6 +43,7 @@ mod records;
 mod scene;
 
 pub use records::{HostHit, HostRay};
+pub(crate) use scene::flat_only;
 pub use scene::{HostScene, Tuning};
 
 use ffi::*;

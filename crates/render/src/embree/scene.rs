@@ -101,6 +101,9 @@ impl HostScene {
         embree: Arc<Embree>,
         scene: &Arc<lumagraph_scene::GpuScene>,
     ) -> Result<Self, String> {
+        if !scene.instances.is_empty() {
+            return Err(flat_only("host intersection", scene));
+        }
         let any_hit = (scene.header.features & lumagraph_scene::FEATURE_ALPHA != 0)
             .then(|| Arc::clone(scene));
         Self::build(embree, &scene.tri_corners, Tuning::default(), any_hit)
@@ -577,4 +580,13 @@ fn host_hit(tfar: f32, u: f32, v: f32, prim_id: u32, geom_id: u32) -> HostHit {
             prim: prim_id,
         }
     }
+}
+
+/// Why an intersector that takes flat scenes only refuses `scene` (it has instances).
+pub(crate) fn flat_only(what: &str, scene: &lumagraph_scene::GpuScene) -> String {
+    format!(
+        "{what} takes flat scenes only, and this one has {} instances (the binary BVH walks \
+         them; `instancing: Off` in the scene file copies them)",
+        scene.instances.len()
+    )
 }
