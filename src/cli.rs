@@ -323,7 +323,9 @@ struct LoadedScene {
 fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
     let Some(path) = path else { return Ok(None) };
     let start = Instant::now();
+    let stage = progressive::Stage::start(format!("loading {} (meshes, textures)", path.display()));
     let scene = Scene::load(path)?;
+    drop(stage);
     let r = &scene.report;
     if r.degenerate_triangles + r.non_finite_triangles + r.replaced_normals > 0 {
         println!(
@@ -335,7 +337,9 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
         println!("scene warning: {w}");
     }
     let built = Instant::now();
+    let stage = progressive::Stage::start("GPU layout (BVH, triangles, lights, texture atlas)");
     let (gpu, bvh_time) = GpuScene::build_timed(&scene)?;
+    drop(stage);
     let layout = built.elapsed();
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     let instanced = if gpu.instances.is_empty() {
@@ -503,7 +507,9 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
     }
     let left_out = plan.left_out.clone();
     let built = std::time::Instant::now();
+    let stage = progressive::Stage::start("pipelines and uploads");
     let mut exec = Executor::with_library(&ctx, plan, &resources, args.library)?;
+    drop(stage);
     progressive::print_built(built);
     for (node, note) in exec.notes() {
         println!("{node}: {note}");

@@ -1256,3 +1256,52 @@ fn textures_over_the_budget_are_refused_or_downscaled_when_asked() {
     );
     assert!(out.join("render.png").is_file());
 }
+
+/// On a terminal, a render names each stage before its first frame with a spinner on
+/// standard error (loading the scene, the GPU layout, pipelines and uploads, the warm-up),
+/// cleared when the stage ends; elsewhere (as in every other test here) nothing of it is
+/// written. The terminal is `script`'s pseudo-terminal (util-linux).
+#[test]
+fn a_render_on_a_terminal_names_the_stage_it_is_in() {
+    let Some(_) = common::gpu() else { return };
+    let out = tempfile::tempdir().unwrap();
+    let log = out.path().join("typescript");
+    let command = format!(
+        "{} render graphs/pathtrace.ron --scene assets/cornell.ron --spp 4 --out {}",
+        env!("CARGO_BIN_EXE_lumagraph"),
+        out.path().display()
+    );
+    let status = std::process::Command::new("script")
+        .args(["-q", "-e", "-c", &command])
+        .arg(&log)
+        .current_dir(common::root())
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .status()
+        .expect("`script` (util-linux) runs the render on a pseudo-terminal");
+    assert!(status.success(), "{status}");
+    let text = std::fs::read_to_string(&log).unwrap();
+    for stage in [
+        "loading assets/cornell.ron (meshes, textures)",
+        "GPU layout (BVH, triangles, lights, texture atlas)",
+        "pipelines and uploads (",
+        "warm-up (the first frame",
+    ] {
+        assert!(text.contains(stage), "no stage {stage:?} in {text}");
+    }
+    // Each spinner line is erased when its stage ends.
+    assert!(text.contains("\u{1b}[2K"), "{text}");
+    // Not on a terminal: none of it.
+    let (ok, stdout, stderr) = common::cli(&[
+        "render",
+        "graphs/pathtrace.ron",
+        "--scene",
+        "assets/cornell.ron",
+        "--spp",
+        "4",
+        "--out",
+        &out.path().join("plain").to_string_lossy(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(!stderr.contains("(meshes, textures)") && !stdout.contains("(meshes, textures)"));
+}

@@ -107,6 +107,35 @@ pub(super) fn on_signal(then: &'static str) {
     }
 }
 
+/// A spinner on standard error naming the stage a render is in before its first frame
+/// (loading the scene, its GPU layout, pipelines and uploads, the warm-up) with the time it
+/// has taken, so a long load shows where it is. Drawn on a terminal only (indicatif hides it
+/// elsewhere) and cleared when the stage ends; each stage's time is still printed on
+/// standard output.
+pub(super) struct Stage(indicatif::ProgressBar);
+
+impl Stage {
+    pub(super) fn start(what: impl Into<String>) -> Self {
+        let bar =
+            indicatif::ProgressBar::with_draw_target(None, indicatif::ProgressDrawTarget::stderr());
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+        );
+        bar.set_message(what.into());
+        // Drawn at once, however short the stage.
+        bar.tick();
+        bar.enable_steady_tick(Duration::from_millis(120));
+        Self(bar)
+    }
+}
+
+impl Drop for Stage {
+    fn drop(&mut self) {
+        self.0.finish_and_clear();
+    }
+}
+
 /// Prints how long building the executor took since `start`: its pipelines (a CPU adapter
 /// spends seconds on each of the path tracer's, less where Mesa's shader cache holds part of
 /// the work from an earlier run) and its nodes' uploads.
@@ -121,7 +150,11 @@ pub(super) fn print_built(start: Instant) {
 /// dispatch, and that is kept out of the timed frames.
 pub(super) fn warm_up(exec: &mut Executor) -> Result<()> {
     let warm = Instant::now();
+    let stage = Stage::start(
+        "warm-up (the first frame: drivers compile pipelines at their first dispatch)",
+    );
     exec.warm_up()?;
+    drop(stage);
     println!(
         "warm-up (shader compilation): {:.0} ms",
         warm.elapsed().as_secs_f64() * 1e3
