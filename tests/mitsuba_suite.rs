@@ -177,6 +177,7 @@ suite!(
     env_map,
     env_map_mirror,
     gltf_lights,
+    instances,
     layer,
     media_absorbing_glass,
     media_scattering,

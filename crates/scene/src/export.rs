@@ -219,9 +219,13 @@ struct MeshGroup {
 
 /// Writes the triangles of `scene` into `dir` as OBJ files, one per material, shading and
 /// texturing, in file order; returns their descriptions and paths.
-fn write_meshes(scene: &Scene, dir: &Path) -> Result<(Vec<MeshOut>, Vec<PathBuf>), SceneError> {
+fn write_meshes(
+    scene: &Scene,
+    triangles: &[&crate::scene::Triangle],
+    dir: &Path,
+) -> Result<(Vec<MeshOut>, Vec<PathBuf>), SceneError> {
     let mut groups: Vec<MeshGroup> = Vec::new();
-    for t in &scene.triangles {
+    for t in triangles {
         let uvs = base_color_uvs(scene, t);
         let key = (t.material, t.normals.is_some(), uvs.is_some());
         let i = if let Some(i) = groups.iter().position(|g| g.key == key) {
@@ -500,15 +504,15 @@ fn environment_out(env: &Environment) -> EnvironmentOut {
 /// When `dir` cannot be created or a file cannot be written, or the copies of instanced
 /// meshes would exceed [`crate::MAX_INSTANCED_TRIANGLES`].
 pub fn export(scene: &Scene, gpu: &GpuScene, dir: &Path) -> Result<Vec<PathBuf>, SceneError> {
-    let flat;
-    let scene = if scene.instanced.is_empty() {
-        scene
-    } else {
-        let mut copy = scene.clone();
-        copy.apply_instancing(crate::Instancing::Off)?;
-        flat = copy;
-        &flat
-    };
+    // Instanced meshes as copies, beside the scene's own triangles (the rest of the scene,
+    // its textures above all, is not copied).
+    let mut copies = Vec::new();
+    crate::scene::copy_instances(
+        &scene.instanced,
+        &mut copies,
+        &mut crate::LoadReport::default(),
+    )?;
+    let triangles: Vec<&crate::scene::Triangle> = scene.triangles.iter().chain(&copies).collect();
     std::fs::create_dir_all(dir).map_err(|source| {
         SceneError::new(ErrorKind::Io {
             what: "export folder",
@@ -516,7 +520,7 @@ pub fn export(scene: &Scene, gpu: &GpuScene, dir: &Path) -> Result<Vec<PathBuf>,
         })
         .in_file(dir)
     })?;
-    let (meshes, mut written) = write_meshes(scene, dir)?;
+    let (meshes, mut written) = write_meshes(scene, &triangles, dir)?;
     let mut materials = Vec::with_capacity(scene.materials.len());
     for (i, m) in scene.materials.iter().enumerate() {
         let mut out = material_out(m);

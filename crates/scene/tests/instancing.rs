@@ -230,3 +230,40 @@ fn gltf_meshes_placed_several_times_are_instances() {
     );
     assert!(off.instanced.is_empty());
 }
+
+/// `export` writes instances as copies: the same OBJ triangles, group by group, as the
+/// scene with its instances copied.
+#[test]
+fn export_writes_instances_as_copies() {
+    let count = |instancing: &str| {
+        let scene = load(instancing);
+        let gpu = GpuScene::build(&scene).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        lumagraph_scene::export::export(&scene, &gpu, dir.path()).unwrap();
+        let text = std::fs::read_to_string(dir.path().join("scene.json")).unwrap();
+        let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let faces: usize = std::fs::read_dir(dir.path())
+            .unwrap()
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "obj"))
+            .map(|p| {
+                std::fs::read_to_string(p)
+                    .unwrap()
+                    .lines()
+                    .filter(|l| l.starts_with("f "))
+                    .count()
+            })
+            .sum();
+        let listed: u64 = json["meshes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m["triangles"].as_u64().unwrap())
+            .sum();
+        (faces, listed)
+    };
+    let (on, off) = (count("On"), count("Off"));
+    assert_eq!(on, off);
+    assert_eq!(on.0, 2 + 7 * 55_200);
+    assert_eq!(on.1, on.0 as u64);
+}
