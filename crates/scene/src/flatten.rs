@@ -463,27 +463,8 @@ impl GpuScene {
                 Aabb::new(c - s.radius, c + s.radius)
             })
             .collect();
-        // Each instance's box: its mesh's box, transformed.
-        let mesh_boxes: Vec<Aabb> = scene
-            .instanced
-            .iter()
-            .map(|m| {
-                m.triangles
-                    .iter()
-                    .fold(Aabb::empty(), |b, t| b.union(&triangle_box(t)))
-            })
-            .collect();
-        let mut placed = Vec::new();
-        let mut instance_boxes = Vec::new();
-        for (mesh, m) in scene.instanced.iter().enumerate() {
-            for t in &m.transforms {
-                placed.push((mesh as u32, *t));
-                instance_boxes.push(transformed_box(&mesh_boxes[mesh], t));
-            }
-        }
         let bvh_started = std::time::Instant::now();
-        let flat = bvh::build(&tri_boxes, &sphere_boxes, &instance_boxes, options)?;
-        // One BVH per mesh, in its own space.
+        // One BVH per mesh, in its own space; its root's box is the mesh's.
         let meshes: Vec<bvh::FlatBvh> = scene
             .instanced
             .iter()
@@ -492,6 +473,19 @@ impl GpuScene {
                 bvh::build(&boxes, &[], &[], options)
             })
             .collect::<Result<_, _>>()?;
+        // Each instance's box: its mesh's box, transformed.
+        let mut placed = Vec::new();
+        let mut instance_boxes = Vec::new();
+        for (mesh, (m, flat)) in scene.instanced.iter().zip(&meshes).enumerate() {
+            let root = flat.nodes.first().map_or_else(Aabb::empty, |n| {
+                Aabb::new(Vec3A::from(n.aabb_min), Vec3A::from(n.aabb_max))
+            });
+            for t in &m.transforms {
+                placed.push((mesh as u32, *t));
+                instance_boxes.push(transformed_box(&root, t));
+            }
+        }
+        let flat = bvh::build(&tri_boxes, &sphere_boxes, &instance_boxes, options)?;
         *bvh_time = bvh_started.elapsed();
 
         let mut out = Self {

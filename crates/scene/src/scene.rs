@@ -528,6 +528,26 @@ impl Scene {
     /// [`ErrorKind::TooManyInstancedTriangles`] where the copies would exceed
     /// [`MAX_INSTANCED_TRIANGLES`].
     pub fn apply_instancing(&mut self, instancing: Instancing) -> Result<(), SceneError> {
+        // An instance whose transform cannot be inverted (a zero scale) or is not finite
+        // places nothing a ray could hit (its copies' triangles would be dropped as
+        // degenerate): it is dropped, and said; so is a mesh left with no triangle.
+        for m in &mut self.instanced {
+            let before = m.transforms.len();
+            m.transforms.retain(|t| {
+                let det = t.determinant();
+                t.is_finite() && det != 0.0 && det.is_finite()
+            });
+            if m.transforms.len() < before {
+                self.report.warnings.push(format!(
+                    "{}: {} of its {before} instances dropped: their transform is singular or \
+                     not finite",
+                    m.name,
+                    before - m.transforms.len()
+                ));
+            }
+        }
+        self.instanced
+            .retain(|m| !m.triangles.is_empty() && !m.transforms.is_empty());
         let all: u64 = self.instanced.iter().map(InstancedMesh::copies).sum();
         let keep = match instancing {
             Instancing::On => true,

@@ -267,3 +267,31 @@ fn export_writes_instances_as_copies() {
     assert_eq!(on.0, 2 + 7 * 55_200);
     assert_eq!(on.1, on.0 as u64);
 }
+
+/// An instance whose transform cannot be inverted (a glTF instance scaled by 0) or is not
+/// finite is dropped with a warning naming its mesh; a mesh left with none is dropped.
+#[test]
+fn singular_instances_are_dropped_and_said() {
+    let mut scene = load("On");
+    scene.instanced[0]
+        .transforms
+        .push(glam::Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0)));
+    scene.instanced[0]
+        .transforms
+        .push(glam::Mat4::from_translation(Vec3::splat(f32::NAN)));
+    scene.apply_instancing(Instancing::On).unwrap();
+    assert_eq!(scene.instanced[0].transforms.len(), 7);
+    assert!(
+        scene
+            .report
+            .warnings
+            .iter()
+            .any(|w| w.contains("grid: 2 of its 9 instances dropped")),
+        "{:?}",
+        scene.report.warnings
+    );
+    scene.instanced[0].transforms.clear();
+    scene.apply_instancing(Instancing::On).unwrap();
+    assert!(scene.instanced.is_empty());
+    GpuScene::build(&scene).unwrap();
+}
