@@ -278,7 +278,7 @@ enum Command {
         #[arg(long = "variant", value_name = "LABEL:NODE.PARAM=VALUE[;...]")]
         variants: Vec<String>,
     },
-    /// Write the resolved scene for other renderers: scene.json (camera, materials, spheres,
+    /// Write the resolved scene for other renderers: scene.json (camera, materials, analytic shapes,
     /// lights, environment, settings) and OBJ files of its triangles; scripts/references/
     /// builds Mitsuba 3 scenes from it.
     #[command(after_help = "Example:\n  lumagraph export assets/cornell.ron --out cornell_export")]
@@ -354,11 +354,11 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
         )
     };
     println!(
-        "scene {}: {} triangles{instanced}, {} spheres, {} lights, {} textures, {} BVH nodes, \
+        "scene {}: {} triangles{instanced}, {} analytic shapes, {} lights, {} textures, {} BVH nodes, \
          {:.1} MiB of geometry ({:.0} ms)",
         path.display(),
         gpu.tri_positions.len(),
-        gpu.spheres.len(),
+        gpu.shapes.len(),
         gpu.lights.len(),
         scene.textures.len(),
         gpu.bvh_nodes.len(),

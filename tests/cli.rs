@@ -539,7 +539,7 @@ fn plan_lists_shader_features_for_the_scene() {
     let left_out = stdout.split("left out:\n").last().unwrap();
     for f in [
         "BVH traversal",
-        "sphere tests",
+        "shape tests",
         "environment",
         "metal lobe",
         "glass lobe",

@@ -2,7 +2,7 @@
 """Mitsuba 3 references for the path tracer's test suite (tests/scenes/*.ron).
 
 For each scene: `lumagraph export` writes the resolved scene (what the path tracer renders:
-materials, spheres, triangles as OBJ, lights, environment, camera) as JSON; this script maps
+materials, analytic shapes, triangles as OBJ, lights, environment, camera) as JSON; this script maps
 it onto Mitsuba 3 plugins, renders a reference at `--spp` samples per pixel and Mitsuba's own
 256-spp images with `--seeds` seeds, and writes into tests/reference/suite/:
 
@@ -261,16 +261,19 @@ def mitsuba_scene(export_dir, spp, seed):
         if inside:
             shape["interior"] = inside
         d[f"mesh_{k}"] = shape
-    for k, sph in enumerate(s["spheres"]):
-        shape = {"type": "sphere", "center": sph["center"], "radius": sph["radius"],
-                 "bsdf": material(sph["material"])}
-        e = emitter(sph["material"])
+    for k, sh in enumerate(s["shapes"]):
+        # Each kind of analytic shape exports its own Mitsuba dictionary.
+        shape = dict(sh["mitsuba"])
+        if "to_world" in shape:
+            shape["to_world"] = T(shape["to_world"])
+        shape["bsdf"] = material(sh["material"])
+        e = emitter(sh["material"])
         if e:
             shape["emitter"] = e
-        inside = medium(mats[sph["material"]])
+        inside = medium(mats[sh["material"]])
         if inside:
             shape["interior"] = inside
-        d[f"sphere_{k}"] = shape
+        d[f"{sh['kind']}_{k}"] = shape
     for k, l in enumerate(s["lights"]):
         if l["type"] == "point":
             d[f"light_{k}"] = {"type": "point", "position": l["position"],

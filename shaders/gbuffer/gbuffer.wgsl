@@ -8,9 +8,10 @@
 // to 0 and tested with `greater`.
 //
 // Triangles interpolate their corner normals (perspective-correct, so the same barycentrics
-// as the ray hit). Spheres arrive as a circumscribed tessellation; each fragment intersects
-// the true sphere along its pixel-center ray, drops the fragment on a miss and writes the
-// exact normal and depth, so silhouettes and normals match the ray tracer's.
+// as the ray hit). Analytic shapes arrive as their kind's hull (crates/scene/src/shapes/);
+// each fragment intersects the shape itself along its pixel-center ray with the path
+// tracer's test (pathtrace/shapes.wgsl), drops the fragment on a miss and writes the exact
+// normal and depth, so silhouettes and normals match the ray tracer's.
 // With textures (HAS_TEXTURES), fragments of textured materials take their albedo and normal
 // through the path tracer's own functions (pathtrace/textures.wgsl) at the interpolated UV.
 // With HAS_ALPHA, fragments of alpha-masked materials whose opacity (times the base colour
@@ -24,6 +25,7 @@
 #import "pathtrace/textures.wgsl"
 #import "gbuffer/options.wgsl"
 #import "common/rng.wgsl"
+#import "pathtrace/shapes.wgsl"
 
 struct RasterCamera {
     position: vec3f,
@@ -47,13 +49,16 @@ const NEAR: f32 = 1e-4;
 @group(0) @binding(1) var<storage, read> materials: array<Material>;
 @group(0) @binding(2) var<storage, read> texture_descs: array<TexDesc>;
 @group(0) @binding(3) var textures: texture_2d_array<f32>;
+// The analytic shapes (a zeroed stand-in without).
+@group(0) @binding(4) var<storage, read> shapes: array<Shape>;
 
 struct VertexIn {
     @location(0) position: vec3f,
     @location(1) normal: vec3f,
     @location(2) albedo: vec3f,
-    // Sphere center and radius; for a triangle, its unit geometric normal and 0.
-    @location(3) sphere: vec4f,
+    // For a triangle, its unit geometric normal and 0; for a shape's hull, 0 and the shape's
+    // index + 1.
+    @location(3) shape: vec4f,
     // Both UV sets (set 0 in xy).
     @location(4) uv: vec4f,
     // Tangent (xyz) and handedness (w, corner 0's on every corner).
@@ -65,7 +70,7 @@ struct VertexIn {
 
 // The instance a vertex is drawn for (a `GpuInstance`, pathtrace/instances.wgsl): its
 // object-to-world and world-to-object rows and (root, flags, pad_scale, pad_base); the identity for
-// the scene's own triangles and spheres.
+// the scene's own triangles and shapes.
 struct InstanceIn {
     @location(8) world_x: vec4f,
     @location(9) world_y: vec4f,
@@ -81,7 +86,7 @@ struct VertexOut {
     @location(0) world: vec3f,
     @location(1) normal: vec3f,
     @location(2) @interpolate(flat) albedo: vec3f,
-    @location(3) @interpolate(flat) sphere: vec4f,
+    @location(3) @interpolate(flat) shape: vec4f,
     @location(4) uv: vec4f,
     @location(5) tangent: vec4f,
     @location(6) @interpolate(flat) material: u32,
@@ -99,10 +104,10 @@ fn vs_main(v: VertexIn, i: InstanceIn) -> VertexOut {
     let turn = select(1.0, -1.0, (i.info.y & INSTANCE_MIRROR) != 0u);
     // The identity has no mesh root: the scene's own geometry is drawn as it was.
     let placed = i.info.x != 0u;
-    var sphere = v.sphere;
-    if placed && v.sphere.w <= 0.0 {
+    var shape = v.shape;
+    if placed && v.shape.w <= 0.0 {
         // A triangle's unit geometric normal.
-        sphere = vec4f(turn * normalize(normal_of * v.sphere.xyz), 0.0);
+        shape = vec4f(turn * normalize(normal_of * v.shape.xyz), 0.0);
     }
     let d = position - cam.position;
     let z = dot(d, cam.forward);
@@ -123,7 +128,7 @@ fn vs_main(v: VertexIn, i: InstanceIn) -> VertexOut {
     out.world = position;
     out.normal = normal_of * v.normal;
     out.albedo = v.albedo;
-    out.sphere = sphere;
+    out.shape = shape;
     out.uv = v.uv;
     out.tangent = vec4f(v.tangent.xyz * to_world, turn * v.tangent.w);
     out.material = v.material;
@@ -154,7 +159,7 @@ fn opaque_here(f: VertexOut) -> bool {
     }
     var alpha = m.opacity;
     let tex = tex_lo(m.tex_base_mr);
-    if HAS_TEXTURES && f.sphere.w <= 0.0 {
+    if HAS_TEXTURES && f.shape.w <= 0.0 {
         alpha *= f.color.a;
         if tex != NO_TEX {
             alpha *= tex_sample(tex, f.uv, false).a;
@@ -177,35 +182,26 @@ fn fs_main(f: VertexOut) -> FragmentOut {
     var out: FragmentOut;
     let flag = select(1.0, 2.0, any(materials[f.material].emission > vec3f(0.0)));
     out.albedo = vec4f(f.albedo, flag);
-    if f.sphere.w > 0.0 {
-        // The ray-sphere hit nearest the camera in front of it (the path tracer's test).
-        let oc = cam.position - f.sphere.xyz;
-        let b = dot(oc, dir);
-        let c = dot(oc, oc) - f.sphere.w * f.sphere.w;
-        let disc = b * b - c;
-        if disc < 0.0 {
-            discard;
-        }
-        let s = sqrt(disc);
-        var t = -b - s;
-        if t <= 0.0 {
-            t = -b + s;
-        }
+    if f.shape.w > 0.0 {
+        // The shape's hit nearest the camera in front of it (the path tracer's test).
+        let i = u32(f.shape.w) - 1u;
+        let s = shapes[i];
+        let t = shape_intersect(i | PRIM_SHAPE, s, Ray(cam.position, dir), F32_MAX);
         if t <= 0.0 {
             discard;
         }
         let p = cam.position + t * dir;
-        out.normal = vec4f(normalize(p - f.sphere.xyz), 1.0);
+        out.normal = vec4f(shape_normal(s, p), 1.0);
         out.depth = vec4f(t, 0.0, 0.0, 0.0);
         out.frag_depth = NEAR / max(dot(p - cam.position, cam.forward), NEAR);
     } else {
         let n = f.normal;
         // A zero interpolated normal falls back to the geometric one, as in the path tracer.
-        var ns = select(f.sphere.xyz, normalize(n), dot(n, n) > 0.0);
+        var ns = select(f.shape.xyz, normalize(n), dot(n, n) > 0.0);
         if HAS_TEXTURES {
             let m = textured_material(materials[f.material], f.uv, f.color);
             out.albedo = vec4f(m.base_color, flag);
-            ns = normal_mapped(m, ns, f.sphere.xyz, f.uv, f.tangent);
+            ns = normal_mapped(m, ns, f.shape.xyz, f.uv, f.tangent);
         }
         out.normal = vec4f(ns, 1.0);
         out.depth = vec4f(length(f.world - cam.position), 0.0, 0.0, 0.0);

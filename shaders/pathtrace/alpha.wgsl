@@ -56,14 +56,14 @@ fn triangle_hit_counts(prim: u32, u: f32, v: f32, ray: Ray) -> bool {
     return alpha_stops(m, alpha, prim, ray);
 }
 
-// Whether a hit on sphere `i` counts (spheres have no texture: the opacity alone).
-fn sphere_hit_counts(i: u32, ray: Ray) -> bool {
+// Whether a hit on shape `i` counts (shapes have no texture: the opacity alone).
+fn shape_hit_counts(i: u32, ray: Ray) -> bool {
     if !HAS_ALPHA {
         return true;
     }
-    let m = scene_material(scene_sphere(i).material);
+    let m = scene_material(scene_shape(i).material);
     if (m.flags & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) == 0u {
         return true;
     }
-    return alpha_stops(m, m.opacity, i | PRIM_SPHERE, ray);
+    return alpha_stops(m, m.opacity, i | PRIM_SHAPE, ray);
 }

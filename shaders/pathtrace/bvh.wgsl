@@ -1,6 +1,6 @@
-// From its includer: the bindings `bvh_nodes`, `tri_positions` and `spheres`, the constants
-// `HAS_TRIANGLES`, `HAS_SPHERES`, `HAS_ALPHA` and `HAS_INSTANCES`, and the any-hit tests `triangle_hit_counts`
-// and `sphere_hit_counts` (in the path tracer options.wgsl and alpha.wgsl; raycast.wgsl
+// From its includer: the bindings `bvh_nodes`, `tri_positions` and `shapes`, the constants
+// `HAS_TRIANGLES`, `HAS_SHAPES`, `HAS_ALPHA` and `HAS_INSTANCES`, and the any-hit tests `triangle_hit_counts`
+// and `shape_hit_counts` (in the path tracer options.wgsl and alpha.wgsl; raycast.wgsl
 // declares its own).
 #import "pathtrace/primitives.wgsl"
 #import "pathtrace/candidates.wgsl"
@@ -10,10 +10,10 @@
 // shader declares the storage buffers:
 //   var<storage, read> bvh_nodes: array<vec4<u32>>;
 //   var<storage, read> tri_positions: array<TriPositions>;
-//   var<storage, read> spheres: array<Sphere>;
-// and the constants HAS_TRIANGLES and HAS_SPHERES (false where the scene has none of them:
+//   var<storage, read> shapes: array<Shape>;
+// and the constants HAS_TRIANGLES and HAS_SHAPES (false where the scene has none of them:
 // that leaf test is left out), and HAS_ALPHA with the any-hit tests `triangle_hit_counts` and
-// `sphere_hit_counts` (alpha.wgsl; always true where HAS_ALPHA is false). A leaf's
+// `shape_hit_counts` (alpha.wgsl; always true where HAS_ALPHA is false). A leaf's
 // primitives are tested as every intersector tests its candidates (candidates.wgsl).
 // Hits count for 0 < t < t_max; callers offset ray origins off surfaces.
 //
@@ -85,7 +85,7 @@ fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                     inst_end = first + 2u * count;
                     resume = bvh_nodes[node_index * 4u + 2u + (octant >> 2u)][octant & 3u];
                     enter = true;
-                } else if (HAS_TRIANGLES && (!HAS_SPHERES || (hi.w & NODE_SPHERES) == 0u)) {
+                } else if (HAS_TRIANGLES && (!HAS_SHAPES || (hi.w & NODE_SHAPES) == 0u)) {
                     for (var i = first; i < first + count; i = i + 1u) {
                         // The scene's own triangles through the same test, placed by the
                         // identity.
@@ -102,11 +102,11 @@ fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                             }
                         }
                     }
-                } else if (HAS_SPHERES) {
+                } else if (HAS_SHAPES) {
                     for (var i = first; i < first + count; i = i + 1u) {
-                        let t = candidate_sphere(i, ray, hit.t);
+                        let t = candidate_shape(i, ray, hit.t);
                         if (t > 0.0) {
-                            hit = Hit(i | PRIM_SPHERE, t, 0.0, 0.0, NO_INSTANCE);
+                            hit = Hit(i | PRIM_SHAPE, t, 0.0, 0.0, NO_INSTANCE);
                             if (any_hit) {
                                 return hit;
                             }

@@ -1,13 +1,14 @@
 #import "pathtrace/primitives.wgsl"
 #import "pathtrace/instances.wgsl"
+#import "pathtrace/shapes.wgsl"
 
 // A candidate primitive tested as every intersector tests the primitives it finds (the BVH's
 // leaves, the wide BVH's, the device's ray-query candidates): the exact ray/primitive test,
 // the rules for rays leaving a surface (`skip_prim`, the origin's error, primitives.wgsl) and
 // the any-hit test of alpha-masked and blended materials (alpha.wgsl).
-// From its includer: the bindings `tri_positions`, `spheres` and (instances.wgsl)
+// From its includer: the bindings `tri_positions`, `shapes` and (instances.wgsl)
 // `bvh_nodes`, the constant `HAS_ALPHA`,
-// and the any-hit tests `triangle_hit_counts` and `sphere_hit_counts`.
+// and the any-hit tests `triangle_hit_counts` and `shape_hit_counts`.
 
 // Triangle `i`: vec4(1, t, u, v) where it counts as a hit with 0 < t < t_max, else x = 0.
 fn candidate_triangle(i: u32, ray: Ray, t_max: f32) -> vec4<f32> {
@@ -44,17 +45,16 @@ fn candidate_instance_triangle(i: u32, slot: u32, placed: Placement, ray: Ray, t
     return vec4<f32>(0.0);
 }
 
-// Sphere `i` (its index in `spheres`, without PRIM_SPHERE): t where it counts as a hit with
+// Shape `i` (its index in `shapes`, without PRIM_SHAPE): t where it counts as a hit with
 // 0 < t < t_max, else 0.
-fn candidate_sphere(i: u32, ray: Ray, t_max: f32) -> f32 {
-    let s = spheres[i];
-    return candidate_sphere_at(i, s.center, s.radius, ray, t_max);
+fn candidate_shape(i: u32, ray: Ray, t_max: f32) -> f32 {
+    return candidate_shape_at(i, shapes[i], ray, t_max);
 }
 
-// Sphere `i` whose center and radius are `center` and `radius`.
-fn candidate_sphere_at(i: u32, center: vec3<f32>, radius: f32, ray: Ray, t_max: f32) -> f32 {
-    let t = intersect_sphere_from(i | PRIM_SPHERE, ray.origin, ray.dir, center, radius, t_max);
-    if (t > 0.0 && (!HAS_ALPHA || sphere_hit_counts(i, ray))) {
+// Shape `i` whose record (`shapes[i]`, or a copy of it) is `s`.
+fn candidate_shape_at(i: u32, s: Shape, ray: Ray, t_max: f32) -> f32 {
+    let t = shape_intersect(i | PRIM_SHAPE, s, ray, t_max);
+    if (t > 0.0 && (!HAS_ALPHA || shape_hit_counts(i, ray))) {
         return t;
     }
     return 0.0;

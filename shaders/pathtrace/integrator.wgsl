@@ -127,8 +127,8 @@ fn bounce_path(p: ptr<function, PathState>, hit: Hit, may_miss: bool) -> u32 {
     let s = surface_at((*p).ray, hit);
     // Rays leaving a surface start at the hit position itself and skip the primitive
     // left: a triangle ignores what is within the position's error (see `leave`), a
-    // sphere is met again only by a ray going into it, at its far side.
-    let on_sphere = is_sphere(hit.prim);
+    // closed shape (a sphere) is met again only by a ray going into it, at its far side.
+    let on_shape = is_shape(hit.prim);
     skip_prim = hit.prim;
     skip_inst = hit.inst;
     var mat = scene_material(s.material);
@@ -136,7 +136,7 @@ fn bounce_path(p: ptr<function, PathState>, hit: Hit, may_miss: bool) -> u32 {
         mat = textured_material(mat, s.uv, s.color);
     }
     if HAS_MEDIA && (mat.flags & MATERIAL_INDEX_MATCHED) != 0u {
-        return cross_boundary(p, s, mat, on_sphere);
+        return cross_boundary(p, s, mat, on_shape);
     }
     let front = dot(s.ng, (*p).ray.dir) < 0.0;
     let two_sided = (mat.flags & MATERIAL_TWO_SIDED) != 0u;
@@ -167,9 +167,9 @@ fn bounce_path(p: ptr<function, PathState>, hit: Hit, may_miss: bool) -> u32 {
         coat_normal = normalize(to_local * select(s.coat_n, -s.coat_n, flip));
     }
     if wo.z > 0.0 {
-        next_event(p, s, mat, on_sphere, ng, front || flip, to_local, wo, has_lights);
+        next_event(p, s, mat, on_shape, ng, front || flip, to_local, wo, has_lights);
     }
-    return scatter(p, s, mat, on_sphere, ng, basis, wo);
+    return scatter(p, s, mat, on_shape, ng, basis, wo);
 }
 
 // The ray of path `p` through the medium it travels in, up to `hit`: Beer-Lambert
@@ -231,7 +231,7 @@ fn add_escaped(p: ptr<function, PathState>) {
 // An index-matched boundary `s`: no surface, the ray goes on into or out of the medium,
 // and this is no scattering event (not counted as a bounce; MIS keeps the last vertex's
 // pdf).
-fn cross_boundary(p: ptr<function, PathState>, s: Surface, mat: Material, on_sphere: bool) -> u32 {
+fn cross_boundary(p: ptr<function, PathState>, s: Surface, mat: Material, on_shape: bool) -> u32 {
     (*p).crossings += 1u;
     if (*p).crossings > MAX_CROSSINGS {
         return PATH_ENDS;
@@ -239,7 +239,7 @@ fn cross_boundary(p: ptr<function, PathState>, s: Surface, mat: Material, on_sph
     let dir = (*p).ray.dir;
     medium_id = medium_after(s.material, mat, s.ng, dir, medium_id);
     let side = select(-s.ng, s.ng, dot(s.ng, dir) > 0.0);
-    (*p).ray = Ray(leave(s, on_sphere, side, dir), dir);
+    (*p).ray = Ray(leave(s, on_shape, side, dir), dir);
     (*p).bounce -= 1u;
     return BOUNCE_DONE;
 }
@@ -254,7 +254,7 @@ fn next_event(
     p: ptr<function, PathState>,
     s: Surface,
     mat: Material,
-    on_sphere: bool,
+    on_shape: bool,
     ng: vec3f,
     toward_ng: bool,
     to_local: mat3x3f,
@@ -274,7 +274,7 @@ fn next_event(
     if !(e.pdf > 0.0 || any(e.f_cos > vec3f(0.0))) {
         return;
     }
-    let shadow = Ray(leave(s, on_sphere, select(-ng, ng, dot(ng, ls.wi) > 0.0), ls.wi), ls.wi);
+    let shadow = Ray(leave(s, on_shape, select(-ng, ng, dot(ng, ls.wi) > 0.0), ls.wi), ls.wi);
     ray_count += 1u;
     let w = select(light_weight(ls.pdf, e.pdf), 1.0, ls.delta);
     if HAS_MEDIA {
@@ -307,7 +307,7 @@ fn scatter(
     p: ptr<function, PathState>,
     s: Surface,
     mat: Material,
-    on_sphere: bool,
+    on_shape: bool,
     ng: vec3f,
     basis: mat3x3f,
     wo: vec3f,
@@ -326,7 +326,7 @@ fn scatter(
     (*p).throughput *= bs.weight;
     (*p).bsdf_pdf = bs.pdf;
     (*p).prev_p = s.p;
-    (*p).ray = Ray(leave(s, on_sphere, side, wi), wi);
+    (*p).ray = Ray(leave(s, on_shape, side, wi), wi);
     return select(PATH_ENDS, BOUNCE_DONE, survives_roulette(p));
 }
 

@@ -1,6 +1,7 @@
 // Light sampling: picking a light (alias table by power, with a uniform share), sampling
-// a point on it or a direction to it (triangles, spheres by solid angle, point, spot and
-// directional lights, the environment map), and the pdfs MIS needs.
+// a point on it or a direction to it (triangles, analytic shapes as their kind samples them
+// (pathtrace/shapes/), point, spot and directional lights, the environment map), and the
+// pdfs MIS needs.
 // From its includer (pathtrace/pathtrace.wgsl): `frame` and the bindings `tri_texcoords`
 // and `textures`.
 #import "pathtrace/scene_types.wgsl"
@@ -12,6 +13,7 @@
 #import "pathtrace/scene_data.wgsl"
 #import "pathtrace/textures.wgsl"
 #import "pathtrace/surface.wgsl"
+#import "pathtrace/shapes.wgsl"
 
 struct LightSample {
     // Unit direction from the shading point to the light.
@@ -55,11 +57,9 @@ fn light_select_pdf(l: Light) -> f32 {
 fn light_pdf(l: Light, x: vec3f, y: vec3f, ny: vec3f) -> f32 {
     let d = y - x;
     let dist2 = dot(d, d);
-    if (l.flags & LIGHT_SPHERE) != 0u {
-        let r = l.e1.x;
-        let s = min(1.0, r * r / dot(l.p0 - x, l.p0 - x));
-        let cone = one_minus_sqrt_one_minus(s);
-        return light_select_pdf(l) / (TWO_PI * cone);
+    if (l.flags & LIGHT_SHAPE) != 0u {
+        let pdf = shape_pdf(scene_shape(l.prim), x, y);
+        return light_select_pdf(l) * pdf.x / pdf.y;
     }
     let cos_y = abs(dot(ny, d)) / sqrt(dist2);
     return light_select_pdf(l) * dist2 / (l.area * cos_y);
@@ -105,30 +105,16 @@ fn sample_light(x: vec3f, bounce: u32) -> LightSample {
         out.radiance = l.emission * (falloff / dist2);
         return out;
     }
-    if (l.flags & LIGHT_SPHERE) != 0u {
-        // Uniform direction in the cone the sphere subtends.
-        let r = l.e1.x;
-        let to_c = l.p0 - x;
-        let d2 = dot(to_c, to_c);
-        if d2 <= r * r {
+    if (l.flags & LIGHT_SHAPE) != 0u {
+        let ss = shape_sample(scene_shape(l.prim), x, u, (l.flags & LIGHT_TWO_SIDED) != 0u);
+        if ss.pdf.x <= 0.0 {
             return out;
         }
-        let d = sqrt(d2);
-        let cone = one_minus_sqrt_one_minus(r * r / d2);
-        let cos_t = 1.0 - u.x * cone;
-        let sin_t = sqrt(max(0.0, (1.0 - cos_t) * (1.0 + cos_t)));
-        let phi = TWO_PI * u.y;
-        let axis = to_c / d;
-        let wi = normalize(onb(axis) * vec3f(sin_t * cos(phi), sin_t * sin(phi), cos_t));
-        // Distance to the near intersection with the sphere.
-        let b = dot(to_c, wi);
-        let h = to_c - b * wi;
-        let dist = b - sqrt(max(0.0, r * r - dot(h, h)));
-        out.wi = wi;
-        out.dist = dist;
+        out.wi = ss.wi;
+        out.dist = ss.dist;
         out.radiance = l.emission;
-        out.pdf = light_select_pdf(l) / (TWO_PI * cone);
-        out.margin = 1e-4 * dist;
+        out.pdf = light_select_pdf(l) * ss.pdf.x / ss.pdf.y;
+        out.margin = ss.margin;
         return out;
     }
     let b = sample_triangle(u);

@@ -87,7 +87,7 @@ fn shadow_transmittance(shadow: Ray, t_max: f32, medium: u32) -> vec3f {
         skip_prim = hit.prim;
         skip_inst = hit.inst;
         let side = select(-s.ng, s.ng, dot(s.ng, ray.dir) > 0.0);
-        ray = Ray(leave(s, is_sphere(hit.prim), side, ray.dir), ray.dir);
+        ray = Ray(leave(s, is_shape(hit.prim), side, ray.dir), ray.dir);
         left -= t;
         ray_count += 1u;
     }

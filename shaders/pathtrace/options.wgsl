@@ -16,10 +16,10 @@ const SPREAD_WORKGROUPS: bool = true;
 // loop per sample.
 const REGENERATE_PATHS: bool = true;
 
-// The scene has triangles; it has spheres. The BVH leaf and surface code of a kind the scene
+// The scene has triangles; it has analytic shapes. The BVH leaf and surface code of a kind the scene
 // lacks is left out (llvmpipe would run it at every node visit and bounce, masked).
 const HAS_TRIANGLES: bool = true;
-const HAS_SPHERES: bool = true;
+const HAS_SHAPES: bool = true;
 
 // Lobes some material of the scene uses; the code of the others is left out.
 const HAS_SPECULAR: bool = true;

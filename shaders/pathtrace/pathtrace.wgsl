@@ -1,6 +1,6 @@
 // Path tracer megakernel: one invocation per pixel traces `samples_per_frame` paths and
 // writes their mean radiance. Unidirectional path tracing with next-event estimation and
-// multiple importance sampling (power heuristic) for emissive triangles and spheres and the
+// multiple importance sampling (power heuristic) for emissive triangles and shapes and the
 // environment map, next-event estimation alone for point, spot and directional lights,
 // Russian roulette from the fifth bounce, the layered material of bsdf.wgsl (diffuse or
 // rough diffuse base under GGX specular, metal, glass) and one-sided emitters (Mitsuba 3's
@@ -74,7 +74,7 @@ const CHUNK_LAST: u32 = 2u;
 @group(0) @binding(2) var<storage, read> bvh_nodes: array<vec4<u32>>;
 @group(0) @binding(3) var<storage, read> tri_positions: array<TriPositions>;
 @group(0) @binding(4) var<storage, read> tri_shading: array<TriShading>;
-@group(0) @binding(5) var<storage, read> spheres: array<Sphere>;
+@group(0) @binding(5) var<storage, read> shapes: array<Shape>;
 @group(0) @binding(6) var<storage, read> materials: array<Material>;
 @group(0) @binding(7) var<storage, read> lights: array<Light>;
 @group(0) @binding(8) var<storage, read> light_alias: array<AliasEntry>;

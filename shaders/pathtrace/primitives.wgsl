@@ -6,17 +6,18 @@
 // beyond `origin_err`, which the CPU mirror does not have: it is always 0 there).
 const F32_MAX: f32 = 3.40282347e38;
 
-// The primitive a ray leaves from (a triangle's index, or a sphere's | PRIM_SPHERE). A flat
-// triangle cannot be hit again by a ray leaving it, nor a sphere by a ray leaving it outwards,
-// so skipping it removes self-intersection whatever the coordinates' magnitude, with no
-// offset of the origin; for triangles the origin's error only has to clear coplanar
-// neighbours (below). A ray entering a sphere (`skip_inward`) meets it at its far side.
+// The primitive a ray leaves from (a triangle's index, or a shape's | PRIM_SHAPE). A flat
+// triangle cannot be hit again by a ray leaving it, nor a sphere by a ray leaving it outwards
+// (each shape's test keeps its own rule, pathtrace/shapes/), so skipping it removes
+// self-intersection whatever the coordinates' magnitude, with no offset of the origin; for
+// triangles the origin's error only has to clear coplanar neighbours (below). A ray entering
+// a sphere (`skip_inward`) meets it at its far side.
 var<private> skip_prim: u32 = NO_HIT;
 // The instance of the triangle left (a hit's `inst`): a triangle of an instanced mesh is one
 // surface per instance.
 var<private> skip_inst: u32 = NO_INSTANCE;
 var<private> skip_inward: bool = false;
-// For rays leaving a triangle (camera rays and rays leaving a sphere have 0 for both): the
+// For rays leaving a triangle (camera rays and rays leaving a shape have 0 for both): the
 // unit normal of the triangle left, and a componentwise bound on the rounding error of the
 // origin. Such rays start exactly at the computed hit, not offset: an offset of even one
 // float step is 1/128 at 1e5, which visibly moves shadow boundaries. Instead a triangle
@@ -103,41 +104,4 @@ fn intersect_planar(origin: vec3<f32>, dir: vec3<f32>, v0: vec3<f32>, e1: vec3<f
     let near_origin = inside && (on_plane || (t > 0.0 && t <= origin_slab));
     hit = select(hit, select(concave, det > 0.0 && concave && !parallel, on_plane), near_origin);
     return vec4<f32>(select(0.0, 1.0, hit), t, u, v);
-}
-
-// Both roots (near, far) of ray/sphere in the robust form of Ray Tracing Gems, ch. 7; (-1, -1)
-// when the ray misses.
-fn sphere_roots(origin: vec3<f32>, dir: vec3<f32>, center: vec3<f32>, radius: f32) -> vec2<f32> {
-    let f = origin - center;
-    let a = dot(dir, dir);
-    let b = -dot(f, dir);
-    let l = f + (b / a) * dir;
-    let disc = a * (radius * radius - dot(l, l));
-    // Selected, not returned early: llvmpipe runs an if's body anyway (see intersect_triangle).
-    let c = dot(f, f) - radius * radius;
-    let root = sqrt(disc);
-    let q = b + select(root, -root, b < 0.0);
-    let t0 = c / q;
-    let t1 = q / a;
-    return select(vec2<f32>(-1.0), vec2<f32>(min(t0, t1), max(t0, t1)), disc >= 0.0);
-}
-
-// The nearest ray/sphere t in (0, t_max), or -1.
-fn intersect_sphere(origin: vec3<f32>, dir: vec3<f32>, center: vec3<f32>, radius: f32, t_max: f32) -> f32 {
-    return nearest_root(sphere_roots(origin, dir, center, radius), t_max);
-}
-
-// The first of the roots `r` (near, far) in (0, t_max), or -1.
-fn nearest_root(r: vec2<f32>, t_max: f32) -> f32 {
-    return select(select(-1.0, r.y, r.y > 0.0 && r.y < t_max), r.x, r.x > 0.0 && r.x < t_max);
-}
-
-// `intersect_sphere` for sphere `prim` (its index | PRIM_SPHERE) by a ray that may be the one
-// leaving it (`skip_prim`, from its surface, not offset): going out, it cannot meet that
-// convex sphere again; going in (`skip_inward`), only at the far root, the near one being its
-// own origin whichever side of the surface rounding put that.
-fn intersect_sphere_from(prim: u32, origin: vec3<f32>, dir: vec3<f32>, center: vec3<f32>, radius: f32, t_max: f32) -> f32 {
-    let r = sphere_roots(origin, dir, center, radius);
-    let own = select(-1.0, r.y, skip_inward && r.y > 0.0 && r.y < t_max);
-    return select(own, nearest_root(r, t_max), prim != skip_prim);
 }

@@ -12,17 +12,17 @@
 // hardware that is its traversal units, elsewhere (lavapipe) the driver's own BVH.
 //
 // The acceleration structure has one instance per kind of primitive, its custom data saying
-// which: triangles (ACCEL_TRIANGLES) and spheres (ACCEL_SPHERES), each primitive a box, in
-// the order of `tri_positions` and `spheres` (a candidate's primitive index is the
+// which: triangles (ACCEL_TRIANGLES) and analytic shapes (ACCEL_SHAPES), each primitive a box, in
+// the order of `tri_positions` and `shapes` (a candidate's primitive index is the
 // primitive's). Every candidate box comes back to this loop, which generates a hit only
 // where the exact test hits, so the device culls the boxes beyond it. (Triangles are boxes,
 // not the device's triangles: its watertight test and Moller-Trumbore disagree at shared
 // edges, and a ray the device sends to one triangle and the exact test to none would go
 // through.)
 //
-// From its includer: the bindings `tri_positions` and `spheres` (as for bvh.wgsl), the
-// constants `HAS_TRIANGLES`, `HAS_SPHERES` and `HAS_ALPHA`, and the any-hit tests
-// `triangle_hit_counts` and `sphere_hit_counts`.
+// From its includer: the bindings `tri_positions` and `shapes` (as for bvh.wgsl), the
+// constants `HAS_TRIANGLES`, `HAS_SHAPES` and `HAS_ALPHA`, and the any-hit tests
+// `triangle_hit_counts` and `shape_hit_counts`.
 
 @group(0) @binding(24) var scene_accel: acceleration_structure;
 
@@ -50,10 +50,10 @@ fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                     rayQueryTerminate(&rq);
                 }
             }
-        } else if (HAS_SPHERES && c.instance_custom_data == ACCEL_SPHERES) {
-            let t = candidate_sphere(i, ray, hit.t);
+        } else if (HAS_SHAPES && c.instance_custom_data == ACCEL_SHAPES) {
+            let t = candidate_shape(i, ray, hit.t);
             if (t > 0.0) {
-                hit = Hit(i | PRIM_SPHERE, t, 0.0, 0.0, NO_INSTANCE);
+                hit = Hit(i | PRIM_SHAPE, t, 0.0, 0.0, NO_INSTANCE);
                 rayQueryGenerateIntersection(&rq, t);
                 if (any_hit) {
                     rayQueryTerminate(&rq);

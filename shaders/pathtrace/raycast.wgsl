@@ -18,14 +18,14 @@ struct Params {
 @group(0) @binding(2) var<storage, read_write> hits: array<Hit>;
 @group(0) @binding(3) var<storage, read> bvh_nodes: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read> tri_positions: array<TriPositions>;
-@group(0) @binding(5) var<storage, read> spheres: array<Sphere>;
+@group(0) @binding(5) var<storage, read> shapes: array<Shape>;
 
 #import "pathtrace/bvh.wgsl"
 
 // Ray queries are not specialized to the scene: both primitive kinds' tests are compiled;
 // they see every surface solid (no material is bound: alpha's any-hit test is not run).
 const HAS_TRIANGLES: bool = true;
-const HAS_SPHERES: bool = true;
+const HAS_SHAPES: bool = true;
 const HAS_ALPHA: bool = false;
 const HAS_INSTANCES: bool = true;
 
@@ -33,7 +33,7 @@ fn triangle_hit_counts(prim: u32, u: f32, v: f32, ray: Ray) -> bool {
     return true;
 }
 
-fn sphere_hit_counts(i: u32, ray: Ray) -> bool {
+fn shape_hit_counts(i: u32, ray: Ray) -> bool {
     return true;
 }
 

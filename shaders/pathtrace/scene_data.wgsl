@@ -1,10 +1,10 @@
 // The path tracer's per-hit scene data: materials, lights and their alias table, and the
-// triangles' and spheres' positions and shading data, read by index from the storage
+// triangles' and shapes' positions and shading data, read by index from the storage
 // buffers the includer declares. For small scenes the renderer replaces this file with
 // generated code that returns them from `switch` statements with the values written into the
 // shader, so no bounce loads them from memory (see crates/render/src/specialize.rs).
 // From its includer: the bindings `materials`, `lights`, `light_alias`, `tri_positions`,
-// `tri_shading` and `spheres`.
+// `tri_shading` and `shapes`.
 #import "pathtrace/scene_types.wgsl"
 
 fn scene_material(id: u32) -> Material {
@@ -27,6 +27,6 @@ fn scene_tri_shading(i: u32) -> TriShading {
     return tri_shading[i];
 }
 
-fn scene_sphere(i: u32) -> Sphere {
-    return spheres[i];
+fn scene_shape(i: u32) -> Shape {
+    return shapes[i];
 }

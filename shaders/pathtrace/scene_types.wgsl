@@ -2,8 +2,8 @@
 // field (same names, same offsets; a test in crates/scene checks them with naga).
 // Padding is explicit so the layout reads the same in both languages.
 
-// A hit's `prim` has this bit set for spheres; the low bits index `spheres`.
-const PRIM_SPHERE: u32 = 0x80000000u;
+// A hit's `prim` has this bit set for analytic shapes; the low bits index `shapes`.
+const PRIM_SHAPE: u32 = 0x80000000u;
 // A hit's `prim` when nothing was hit.
 const NO_HIT: u32 = 0xffffffffu;
 // A hit's `inst` off instanced meshes.
@@ -23,7 +23,7 @@ const MATERIAL_ALPHA_MASK: u32 = 32u;
 const MATERIAL_ALPHA_BLEND: u32 = 64u;
 // TriPositions::flags: the triangle's material is alpha-masked or blended.
 const TRI_ALPHA: u32 = 1u;
-const LIGHT_SPHERE: u32 = 1u;
+const LIGHT_SHAPE: u32 = 1u;
 const LIGHT_TWO_SIDED: u32 = 2u;
 const LIGHT_POINT: u32 = 4u;
 const LIGHT_SPOT: u32 = 8u;
@@ -35,7 +35,7 @@ const ENV_CONSTANT: u32 = 1u;
 const ENV_MAP: u32 = 2u;
 const ENV_SHOW_BACKGROUND: u32 = 1u;
 
-const FEATURE_SPHERES: u32 = 1u;
+const FEATURE_SHAPES: u32 = 1u;
 const FEATURE_TRANSMISSION: u32 = 2u;
 const FEATURE_TEXTURES: u32 = 4u;
 const FEATURE_ENVIRONMENT: u32 = 8u;
@@ -48,7 +48,7 @@ const FEATURE_INSTANCES: u32 = 256u;
 const INSTANCE_MIRROR: u32 = 1u;
 
 // BVH node, 32 bytes. Depth-first order: an inner node's first child is the next node.
-//   bits 0-1: split axis (inner); leaf kind: bit 0 instances (NODE_INSTANCES), bit 2 spheres,
+//   bits 0-1: split axis (inner); leaf kind: bit 0 instances (NODE_INSTANCES), bit 2 shapes,
 //   neither triangles;
 //   bits 3-31: primitive count (0 = inner node).
 //   index: inner = second child's node index; leaf = first primitive in its kind's array.
@@ -59,7 +59,7 @@ struct BvhNode {
     bits: u32,
 }
 
-const NODE_SPHERES: u32 = 4u;
+const NODE_SHAPES: u32 = 4u;
 const NODE_INSTANCES: u32 = 1u;
 const NODE_COUNT_SHIFT: u32 = 3u;
 
@@ -84,14 +84,27 @@ struct TriShading {
     flags: u32,
 }
 
-// Sphere, 32 bytes; traversal reads center and radius only.
-struct Sphere {
+// Analytic shape (crates/scene/src/shapes/), 48 bytes: its kind's parameters (`center`,
+// `radius`, `axis`), then what shading reads.
+struct Shape {
     center: vec3<f32>,
     radius: f32,
+    axis: vec3<f32>,
+    kind: u32,
     material: u32,
     light: u32,
     pad0: u32,
     pad1: u32,
+}
+
+// A point sampled on a shape as seen from a shading point: the unit direction to it, its
+// distance, the solid-angle pdf as (numerator, denominator) (numerator 0: no sample), and
+// how far a shadow ray stops short of it.
+struct ShapeSample {
+    wi: vec3f,
+    dist: f32,
+    pdf: vec2f,
+    margin: f32,
 }
 
 // Material, 208 bytes. Texture indices: 16 bits each, 0xffff = none; each texture
@@ -172,7 +185,7 @@ struct TexDesc {
     pad: u32,
 }
 
-// Emissive triangle (p0, e1, e2) or sphere (center p0, radius e1.x), 64 bytes, or a light
+// Emissive triangle (p0, e1, e2) or analytic shape (LIGHT_SHAPE: `prim`), 64 bytes, or a light
 // without area: point (position p0, intensity in `emission`), spot (also unit axis e1,
 // e2 = (cutoff, beam width) half-angles in radians), directional (unit travel direction e1,
 // irradiance in `emission`).
@@ -225,7 +238,7 @@ struct Settings {
 struct SceneHeader {
     num_nodes: u32,
     num_triangles: u32,
-    num_spheres: u32,
+    num_shapes: u32,
     num_materials: u32,
     num_lights: u32,
     bvh_depth: u32,
@@ -238,8 +251,8 @@ struct Ray {
     dir: vec3<f32>,
 }
 
-// prim: triangle index, or sphere index | PRIM_SPHERE, or NO_HIT.
-// u, v: barycentric weights of corners 1 and 2 (0 for spheres).
+// prim: triangle index, or shape index | PRIM_SHAPE, or NO_HIT.
+// u, v: barycentric weights of corners 1 and 2 (0 for shapes).
 // inst: the instance whose mesh the triangle is of (its node slot in `bvh_nodes`,
 // instances.wgsl), or NO_INSTANCE for the scene's own primitives.
 struct Hit {

@@ -9,10 +9,11 @@
 #import "pathtrace/scene_data.wgsl"
 #import "pathtrace/textures.wgsl"
 #import "pathtrace/instances.wgsl"
+#import "pathtrace/shapes.wgsl"
 
 struct Surface {
     p: vec3f,
-    // Geometric normal, front side (triangles: e1 x e2; spheres: outward).
+    // Geometric normal, front side (triangles: e1 x e2; shapes: `shape_normal`).
     ng: vec3f,
     // Shading normal, front side.
     ns: vec3f,
@@ -21,11 +22,11 @@ struct Surface {
     coat_n: vec3f,
     material: u32,
     light: u32,
-    // Componentwise bound on the rounding error of `p` (triangles; 0 on spheres).
+    // Componentwise bound on the rounding error of `p` (triangles; 0 on shapes).
     err: vec3f,
-    // Texture coordinates, set 0 in xy and set 1 in zw (HAS_TEXTURES; 0 on spheres).
+    // Texture coordinates, set 0 in xy and set 1 in zw (HAS_TEXTURES; 0 on shapes).
     uv: vec4f,
-    // Vertex colour (HAS_TEXTURES; white on spheres).
+    // Vertex colour (HAS_TEXTURES; white on shapes).
     color: vec4f,
 }
 
@@ -40,9 +41,9 @@ fn barycentric_err(v0: vec3f, e1: vec3f, e2: vec3f, u: f32, v: f32) -> vec3f {
     return POSITION_ERR * (abs(v0) + abs(u * e1) + abs(v * e2)) + EDGE_ERR * (abs(e1) + abs(e2));
 }
 
-// Whether `prim` (a hit's) is a sphere; a constant where the scene has one kind only.
-fn is_sphere(prim: u32) -> bool {
-    return HAS_SPHERES && (!HAS_TRIANGLES || (prim & PRIM_SPHERE) != 0u);
+// Whether `prim` (a hit's) is an analytic shape; a constant where the scene has one kind only.
+fn is_shape(prim: u32) -> bool {
+    return HAS_SHAPES && (!HAS_TRIANGLES || (prim & PRIM_SHAPE) != 0u);
 }
 
 fn surface_at(ray: Ray, hit: Hit) -> Surface {
@@ -51,13 +52,13 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
     s.err = vec3f(0.0);
     s.uv = vec4f(0.0);
     s.color = vec4f(1.0);
-    if is_sphere(hit.prim) {
-        let sph = scene_sphere(hit.prim & ~PRIM_SPHERE);
-        s.ng = normalize(s.p - sph.center);
+    if is_shape(hit.prim) {
+        let sh = scene_shape(hit.prim & ~PRIM_SHAPE);
+        s.ng = shape_normal(sh, s.p);
         s.ns = s.ng;
         s.coat_n = s.ns;
-        s.material = sph.material;
-        s.light = sph.light;
+        s.material = sh.material;
+        s.light = sh.light;
     } else {
         let tri = scene_tri_positions(hit.prim);
         let sh = scene_tri_shading(hit.prim);
@@ -122,8 +123,8 @@ fn leave_no_surface() {
 // The origin of a ray leaving `s` towards the side `n` faces, and its error for the
 // intersection routines (`origin_n`, `origin_err`, `origin_off`, `origin_slab`,
 // `skip_inward`). Rays start at the hit itself, never offset (`skip_prim`).
-fn leave(s: Surface, on_sphere: bool, n: vec3f, dir: vec3f) -> vec3f {
-    if on_sphere {
+fn leave(s: Surface, on_shape: bool, n: vec3f, dir: vec3f) -> vec3f {
+    if on_shape {
         origin_n = vec3f(0.0);
         origin_err = vec3f(0.0);
         origin_off = 0.0;

@@ -1,6 +1,6 @@
-// From its includer: the bindings `bvh_nodes`, `tri_positions` and `spheres`, the constants
-// `HAS_TRIANGLES`, `HAS_SPHERES` and `HAS_ALPHA`, and the any-hit tests `triangle_hit_counts`
-// and `sphere_hit_counts` (in the path tracer options.wgsl and alpha.wgsl; raycast.wgsl
+// From its includer: the bindings `bvh_nodes`, `tri_positions` and `shapes`, the constants
+// `HAS_TRIANGLES`, `HAS_SHAPES` and `HAS_ALPHA`, and the any-hit tests `triangle_hit_counts`
+// and `shape_hit_counts` (in the path tracer options.wgsl and alpha.wgsl; raycast.wgsl
 // declares its own).
 #import "pathtrace/primitives.wgsl"
 #import "pathtrace/candidates.wgsl"
@@ -16,8 +16,8 @@
 // bvh.wgsl.
 //
 // The including shader declares `bvh_nodes: array<vec4<u32>>` (here: the wide BVH's records,
-// see wide_bvh.rs for the layout), `tri_positions` and `spheres`, and the constants
-// HAS_TRIANGLES, HAS_SPHERES and HAS_ALPHA.
+// see wide_bvh.rs for the layout), `tri_positions` and `shapes`, and the constants
+// HAS_TRIANGLES, HAS_SHAPES and HAS_ALPHA.
 
 // Entries of the traversal stack: one per level of the tree at most (wide_bvh.rs refuses
 // deeper trees). It is private to the invocation: in workgroup memory (entry d of invocation
@@ -80,7 +80,7 @@ fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
             let r0 = bvh_nodes[at];
             let r1 = bvh_nodes[at + 1u];
             let p = r1.w;
-            if (HAS_TRIANGLES && (!HAS_SPHERES || (p & PRIM_SPHERE) == 0u)) {
+            if (HAS_TRIANGLES && (!HAS_SHAPES || (p & PRIM_SHAPE) == 0u)) {
                 let r2 = bvh_nodes[at + 2u];
                 let r = candidate_triangle_at(p, bitcast<vec3<f32>>(r0.xyz), bitcast<vec3<f32>>(r1.xyz), bitcast<vec3<f32>>(r2.xyz), r0.w, ray, hit.t);
                 if (r.x != 0.0) {
@@ -89,8 +89,10 @@ fn trace_scene(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                         return hit;
                     }
                 }
-            } else if (HAS_SPHERES) {
-                let t = candidate_sphere_at(p & ~PRIM_SPHERE, bitcast<vec3<f32>>(r0.xyz), bitcast<f32>(r0.w), ray, hit.t);
+            } else if (HAS_SHAPES) {
+                let r2 = bvh_nodes[at + 2u];
+                let s = Shape(bitcast<vec3<f32>>(r0.xyz), bitcast<f32>(r0.w), bitcast<vec3<f32>>(r1.xyz), r2.x, 0u, 0u, 0u, 0u);
+                let t = candidate_shape_at(p & ~PRIM_SHAPE, s, ray, hit.t);
                 if (t > 0.0) {
                     hit = Hit(p, t, 0.0, 0.0, NO_INSTANCE);
                     if (any_hit) {

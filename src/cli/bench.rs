@@ -309,11 +309,11 @@ fn diffuse_ray(
     }
     let (o, d) = (Vec3::from(ray.origin), Vec3::from(ray.dir));
     let p = o + d * hit.t;
-    let n = if hit.prim & crate::scene::PRIM_SPHERE != 0 {
+    let n = if hit.prim & crate::scene::PRIM_SHAPE != 0 {
         let s = scene
-            .spheres
-            .get((hit.prim & !crate::scene::PRIM_SPHERE) as usize)?;
-        (p - Vec3::from(s.center)).normalize_or_zero()
+            .shapes
+            .get((hit.prim & !crate::scene::PRIM_SHAPE) as usize)?;
+        crate::scene::shapes::KINDS[s.kind as usize].normal(s, p)
     } else {
         let t = scene.tri_positions.get(hit.prim as usize)?;
         Vec3::from(t.e1).cross(Vec3::from(t.e2)).normalize_or_zero()

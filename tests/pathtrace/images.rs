@@ -393,14 +393,14 @@ fn spreading_workgroups_over_the_image_renders_bit_identical_images() {
 }
 
 /// The specialized shader leaves out the leaf and surface code of a primitive kind the
-/// scene lacks (`HAS_TRIANGLES`, `HAS_SPHERES`); the general shader keeps both and chooses
+/// scene lacks (`HAS_TRIANGLES`, `HAS_SHAPES`); the general shader keeps both and chooses
 /// by the BVH node's and the hit's flags. Same arithmetic on the path taken, so the images
 /// must agree bit for bit: a triangles-only scene (the textured box) and a spheres-only one
 /// (the material furnace), both traversing the BVH with data in buffers.
 #[test]
 fn leaving_out_a_missing_primitive_kind_renders_bit_identical_images() {
     for (name, left_out) in [
-        ("boxtextured.ron", Feature::Spheres),
+        ("boxtextured.ron", Feature::Shapes),
         ("furnace_materials.ron", Feature::Triangles),
     ] {
         let run = |general| {

@@ -143,7 +143,7 @@ fn the_wavefront_is_used_where_asked_for_or_measured_faster() {
     let f = decide(&spheres, Schedule::Wavefront, false);
     assert!(!f.on(Feature::Wavefront));
     let why = f.reason(Feature::Wavefront);
-    assert!(why.contains("spheres"), "{why}");
+    assert!(why.contains("analytic shapes"), "{why}");
     let media = common::gpu_scene("tests/scenes/media_scattering.ron", Some(32));
     assert!(!decide(&media, Schedule::Wavefront, false).on(Feature::Wavefront));
 }

@@ -11,7 +11,7 @@ use lumagraph::render::specialize::{
     Feature, Features, Intersector, PathTraceOptions, Specialization,
 };
 use lumagraph::render::wide_bvh::{WIDE_BVH_STACK, WideBvh};
-use lumagraph::scene::{GpuScene, PRIM_SPHERE, Scene};
+use lumagraph::scene::{GpuScene, PRIM_SHAPE, Scene};
 
 fn scene(rel: &str) -> GpuScene {
     GpuScene::build(&Scene::load(&common::repo(rel)).unwrap()).unwrap()
@@ -211,7 +211,7 @@ fn check_node(
                 let p = record[1][3];
                 found.push(p);
                 // The copy is the scene's primitive, bit for bit.
-                if p & PRIM_SPHERE == 0 {
+                if p & PRIM_SHAPE == 0 {
                     let t = &scene.tri_positions[p as usize];
                     let bits = |a: [f32; 3]| a.map(f32::to_bits);
                     assert_eq!(record[0][..3], bits(t.v0));
@@ -219,7 +219,7 @@ fn check_node(
                     assert_eq!(record[1][..3], bits(t.e1));
                     assert_eq!(record[2][..3], bits(t.e2));
                 } else {
-                    let sp = &scene.spheres[(p & !PRIM_SPHERE) as usize];
+                    let sp = &scene.shapes[(p & !PRIM_SHAPE) as usize];
                     assert_eq!(record[0][..3], sp.center.map(f32::to_bits));
                     assert_eq!(record[0][3], sp.radius.to_bits());
                 }
@@ -249,13 +249,13 @@ fn check_node(
     (lo_all, hi_all, depth)
 }
 
-/// The unpadded box of primitive `p` (a triangle's index, or a sphere's `| PRIM_SPHERE`).
+/// The unpadded box of primitive `p` (a triangle's index, or a shape's `| PRIM_SHAPE`).
 fn exact_box(scene: &GpuScene, p: u32) -> ([f32; 3], [f32; 3]) {
     use glam::Vec3;
-    if p & PRIM_SPHERE != 0 {
-        let s = &scene.spheres[(p & !PRIM_SPHERE) as usize];
-        let (c, r) = (Vec3::from(s.center), Vec3::splat(s.radius.abs()));
-        ((c - r).to_array(), (c + r).to_array())
+    if p & PRIM_SHAPE != 0 {
+        let s = &scene.shapes[(p & !PRIM_SHAPE) as usize];
+        let [lo, hi] = lumagraph::scene::shapes::KINDS[s.kind as usize].bounds(s);
+        (lo.to_array(), hi.to_array())
     } else {
         let t = &scene.tri_positions[p as usize];
         let v0 = Vec3::from(t.v0);
@@ -282,7 +282,7 @@ fn every_primitive_sits_inside_its_ancestors_boxes() {
         let (_, _, depth) = check_node(&s, &bvh.records, 0, &mut found);
         found.sort_unstable();
         let mut expected: Vec<u32> = (0..s.tri_positions.len() as u32)
-            .chain((0..s.spheres.len() as u32).map(|i| i | PRIM_SPHERE))
+            .chain((0..s.shapes.len() as u32).map(|i| i | PRIM_SHAPE))
             .collect();
         expected.sort_unstable();
         println!(

@@ -259,7 +259,7 @@ fn main() {
     println!(
         "{path}: {} triangles ({} spheres ignored); {} from {}; {} rayon threads",
         g.tri_corners.len(),
-        g.spheres.len(),
+        g.shapes.len(),
         embree.version(),
         embree.library(),
         rayon::current_num_threads()

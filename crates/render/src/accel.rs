@@ -2,7 +2,7 @@
 //! (`wgpu::Features::EXPERIMENTAL_RAY_QUERY`): what `pathtrace/ray_query.wgsl` traces
 //! instead of the WGSL BVH. One bottom-level structure holds the triangles' boxes (in the
 //! order of `GpuScene::tri_positions`, so a candidate's primitive index is the triangle's),
-//! another the spheres'; the top level has one instance of each, untransformed. Every
+//! another the analytic shapes'; the top level has one instance of each, untransformed. Every
 //! primitive is a box: the shader tests the candidates with the WGSL BVH's own tests, so
 //! images agree with the WGSL BVH's.
 
@@ -11,7 +11,7 @@ use wgpu::util::DeviceExt as _;
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::shared::{ACCEL_SPHERES, ACCEL_TRIANGLES};
+use crate::shared::{ACCEL_SHAPES, ACCEL_TRIANGLES};
 
 /// The identity as a TLAS instance's 3×4 row-major transform.
 const IDENTITY: [f32; 12] = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0];
@@ -34,14 +34,14 @@ pub fn unsupported(scene: &GpuScene, most: u32) -> Option<String> {
     let over = |n: usize| n as u64 > most;
     if !scene.instances.is_empty() {
         Some(crate::embree::flat_only("ray queries", scene))
-    } else if over(scene.tri_positions.len()) || over(scene.spheres.len()) {
+    } else if over(scene.tri_positions.len()) || over(scene.shapes.len()) {
         Some(format!(
-            "{} triangles and {} spheres: the device holds at most {most} primitives in one \
+            "{} triangles and {} analytic shapes: the device holds at most {most} primitives in one \
              acceleration structure",
             scene.tri_positions.len(),
-            scene.spheres.len()
+            scene.shapes.len()
         ))
-    } else if scene.tri_positions.is_empty() && scene.spheres.is_empty() {
+    } else if scene.tri_positions.is_empty() && scene.shapes.is_empty() {
         Some("nothing to intersect".to_owned())
     } else {
         None
@@ -73,7 +73,7 @@ impl SceneAccel {
         // geometry would let the device test the triangles itself, with its own rounding:
         // watertight where Möller-Trumbore is not, so at shared edges the two disagree, and
         // a ray the device sends to one triangle and the exact test to none goes through.)
-        let (tri_boxes, sphere_boxes) = crate::wide_bvh::primitive_boxes(scene);
+        let (tri_boxes, shape_boxes) = crate::wide_bvh::primitive_boxes(scene);
         let mut tlas = device.create_tlas(&wgpu::CreateTlasDescriptor {
             label: Some("scene accel"),
             max_instances: 2,
@@ -87,11 +87,7 @@ impl SceneAccel {
                 "scene accel triangles",
                 tri_boxes.as_slice(),
             ),
-            (
-                ACCEL_SPHERES,
-                "scene accel spheres",
-                sphere_boxes.as_slice(),
-            ),
+            (ACCEL_SHAPES, "scene accel shapes", shape_boxes.as_slice()),
         ]
         .into_iter()
         .filter(|(_, _, boxes)| !boxes.is_empty())
@@ -153,7 +149,7 @@ impl SceneAccel {
         ctx.queue.submit([encoder.finish()]);
         ctx.wait()?;
         let input_bytes = (std::mem::size_of_val(tri_boxes.as_slice())
-            + std::mem::size_of_val(sphere_boxes.as_slice())) as u64;
+            + std::mem::size_of_val(shape_boxes.as_slice())) as u64;
         Ok(Self {
             tlas,
             _blas: blas,

@@ -104,7 +104,7 @@ impl Raycaster {
                 .buffer(&hits)
                 .buffer(nodes)
                 .buffer(&scene.tri_positions)
-                .buffer(&scene.spheres)
+                .buffer(&scene.shapes)
                 .dispatch(ctx, &mut encoder, groups_1d(count, 64), None)?;
         }
         // Uploads done before the clock starts.
@@ -154,7 +154,7 @@ impl Raycaster {
                     .buffer(output)
                     .buffer(nodes)
                     .buffer(&scene.tri_positions)
-                    .buffer(&scene.spheres)
+                    .buffer(&scene.shapes)
                     .dispatch(ctx, encoder, groups_1d(count, 64), None)
             })?;
         Ok(hits

@@ -21,8 +21,8 @@ pub struct SceneBuffers {
     pub tri_positions: wgpu::Buffer,
     /// Triangle shading data.
     pub tri_shading: wgpu::Buffer,
-    /// Spheres.
-    pub spheres: wgpu::Buffer,
+    /// Analytic shapes.
+    pub shapes: wgpu::Buffer,
     /// Materials.
     pub materials: wgpu::Buffer,
     /// Emitters.
@@ -40,7 +40,7 @@ pub struct SceneBuffers {
 }
 
 fn storage(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
-    // Bindings may not be empty: a scene without spheres still binds a (zeroed) buffer.
+    // Bindings may not be empty: a scene without shapes still binds a (zeroed) buffer.
     let mut padded;
     let contents = if bytes.len() < 64 {
         padded = bytes.to_vec();
@@ -119,9 +119,9 @@ fn check_parts(
             std::mem::size_of_val(&scene.tri_texcoords[..]),
         ),
         (
-            "\"spheres\"",
-            scene.spheres.len(),
-            std::mem::size_of_val(&scene.spheres[..]),
+            "\"shapes\"",
+            scene.shapes.len(),
+            std::mem::size_of_val(&scene.shapes[..]),
         ),
         (
             "\"materials\"",
@@ -283,7 +283,7 @@ impl SceneBuffers {
             ("bvh_nodes", bytemuck::cast_slice(&records)),
             ("tri_positions", bytemuck::cast_slice(&scene.tri_positions)),
             ("tri_shading", bytemuck::cast_slice(&scene.tri_shading)),
-            ("spheres", bytemuck::cast_slice(&scene.spheres)),
+            ("shapes", bytemuck::cast_slice(&scene.shapes)),
             ("materials", bytemuck::cast_slice(&scene.materials)),
             ("lights", bytemuck::cast_slice(&scene.lights)),
             ("light_alias", bytemuck::cast_slice(&scene.light_alias)),
@@ -304,7 +304,7 @@ impl SceneBuffers {
             bvh_nodes: b0,
             tri_positions: b1,
             tri_shading: b2,
-            spheres: b3,
+            shapes: b3,
             materials: b4,
             lights: b5,
             light_alias: b6,

@@ -30,14 +30,17 @@ fn disk_dir() -> Option<PathBuf> {
     }
 }
 
-/// The raw text of one shader file (or of the one generated file,
-/// [`crate::shared::FILE`]).
+/// The raw text of one shader file (or of a generated one: [`crate::shared::FILE`], and
+/// [`lumagraph_scene::shapes::FILE`], which calls each kind of shape).
 ///
 /// # Errors
 /// When there is no such file.
 pub fn raw(name: &str) -> Result<String> {
     if name == crate::shared::FILE {
         return Ok(crate::shared::wgsl());
+    }
+    if name == lumagraph_scene::shapes::FILE {
+        return Ok(lumagraph_scene::shapes::wgsl());
     }
     // Only names inside the folder: an `#import` of a kind declared in a graph file names
     // a shader, never another file on disk.

@@ -52,8 +52,8 @@ pub const LIGHT_UNIFORM_SHARE: f32 = lumagraph_scene::LIGHT_UNIFORM_SHARE;
 /// The custom data of the ray queries' instance of the triangles' boxes
 /// ([`crate::accel`], `pathtrace/ray_query.wgsl`).
 pub const ACCEL_TRIANGLES: u32 = 0;
-/// The custom data of the ray queries' instance of the spheres' boxes.
-pub const ACCEL_SPHERES: u32 = 1;
+/// The custom data of the ray queries' instance of the analytic shapes' boxes.
+pub const ACCEL_SHAPES: u32 = 1;
 
 crate::param_block! {
     /// The rays a step of host intersection writes for one slot: the next ray and the
@@ -85,7 +85,7 @@ pub fn wgsl() -> String {
         ("WAVE_FRONT_LISTS_AT", WAVE_FRONT_LISTS_AT),
         ("WAVE_COUNTS_AT", WAVE_COUNTS_AT),
         ("ACCEL_TRIANGLES", ACCEL_TRIANGLES),
-        ("ACCEL_SPHERES", ACCEL_SPHERES),
+        ("ACCEL_SHAPES", ACCEL_SHAPES),
     ] {
         let _ = writeln!(out, "const {name}: u32 = {value}u;");
     }

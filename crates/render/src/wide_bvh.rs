@@ -11,7 +11,7 @@
 //! |---|---|
 //! | 0 | header: x = the record where the primitive list starts, y = node count, z = depth |
 //! | 1 + 5 i .. 1 + 5 i + 5 | node i: obvhs's 80-byte `CwBvhNode`, byte for byte |
-//! | `x` + 3 j .. `x` + 3 j + 3 | leaf slot j's primitive, copied from the scene in leaf order: a triangle's `GpuTriangle` (v0 and flags, e1, e2) with its index in `tri_positions` in the second record's w; a sphere's center and radius, then its index `| PRIM_SPHERE` in the second record's w |
+//! | `x` + 3 j .. `x` + 3 j + 3 | leaf slot j's primitive, copied from the scene in leaf order: a triangle's `GpuTriangle` (v0 and flags, e1, e2) with its index in `tri_positions` in the second record's w; a shape's center and radius, its axis and its index `| PRIM_SHAPE` (second record), its kind (third record's x) |
 //!
 //! A node (80 bytes): its box's corner `p` (3 f32) and per axis the exponent of the child
 //! grid's step (a byte each) and `imask` (which children are inner nodes); the first child
@@ -37,8 +37,8 @@ use crate::error::{RenderError, Result};
 /// Most nodes on a path from the root: the traversal's stack holds one entry a level.
 pub const WIDE_BVH_STACK: usize = 32;
 
-/// `pathtrace/wide_bvh.wgsl`'s sphere bit in the primitive list (the shader's `PRIM_SPHERE`).
-const PRIM_SPHERE: u32 = lumagraph_scene::PRIM_SPHERE;
+/// `pathtrace/wide_bvh.wgsl`'s shape bit in the primitive list (the shader's `PRIM_SHAPE`).
+const PRIM_SHAPE: u32 = lumagraph_scene::PRIM_SHAPE;
 
 /// A box from `lo` to `hi`, grown by a few ulps of `scale` (the largest magnitude the
 /// primitive's inputs have): a point the shader's tests find on the primitive, computed from
@@ -50,8 +50,8 @@ fn padded(lo: Vec3, hi: Vec3, scale: f32) -> [f32; 6] {
     [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z]
 }
 
-/// Every triangle's and sphere's box (min xyz, max xyz), in the order of
-/// `GpuScene::tri_positions` and `GpuScene::spheres`, padded so that any point the WGSL
+/// Every triangle's and analytic shape's box (min xyz, max xyz), in the order of
+/// `GpuScene::tri_positions` and `GpuScene::shapes`, padded so that any point the WGSL
 /// tests find on the primitive lies inside: the inputs of both the device's acceleration
 /// structure ([`crate::accel`]) and the wide BVH.
 pub fn primitive_boxes(scene: &GpuScene) -> (Vec<[f32; 6]>, Vec<[f32; 6]>) {
@@ -69,16 +69,15 @@ pub fn primitive_boxes(scene: &GpuScene) -> (Vec<[f32; 6]>, Vec<[f32; 6]>) {
             padded(v0.min(v1).min(v2), v0.max(v1).max(v2), scale)
         })
         .collect();
-    let spheres = scene
-        .spheres
+    let shapes = scene
+        .shapes
         .iter()
         .map(|s| {
-            let c = Vec3::from(s.center);
-            let r = Vec3::splat(s.radius.abs());
-            padded(c - r, c + r, c.abs().max_element() + s.radius.abs())
+            let [lo, hi] = lumagraph_scene::shapes::KINDS[s.kind as usize].bounds(s);
+            padded(lo, hi, lo.abs().max(hi.abs()).max_element())
         })
         .collect();
-    (tris, spheres)
+    (tris, shapes)
 }
 
 /// A scene's wide BVH, packed for the GPU.
@@ -103,11 +102,11 @@ impl WideBvh {
         if !scene.instances.is_empty() {
             return Err(crate::embree::flat_only("the 8-wide BVH", scene));
         }
-        let (tri_boxes, sphere_boxes) = primitive_boxes(scene);
+        let (tri_boxes, shape_boxes) = primitive_boxes(scene);
         let n_tris = u32::try_from(tri_boxes.len()).map_err(|_| "too many triangles")?;
         let boxes: Vec<Aabb> = tri_boxes
             .iter()
-            .chain(&sphere_boxes)
+            .chain(&shape_boxes)
             .map(|b| {
                 Aabb::new(
                     Vec3::from_slice(&b[..3]).into(),
@@ -150,12 +149,12 @@ impl WideBvh {
                 records.extend([v(t.v0, t.flags), v(t.e1, p), v(t.e2, 0)]);
             } else {
                 let i = p - n_tris;
-                let sp = &scene.spheres[i as usize];
-                let c = sp.center.map(f32::to_bits);
+                let sp = &scene.shapes[i as usize];
+                let (c, a) = (sp.center.map(f32::to_bits), sp.axis.map(f32::to_bits));
                 records.extend([
                     [c[0], c[1], c[2], sp.radius.to_bits()],
-                    [0, 0, 0, i | PRIM_SPHERE],
-                    [0; 4],
+                    [a[0], a[1], a[2], i | PRIM_SHAPE],
+                    [sp.kind, 0, 0, 0],
                 ]);
             }
         }

@@ -52,7 +52,7 @@ fn main() {
     println!(
         "{path}: {} triangles, {} spheres (ignored), load + BVH {:.0} ms",
         scene.tri_positions.len(),
-        scene.spheres.len(),
+        scene.shapes.len(),
         start.elapsed().as_secs_f64() * 1e3
     );
     let tris: Vec<Triangle> = scene

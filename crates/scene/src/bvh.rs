@@ -67,7 +67,7 @@ pub const BVH_END: u32 = u32::MAX;
 pub const BVH_OCTANTS: usize = 8;
 
 /// `bits` bit: the leaf holds spheres.
-pub const NODE_SPHERES: u32 = 4;
+pub const NODE_SHAPES: u32 = 4;
 /// `bits` bit: the leaf holds instances.
 pub const NODE_INSTANCES: u32 = 1;
 /// `bits` shift of the primitive count.
@@ -99,7 +99,7 @@ pub(crate) struct FlatBvh {
     /// New triangle order: `tri_order[i]` is the input triangle stored at `i`.
     pub tri_order: Vec<u32>,
     /// New sphere order, likewise.
-    pub sphere_order: Vec<u32>,
+    pub shape_order: Vec<u32>,
     /// New instance order, likewise; an instance leaf's `index` is its first instance in
     /// this order until [`crate::GpuScene`] makes it a node slot.
     pub instance_order: Vec<u32>,
@@ -139,19 +139,19 @@ pub fn skip_links(nodes: &[GpuBvhNode]) -> Vec<[u32; BVH_OCTANTS]> {
     skips
 }
 
-/// Builds and flattens the BVH over `tri_boxes` (primitives `0..n`), `sphere_boxes`
+/// Builds and flattens the BVH over `tri_boxes` (primitives `0..n`), `shape_boxes`
 /// (primitives `n..`) and `instance_boxes` (after the spheres).
 pub(crate) fn build(
     tri_boxes: &[Aabb],
-    sphere_boxes: &[Aabb],
+    shape_boxes: &[Aabb],
     instance_boxes: &[Aabb],
     options: &BvhOptions,
 ) -> Result<FlatBvh, SceneError> {
     let n_tris = tri_boxes.len() as u32;
-    let n_spheres = sphere_boxes.len() as u32;
+    let n_shapes = shape_boxes.len() as u32;
     let boxes: Vec<Aabb> = tri_boxes
         .iter()
-        .chain(sphere_boxes)
+        .chain(shape_boxes)
         .chain(instance_boxes)
         .copied()
         .collect();
@@ -169,7 +169,7 @@ pub(crate) fn build(
         bvh: &bvh,
         boxes: &boxes,
         n_tris,
-        n_spheres,
+        n_shapes,
         out: &mut flat,
     };
     f.node(0, 0)?;
@@ -181,7 +181,7 @@ struct Flattener<'a> {
     bvh: &'a Bvh2,
     boxes: &'a [Aabb],
     n_tris: u32,
-    n_spheres: u32,
+    n_shapes: u32,
     out: &'a mut FlatBvh,
 }
 
@@ -214,7 +214,7 @@ impl Flattener<'_> {
             for &p in prims {
                 let kind = if p < self.n_tris {
                     0
-                } else if p < self.n_tris + self.n_spheres {
+                } else if p < self.n_tris + self.n_shapes {
                     1
                 } else {
                     2
@@ -296,10 +296,10 @@ impl Flattener<'_> {
         }
         let (order, offset, bits) = match kind {
             0 => (&mut self.out.tri_order, 0, 0),
-            1 => (&mut self.out.sphere_order, self.n_tris, NODE_SPHERES),
+            1 => (&mut self.out.shape_order, self.n_tris, NODE_SHAPES),
             _ => (
                 &mut self.out.instance_order,
-                self.n_tris + self.n_spheres,
+                self.n_tris + self.n_shapes,
                 NODE_INSTANCES,
             ),
         };

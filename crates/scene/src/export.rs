@@ -1,5 +1,5 @@
 //! The resolved scene written out for other renderers: one JSON file with every number
-//! explicit (camera, materials, spheres, lights, environment, render settings), OBJ files
+//! explicit (camera, materials, analytic shapes, lights, environment, render settings), OBJ files
 //! of its world-space triangles, one per material and shading (flat or with vertex
 //! normals; with the base colour texture's coordinates, its transform applied, where the
 //! material has one), and PNG files of the base colour textures and of the opacity the path
@@ -32,7 +32,7 @@ struct Export {
     render: RenderOut,
     materials: Vec<MaterialOut>,
     meshes: Vec<MeshOut>,
-    spheres: Vec<SphereOut>,
+    shapes: Vec<ShapeOut>,
     lights: Vec<LightOut>,
     environment: EnvironmentOut,
 }
@@ -143,10 +143,12 @@ struct MeshOut {
     vertex_colors: bool,
 }
 
+/// An analytic shape: its kind's Mitsuba 3 dictionary (`ShapeKind::mitsuba`) and its
+/// material.
 #[derive(Serialize)]
-struct SphereOut {
-    center: [f32; 3],
-    radius: f32,
+struct ShapeOut {
+    kind: &'static str,
+    mitsuba: serde_json::Value,
     material: u32,
 }
 
@@ -549,12 +551,12 @@ pub fn export(scene: &Scene, gpu: &GpuScene, dir: &Path) -> Result<Vec<PathBuf>,
         },
         materials,
         meshes,
-        spheres: scene
-            .spheres
+        shapes: scene
+            .shapes
             .iter()
-            .map(|s| SphereOut {
-                center: s.center.to_array(),
-                radius: s.radius,
+            .map(|s| ShapeOut {
+                kind: s.kind().name(),
+                mitsuba: s.kind().mitsuba(&s.record()),
                 material: s.material,
             })
             .collect(),

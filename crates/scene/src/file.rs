@@ -399,6 +399,23 @@ pub enum ShapeDesc {
 }
 
 impl ShapeDesc {
+    /// Every kind, as written in the file.
+    pub const KINDS: [&'static str; 5] = ["Mesh", "Sphere", "Rectangle", "Box", "Quad"];
+
+    /// An analytic shape's kind ([`crate::shapes::KINDS`]), center, radius, axis (zero
+    /// where its kind has none) and material; `None` for the shapes made of triangles.
+    pub fn analytic(&self) -> Option<(u32, V3, f32, V3, &str)> {
+        match self {
+            Self::Sphere {
+                center,
+                radius,
+                material,
+                ..
+            } => Some((crate::shapes::SPHERE, *center, *radius, [0.0; 3], material)),
+            _ => None,
+        }
+    }
+
     /// The shape's name, if it has one.
     pub fn name(&self) -> Option<&str> {
         match self {

@@ -11,17 +11,17 @@ use crate::error::{ErrorKind, SceneError};
 use crate::file::Environment;
 use crate::gpu::{
     ENV_CONSTANT, ENV_MAP, ENV_NONE, ENV_SHOW_BACKGROUND, FEATURE_ENVIRONMENT, FEATURE_LIGHTS,
-    FEATURE_MEDIA, FEATURE_METAL, FEATURE_SPHERES, FEATURE_TEXTURES, FEATURE_TRANSMISSION,
+    FEATURE_MEDIA, FEATURE_METAL, FEATURE_SHAPES, FEATURE_TEXTURES, FEATURE_TRANSMISSION,
     GpuAliasEntry, GpuBvhNode, GpuBvhRecord, GpuCamera, GpuHeader, GpuLight, GpuMaterial,
-    GpuSettings, GpuSphere, GpuTriShading, GpuTriTexcoords, GpuTriangle, LIGHT_DIRECTIONAL,
-    LIGHT_POINT, LIGHT_SPHERE, LIGHT_SPOT, LIGHT_TWO_SIDED, MATERIAL_CONDUCTOR,
+    GpuSettings, GpuShape, GpuTriShading, GpuTriTexcoords, GpuTriangle, LIGHT_DIRECTIONAL,
+    LIGHT_POINT, LIGHT_SHAPE, LIGHT_SPOT, LIGHT_TWO_SIDED, MATERIAL_CONDUCTOR,
     MATERIAL_INDEX_MATCHED, MATERIAL_MEDIUM, MATERIAL_SINGLE_SCATTER, MATERIAL_TWO_SIDED, NO_LIGHT,
     TRI_VERTEX_NORMALS,
 };
 use crate::scene::{Material, NO_TEXTURE, PunctualLight, Scene};
 
 /// Everything the render crate uploads: one `Vec` per storage buffer, plus small blocks.
-/// Arrays may be empty (no spheres, no lights); the uploader pads empty buffers.
+/// Arrays may be empty (no shapes, no lights); the uploader pads empty buffers.
 #[derive(Clone, Debug, Default)]
 pub struct GpuScene {
     /// Counts and scene-wide values.
@@ -42,8 +42,8 @@ pub struct GpuScene {
     pub tri_corners: Vec<[[f32; 3]; 3]>,
     /// Triangle shading data, same order (buffer `tri_shading`).
     pub tri_shading: Vec<GpuTriShading>,
-    /// Spheres in BVH order (buffer `spheres`).
-    pub spheres: Vec<GpuSphere>,
+    /// Analytic shapes in BVH order (buffer `shapes`).
+    pub shapes: Vec<GpuShape>,
     /// Materials, as in [`Scene::materials`] (buffer `materials`).
     pub materials: Vec<GpuMaterial>,
     /// Emissive triangles and spheres (buffer `lights`).
@@ -66,7 +66,7 @@ pub struct GpuScene {
     /// For each GPU triangle, its index in [`Scene::triangles`] (CPU side only).
     pub tri_source: Vec<u32>,
     /// For each GPU sphere, its index in [`Scene::spheres`] (CPU side only).
-    pub sphere_source: Vec<u32>,
+    pub shape_source: Vec<u32>,
     /// The instances of the scene's instanced meshes, in top-level BVH order (uploaded in
     /// `bvh_nodes` after the nodes, two node slots each: see [`crate::bvh`]). Their meshes'
     /// triangles follow the scene's own ones (the first `tri_source.len()`) in
@@ -386,7 +386,7 @@ impl GpuScene {
                 self.tri_texcoords.len(),
                 std::mem::size_of::<GpuTriTexcoords>(),
             )
-            + size(self.spheres.len(), std::mem::size_of::<GpuSphere>())
+            + size(self.shapes.len(), std::mem::size_of::<GpuShape>())
     }
 
     /// Instance `k` of a leaf whose `index` is `slot` (its first instance's node slot).
@@ -444,23 +444,23 @@ impl GpuScene {
         bvh_time: &mut std::time::Duration,
     ) -> Result<Self, SceneError> {
         let unique: usize = scene.instanced.iter().map(|m| m.triangles.len()).sum();
-        let total = scene.triangles.len() + unique + scene.spheres.len();
+        let total = scene.triangles.len() + unique + scene.shapes.len();
         if total >= 1 << 28 {
             return Err(SceneError::new(ErrorKind::TooManyPrimitives(total)));
         }
         if total == 0 {
             return Err(SceneError::new(ErrorKind::BadValue {
                 field: "shapes",
-                message: "the scene has no triangle or sphere".to_owned(),
+                message: "the scene has no triangle or analytic shape".to_owned(),
             }));
         }
         let tri_boxes: Vec<Aabb> = scene.triangles.iter().map(triangle_box).collect();
-        let sphere_boxes: Vec<Aabb> = scene
-            .spheres
+        let shape_boxes: Vec<Aabb> = scene
+            .shapes
             .iter()
             .map(|s| {
-                let c = Vec3A::from(s.center);
-                Aabb::new(c - s.radius, c + s.radius)
+                let [lo, hi] = s.kind().bounds(&s.record());
+                Aabb::new(lo.into(), hi.into())
             })
             .collect();
         let bvh_started = std::time::Instant::now();
@@ -485,7 +485,7 @@ impl GpuScene {
                 instance_boxes.push(transformed_box(&root, t));
             }
         }
-        let flat = bvh::build(&tri_boxes, &sphere_boxes, &instance_boxes, options)?;
+        let flat = bvh::build(&tri_boxes, &shape_boxes, &instance_boxes, options)?;
         *bvh_time = bvh_started.elapsed();
 
         let mut out = Self {
@@ -493,7 +493,7 @@ impl GpuScene {
             bvh_nodes: flat.nodes,
             bvh_skips: flat.skips,
             tri_source: flat.tri_order,
-            sphere_source: flat.sphere_order,
+            shape_source: flat.shape_order,
             environment_map: match &scene.environment {
                 Environment::Map { path, .. } => Some(path.into()),
                 _ => None,
@@ -526,7 +526,7 @@ impl GpuScene {
         let order = std::mem::take(&mut out.tri_source);
         out.push_triangles(scene, &scene.triangles, &order, textured, &mut weights);
         out.tri_source = order;
-        out.push_spheres(scene, &mut weights);
+        out.push_shapes(scene, &mut weights);
         let depth = out.push_instances(scene, meshes, &placed, &flat.instance_order, textured);
         let radius = out.bvh_nodes.first().map_or(1.0, |root| {
             0.5 * (Vec3::from(root.aabb_max) - Vec3::from(root.aabb_min)).length()
@@ -730,36 +730,36 @@ impl GpuScene {
         }
     }
 
-    /// Appends the spheres in BVH order, and a light for each emissive one (its power
+    /// Appends the shapes in BVH order, and a light for each emissive one (its power
     /// pushed to `weights`).
-    fn push_spheres(&mut self, scene: &Scene, weights: &mut Vec<f32>) {
-        for (i, &src) in self.sphere_source.iter().enumerate() {
-            let s = &scene.spheres[src as usize];
+    fn push_shapes(&mut self, scene: &Scene, weights: &mut Vec<f32>) {
+        for (i, &src) in self.shape_source.iter().enumerate() {
+            let s = &scene.shapes[src as usize];
+            let record = s.record();
             let m = &scene.materials[s.material as usize];
             let mut light = NO_LIGHT;
             if m.is_emissive() {
                 light = self.lights.len() as u32;
-                let area = 4.0 * std::f32::consts::PI * s.radius * s.radius;
-                let power = luminance(m.emission) * area * std::f32::consts::PI;
+                let area = s.kind().area(&record);
+                // A closed shape is seen from outside only; an open one from its front, or
+                // both sides.
+                let sides = if m.two_sided && !s.kind().closed() {
+                    2.0
+                } else {
+                    1.0
+                };
+                let power = luminance(m.emission) * area * std::f32::consts::PI * sides;
                 weights.push(power);
                 self.lights.push(GpuLight {
-                    p0: s.center.to_array(),
-                    flags: LIGHT_SPHERE,
-                    e1: [s.radius, 0.0, 0.0],
+                    flags: LIGHT_SHAPE | if m.two_sided { LIGHT_TWO_SIDED } else { 0 },
                     prim: i as u32,
-                    e2: [0.0; 3],
                     area,
                     emission: m.emission.to_array(),
                     power,
+                    ..GpuLight::default()
                 });
             }
-            self.spheres.push(GpuSphere {
-                center: s.center.to_array(),
-                radius: s.radius,
-                material: s.material,
-                light,
-                ..GpuSphere::default()
-            });
+            self.shapes.push(GpuShape { light, ..record });
         }
     }
 }
@@ -827,8 +827,8 @@ fn check_textures(scene: &Scene) -> Result<(), SceneError> {
 
 fn header(scene: &Scene, g: &GpuScene, depth: usize, total_power: f32) -> GpuHeader {
     let mut features = 0;
-    if !g.spheres.is_empty() {
-        features |= FEATURE_SPHERES;
+    if !g.shapes.is_empty() {
+        features |= FEATURE_SHAPES;
     }
     if !g.lights.is_empty() {
         features |= FEATURE_LIGHTS;
@@ -870,7 +870,7 @@ fn header(scene: &Scene, g: &GpuScene, depth: usize, total_power: f32) -> GpuHea
     GpuHeader {
         num_nodes: g.bvh_nodes.len() as u32,
         num_triangles: g.tri_positions.len() as u32,
-        num_spheres: g.spheres.len() as u32,
+        num_shapes: g.shapes.len() as u32,
         num_materials: g.materials.len() as u32,
         num_lights: g.lights.len() as u32,
         bvh_depth: depth as u32,

@@ -6,19 +6,19 @@
 //!
 //! Intersection data is kept apart from shading data so the traversal loop loads little:
 //! [`GpuBvhNode`] (32 B, then one 4-byte skip link of its [`GpuBvhRecord`]) and
-//! [`GpuTriangle`] (48 B: a corner and two edges) or the first 16 bytes of [`GpuSphere`];
+//! [`GpuTriangle`] (48 B: a corner and two edges) or the first 32 bytes of [`GpuShape`];
 //! normals and material ids live in [`GpuTriShading`], read once per hit.
 //!
-//! Primitive ids: triangles and spheres are stored in BVH leaf order (see [`crate::bvh`]).
-//! A hit's `prim` is the triangle index, or the sphere index with [`PRIM_SPHERE`] set.
+//! Primitive ids: triangles and shapes are stored in BVH leaf order (see [`crate::bvh`]).
+//! A hit's `prim` is the triangle index, or the shape index with [`PRIM_SHAPE`] set.
 
 use bytemuck::{Pod, Zeroable};
 
-/// Set in a hit's `prim` when it is a sphere; the low bits are then the sphere index.
-pub const PRIM_SPHERE: u32 = 0x8000_0000;
+/// Set in a hit's `prim` when it is an analytic shape; the low bits are then its index.
+pub const PRIM_SHAPE: u32 = 0x8000_0000;
 /// A hit's `prim` when nothing was hit.
 pub const NO_HIT: u32 = u32::MAX;
-/// No light: the value of `light` in [`GpuTriShading`] and [`GpuSphere`] for a
+/// No light: the value of `light` in [`GpuTriShading`] and [`GpuShape`] for a
 /// non-emissive primitive.
 pub const NO_LIGHT: u32 = u32::MAX;
 
@@ -45,8 +45,8 @@ pub const TRI_ALPHA: u32 = 1;
 pub const MATERIAL_ALPHA_MASK: u32 = 32;
 /// Material flag: a ray passes through the surface with probability 1 − opacity.
 pub const MATERIAL_ALPHA_BLEND: u32 = 64;
-/// [`GpuLight::flags`]: the light is a sphere (else a triangle).
-pub const LIGHT_SPHERE: u32 = 1;
+/// [`GpuLight::flags`]: the light is an analytic shape, `prim` its index (else a triangle).
+pub const LIGHT_SHAPE: u32 = 1;
 /// [`GpuLight::flags`]: emission leaves both sides of the triangle.
 pub const LIGHT_TWO_SIDED: u32 = 2;
 /// [`GpuLight::flags`]: a point light at `p0` of radiant intensity `emission`.
@@ -68,8 +68,8 @@ pub const ENV_MAP: u32 = 2;
 /// [`GpuSettings::env_flags`]: camera rays that miss see the environment.
 pub const ENV_SHOW_BACKGROUND: u32 = 1;
 
-/// [`GpuHeader::features`]: the scene has spheres.
-pub const FEATURE_SPHERES: u32 = 1;
+/// [`GpuHeader::features`]: the scene has analytic shapes.
+pub const FEATURE_SHAPES: u32 = 1;
 /// [`GpuHeader::features`]: some material transmits (glass lobe needed).
 pub const FEATURE_TRANSMISSION: u32 = 2;
 /// [`GpuHeader::features`]: some material has a texture.
@@ -97,7 +97,7 @@ pub struct GpuBvhNode {
     pub index: u32,
     /// Box maximum corner (offset 16).
     pub aabb_max: [f32; 3],
-    /// Bits 0–1 split axis (inner), leaf kind (bit 0: instances, bit 2: spheres, neither:
+    /// Bits 0–1 split axis (inner), leaf kind (bit 0: instances, bit 2: shapes, neither:
     /// triangles), bits 3–31 primitive count (0 = inner node) (offset 28).
     pub bits: u32,
 }
@@ -189,21 +189,26 @@ pub struct GpuTriShading {
     pub flags: u32,
 }
 
-/// An analytic sphere, 32 bytes; the traversal reads only the first 16.
+/// An analytic shape ([`crate::Shape`]), 48 bytes: its kind's parameters, then what
+/// shading reads.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct GpuSphere {
+pub struct GpuShape {
     /// Center (offset 0).
     pub center: [f32; 3],
     /// Radius (offset 12).
     pub radius: f32,
-    /// Material index (offset 16).
+    /// Unit axis, or zero (offset 16).
+    pub axis: [f32; 3],
+    /// Index into [`crate::shapes::KINDS`] (offset 28).
+    pub kind: u32,
+    /// Material index (offset 32).
     pub material: u32,
-    /// Index into the lights, or [`NO_LIGHT`] (offset 20).
+    /// Index into the lights, or [`NO_LIGHT`] (offset 36).
     pub light: u32,
-    /// Padding (offset 24).
+    /// Padding (offset 40).
     pub pad0: u32,
-    /// Padding (offset 28).
+    /// Padding (offset 44).
     pub pad1: u32,
 }
 
@@ -376,18 +381,18 @@ impl GpuTriTexcoords {
     }
 }
 
-/// An emitter, 64 bytes: an emissive triangle or sphere, or a point, spot or directional
+/// An emitter, 64 bytes: an emissive triangle or shape, or a point, spot or directional
 /// light ([`LIGHT_POINT`], [`LIGHT_SPOT`], [`LIGHT_DIRECTIONAL`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuLight {
-    /// Triangle corner 0, or sphere center (offset 0).
+    /// Triangle corner 0; zero for a shape, whose sampling reads the shape (offset 0).
     pub p0: [f32; 3],
-    /// [`LIGHT_SPHERE`], [`LIGHT_TWO_SIDED`] (offset 12).
+    /// [`LIGHT_SHAPE`], [`LIGHT_TWO_SIDED`] (offset 12).
     pub flags: u32,
-    /// Triangle edge 1, or `(radius, 0, 0)` (offset 16).
+    /// Triangle edge 1, or zero (offset 16).
     pub e1: [f32; 3],
-    /// The primitive: triangle index, or sphere index (offset 28).
+    /// The primitive: triangle index, or shape index (offset 28).
     pub prim: u32,
     /// Triangle edge 2, or zero (offset 32).
     pub e2: [f32; 3],
@@ -470,8 +475,8 @@ pub struct GpuHeader {
     pub num_nodes: u32,
     /// Triangles (offset 4).
     pub num_triangles: u32,
-    /// Spheres (offset 8).
-    pub num_spheres: u32,
+    /// Analytic shapes (offset 8).
+    pub num_shapes: u32,
     /// Materials (offset 12).
     pub num_materials: u32,
     /// Lights, and alias table entries (offset 16).

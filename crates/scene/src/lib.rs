@@ -32,6 +32,7 @@ mod load;
 pub mod orbit;
 pub mod save;
 mod scene;
+pub mod shapes;
 pub mod texture;
 pub mod traverse;
 
@@ -44,7 +45,7 @@ pub use load::transform_matrix;
 pub use scene::{
     AUTO_FLATTEN_MAX_TRIANGLES, AlphaMode, Camera, InstancedMesh, Instancing, LoadReport,
     LoadStats, MAX_INSTANCED_TRIANGLES, Material, MaterialTextures, Medium, NO_TEXTURE,
-    PunctualLight, Scene, Sphere, Triangle, cube_quads, push_triangle, quad_triangles,
+    PunctualLight, Scene, Shape, Triangle, cube_quads, push_triangle, quad_triangles,
     rectangle_quad, transform_triangle,
 };
 pub use texture::{

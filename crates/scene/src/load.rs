@@ -17,7 +17,7 @@ use crate::file::{
 };
 use crate::import::import_mesh;
 use crate::scene::{
-    Camera, LoadReport, Material, Medium, PunctualLight, Scene, Sphere, cube_quads, push_triangle,
+    Camera, LoadReport, Material, Medium, PunctualLight, Scene, Shape, cube_quads, push_triangle,
     quad_triangles, rectangle_quad, transform_triangle,
 };
 
@@ -35,7 +35,7 @@ struct Locator<'a> {
 
 impl<'a> Locator<'a> {
     fn new(text: &'a str) -> Self {
-        let kinds = ["Mesh", "Sphere", "Rectangle", "Box", "Quad"];
+        let kinds = ShapeDesc::KINDS;
         let start = text.find("shapes").unwrap_or(0);
         let end = text[start..]
             .find("lights:")
@@ -575,7 +575,7 @@ struct Builder<'a> {
     derived: HashMap<(u32, [u32; 3], bool), u32>,
     scene_triangles: Vec<crate::scene::Triangle>,
     instanced: Vec<crate::scene::InstancedMesh>,
-    spheres: Vec<Sphere>,
+    shapes: Vec<Shape>,
     lights: Vec<PunctualLight>,
     textures: Vec<crate::texture::Texture>,
     report: LoadReport,
@@ -616,7 +616,7 @@ impl<'a> Builder<'a> {
             derived: HashMap::new(),
             scene_triangles: Vec::new(),
             instanced: Vec::new(),
-            spheres: Vec::new(),
+            shapes: Vec::new(),
             lights: Vec::new(),
             textures: Vec::new(),
             report: LoadReport::default(),
@@ -627,13 +627,13 @@ impl<'a> Builder<'a> {
     }
 
     /// Records the medium of the shape just built (its primitives from `first_tri` and
-    /// `first_sphere` on), refusing one that overlaps an earlier shape's medium: a path
+    /// `first_shape` on), refusing one that overlaps an earlier shape's medium: a path
     /// is in one medium at a time.
     fn check_medium(
         &mut self,
         label: &str,
         first_tri: usize,
-        first_sphere: usize,
+        first_shape: usize,
     ) -> Result<(), SceneError> {
         let has = |m: u32| self.materials[m as usize].medium.is_some();
         let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
@@ -646,11 +646,24 @@ impl<'a> Builder<'a> {
                 }
             }
         }
-        for sph in &self.spheres[first_sphere..] {
-            if has(sph.material) {
-                min = min.min(sph.center - sph.radius);
-                max = max.max(sph.center + sph.radius);
-                spheres.push((sph.center, sph.radius));
+        for s in &self.shapes[first_shape..] {
+            if has(s.material) {
+                let kind = s.kind();
+                if !kind.closed() {
+                    return Err(bad(
+                        "medium",
+                        format!(
+                            "a {} encloses no volume, so it cannot have a medium inside",
+                            kind.name()
+                        ),
+                    ));
+                }
+                let [lo, hi] = kind.bounds(&s.record());
+                min = min.min(lo);
+                max = max.max(hi);
+                if s.kind == crate::shapes::SPHERE {
+                    spheres.push((s.center, s.radius));
+                }
             }
         }
         if min.x > max.x {
@@ -695,9 +708,9 @@ impl<'a> Builder<'a> {
                 Some(n) => format!("shape \"{n}\""),
                 None => format!("shape {i} ({})", shape.kind()),
             };
-            let (first_tri, first_sphere) = (self.scene_triangles.len(), self.spheres.len());
+            let (first_tri, first_shape) = (self.scene_triangles.len(), self.shapes.len());
             self.shape(shape)
-                .and_then(|()| self.check_medium(&label, first_tri, first_sphere))
+                .and_then(|()| self.check_medium(&label, first_tri, first_shape))
                 .map_err(|e| {
                     let needle = match &e.kind {
                         ErrorKind::UnknownMaterial { material, .. } => format!("\"{material}\""),
@@ -746,7 +759,7 @@ impl<'a> Builder<'a> {
             materials: self.materials,
             triangles: self.scene_triangles,
             instanced: self.instanced,
-            spheres: self.spheres,
+            shapes: self.shapes,
             lights: self.lights,
             textures: self.textures,
             environment,
@@ -805,25 +818,32 @@ impl<'a> Builder<'a> {
 
     fn shape(&mut self, shape: &ShapeDesc) -> Result<(), SceneError> {
         let (emission, two_sided) = shape.emitter();
-        match shape {
-            ShapeDesc::Sphere {
+        if let Some((kind, center, radius, axis, material)) = shape.analytic() {
+            let center = finite3("center", center)?;
+            if !(radius > 0.0 && radius.is_finite()) {
+                return Err(bad("radius", format!("{radius} must be a positive number")));
+            }
+            let mut axis = finite3("normal", axis)?;
+            if axis != Vec3::ZERO {
+                axis = axis.normalize();
+                if !axis.is_finite() {
+                    return Err(bad("normal", "is too short to have a direction"));
+                }
+            } else if kind != crate::shapes::SPHERE {
+                return Err(bad("normal", "must not be (0, 0, 0)"));
+            }
+            let m = self.lookup(material)?;
+            let material = self.emissive(m, emission, two_sided)?;
+            self.shapes.push(Shape {
+                kind,
                 center,
                 radius,
+                axis,
                 material,
-                ..
-            } => {
-                let center = finite3("center", *center)?;
-                if !(*radius > 0.0 && radius.is_finite()) {
-                    return Err(bad("radius", format!("{radius} must be a positive number")));
-                }
-                let m = self.lookup(material)?;
-                let material = self.emissive(m, emission, two_sided)?;
-                self.spheres.push(Sphere {
-                    center,
-                    radius: *radius,
-                    material,
-                });
-            }
+            });
+            return Ok(());
+        }
+        match shape {
             ShapeDesc::Quad {
                 corners, material, ..
             } => {
@@ -881,6 +901,8 @@ impl<'a> Builder<'a> {
                 emission,
                 two_sided,
             )?,
+            // The analytic shapes (`ShapeDesc::analytic`), built above.
+            _ => {}
         }
         Ok(())
     }

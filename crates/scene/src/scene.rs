@@ -366,15 +366,52 @@ impl Triangle {
     }
 }
 
-/// An analytic sphere.
+/// An analytic shape: a kind of [`crate::shapes::KINDS`] and the parameters every kind
+/// reads its own way (a sphere its `center` and `radius`; a disk also its front normal,
+/// `axis`). Each kind is one file, `crates/scene/src/shapes/<kind>.rs`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Sphere {
+pub struct Shape {
+    /// Index into [`crate::shapes::KINDS`].
+    pub kind: u32,
     /// Center.
     pub center: Vec3,
     /// Radius.
     pub radius: f32,
+    /// Unit axis (a disk's front normal); zero where the kind has none.
+    pub axis: Vec3,
     /// Index into [`Scene::materials`].
     pub material: u32,
+}
+
+impl Shape {
+    /// A sphere.
+    pub fn sphere(center: Vec3, radius: f32, material: u32) -> Self {
+        Self {
+            kind: crate::shapes::SPHERE,
+            center,
+            radius,
+            axis: Vec3::ZERO,
+            material,
+        }
+    }
+
+    /// Its kind's code.
+    pub fn kind(&self) -> &'static dyn crate::shapes::ShapeKind {
+        crate::shapes::KINDS[self.kind as usize]
+    }
+
+    /// Its GPU record, without a light.
+    pub fn record(&self) -> crate::gpu::GpuShape {
+        crate::gpu::GpuShape {
+            center: self.center.to_array(),
+            radius: self.radius,
+            axis: self.axis.to_array(),
+            kind: self.kind,
+            material: self.material,
+            light: crate::gpu::NO_LIGHT,
+            ..crate::gpu::GpuShape::default()
+        }
+    }
 }
 
 /// A light without area: it lights the scene through light sampling only and is never hit.
@@ -443,15 +480,15 @@ impl LoadReport {
 pub struct Scene {
     /// The camera.
     pub camera: Camera,
-    /// Materials; triangles and spheres index into this.
+    /// Materials; triangles and shapes index into this.
     pub materials: Vec<Material>,
     /// World-space triangles.
     pub triangles: Vec<Triangle>,
     /// Meshes placed several times, stored once each ([`Scene::instancing`] decides which
     /// stay so and which become copies in `triangles`).
     pub instanced: Vec<InstancedMesh>,
-    /// Analytic spheres.
-    pub spheres: Vec<Sphere>,
+    /// Analytic shapes (spheres, disks, …).
+    pub shapes: Vec<Shape>,
     /// Point, spot and directional lights.
     pub lights: Vec<PunctualLight>,
     /// Decoded textures; materials index into this.

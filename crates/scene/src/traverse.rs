@@ -7,11 +7,11 @@
 
 use glam::Vec3;
 
-use crate::bvh::{BVH_END, NODE_COUNT_SHIFT, NODE_INSTANCES, NODE_SPHERES};
+use crate::bvh::{BVH_END, NODE_COUNT_SHIFT, NODE_INSTANCES, NODE_SHAPES};
 use crate::flatten::GpuScene;
 use crate::gpu::{
     GpuInstance, INSTANCE_MIRROR, MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, NO_HIT, NO_INSTANCE,
-    PRIM_SPHERE,
+    PRIM_SHAPE,
 };
 
 /// A ray.
@@ -26,7 +26,7 @@ pub struct Ray {
 /// The closest hit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
-    /// Triangle index, or sphere index | [`PRIM_SPHERE`].
+    /// Triangle index, or sphere index | [`PRIM_SHAPE`].
     pub prim: u32,
     /// Distance along the ray, in units of `dir`.
     pub t: f32,
@@ -41,13 +41,13 @@ pub struct Hit {
 
 impl Hit {
     /// Whether the hit is on a sphere.
-    pub fn is_sphere(&self) -> bool {
-        self.prim & PRIM_SPHERE != 0
+    pub fn is_shape(&self) -> bool {
+        self.prim & PRIM_SHAPE != 0
     }
 
     /// The index in `tri_positions` or `spheres`.
     pub fn index(&self) -> usize {
-        (self.prim & !PRIM_SPHERE) as usize
+        (self.prim & !PRIM_SHAPE) as usize
     }
 }
 
@@ -204,13 +204,13 @@ fn alpha_stops(m: &crate::gpu::GpuMaterial, alpha: f32, prim: u32, ray: &Ray) ->
     alpha_hash(prim, ray) < alpha
 }
 
-/// [`triangle_hit_counts`] for sphere `i` (no texture: the opacity alone).
-pub fn sphere_hit_counts(scene: &GpuScene, i: u32, ray: &Ray) -> bool {
-    let m = &scene.materials[scene.spheres[i as usize].material as usize];
+/// [`triangle_hit_counts`] for shape `i` (no texture: the opacity alone).
+pub fn shape_hit_counts(scene: &GpuScene, i: u32, ray: &Ray) -> bool {
+    let m = &scene.materials[scene.shapes[i as usize].material as usize];
     if m.flags & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND) == 0 {
         return true;
     }
-    alpha_stops(m, m.opacity, i | PRIM_SPHERE, ray)
+    alpha_stops(m, m.opacity, i | PRIM_SHAPE, ray)
 }
 
 /// The closest hit with `0 < t < t_max`, walking the BVH.
@@ -333,7 +333,7 @@ fn leaf_hits<const ANY: bool>(
 ) -> bool {
     let (first, count) = (node.index, node.bits >> NODE_COUNT_SHIFT);
     let slot = |s: u32| scene.instance_at(s, 0);
-    if node.bits & NODE_SPHERES == 0 {
+    if node.bits & NODE_SHAPES == 0 {
         for i in first..first + count {
             let tri = scene.tri_positions[i as usize];
             let r = if inst == NO_INSTANCE {
@@ -367,12 +367,13 @@ fn leaf_hits<const ANY: bool>(
         }
     } else {
         for i in first..first + count {
-            let s = scene.spheres[i as usize];
-            if let Some(t) = intersect_sphere(ray.origin, ray.dir, v3(s.center), s.radius, hit.t)
-                && (!alpha || sphere_hit_counts(scene, i, ray))
+            let s = &scene.shapes[i as usize];
+            if let Some(t) =
+                crate::shapes::KINDS[s.kind as usize].intersect(s, ray.origin, ray.dir, hit.t)
+                && (!alpha || shape_hit_counts(scene, i, ray))
             {
                 *hit = Hit {
-                    prim: i | PRIM_SPHERE,
+                    prim: i | PRIM_SHAPE,
                     t,
                     u: 0.0,
                     v: 0.0,
@@ -500,11 +501,13 @@ pub fn intersect_brute_force(scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<
             });
         }
     }
-    for (i, s) in scene.spheres.iter().enumerate() {
-        if let Some(t) = intersect_sphere(ray.origin, ray.dir, v3(s.center), s.radius, best) {
+    for (i, s) in scene.shapes.iter().enumerate() {
+        if let Some(t) =
+            crate::shapes::KINDS[s.kind as usize].intersect(s, ray.origin, ray.dir, best)
+        {
             best = t;
             hit = Some(Hit {
-                prim: i as u32 | PRIM_SPHERE,
+                prim: i as u32 | PRIM_SHAPE,
                 t,
                 u: 0.0,
                 v: 0.0,

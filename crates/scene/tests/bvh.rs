@@ -8,7 +8,7 @@ use glam::{Mat4, Vec3};
 use lumagraph_scene::import::import_mesh;
 use lumagraph_scene::traverse::{intersect_brute_force, ray_aabb, safe_inverse};
 use lumagraph_scene::{
-    Environment, GpuScene, Hit, Material, Ray, RenderSettings, Scene, Sphere, intersect,
+    Environment, GpuScene, Hit, Material, Ray, RenderSettings, Scene, Shape, intersect,
     intersect_within, occluded,
 };
 
@@ -22,20 +22,16 @@ fn sphere_grid_scene() -> Scene {
     });
     let glow = materials.len() as u32 - 1;
     // Spheres between and in front of the grid's spheres, one overlapping a mesh sphere.
-    let mut spheres = Vec::new();
+    let mut shapes = Vec::new();
     for i in 0..8 {
         let f = i as f32;
-        spheres.push(Sphere {
-            center: Vec3::new(-2.4 + 0.6 * f, 0.6 * (f - 3.5), 0.3 * (f - 4.0)),
-            radius: 0.15 + 0.05 * f,
-            material: if i % 3 == 0 { glow } else { 0 },
-        });
+        shapes.push(Shape::sphere(
+            Vec3::new(-2.4 + 0.6 * f, 0.6 * (f - 3.5), 0.3 * (f - 4.0)),
+            0.15 + 0.05 * f,
+            if i % 3 == 0 { glow } else { 0 },
+        ));
     }
-    spheres.push(Sphere {
-        center: Vec3::new(0.0, 0.0, 0.4),
-        radius: 0.3,
-        material: 1,
-    });
+    shapes.push(Shape::sphere(Vec3::new(0.0, 0.0, 0.4), 0.3, 1));
     Scene {
         camera: lumagraph_scene::Camera {
             position: Vec3::new(0.0, 0.0, 8.0),
@@ -51,7 +47,7 @@ fn sphere_grid_scene() -> Scene {
         instanced: Vec::new(),
         lights: Vec::new(),
         textures: Vec::new(),
-        spheres,
+        shapes,
         environment: Environment::None,
         settings: RenderSettings {
             width: 64,
@@ -186,18 +182,13 @@ impl Reference {
                 }
             }
         }
-        for (i, s) in g.spheres.iter().enumerate() {
-            let r = lumagraph_scene::traverse::intersect_sphere(
-                ray.origin,
-                ray.dir,
-                Vec3::from(s.center),
-                s.radius,
-                t_max,
-            );
+        for (i, s) in g.shapes.iter().enumerate() {
+            let r = lumagraph_scene::shapes::KINDS[s.kind as usize]
+                .intersect(s, ray.origin, ray.dir, t_max);
             if let Some(t) = r {
                 t_max = t;
                 best = Some(Hit {
-                    prim: i as u32 | lumagraph_scene::PRIM_SPHERE,
+                    prim: i as u32 | lumagraph_scene::PRIM_SHAPE,
                     t,
                     u: 0.0,
                     v: 0.0,
@@ -272,7 +263,7 @@ fn bvh_agrees_with_brute_force_on_100k_rays() {
     let g = GpuScene::build(&scene).unwrap();
     let build = start.elapsed();
     assert_eq!(g.tri_positions.len(), scene.triangles.len());
-    assert_eq!(g.spheres.len(), 9);
+    assert_eq!(g.shapes.len(), 9);
     assert_eq!(g.lights.len(), 3);
     assert!(g.header.bvh_depth as usize <= lumagraph_scene::BVH_MAX_DEPTH);
 
@@ -309,7 +300,7 @@ fn bvh_structure_is_consistent() {
     let g = GpuScene::build(&scene).unwrap();
     // Every primitive is in exactly one leaf; children lie inside their parent's box.
     let mut tri_seen = vec![0u32; g.tri_positions.len()];
-    let mut sphere_seen = vec![0u32; g.spheres.len()];
+    let mut sphere_seen = vec![0u32; g.shapes.len()];
     let mut stack = vec![(0usize, 0usize)];
     let mut max_depth = 0;
     while let Some((i, depth)) = stack.pop() {
@@ -346,7 +337,7 @@ fn bvh_structure_is_consistent() {
     assert!(src.iter().enumerate().all(|(i, &s)| s == i as u32));
     // Leaves are small.
     let leaves = g.bvh_nodes.iter().filter(|n| n.bits >> 3 != 0).count();
-    let mean = (g.tri_positions.len() + g.spheres.len()) as f32 / leaves as f32;
+    let mean = (g.tri_positions.len() + g.shapes.len()) as f32 / leaves as f32;
     eprintln!(
         "{} nodes, {leaves} leaves, {mean:.2} primitives a leaf",
         g.bvh_nodes.len()

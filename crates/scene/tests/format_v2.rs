@@ -264,7 +264,7 @@ fn export_writes_the_resolved_scene() {
     assert_eq!(json["format"], "lumagraph-scene-export");
     assert_eq!(json["lights"].as_array().unwrap().len(), 3);
     assert_eq!(json["lights"][1]["type"], "spot");
-    assert_eq!(json["spheres"].as_array().unwrap().len(), 2);
+    assert_eq!(json["shapes"].as_array().unwrap().len(), 2);
     let gold = json["materials"]
         .as_array()
         .unwrap()

@@ -41,9 +41,9 @@ fn load(instancing: &str) -> Scene {
 
 /// Where a hit is and which way its triangle faces, in world space.
 fn world_point(g: &GpuScene, ray: &Ray, hit: &Hit) -> (Vec3, Vec3) {
-    if hit.is_sphere() || hit.inst == NO_INSTANCE {
+    if hit.is_shape() || hit.inst == NO_INSTANCE {
         let t = &g.tri_positions[hit.index()];
-        let n = if hit.is_sphere() {
+        let n = if hit.is_shape() {
             Vec3::ZERO
         } else {
             Vec3::from(t.e1).cross(Vec3::from(t.e2)).normalize()
@@ -146,8 +146,8 @@ fn instanced_traversal_finds_what_the_copies_give() {
                     pa.distance(pb) < 1e-4 * (1.0 + pb.abs().max_element()),
                     "ray {k}: point {pa} against {pb}"
                 );
-                assert_eq!(a.is_sphere(), b.is_sphere(), "ray {k}");
-                if !a.is_sphere() && na.dot(nb) < 0.999 {
+                assert_eq!(a.is_shape(), b.is_shape(), "ray {k}");
+                if !a.is_shape() && na.dot(nb) < 0.999 {
                     differ += 1;
                 }
             }

@@ -26,7 +26,7 @@ const MINIMAL: &str = r#"(
 #[test]
 fn minimal_scene_and_defaults() {
     let s = parse(MINIMAL).unwrap();
-    assert_eq!(s.spheres.len(), 1);
+    assert_eq!(s.shapes.len(), 1);
     assert_eq!(s.settings.max_bounces, 20);
     assert_eq!(s.settings.spp, 1);
     assert_eq!(s.environment, Environment::None);
@@ -114,7 +114,7 @@ fn cornell_loads_with_36_triangles_and_2_lights() {
     assert!(s.report.is_clean(), "{:?}", s.report);
     // 5 walls + light = 6 quads, 2 boxes × 6 faces = 12 quads: 18 quads, 36 triangles.
     assert_eq!(s.triangles.len(), 36);
-    assert_eq!(s.spheres.len(), 0);
+    assert_eq!(s.shapes.len(), 0);
     assert_eq!(s.camera.position, Vec3::new(0.0, 0.0, 3.9));
     assert_eq!(s.camera.fov_y_deg, 39.3077);
     assert_eq!((s.settings.width, s.settings.height), (256, 256));
@@ -227,15 +227,15 @@ fn cornell_box_transform_matches_world_quads() {
 #[test]
 fn furnace_loads() {
     let s = Scene::load(&common::assets().join("furnace.ron")).unwrap();
-    assert_eq!(s.spheres.len(), 1);
-    assert_eq!(s.spheres[0].radius, 1.0);
+    assert_eq!(s.shapes.len(), 1);
+    assert_eq!(s.shapes[0].radius, 1.0);
     assert_eq!(s.environment, Environment::Constant([1.0; 3]));
     assert_eq!(s.camera.position, Vec3::new(0.0, 0.0, 4.0));
     assert_eq!(s.camera.fov_y_deg, 40.0);
-    let m = &s.materials[s.spheres[0].material as usize];
+    let m = &s.materials[s.shapes[0].material as usize];
     assert_eq!(m.base_color, Vec3::ONE);
     let g = GpuScene::build(&s).unwrap();
-    assert_eq!(g.header.num_spheres, 1);
+    assert_eq!(g.header.num_shapes, 1);
     assert_eq!(g.lights.len(), 0);
     assert_eq!(g.bvh_nodes.len(), 1);
 }

@@ -6,15 +6,23 @@ mod common;
 use std::mem::{offset_of, size_of};
 
 use lumagraph_scene::{
-    GpuAliasEntry, GpuBvhNode, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuSphere,
+    GpuAliasEntry, GpuBvhNode, GpuCamera, GpuHeader, GpuLight, GpuMaterial, GpuSettings, GpuShape,
     GpuTexDesc, GpuTriShading, GpuTriTexcoords, GpuTriangle,
 };
+
+/// The shader folder, and the one generated file the scene crate writes (the dispatch over
+/// the kinds of shapes).
+fn source(name: &str) -> Option<String> {
+    if name == lumagraph_scene::shapes::FILE {
+        return Some(lumagraph_scene::shapes::wgsl());
+    }
+    lumagraph_wgsl::from_dir(common::shaders())(name)
+}
 
 /// `name` with its imports resolved as the renderer resolves them (`lumagraph-wgsl`), read
 /// from the repository's `shaders/` folder.
 fn resolve(name: &str) -> String {
-    lumagraph_wgsl::resolve(name, &[], &lumagraph_wgsl::from_dir(common::shaders()))
-        .unwrap_or_else(|e| panic!("{e}"))
+    lumagraph_wgsl::resolve(name, &[], &source).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn validate(source: &str, what: &str) -> naga::Module {
@@ -31,14 +39,14 @@ fn validate(source: &str, what: &str) -> naga::Module {
 
 const STUB: &str = r#"
 const HAS_TRIANGLES: bool = true;
-const HAS_SPHERES: bool = true;
+const HAS_SHAPES: bool = true;
 const HAS_ALPHA: bool = false;
 const HAS_INSTANCES: bool = true;
 fn triangle_hit_counts(prim: u32, u: f32, v: f32, ray: Ray) -> bool { return true; }
-fn sphere_hit_counts(i: u32, ray: Ray) -> bool { return true; }
+fn shape_hit_counts(i: u32, ray: Ray) -> bool { return true; }
 @group(0) @binding(0) var<storage, read> bvh_nodes: array<vec4<u32>>;
 @group(0) @binding(1) var<storage, read> tri_positions: array<TriPositions>;
-@group(0) @binding(2) var<storage, read> spheres: array<Sphere>;
+@group(0) @binding(2) var<storage, read> shapes: array<Shape>;
 @group(0) @binding(3) var<storage, read_write> out_hits: array<Hit>;
 
 @compute @workgroup_size(64)
@@ -56,11 +64,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 
 #[test]
 fn bvh_wgsl_validates_with_a_stub() {
-    let imported = lumagraph_wgsl::imports(
-        "pathtrace/bvh.wgsl",
-        &lumagraph_wgsl::from_dir(common::shaders()),
-    )
-    .unwrap();
+    let imported = lumagraph_wgsl::imports("pathtrace/bvh.wgsl", &source).unwrap();
     assert!(imported.iter().any(|f| f == "pathtrace/scene_types.wgsl"));
     let mut src = resolve("pathtrace/bvh.wgsl");
     src.push_str(STUB);
@@ -137,9 +141,9 @@ fn wgsl_layouts_match_rust() {
             [n0, material, n1, light, n2, flags]
         ),
         layout!(
-            GpuSphere,
-            "Sphere",
-            [center, radius, material, light, pad0, pad1]
+            GpuShape,
+            "Shape",
+            [center, radius, axis, kind, material, light, pad0, pad1]
         ),
         material_layout(),
         layout!(
@@ -190,7 +194,7 @@ fn wgsl_layouts_match_rust() {
             [
                 num_nodes,
                 num_triangles,
-                num_spheres,
+                num_shapes,
                 num_materials,
                 num_lights,
                 bvh_depth,
@@ -252,16 +256,16 @@ fn wgsl_constants_match_rust() {
     let types =
         std::fs::read_to_string(common::shaders().join("pathtrace/scene_types.wgsl")).unwrap();
     for (name, value) in [
-        ("PRIM_SPHERE", lumagraph_scene::PRIM_SPHERE),
+        ("PRIM_SHAPE", lumagraph_scene::PRIM_SHAPE),
         ("NO_HIT", lumagraph_scene::NO_HIT),
         ("NO_LIGHT", lumagraph_scene::NO_LIGHT),
-        ("NODE_SPHERES", lumagraph_scene::bvh::NODE_SPHERES),
+        ("NODE_SHAPES", lumagraph_scene::bvh::NODE_SHAPES),
         ("NODE_INSTANCES", lumagraph_scene::bvh::NODE_INSTANCES),
         ("NO_INSTANCE", lumagraph_scene::NO_INSTANCE),
         ("INSTANCE_MIRROR", lumagraph_scene::INSTANCE_MIRROR),
         ("FEATURE_INSTANCES", lumagraph_scene::FEATURE_INSTANCES),
         ("NODE_COUNT_SHIFT", lumagraph_scene::bvh::NODE_COUNT_SHIFT),
-        ("LIGHT_SPHERE", lumagraph_scene::LIGHT_SPHERE),
+        ("LIGHT_SHAPE", lumagraph_scene::LIGHT_SHAPE),
         ("LIGHT_TWO_SIDED", lumagraph_scene::LIGHT_TWO_SIDED),
         ("MATERIAL_TWO_SIDED", lumagraph_scene::MATERIAL_TWO_SIDED),
         ("TRI_VERTEX_NORMALS", lumagraph_scene::TRI_VERTEX_NORMALS),
@@ -269,7 +273,7 @@ fn wgsl_constants_match_rust() {
         ("ENV_CONSTANT", lumagraph_scene::ENV_CONSTANT),
         ("ENV_MAP", lumagraph_scene::ENV_MAP),
         ("ENV_SHOW_BACKGROUND", lumagraph_scene::ENV_SHOW_BACKGROUND),
-        ("FEATURE_SPHERES", lumagraph_scene::FEATURE_SPHERES),
+        ("FEATURE_SHAPES", lumagraph_scene::FEATURE_SHAPES),
         (
             "FEATURE_TRANSMISSION",
             lumagraph_scene::FEATURE_TRANSMISSION,

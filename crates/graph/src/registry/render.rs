@@ -256,7 +256,7 @@ fn gbuffer() -> NodeKind {
         name: "GBuffer",
         category: Category::Render,
         doc: "Rasterizes the scene (`--scene`) from the path tracer's camera: triangles with \
-          their shading normals, spheres tessellated and then intersected exactly per \
+          their shading normals, analytic shapes drawn as hulls and then intersected exactly per \
           pixel. Writes what the path tracer's first hit through the pixel center sees, \
           without tracing a ray; the guides of Denoise. Image size from the scene.",
         inputs: vec![],
@@ -287,8 +287,8 @@ fn gbuffer() -> NodeKind {
                 min: 8,
                 max: 512,
             },
-            doc: "segments around a sphere's tessellation (the silhouette is exact anyway: \
-              each fragment intersects the true sphere)",
+            doc: "segments around an analytic shape's hull, a sphere's or a disk's (the \
+              silhouette is exact anyway: each fragment intersects the shape itself)",
         }],
         sink: false,
         history: false,

@@ -7,9 +7,11 @@
 //!
 //! The scene's triangles go to one non-indexed vertex buffer with their corner normals and
 //! material color (and, with textures, UV, tangent and material id: the fragment shader
-//! applies the base color texture and the normal map as the path tracer does); each sphere becomes a UV sphere circumscribing the true one, and the
-//! fragment shader intersects the true sphere along the pixel-center ray (dropping misses,
-//! writing the exact normal and depth), so spheres agree with the ray tracer to the pixel.
+//! applies the base color texture and the normal map as the path tracer does); each analytic shape becomes its kind's hull (`ShapeKind::hull`: a UV
+//! sphere circumscribing a sphere, a polygon around a disk), and the fragment shader
+//! intersects the shape itself along the pixel-center ray with the path tracer's test
+//! (dropping misses, writing the exact normal and depth), so shapes agree with the ray
+//! tracer to the pixel.
 //! See `shaders/gbuffer/gbuffer.wgsl` for the projection (reversed, infinite depth).
 //!
 //! Outputs nothing reads are rendered into node-owned stand-ins of the same size, since
@@ -25,7 +27,7 @@ use crate::kernel::uniform_buffer;
 use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed};
 use crate::pool::{PooledTexture, create, wgpu_format};
 
-/// Floats per vertex: position, normal, albedo (3 each), sphere (4), uv (both sets: 4),
+/// Floats per vertex: position, normal, albedo (3 each), shape (4), uv (both sets: 4),
 /// tangent (4), material id (the bits of a `u32`), vertex colour (4, decoded).
 const VERTEX_FLOATS: usize = 26;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -115,6 +117,8 @@ impl GBuffer {
             crate::scene_gpu::check_limits(&scene, &ctx.device.limits(), &ctx.info.name)?;
         }
         let textures = crate::scene_gpu::atlas_texture(ctx, &scene);
+        // The analytic shapes each fragment of their hulls intersects.
+        let shapes = storage("gbuffer shapes", bytemuck::cast_slice(&scene.shapes), true);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer"),
             layout: &layout,
@@ -134,6 +138,10 @@ impl GBuffer {
                 wgpu::BindGroupEntry {
                     binding: 3,
                     resource: wgpu::BindingResource::TextureView(&textures),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: shapes.as_entire_binding(),
                 },
             ],
         });
@@ -155,7 +163,7 @@ impl GBuffer {
 }
 
 /// The raster pipeline of `source` (the resolved G-buffer shader) and its bind group layout
-/// (camera uniform, materials, texture descriptors, the texture atlas).
+/// (camera uniform, materials, texture descriptors, the texture atlas, the analytic shapes).
 fn pipeline(
     ctx: &GpuContext,
     source: String,
@@ -191,6 +199,7 @@ fn pipeline(
                 },
                 count: None,
             },
+            storage_entry(4),
         ],
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -319,10 +328,6 @@ fn raster_camera(
     }
 }
 
-fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
 fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
@@ -403,7 +408,7 @@ pub(crate) fn draws(scene: &GpuScene, segments: u32) -> (Vec<f32>, Vec<GpuInstan
 }
 
 /// The vertex data of the triangles `triangles` (indices in `tri_positions`) and, where
-/// `segments` is not 0, every tessellated sphere, `VERTEX_FLOATS` per vertex.
+/// `segments` is not 0, every analytic shape's hull, `VERTEX_FLOATS` per vertex.
 pub(crate) fn vertices(
     scene: &GpuScene,
     triangles: std::ops::Range<usize>,
@@ -466,38 +471,14 @@ pub(crate) fn vertices(
     if segments == 0 {
         return out;
     }
-    // UV spheres: `segments` around, `segments / 2` from pole to pole, with corners pushed
-    // out by 1/cos(step) so the faces enclose the true sphere.
-    let around = segments.max(8);
-    let rings = (around / 2).max(4);
-    let step = std::f32::consts::PI / rings as f32;
-    let scale = 1.0 / step.cos();
-    for s in &scene.spheres {
-        let r = s.radius * scale;
+    // Each analytic shape as its kind's hull, which its fragments intersect (the shape's
+    // index + 1 in the fourth float of `shape`).
+    for (k, s) in scene.shapes.iter().enumerate() {
         let a = albedo(s.material);
-        let sphere = [s.center[0], s.center[1], s.center[2], s.radius];
-        let point = |i: u32, j: u32| {
-            let theta = j as f32 * step;
-            let phi = i as f32 * std::f32::consts::TAU / around as f32;
-            let d = [
-                theta.sin() * phi.cos(),
-                theta.cos(),
-                theta.sin() * phi.sin(),
-            ];
-            add(s.center, d.map(|x| x * r))
-        };
-        for j in 0..rings {
-            for i in 0..around {
-                let q = [
-                    point(i, j),
-                    point(i + 1, j),
-                    point(i + 1, j + 1),
-                    point(i, j + 1),
-                ];
-                for k in [0, 1, 2, 0, 2, 3] {
-                    let tex = no_tex(s.material);
-                    push(q[k], normalize(sub(q[k], s.center)), a, sphere, tex);
-                }
+        let shape = [0.0, 0.0, 0.0, (k + 1) as f32];
+        for tri in lumagraph_scene::shapes::KINDS[s.kind as usize].hull(s, segments) {
+            for p in tri {
+                push(p.to_array(), [0.0; 3], a, shape, no_tex(s.material));
             }
         }
     }

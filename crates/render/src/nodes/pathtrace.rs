@@ -519,7 +519,7 @@ impl PathTrace {
             .buffer(self.wide.as_ref().map_or(&b.bvh_nodes, |(w, _, _)| w))
             .buffer(&b.tri_positions)
             .buffer(&b.tri_shading)
-            .buffer(&b.spheres)
+            .buffer(&b.shapes)
             .buffer(&b.materials)
             .buffer(&b.lights)
             .buffer(&b.light_alias)
@@ -878,7 +878,7 @@ impl NodeExec for PathTrace {
                 "ray queries: acceleration structure over {} triangles and {} spheres ({} of \
                  boxes) built in {:.1} ms",
                 self.scene.tri_positions.len(),
-                self.scene.spheres.len(),
+                self.scene.shapes.len(),
                 crate::human_bytes(accel.input_bytes),
                 took.as_secs_f64() * 1e3
             ));

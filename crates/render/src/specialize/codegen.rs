@@ -62,12 +62,12 @@ pub fn parallelograms(tris: &[lumagraph_scene::GpuTriangle]) -> Vec<(usize, Opti
 /// large to inline. With `alpha` ([`super::Feature::Alpha`]), the primitives of alpha-masked
 /// or blended materials take the any-hit test.
 pub fn inline_intersection(scene: &GpuScene, alpha: bool) -> Option<String> {
-    let (tris, spheres) = (&scene.tri_positions, &scene.spheres);
-    if tris.len() + spheres.len() > INLINE_MAX_PRIMITIVES {
+    let (tris, shapes) = (&scene.tri_positions, &scene.shapes);
+    if tris.len() + shapes.len() > INLINE_MAX_PRIMITIVES {
         return None;
     }
     // Primitives of alpha-masked or blended materials take the any-hit test
-    // (`triangle_hit_counts`, `sphere_hit_counts` in pathtrace/alpha.wgsl), each triangle
+    // (`triangle_hit_counts`, `shape_hit_counts` in pathtrace/alpha.wgsl), each triangle
     // on its own.
     let alpha_material = |m: u32| {
         alpha
@@ -118,26 +118,35 @@ pub fn inline_intersection(scene: &GpuScene, alpha: bool) -> Option<String> {
             None => single(a, &mut closest, &mut any),
         }
     }
-    for (i, s) in spheres.iter().enumerate() {
-        let args = format!("{}, {:?}", v3(s.center), s.radius);
+    // Each shape through its kind's own test (the dispatch's choice made here).
+    for (i, s) in shapes.iter().enumerate() {
+        let kind = lumagraph_scene::shapes::KINDS[s.kind as usize].name();
+        let args = format!(
+            "Shape({}, {:?}, {}, {}u, 0u, 0u, 0u, 0u)",
+            v3(s.center),
+            s.radius,
+            v3(s.axis),
+            s.kind
+        );
         let test = if alpha_material(s.material) {
-            format!(" && sphere_hit_counts({i}u, ray)")
+            format!(" && shape_hit_counts({i}u, ray)")
         } else {
             String::new()
         };
         let _ = writeln!(
             closest,
-            "    t = intersect_sphere_from({i}u | PRIM_SPHERE, ray.origin, ray.dir, {args}, hit.t);\n    if (t > 0.0{test}) {{ hit = Hit({i}u | PRIM_SPHERE, t, 0.0, 0.0, NO_INSTANCE); }}"
+            "    t = {kind}_intersect({i}u | PRIM_SHAPE, {args}, ray, hit.t);\n    if (t > 0.0{test}) {{ hit = Hit({i}u | PRIM_SHAPE, t, 0.0, 0.0, NO_INSTANCE); }}"
         );
         let _ = writeln!(
             any,
-            "    if (intersect_sphere_from({i}u | PRIM_SPHERE, ray.origin, ray.dir, {args}, t_max) > 0.0{test}) {{ return true; }}"
+            "    if ({kind}_intersect({i}u | PRIM_SHAPE, {args}, ray, t_max) > 0.0{test}) {{ return true; }}"
         );
     }
     Some(format!(
-        "// Generated for this scene: {} triangles and {} spheres, tested one by one with their
-// coordinates inline (no BVH, no geometry buffers read).
+        "// Generated for this scene: {} triangles and {} analytic shapes, tested one by one with
+// their coordinates inline (no BVH, no geometry buffers read).
 #import \"pathtrace/primitives.wgsl\"
+#import \"pathtrace/shapes.wgsl\"
 
 fn intersect_scene_within(ray: Ray, t_max: f32) -> Hit {{
     var hit = Hit(NO_HIT, t_max, 0.0, 0.0, NO_INSTANCE);
@@ -156,7 +165,7 @@ fn occluded(ray: Ray, t_max: f32) -> bool {{
 }}
 ",
         tris.len(),
-        spheres.len()
+        shapes.len()
     ))
 }
 
@@ -344,15 +353,17 @@ fn shading_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
         .collect()
 }
 
-/// Every sphere as WGSL literals.
-fn spheres_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
+/// Every shape as WGSL literals.
+fn shapes_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
     scene
-        .spheres
+        .shapes
         .iter()
         .map(|s| {
             vec![
                 l.v3(s.center),
                 l.f(s.radius),
+                l.v3(s.axis),
+                u(s.kind),
                 u(s.material),
                 u(s.light),
                 u(0),
@@ -368,7 +379,7 @@ fn spheres_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
 /// [`INLINE_MAX_MATERIALS`]), textured (texture lookups read their buffers anyway), or holds
 /// a value that is not finite.
 pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
-    if scene.tri_positions.len() + scene.spheres.len() > INLINE_MAX_PRIMITIVES
+    if scene.tri_positions.len() + scene.shapes.len() > INLINE_MAX_PRIMITIVES
         || scene.materials.len() > INLINE_MAX_MATERIALS
         || scene.header.features & lumagraph_scene::FEATURE_TEXTURES != 0
     {
@@ -381,12 +392,12 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
     let alias = alias_rows(scene, &l);
     let positions = positions_rows(scene, &l);
     let shading = shading_rows(scene, &l);
-    let spheres = spheres_rows(scene, &l);
+    let shapes = shapes_rows(scene, &l);
     if l.not_finite.get() {
         return None;
     }
     Some(format!(
-        "// Generated for this scene: {} materials, {} lights, {} triangles and {} spheres,
+        "// Generated for this scene: {} materials, {} lights, {} triangles and {} shapes,
 // returned by id with their values in the code (no material, light or shading buffer read).
 #import \"pathtrace/scene_types.wgsl\"
 
@@ -394,7 +405,7 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
         materials.len(),
         lights.len(),
         positions.len(),
-        spheres.len(),
+        shapes.len(),
         table_fns("scene_material", "Material", &MATERIAL_TYPES, &materials),
         table_fns(
             "scene_light",
@@ -416,10 +427,10 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
             &shading
         ),
         table_fns(
-            "scene_sphere",
-            "Sphere",
-            &[f3, f1, u1, u1, u1, u1],
-            &spheres
+            "scene_shape",
+            "Shape",
+            &[f3, f1, f3, u1, u1, u1, u1, u1],
+            &shapes
         ),
     ))
 }
@@ -466,7 +477,7 @@ pub fn inline_materials_data(scene: &GpuScene) -> Option<String> {
     };
     Some(format!(
         "// Generated for this scene: {} materials{} returned by id with their values in the
-// code; the {} triangles' and {} spheres' data read from their buffers.
+// code; the {} triangles' and {} shapes' data read from their buffers.
 #import \"pathtrace/scene_types.wgsl\"
 
 {}{light_fns}fn scene_tri_positions(i: u32) -> TriPositions {{
@@ -477,8 +488,8 @@ fn scene_tri_shading(i: u32) -> TriShading {{
     return tri_shading[i];
 }}
 
-fn scene_sphere(i: u32) -> Sphere {{
-    return spheres[i];
+fn scene_shape(i: u32) -> Shape {{
+    return shapes[i];
 }}
 ",
         materials.len(),
@@ -488,7 +499,7 @@ fn scene_sphere(i: u32) -> Sphere {{
             String::new()
         },
         scene.tri_positions.len(),
-        scene.spheres.len(),
+        scene.shapes.len(),
         table_fns("scene_material", "Material", &MATERIAL_TYPES, &materials),
     ))
 }
@@ -506,7 +517,7 @@ pub(super) fn inlinable(scene: &GpuScene, inline: bool) -> bool {
     if inline {
         positions_rows(scene, &l);
         shading_rows(scene, &l);
-        spheres_rows(scene, &l);
+        shapes_rows(scene, &l);
     }
     !l.not_finite.get()
 }

@@ -42,8 +42,8 @@ pub enum Feature {
     EnvMapSampling,
     /// Triangle leaves and surfaces.
     Triangles,
-    /// Sphere leaves and surfaces.
-    Spheres,
+    /// Analytic shapes' leaves and surfaces.
+    Shapes,
     /// The dielectric specular (GGX) lobe over the diffuse base.
     SpecularLobe,
     /// The metal lobe.
@@ -91,7 +91,7 @@ impl Feature {
         Self::Environment,
         Self::EnvMapSampling,
         Self::Triangles,
-        Self::Spheres,
+        Self::Shapes,
         Self::SpecularLobe,
         Self::MetalLobe,
         Self::GlassLobe,
@@ -122,7 +122,7 @@ impl Feature {
             Self::Environment => "environment",
             Self::EnvMapSampling => "environment map sampling",
             Self::Triangles => "triangle tests",
-            Self::Spheres => "sphere tests",
+            Self::Shapes => "shape tests",
             Self::SpecularLobe => "dielectric specular lobe",
             Self::MetalLobe => "metal lobe",
             Self::GlassLobe => "glass lobe",
@@ -158,7 +158,7 @@ impl Feature {
             Self::Environment => "HAS_ENVIRONMENT",
             Self::EnvMapSampling => "HAS_ENV_MAP",
             Self::Triangles => "HAS_TRIANGLES",
-            Self::Spheres => "HAS_SPHERES",
+            Self::Shapes => "HAS_SHAPES",
             Self::SpecularLobe => "HAS_SPECULAR",
             Self::MetalLobe => "HAS_METAL",
             Self::GlassLobe => "HAS_GLASS",
@@ -406,7 +406,7 @@ struct Facts<'a> {
 
 impl<'a> Facts<'a> {
     fn new(scene: &'a GpuScene, options: PathTraceOptions) -> Self {
-        let prims = scene.tri_positions.len() + scene.spheres.len();
+        let prims = scene.tri_positions.len() + scene.shapes.len();
         let instanced = !scene.instances.is_empty();
         // Why the device's ray queries cannot trace this scene, if they cannot.
         let no_ray_queries = if !options.specialize {
@@ -446,7 +446,7 @@ impl<'a> Facts<'a> {
         };
         let mut inline = inline_for(asked);
         let mut host = super::host_rays_decision(scene, options, inline, asked);
-        // The host asked for where it cannot trace the scene (no Embree, spheres, media…):
+        // The host asked for where it cannot trace the scene (no Embree, analytic shapes, media…):
         // the adapter decides, as for the others.
         let asked = if asked == Intersector::Host && !host.included {
             inline = inline_for(Intersector::Auto);
@@ -593,7 +593,7 @@ impl<'a> Facts<'a> {
                 )
             }
             Feature::Triangles => self.needed(s.tri_positions.len(), "triangles"),
-            Feature::Spheres => self.needed(s.spheres.len(), "spheres"),
+            Feature::Shapes => self.needed(s.shapes.len(), "analytic shapes"),
             Feature::SpecularLobe
             | Feature::MetalLobe
             | Feature::GlassLobe

@@ -211,7 +211,7 @@ impl Specialization {
 
 /// Why materials, lights and shading data are (or are not) written into the shader.
 fn inline_intersection_reason(scene: &GpuScene, inline: bool) -> String {
-    let prims = scene.tri_positions.len() + scene.spheres.len();
+    let prims = scene.tri_positions.len() + scene.shapes.len();
     let pairs = if inline {
         parallelograms(&scene.tri_positions)
             .iter()
@@ -235,7 +235,7 @@ fn inline_data_reason(
 ) -> String {
     let m = scene.materials.len();
     let lights = scene.lights.len();
-    let prims = scene.tri_positions.len() + scene.spheres.len();
+    let prims = scene.tri_positions.len() + scene.shapes.len();
     let textured = scene.header.features & lumagraph_scene::FEATURE_TEXTURES != 0;
     if included && all {
         format!("{m} materials, {lights} lights, {prims} primitives' shading data")
@@ -306,8 +306,8 @@ fn steps_cannot_trace(scene: &GpuScene, options: PathTraceOptions) -> Option<Str
     let media = scene.materials.iter().any(|x| {
         x.flags & (lumagraph_scene::MATERIAL_MEDIUM | lumagraph_scene::MATERIAL_INDEX_MATCHED) != 0
     });
-    if scene.tri_positions.is_empty() || !scene.spheres.is_empty() {
-        Some("spheres or no triangles: the steps shade triangle hits only".to_owned())
+    if scene.tri_positions.is_empty() || !scene.shapes.is_empty() {
+        Some("analytic shapes or no triangles: the steps shade triangle hits only".to_owned())
     } else if !scene.instances.is_empty() {
         Some(INSTANCES_REASON.to_owned())
     } else if media {
