@@ -174,6 +174,7 @@ suite!(
     diffuse_sphere_quad_light,
     diffuse_sphere_sphere_light,
     diffuse_spheres_outside,
+    disk,
     env_map,
     env_map_mirror,
     gltf_lights,

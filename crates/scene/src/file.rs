@@ -345,6 +345,27 @@ pub enum ShapeDesc {
         #[serde(default)]
         two_sided: bool,
     },
+    /// An analytic disk (Mitsuba's `disk`), one-sided as a triangle is: its front faces
+    /// `normal`.
+    Disk {
+        /// Name for messages.
+        #[serde(default)]
+        name: Option<String>,
+        /// Center, world space.
+        center: V3,
+        /// Front normal, world space (any length but 0).
+        normal: V3,
+        /// Radius, > 0.
+        radius: f32,
+        /// Material name.
+        material: String,
+        /// Emitted radiance, replacing the material's own.
+        #[serde(default)]
+        emission: Option<V3>,
+        /// Emission leaves both sides.
+        #[serde(default)]
+        two_sided: bool,
+    },
     /// The square [-1,1]² in z=0, front normal +z, then `transform`: 2 triangles.
     Rectangle {
         /// Name for messages.
@@ -400,7 +421,7 @@ pub enum ShapeDesc {
 
 impl ShapeDesc {
     /// Every kind, as written in the file.
-    pub const KINDS: [&'static str; 5] = ["Mesh", "Sphere", "Rectangle", "Box", "Quad"];
+    pub const KINDS: [&'static str; 6] = ["Mesh", "Sphere", "Disk", "Rectangle", "Box", "Quad"];
 
     /// An analytic shape's kind ([`crate::shapes::KINDS`]), center, radius, axis (zero
     /// where its kind has none) and material; `None` for the shapes made of triangles.
@@ -412,6 +433,13 @@ impl ShapeDesc {
                 material,
                 ..
             } => Some((crate::shapes::SPHERE, *center, *radius, [0.0; 3], material)),
+            Self::Disk {
+                center,
+                normal,
+                radius,
+                material,
+                ..
+            } => Some((crate::shapes::DISK, *center, *radius, *normal, material)),
             _ => None,
         }
     }
@@ -421,6 +449,7 @@ impl ShapeDesc {
         match self {
             Self::Mesh { name, .. }
             | Self::Sphere { name, .. }
+            | Self::Disk { name, .. }
             | Self::Rectangle { name, .. }
             | Self::Box { name, .. }
             | Self::Quad { name, .. } => name.as_deref(),
@@ -432,6 +461,7 @@ impl ShapeDesc {
         match self {
             Self::Mesh { .. } => "Mesh",
             Self::Sphere { .. } => "Sphere",
+            Self::Disk { .. } => "Disk",
             Self::Rectangle { .. } => "Rectangle",
             Self::Box { .. } => "Box",
             Self::Quad { .. } => "Quad",
@@ -447,6 +477,11 @@ impl ShapeDesc {
                 ..
             }
             | Self::Sphere {
+                emission,
+                two_sided,
+                ..
+            }
+            | Self::Disk {
                 emission,
                 two_sided,
                 ..

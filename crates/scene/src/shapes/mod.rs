@@ -12,6 +12,7 @@
 //! [`ShapeKind`]. Adding a kind: its two files, a line in [`KINDS`] and its variant in the
 //! scene format ([`crate::file::ShapeDesc`]).
 
+mod disk;
 mod sphere;
 
 use std::fmt::Write as _;
@@ -48,9 +49,11 @@ pub trait ShapeKind: Sync {
 
 /// [`crate::Shape::kind`] of a sphere.
 pub const SPHERE: u32 = 0;
+/// [`crate::Shape::kind`] of a disk.
+pub const DISK: u32 = 1;
 
 /// Every kind of shape, by its index. The first is what the WGSL dispatch falls back to.
-pub static KINDS: [&dyn ShapeKind; 1] = [&sphere::Sphere];
+pub static KINDS: [&dyn ShapeKind; 2] = [&sphere::Sphere, &disk::Disk];
 
 /// The kind named `name` (the scene format's word, any case).
 pub fn kind_named(name: &str) -> Option<u32> {
