@@ -67,6 +67,13 @@ fn diffuse_sphere_under_a_sphere_light() {
     strategies_agree("tests/scenes/diffuse_sphere_sphere_light.ron");
 }
 
+/// Area sampling of disk lights (one tilted), one-sided: a disk's `disk_pdf` must be the
+/// density `disk_sample` draws with, or MIS and light sampling part.
+#[test]
+fn disk_lights() {
+    strategies_agree("tests/scenes/disk.ron");
+}
+
 /// Rough conductors (alpha 0.05 to 0.7) and a mirror under the quad light: the glossy
 /// highlight that was lost on spheres.
 #[test]

@@ -122,6 +122,12 @@ fn furnace_sphere_gbuffer_matches_pathtrace_aovs() {
     check_against_pathtrace("furnace.ron");
 }
 
+/// Disks (seen from both sides, tilted) beside a sphere and triangles.
+#[test]
+fn disks_gbuffer_matches_pathtrace_aovs() {
+    check_against_pathtrace("../tests/scenes/disk.ron");
+}
+
 /// A glTF mesh with vertex normals (55 200 triangles) and analytic spheres in front of it.
 #[test]
 fn smooth_mesh_and_spheres_gbuffer_matches_pathtrace_aovs() {

@@ -309,10 +309,11 @@ fn render_small(
 /// Cornell (triangles, an area light: NEE + MIS), the material furnace (spheres, every lobe,
 /// a constant environment), Cornell with 28 spheres of 28 materials (64 primitives, the
 /// largest inlined).
-const SMALL_SCENES: [&str; 3] = [
+const SMALL_SCENES: [&str; 4] = [
     "cornell.ron",
     "furnace_materials.ron",
     "cornell_spheres.ron",
+    "../tests/scenes/disk.ron",
 ];
 
 /// Each output of `a` equal to `b`'s bit for bit (the pixels that differ are printed).

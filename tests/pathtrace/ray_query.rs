@@ -188,6 +188,7 @@ fn ray_queries_render_what_the_wgsl_bvh_renders() {
         "furnace_materials.ron",
         "../tests/scenes/mesh_env.ron",
         "../tests/scenes/media_scattering.ron",
+        "../tests/scenes/disk.ron",
     ] {
         let Some((far, mean)) = against_wgsl_bvh(name) else {
             return;

@@ -275,6 +275,7 @@ fn every_primitive_sits_inside_its_ancestors_boxes() {
         "assets/cornell_spheres.ron",
         "assets/furnace_materials.ron",
         "tests/scenes/mesh_env.ron",
+        "tests/scenes/disk.ron",
     ] {
         let s = scene(rel);
         let bvh = WideBvh::build(&s).unwrap();
@@ -305,7 +306,8 @@ fn records_nodes(bvh: &WideBvh) -> usize {
 
 /// The wide BVH against the binary one, both as a GPU adapter runs them, on scenes that
 /// exercise the intersector contract: triangles and an area light (Cornell box: shadow
-/// rays), triangles and spheres in one tree (leaves of both kinds), spheres under an
+/// rays), triangles and spheres in one tree (leaves of both kinds), disk lights and a disk
+/// among triangles and a sphere, spheres under an
 /// environment with every lobe (rays entering and leaving spheres), 5 120 triangles under an
 /// environment map, a scattering medium (`intersect_scene_within`). The same exact tests on
 /// the same primitives: the first-hit depth is bit-identical, albedo and normal differ only
@@ -328,6 +330,7 @@ fn the_wide_bvh_renders_what_the_binary_bvh_renders() {
         "furnace_materials.ron",
         "../tests/scenes/mesh_env.ron",
         "../tests/scenes/media_scattering.ron",
+        "../tests/scenes/disk.ron",
     ] {
         let Some((far, mean)) = common::same_hits(name, wide.clone(), binary.clone(), |a, b| {
             assert!(a.on(Feature::WideBvh), "{}", a.summary());

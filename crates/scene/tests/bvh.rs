@@ -21,7 +21,8 @@ fn sphere_grid_scene() -> Scene {
         ..Material::named("glow")
     });
     let glow = materials.len() as u32 - 1;
-    // Spheres between and in front of the grid's spheres, one overlapping a mesh sphere.
+    // Spheres between and in front of the grid's spheres, one overlapping a mesh sphere,
+    // and disks turned every way among them.
     let mut shapes = Vec::new();
     for i in 0..8 {
         let f = i as f32;
@@ -32,6 +33,16 @@ fn sphere_grid_scene() -> Scene {
         ));
     }
     shapes.push(Shape::sphere(Vec3::new(0.0, 0.0, 0.4), 0.3, 1));
+    for i in 0..6 {
+        let f = i as f32;
+        shapes.push(Shape {
+            kind: lumagraph_scene::shapes::DISK,
+            center: Vec3::new(2.0 - 0.8 * f, 1.5 - 0.5 * f, 0.5),
+            radius: 0.2 + 0.1 * f,
+            axis: Vec3::new(f.sin(), 0.5, f.cos()).normalize(),
+            material: if i % 2 == 0 { glow } else { 1 },
+        });
+    }
     Scene {
         camera: lumagraph_scene::Camera {
             position: Vec3::new(0.0, 0.0, 8.0),
@@ -263,8 +274,8 @@ fn bvh_agrees_with_brute_force_on_100k_rays() {
     let g = GpuScene::build(&scene).unwrap();
     let build = start.elapsed();
     assert_eq!(g.tri_positions.len(), scene.triangles.len());
-    assert_eq!(g.shapes.len(), 9);
-    assert_eq!(g.lights.len(), 3);
+    assert_eq!(g.shapes.len(), 15);
+    assert_eq!(g.lights.len(), 6);
     assert!(g.header.bvh_depth as usize <= lumagraph_scene::BVH_MAX_DEPTH);
 
     let mut rng = common::Pcg::new(7);
