@@ -573,9 +573,10 @@ impl PathTrace {
             .dispatch_2d(ctx, encoder, pass.extent, timer)
     }
 
-    /// Records a frame traced with host intersection: the steps of its paths are
-    /// dispatched and submitted here, the host intersecting the rays of each step; the pass
-    /// that writes the pixels' means (and AOVs) is recorded into `encoder` with the graph.
+    /// Records a frame traced with host intersection: what the graph recorded before is
+    /// submitted first, then the steps of its paths are dispatched and submitted here in
+    /// order, the host intersecting the rays of each step; the pass that writes the pixels'
+    /// means (and AOVs) is recorded into `encoder` with the graph.
     fn record_host(
         &mut self,
         ctx: &GpuContext,
@@ -589,7 +590,8 @@ impl PathTrace {
             return Ok(());
         };
         host.fit(ctx, pass.extent);
-        let sums = steps_sums(ctx, pass);
+        let sums = self.steps_sums(ctx, pass);
+        submit_pending(ctx, encoder);
         let views = self.views(pass, io);
         let max_steps = self.max_steps(&frame);
         let result = host.trace_frame(ctx, max_steps, |step, enc, wave| {
@@ -632,9 +634,19 @@ impl PathTrace {
 }
 
 impl PathTrace {
-    /// Records a frame traced by the wavefront: its steps are recorded and submitted here,
-    /// all on the device; the pass that writes the pixels' means (and AOVs) is recorded into
-    /// `encoder` with the graph.
+    /// The per-pixel sums of a frame traced in steps: `chunk_sums`, grown to the window
+    /// once, not a buffer per frame.
+    fn steps_sums(&mut self, ctx: &GpuContext, pass: &Pass) -> wgpu::Buffer {
+        let size = 16 * pass.extent.pixels();
+        if self.chunk_sums.size() < size {
+            self.chunk_sums = storage(ctx, "pathtrace chunk sums", size);
+        }
+        self.chunk_sums.clone()
+    }
+
+    /// Records a frame traced by the wavefront: what the graph recorded before is submitted
+    /// first, then its steps are recorded and submitted here, all on the device; the pass
+    /// that writes the pixels' means (and AOVs) is recorded into `encoder` with the graph.
     fn record_wavefront(
         &mut self,
         ctx: &GpuContext,
@@ -648,7 +660,8 @@ impl PathTrace {
             return Ok(());
         };
         front.fit(ctx, pass.extent);
-        let sums = steps_sums(ctx, pass);
+        let sums = self.steps_sums(ctx, pass);
+        submit_pending(ctx, encoder);
         let views = self.views(pass, io);
         let max_steps = self.max_steps(&frame);
         let list_at = std::mem::offset_of!(Frame, wave_list) as u64;
@@ -723,8 +736,18 @@ fn entry_points(features: &Features) -> (&'static str, &'static [&'static str]) 
 /// A frame's sums for the steps of host intersection or the wavefront: a buffer of its own,
 /// which the finish pass, recorded now and run later, reads whatever frames follow before
 /// it runs.
-fn steps_sums(ctx: &GpuContext, pass: &Pass) -> wgpu::Buffer {
-    storage(ctx, "pathtrace steps sums", 16 * pass.extent.pixels())
+/// Submits what the graph recorded before this pass, so that the steps a frame traced in
+/// steps submits itself run after it, and after the previous frame's finish pass, which
+/// reads the sums those steps overwrite (`chunk_sums`, kept from frame to frame).
+fn submit_pending(ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
+    let pending = std::mem::replace(
+        encoder,
+        ctx.device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("graph"),
+            }),
+    );
+    ctx.queue.submit([pending.finish()]);
 }
 
 /// Records a copy of `frame` into the uniform buffer `dst` through a staging buffer, in

@@ -156,11 +156,17 @@ pub struct Specialization {
     intersection: Option<String>,
     /// Replaces `pathtrace/scene_data.wgsl` ([`Feature::InlineData`]).
     scene_data: Option<String>,
+    /// Replaces `pathtrace/shapes.wgsl` with the dispatch over the kinds of shapes the
+    /// scene has (specialized shaders only).
+    shapes: Option<String>,
 }
 
 impl Specialization {
     /// Decides the features for `scene` and `options` and writes the code they ask for.
     pub fn new(scene: &GpuScene, options: PathTraceOptions) -> Self {
+        let shapes = options.specialize.then(|| {
+            lumagraph_scene::shapes::wgsl_for(|k| scene.shapes.iter().any(|s| s.kind == k))
+        });
         let features = Features::decide(scene, options);
         let inline = features.on(Feature::InlineIntersection);
         let intersection = if inline {
@@ -183,6 +189,7 @@ impl Specialization {
             features,
             intersection,
             scene_data,
+            shapes,
         }
     }
 
@@ -198,6 +205,9 @@ impl Specialization {
         }
         if let Some(code) = &self.scene_data {
             overrides.push(("pathtrace/scene_data.wgsl", code.clone()));
+        }
+        if let Some(code) = &self.shapes {
+            overrides.push((lumagraph_scene::shapes::FILE, code.clone()));
         }
         let source = crate::shader::resolve_with("pathtrace/pathtrace.wgsl", &overrides)?;
         Ok(if self.features.on(Feature::RayQueries) {

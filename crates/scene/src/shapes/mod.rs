@@ -70,11 +70,28 @@ pub const FILE: &str = "pathtrace/shapes.wgsl";
 /// constant `SHAPE_<NAME>`, and `shape_intersect`, `shape_normal`, `shape_sample` and
 /// `shape_pdf` calling the kind of the shape they are given.
 pub fn wgsl() -> String {
+    wgsl_for(|_| true)
+}
+
+/// [`wgsl`] for the kinds `present` says a scene has, the others left out (every kind if
+/// it has none): a scene of spheres compiles no branch on the kind at all. The path tracer's
+/// specialization writes it for its scene; leaving a kind out never changes an image, as the
+/// scene has no shape of it.
+pub fn wgsl_for(present: impl Fn(u32) -> bool) -> String {
+    let mut kinds: Vec<(u32, &dyn ShapeKind)> = (0..KINDS.len() as u32)
+        .filter(|&i| present(i))
+        .map(|i| (i, KINDS[i as usize]))
+        .collect();
+    if kinds.is_empty() {
+        kinds = (0..KINDS.len() as u32)
+            .map(|i| (i, KINDS[i as usize]))
+            .collect();
+    }
     let mut out = String::from(
         "// Generated from crates/scene/src/shapes/mod.rs (`KINDS`): calls each analytic \
          shape's\n// functions by its kind. Not a file on disk.\n",
     );
-    for k in KINDS {
+    for (_, k) in &kinds {
         let _ = writeln!(out, "#import \"pathtrace/shapes/{}.wgsl\"", k.name());
     }
     for (i, k) in KINDS.iter().enumerate() {
@@ -82,14 +99,14 @@ pub fn wgsl() -> String {
     }
     let dispatch = |out: &mut String, doc: &str, sig: &str, call: &str| {
         let _ = writeln!(out, "\n// {doc}\nfn shape_{sig} {{");
-        for (i, k) in KINDS.iter().enumerate().skip(1) {
+        for (i, k) in kinds.iter().skip(1) {
             let _ = writeln!(
                 out,
                 "    if s.kind == {i}u {{\n        return {}_{call};\n    }}",
                 k.name()
             );
         }
-        let _ = writeln!(out, "    return {}_{call};\n}}", KINDS[0].name());
+        let _ = writeln!(out, "    return {}_{call};\n}}", kinds[0].1.name());
     };
     dispatch(
         &mut out,
