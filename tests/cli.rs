@@ -717,7 +717,7 @@ fn gltf_gallery_lists_each_model_with_what_it_tests() {
         "Does not load: `",
         "requires the extension KHR_materials_iridescence",
         "## Empty",
-        "the scene has no triangle or sphere",
+        "the scene has no triangle or analytic shape",
     ] {
         assert!(page.contains(want), "missing «{want}» in:\n{page}");
     }
