@@ -611,6 +611,10 @@ impl Executor {
                     let before = std::mem::replace(&mut encoder, new_encoder(&self.ctx));
                     submit_and_wait(&self.ctx, before)?;
                     let t = Instant::now();
+                    if node.submits_own() {
+                        node.submit_own(&self.ctx, pass, &io)
+                            .map_err(|e| e.in_node(&pass.node))?;
+                    }
                     let rec = Recording {
                         ctx: &self.ctx,
                         encoder: &mut encoder,
@@ -626,6 +630,13 @@ impl Executor {
                         None => wall_ms.push((pass.node.clone(), ms)),
                     }
                 } else {
+                    if node.submits_own() {
+                        // What the graph recorded so far runs before the node's own work.
+                        let before = std::mem::replace(&mut encoder, new_encoder(&self.ctx));
+                        self.ctx.queue.submit([before.finish()]);
+                        node.submit_own(&self.ctx, pass, &io)
+                            .map_err(|e| e.in_node(&pass.node))?;
+                    }
                     let rec = Recording {
                         ctx: &self.ctx,
                         encoder: &mut encoder,

@@ -217,6 +217,24 @@ pub trait NodeExec {
     /// (a tiled render's window: left and top; the size is the pass's extent).
     fn set_origin(&mut self, _origin: [u32; 2]) {}
 
+    /// Whether this frame's work includes submissions of the node's own, which must run
+    /// after what the graph recorded before the node (a frame traced in steps, each step
+    /// submitted and waited for). The executor then submits the graph's work so far and
+    /// calls [`NodeExec::submit_own`] before [`NodeExec::record`], so no node submits from
+    /// inside `record`.
+    fn submits_own(&self) -> bool {
+        false
+    }
+
+    /// This frame's own submissions (see [`NodeExec::submits_own`]), before its pass is
+    /// recorded.
+    ///
+    /// # Errors
+    /// When the work fails.
+    fn submit_own(&mut self, _ctx: &GpuContext, _pass: &Pass, _io: &FrameIo<'_>) -> Result<()> {
+        Ok(())
+    }
+
     /// Records this frame's GPU work.
     ///
     /// # Errors

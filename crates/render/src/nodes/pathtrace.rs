@@ -319,6 +319,8 @@ pub(crate) struct PathTrace {
     wave_stand_in: wgpu::Buffer,
     /// The wavefront's buffers, where the plan says "wavefront".
     wavefront: Option<crate::wavefront::Wavefront>,
+    /// The frame `submit_own` traced in steps, whose finish `record` records.
+    traced: Option<Frame>,
     /// The scene's acceleration structure, where the plan says "ray queries", and how long
     /// it took to build.
     accel: Option<(crate::accel::SceneAccel, std::time::Duration)>,
@@ -447,6 +449,7 @@ impl PathTrace {
             host,
             wave_stand_in: storage(ctx, "pathtrace wave stand-in", 16),
             wavefront,
+            traced: None,
             accel,
             wide,
         };
@@ -573,25 +576,21 @@ impl PathTrace {
             .dispatch_2d(ctx, encoder, pass.extent, timer)
     }
 
-    /// Records a frame traced with host intersection: what the graph recorded before is
-    /// submitted first, then the steps of its paths are dispatched and submitted here in
-    /// order, the host intersecting the rays of each step; the pass that writes the pixels'
-    /// means (and AOVs) is recorded into `encoder` with the graph.
-    fn record_host(
+    /// Traces a frame with host intersection: the steps of its paths are dispatched and
+    /// submitted in order, the host intersecting the rays of each step, leaving the
+    /// pixels' sums in `chunk_sums` for the pass [`Self::record_steps_finish`] records.
+    fn trace_host(
         &mut self,
         ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
         io: &FrameIo<'_>,
         pass: &Pass,
         frame: Frame,
-        timer: Option<&mut crate::timing::GpuTimer>,
     ) -> Result<()> {
         let Some(mut host) = self.host.take() else {
             return Ok(());
         };
         host.fit(ctx, pass.extent);
         let sums = self.steps_sums(ctx, pass);
-        submit_pending(ctx, encoder);
         let views = self.views(pass, io);
         let max_steps = self.max_steps(&frame);
         let result = host.trace_frame(ctx, max_steps, |step, enc, wave| {
@@ -618,18 +617,29 @@ impl PathTrace {
             }
             Ok(())
         });
-        let finish = result.and_then(|()| {
-            self.record_finish(
-                ctx,
-                encoder,
-                pass,
-                frame,
-                (views, &sums, host.wave()),
-                timer,
-            )
-        });
         self.host = Some(host);
-        finish
+        result
+    }
+
+    /// Records the pass that writes the means (and AOVs) of a frame traced in steps, with
+    /// the graph.
+    fn record_steps_finish(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        io: &FrameIo<'_>,
+        pass: &Pass,
+        frame: Frame,
+        timer: Option<&mut crate::timing::GpuTimer>,
+    ) -> Result<()> {
+        let sums = self.steps_sums(ctx, pass);
+        let views = self.views(pass, io);
+        let wave = match (&self.host, &self.wavefront) {
+            (Some(host), _) => host.wave().clone(),
+            (None, Some(front)) => front.wave().clone(),
+            (None, None) => return Ok(()),
+        };
+        self.record_finish(ctx, encoder, pass, frame, (views, &sums, &wave), timer)
     }
 }
 
@@ -644,24 +654,21 @@ impl PathTrace {
         self.chunk_sums.clone()
     }
 
-    /// Records a frame traced by the wavefront: what the graph recorded before is submitted
-    /// first, then its steps are recorded and submitted here, all on the device; the pass
-    /// that writes the pixels' means (and AOVs) is recorded into `encoder` with the graph.
-    fn record_wavefront(
+    /// Traces a frame by the wavefront: its steps are recorded and submitted in order, all
+    /// on the device, leaving the pixels' sums in `chunk_sums` for the pass
+    /// [`Self::record_steps_finish`] records.
+    fn trace_wavefront(
         &mut self,
         ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
         io: &FrameIo<'_>,
         pass: &Pass,
         frame: Frame,
-        timer: Option<&mut crate::timing::GpuTimer>,
     ) -> Result<()> {
         let Some(mut front) = self.wavefront.take() else {
             return Ok(());
         };
         front.fit(ctx, pass.extent);
         let sums = self.steps_sums(ctx, pass);
-        submit_pending(ctx, encoder);
         let views = self.views(pass, io);
         let max_steps = self.max_steps(&frame);
         let list_at = std::mem::offset_of!(Frame, wave_list) as u64;
@@ -701,11 +708,23 @@ impl PathTrace {
                     bound.dispatch(enc, Some("wave_trace"), groups, None)
                 })
             });
-        let finish = result.and_then(|()| {
-            self.record_finish(ctx, encoder, pass, frame, (views, &sums, &wave), timer)
-        });
         self.wavefront = Some(front);
-        finish
+        result
+    }
+
+    /// Traces a frame in steps, host intersection's or the wavefront's.
+    fn trace_steps(
+        &mut self,
+        ctx: &GpuContext,
+        io: &FrameIo<'_>,
+        pass: &Pass,
+        frame: Frame,
+    ) -> Result<()> {
+        if self.host.is_some() {
+            self.trace_host(ctx, io, pass, frame)
+        } else {
+            self.trace_wavefront(ctx, io, pass, frame)
+        }
     }
 }
 
@@ -733,12 +752,10 @@ fn entry_points(features: &Features) -> (&'static str, &'static [&'static str]) 
     }
 }
 
-/// A frame's sums for the steps of host intersection or the wavefront: a buffer of its own,
-/// which the finish pass, recorded now and run later, reads whatever frames follow before
-/// it runs.
-/// Submits what the graph recorded before this pass, so that the steps a frame traced in
-/// steps submits itself run after it, and after the previous frame's finish pass, which
-/// reads the sums those steps overwrite (`chunk_sums`, kept from frame to frame).
+/// Submits what the graph recorded before this pass, so that the steps of a frame traced
+/// in steps run after it, and after the previous frame's finish pass, which reads the sums
+/// those steps overwrite (`chunk_sums`, kept from frame to frame). The executor does the
+/// same before [`NodeExec::submit_own`].
 fn submit_pending(ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
     let pending = std::mem::replace(
         encoder,
@@ -835,6 +852,17 @@ impl NodeExec for PathTrace {
         self.reset();
     }
 
+    fn submits_own(&self) -> bool {
+        self.host.is_some() || self.wavefront.is_some()
+    }
+
+    fn submit_own(&mut self, ctx: &GpuContext, pass: &Pass, io: &FrameIo<'_>) -> Result<()> {
+        let frame = self.frame(pass.extent);
+        self.trace_steps(ctx, io, pass, frame)?;
+        self.traced = Some(frame);
+        Ok(())
+    }
+
     fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
         let (ctx, encoder, io, mut timer) = rec.parts();
         let samples = pass.output("samples");
@@ -850,14 +878,22 @@ impl NodeExec for PathTrace {
                 timer.as_deref_mut(),
             )?;
         }
+        if self.host.is_some() || self.wavefront.is_some() {
+            let frame = match self.traced.take() {
+                Some(frame) => frame,
+                None => {
+                    // Recorded without `submit_own`: the graph's work so far first.
+                    submit_pending(ctx, encoder);
+                    let frame = self.frame(pass.extent);
+                    self.trace_steps(ctx, io, pass, frame)?;
+                    frame
+                }
+            };
+            self.samples += self.samples_per_frame;
+            return self.record_steps_finish(ctx, encoder, io, pass, frame, timer);
+        }
         let frame = self.frame(pass.extent);
         self.samples += self.samples_per_frame;
-        if self.host.is_some() {
-            return self.record_host(ctx, encoder, io, pass, frame, timer);
-        }
-        if self.wavefront.is_some() {
-            return self.record_wavefront(ctx, encoder, io, pass, frame, timer);
-        }
         // The frame's samples in dispatches of at most `samples_per_dispatch` (one on GPU
         // adapters), the partial sums kept per pixel between them.
         let n = self.samples_per_frame.max(1);

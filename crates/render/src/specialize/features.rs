@@ -110,8 +110,13 @@ impl Feature {
         Self::Wavefront,
     ];
 
-    /// What `plan` and the render's shader line call it: words for people, never looked up.
-    pub const fn label(self) -> &'static str {
+    /// What `plan` and the render's shader line call it: words for people, never looked up
+    /// (a test renames every label and checks that no choice changes).
+    pub fn label(self) -> &'static str {
+        #[cfg(test)]
+        if RENAMED.with(std::cell::Cell::get) {
+            return Box::leak(format!("feature #{}", self as usize).into_boxed_str());
+        }
         match self {
             Self::BvhTraversal => "BVH traversal",
             Self::WideBvh => "8-wide BVH",
@@ -701,5 +706,86 @@ impl<'a> Facts<'a> {
                 format!("{} nodes", s.bvh_nodes.len())
             },
         )
+    }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Set by a test: every label is then another word.
+    static RENAMED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Feature, Features, RENAMED};
+    use crate::specialize::{Intersector, PathTraceOptions, Schedule, Specialization};
+    use lumagraph_scene::{GpuScene, Scene};
+
+    /// Every label renamed, the features of scenes of every kind under every set of
+    /// options decide the same (each feature's decision, the WGSL options, the whole
+    /// shader source), while the plan's words do change: nothing is found by its label.
+    #[test]
+    fn no_choice_depends_on_a_label() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let mut compared = 0;
+        for rel in [
+            "assets/cornell.ron",
+            "assets/cornell_spheres.ron",
+            "assets/furnace_materials.ron",
+            "tests/scenes/mesh_env.ron",
+            "tests/scenes/media_scattering.ron",
+            "tests/scenes/env_map.ron",
+            "tests/scenes/disk.ron",
+            "tests/scenes/instances.ron",
+        ] {
+            let scene = GpuScene::build(&Scene::load(&root.join(rel)).unwrap()).unwrap();
+            for bits in 0..64_u32 {
+                for intersector in [
+                    Intersector::Auto,
+                    Intersector::Inline,
+                    Intersector::Host,
+                    Intersector::BinaryBvh,
+                    Intersector::WideBvh,
+                    Intersector::RayQueries,
+                ] {
+                    let options = PathTraceOptions {
+                        specialize: bits & 1 != 0,
+                        cpu_adapter: bits & 2 != 0,
+                        aovs: bits & 4 != 0,
+                        adaptive: bits & 8 != 0,
+                        host_rays: bits & 16 != 0,
+                        ray_query_limit: (bits & 32 != 0).then_some(1 << 24),
+                        intersector,
+                        schedule: if bits % 3 == 0 {
+                            Schedule::Wavefront
+                        } else {
+                            Schedule::Auto
+                        },
+                        ..PathTraceOptions::default()
+                    };
+                    let decide = |renamed: bool| {
+                        RENAMED.with(|r| r.set(renamed));
+                        let f = Features::decide(&scene, options);
+                        let source = Specialization::new(&scene, options).source().unwrap();
+                        let words = f.summary();
+                        RENAMED.with(|r| r.set(false));
+                        (f, source, words)
+                    };
+                    let (a, source_a, words_a) = decide(false);
+                    let (b, source_b, words_b) = decide(true);
+                    for f in Feature::ALL {
+                        assert_eq!(a.on(f), b.on(f), "{rel} {options:?}: {f:?}");
+                    }
+                    assert_eq!(a.wgsl_options(), b.wgsl_options(), "{rel} {options:?}");
+                    assert!(
+                        source_a == source_b,
+                        "{rel} {options:?}: the shader differs"
+                    );
+                    assert_ne!(words_a, words_b, "{rel}: the labels were not renamed");
+                    compared += 1;
+                }
+            }
+        }
+        assert_eq!(compared, 8 * 64 * 6);
     }
 }
