@@ -6,12 +6,16 @@
 //! - [`render`]: the wgpu executor, node implementations and image files;
 //! - [`editor`]: the node editor.
 //!
+//! [`session::Session`] renders a graph and its scene from a program: progressively, read
+//! back as images, params changed as it goes.
+//!
 //! [`cli`] is the `lumagraph` command line (see `lumagraph --help`). A program that adds
 //! node kinds of its own to a [`render::NodeLibrary`] runs it with
 //! [`cli::main_with`] and gets every subcommand, the editor included, with its kinds in it
 //! (`docs/extending.md`, `examples/custom-node/`).
 
 pub mod cli;
+pub mod session;
 
 pub use lumagraph_editor as editor;
 pub use lumagraph_graph as graph;

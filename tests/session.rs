@@ -1,0 +1,125 @@
+//! The session API (`lumagraph::session`): the same files as `lumagraph render`, images
+//! read back at the scene's size, a param change that re-runs only what is downstream, and
+//! errors that name the file and line.
+
+mod common;
+
+use std::process::Command;
+
+use lumagraph::session::{Session, SessionOptions};
+
+fn open(out: &std::path::Path, write_outputs: bool, keep: &[&str]) -> Session {
+    Session::open(
+        &common::repo("graphs/pathtrace.ron"),
+        Some(&common::repo("assets/cornell.ron")),
+        SessionOptions {
+            out: out.to_owned(),
+            write_outputs,
+            keep: keep.iter().map(|k| (*k).to_owned()).collect(),
+            ..SessionOptions::default()
+        },
+    )
+    .unwrap()
+}
+
+/// A session's render of `graphs/pathtrace.ron` on the Cornell box at 16 spp writes the
+/// files `lumagraph render` writes for the same graph, scene and spp, byte for byte.
+#[test]
+fn a_session_renders_what_the_cli_renders() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (cli, ours) = (dir.path().join("cli"), dir.path().join("session"));
+    let o = Command::new(env!("CARGO_BIN_EXE_lumagraph"))
+        .args([
+            "render",
+            "graphs/pathtrace.ron",
+            "--scene",
+            "assets/cornell.ron",
+        ])
+        .args(["--spp", "16", "--out", cli.to_str().unwrap()])
+        .current_dir(common::root())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut s = open(&ours, true, &[]);
+    let report = s.render(16).unwrap();
+    assert_eq!(s.spp(), 16);
+    assert_eq!(report.written.len(), 2, "{:?}", report.written);
+    for file in ["render.exr", "render.png"] {
+        let (a, b) = (
+            std::fs::read(cli.join(file)).unwrap(),
+            std::fs::read(ours.join(file)).unwrap(),
+        );
+        assert!(a == b, "{file}: the session's differs from the CLI's");
+    }
+}
+
+/// Ports read back as images of the scene's size; a port the plan does not keep is an
+/// error naming it; files are written only where asked.
+#[test]
+fn ports_read_back_at_the_scenes_size() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = open(dir.path(), false, &["pathtrace.color"]);
+    let report = s.render(8).unwrap();
+    assert!(report.written.is_empty(), "{:?}", report.written);
+    assert!(!dir.path().join("render.png").exists());
+    for port in ["accumulate.color", "tonemap.color", "pathtrace.color"] {
+        let img = s.read(port).unwrap();
+        assert_eq!((img.width, img.height), (256, 256), "{port}");
+        assert_eq!(img.pixels.len(), 256 * 256, "{port}");
+        let mean: f32 =
+            img.pixels.iter().map(|p| p[0] + p[1] + p[2]).sum::<f32>() / img.pixels.len() as f32;
+        assert!(mean.is_finite() && mean > 0.01, "{port}: mean {mean}");
+    }
+    let e = s.read("pathtrace.albedo").unwrap_err().to_string();
+    assert!(e.contains("pathtrace.albedo"), "{e}");
+}
+
+/// An exposure change re-runs exposure, tone mapping and the PNG output only (counted by
+/// the passes that ran), over the accumulation as it is: the accumulation is unchanged,
+/// the tone-mapped image brighter.
+#[test]
+fn a_param_change_reruns_only_what_is_downstream() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = open(dir.path(), false, &[]);
+    s.render(8).unwrap();
+    let (hdr, ldr) = (
+        s.read("accumulate.color").unwrap(),
+        s.read("tonemap.color").unwrap(),
+    );
+    let report = s.set_param("exposure.ev", "1.0").unwrap();
+    assert_eq!(report.executed, ["exposure", "tonemap", "png"]);
+    assert_eq!(s.read("accumulate.color").unwrap().pixels, hdr.pixels);
+    let brighter = s.read("tonemap.color").unwrap();
+    let sum = |i: &lumagraph::render::cpu::Image| i.pixels.iter().map(|p| p[1]).sum::<f32>();
+    assert!(sum(&brighter) > 1.2 * sum(&ldr));
+    assert_eq!(s.spp(), 8);
+    let e = s.set_param("exposure.nope", "1").unwrap_err().to_string();
+    assert!(e.contains("nope"), "{e}");
+}
+
+/// A graph file that does not parse: the error names the file and the line.
+#[test]
+fn a_bad_graph_names_its_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("broken.ron");
+    std::fs::write(
+        &path,
+        "(\n    version: 1,\n    nodes: [\n        (id: \"a\" kind: \"Tonemap\"),\n    ],\n)\n",
+    )
+    .unwrap();
+    let e = match Session::open(&path, None, SessionOptions::default()) {
+        Ok(_) => panic!("a broken graph opened"),
+        Err(e) => format!("{e:#}"),
+    };
+    assert!(e.contains("broken.ron"), "{e}");
+    assert!(e.contains(":4:") || e.contains("line 4"), "{e}");
+}
