@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # Installs what lumagraph needs on a Debian/Ubuntu machine, skipping what is already there:
 # the Vulkan loader and Mesa's drivers (lavapipe, the CPU Vulkan driver, is the GPU of last
-# resort and the one the tests run on), a C toolchain, Python 3 (scripts/test.sh makes a test
-# mesh with it), Embree 3 (the path tracer traces its rays with it on CPU adapters; loaded at
+# resort and the one the tests run on), a C toolchain, Python 3 with its headers and venv
+# (scripts/test.sh makes a test mesh with it; the Python package links it and is tested in a
+# virtual environment), Embree 3 (the path tracer traces its rays with it on CPU adapters; loaded at
 # run time, optional), and Rust through rustup.
 # Safe to run again: it only installs what is missing.
 set -euo pipefail
 
-packages=(mesa-vulkan-drivers libvulkan1 ca-certificates curl gcc libc6-dev pkg-config python3 libembree3-3)
+packages=(mesa-vulkan-drivers libvulkan1 ca-certificates curl gcc libc6-dev pkg-config python3 python3-dev python3-venv libembree3-3)
 missing=()
 for p in "${packages[@]}"; do
     dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

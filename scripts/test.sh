@@ -9,3 +9,7 @@ bash scripts/setup.sh
 # The mesh of assets/bench/mesh_env.ron (a suite scene of tests/denoise/suite.rs) is made, not stored.
 [ -f assets/bench/blob.obj ] || python3 scripts/bench/mesh_env.py make assets/bench/blob.obj
 cargo test --locked --workspace "$@"
+# The Python package's tests, when every test runs (no filter given).
+if [ $# -eq 0 ]; then
+    bash scripts/python.sh test
+fi

@@ -173,6 +173,20 @@ impl Session {
         self.render(spp.max(1))
     }
 
+    /// Each sink (`Output` node) of the plan and the port whose image it writes
+    /// (`"node.port"`, readable with [`Session::read`]).
+    pub fn outputs(&mut self) -> Vec<(String, String)> {
+        let plan = self.exec.plan();
+        plan.passes
+            .iter()
+            .filter(|p| p.kind.sink)
+            .filter_map(|p| {
+                let (_, t) = p.inputs.first()?;
+                Some((p.node.clone(), plan.texture(*t).name.clone()))
+            })
+            .collect()
+    }
+
     /// The graph as it stands (with the params set since it was opened).
     pub fn graph(&self) -> &Graph {
         &self.graph

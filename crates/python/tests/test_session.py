@@ -1,0 +1,75 @@
+"""The Python package against the command line: the same files for the same graph, scene
+and spp; arrays of the scene's size in float32; a param change that re-runs only what is
+downstream of it; errors that name the file and line.
+
+Run by `bash scripts/python.sh test` (and `bash scripts/test.sh`), which sets LUMAGRAPH_BIN
+to the command line built from the same checkout."""
+
+import os
+import pathlib
+import subprocess
+
+import numpy as np
+import pytest
+
+import lumagraph as lg
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+GRAPH = ROOT / "graphs" / "pathtrace.ron"
+SCENE = ROOT / "assets" / "cornell.ron"
+
+
+def cli():
+    path = os.environ.get("LUMAGRAPH_BIN")
+    if not path:
+        pytest.skip("LUMAGRAPH_BIN is not set (scripts/python.sh test sets it)")
+    return str(ROOT / path) if not os.path.isabs(path) else path
+
+
+def test_a_render_from_python_is_byte_identical_to_the_cli(tmp_path):
+    theirs, ours = tmp_path / "cli", tmp_path / "python"
+    subprocess.run(
+        [cli(), "render", str(GRAPH), "--scene", str(SCENE), "--spp", "16", "--out", str(theirs)],
+        check=True, cwd=ROOT, capture_output=True,
+    )
+    s = lg.Session(str(GRAPH), str(SCENE), out=str(ours), write_outputs=True)
+    s.render(16)
+    assert s.spp == 16
+    for name in ["render.exr", "render.png"]:
+        assert (theirs / name).read_bytes() == (ours / name).read_bytes(), name
+
+
+def test_outputs_are_float32_arrays_of_the_scenes_size(tmp_path):
+    s = lg.Session(str(GRAPH), str(SCENE), out=str(tmp_path), keep=["pathtrace.color"])
+    images = s.render(8)
+    assert sorted(images) == ["exr", "png"]
+    for name, a in images.items():
+        assert a.shape == (256, 256, 4), name
+        assert a.dtype == np.float32, name
+        assert np.isfinite(a).all() and a[..., :3].mean() > 0.01, name
+    # Nothing written unless asked.
+    assert not any(tmp_path.iterdir())
+    raw = s.read("pathtrace.color")
+    assert raw.shape == (256, 256, 4) and raw.dtype == np.float32
+    with pytest.raises(lg.LumagraphError, match="pathtrace.albedo"):
+        s.read("pathtrace.albedo")
+
+
+def test_a_param_change_reruns_only_what_is_downstream(tmp_path):
+    s = lg.Session(str(GRAPH), str(SCENE), out=str(tmp_path))
+    before = s.render(8)
+    hdr = s.read("accumulate.color")
+    ran = s.set_param("exposure.ev", "1.0")
+    assert ran == ["exposure", "tonemap", "png"]
+    np.testing.assert_array_equal(s.read("accumulate.color"), hdr)
+    after = s.read("tonemap.color")
+    assert after[..., 1].sum() > 1.2 * before["png"][..., 1].sum()
+    with pytest.raises(lg.LumagraphError, match="nope"):
+        s.set_param("exposure.nope", "1")
+
+
+def test_a_bad_graph_raises_an_error_naming_file_and_line(tmp_path):
+    bad = tmp_path / "broken.ron"
+    bad.write_text('(\n    version: 1,\n    nodes: [\n        (id: "a" kind: "Tonemap"),\n    ],\n)\n')
+    with pytest.raises(lg.LumagraphError, match=r"broken\.ron:4:"):
+        lg.Session(str(bad))
