@@ -69,7 +69,14 @@ impl Session {
     /// When a file does not load (the error names the file and line), the graph does not
     /// compile (it names the node), or no adapter is found.
     pub fn open(graph: &Path, scene: Option<&Path>, options: SessionOptions) -> Result<Self> {
-        let graph = Graph::load(graph)?;
+        Self::open_graph(Graph::load(graph)?, scene, options)
+    }
+
+    /// [`Session::open`] for a graph already loaded or built in code.
+    ///
+    /// # Errors
+    /// As [`Session::open`].
+    pub fn open_graph(graph: Graph, scene: Option<&Path>, options: SessionOptions) -> Result<Self> {
         let scene = scene
             .map(|path| -> Result<Arc<GpuScene>> {
                 Ok(Arc::new(GpuScene::build(&Scene::load(path)?)?))

@@ -40,6 +40,103 @@ fn array<'py>(py: Python<'py>, img: &Image) -> PyResult<Bound<'py, PyArray3<f32>
     Ok(a.into_pyarray(py))
 }
 
+/// A render graph: loaded from a file or built in code.
+#[pyclass(module = "lumagraph")]
+#[derive(Clone)]
+struct Graph {
+    inner: lumagraph::graph::Graph,
+}
+
+#[pymethods]
+impl Graph {
+    /// An empty graph.
+    #[new]
+    fn new() -> Self {
+        Self {
+            inner: lumagraph::graph::Graph::new(),
+        }
+    }
+
+    /// Loads a graph file.
+    #[staticmethod]
+    #[expect(
+        clippy::needless_pass_by_value,
+        reason = "Python arguments arrive by value"
+    )]
+    fn load(path: PathBuf) -> PyResult<Self> {
+        let inner = lumagraph::graph::Graph::load(&path)
+            .map_err(|e| LumagraphError::new_err(e.to_string()))?;
+        Ok(Self { inner })
+    }
+
+    /// Adds a node of `kind` called `name`, its params as keyword arguments
+    /// (`add_node("Tonemap", "tonemap", operator="aces")`); returns the name.
+    #[pyo3(signature = (kind, name, **params))]
+    fn add_node(
+        &mut self,
+        kind: &str,
+        name: &str,
+        params: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<String> {
+        use lumagraph::graph::ParamValue;
+        if self.inner.node(name).is_some() {
+            return Err(LumagraphError::new_err(format!(
+                "there is already a node \"{name}\""
+            )));
+        }
+        let mut node = lumagraph::graph::Node::new(name, kind);
+        if let Some(params) = params {
+            for (k, v) in params.iter() {
+                let key: String = k.extract()?;
+                // bool before int: a Python bool is an int.
+                let value = if let Ok(b) = v.extract::<bool>() {
+                    ParamValue::Bool(b)
+                } else if let Ok(i) = v.extract::<i64>() {
+                    ParamValue::Int(i)
+                } else if let Ok(f) = v.extract::<f64>() {
+                    ParamValue::Float(f)
+                } else if let Ok(s) = v.extract::<String>() {
+                    ParamValue::Str(s)
+                } else {
+                    return Err(LumagraphError::new_err(format!(
+                        "{name}.{key}: a param is a bool, an int, a float or a str"
+                    )));
+                };
+                node = node.with(&key, value);
+            }
+        }
+        self.inner.nodes.push(node);
+        Ok(name.to_owned())
+    }
+
+    /// Connects output port `src` ("node.port") to input port `dst`.
+    fn connect(&mut self, src: &str, dst: &str) {
+        self.inner.edges.push(lumagraph::graph::Edge::new(src, dst));
+    }
+
+    /// Writes the graph file (atomically).
+    #[expect(
+        clippy::needless_pass_by_value,
+        reason = "Python arguments arrive by value"
+    )]
+    fn save(&self, path: PathBuf) -> PyResult<()> {
+        self.inner
+            .save(&path)
+            .map_err(|e| LumagraphError::new_err(e.to_string()))
+    }
+
+    /// The graph file's text.
+    fn to_ron(&self) -> String {
+        self.inner.to_ron()
+    }
+
+    /// The ids of its nodes, in order.
+    #[getter]
+    fn nodes(&self) -> Vec<String> {
+        self.inner.nodes.iter().map(|n| n.id.clone()).collect()
+    }
+}
+
 /// A graph and its scene on a device, rendered progressively.
 #[pyclass(unsendable, module = "lumagraph")]
 struct Session {
@@ -50,7 +147,8 @@ struct Session {
 impl Session {
     /// `Session(graph, scene=None, out="out", write_outputs=False, keep=[])`
     ///
-    /// Loads the graph file and the scene file and sets them up on the default adapter.
+    /// Loads the graph (a file, or a `Graph`) and the scene file and sets them up on the
+    /// default adapter.
     /// `Output` nodes write their files under `out` only with `write_outputs`; `keep` names
     /// more ports ("node.port") to read back with `read`.
     #[new]
@@ -60,7 +158,7 @@ impl Session {
     )]
     #[pyo3(signature = (graph, scene=None, out="out", write_outputs=false, keep=Vec::new()))]
     fn new(
-        graph: PathBuf,
+        graph: &Bound<'_, PyAny>,
         scene: Option<PathBuf>,
         out: &str,
         write_outputs: bool,
@@ -72,8 +170,17 @@ impl Session {
             keep,
             ..SessionOptions::default()
         };
-        let inner = lumagraph::session::Session::open(&graph, scene.as_deref(), options)
-            .map_err(|e| error(&e))?;
+        let opened = if let Ok(g) = graph.cast::<Graph>() {
+            lumagraph::session::Session::open_graph(
+                g.borrow().inner.clone(),
+                scene.as_deref(),
+                options,
+            )
+        } else {
+            let path: PathBuf = graph.extract()?;
+            lumagraph::session::Session::open(&path, scene.as_deref(), options)
+        };
+        let inner = opened.map_err(|e| error(&e))?;
         Ok(Self { inner })
     }
 
@@ -112,6 +219,7 @@ impl Session {
 /// Render graphs from Python.
 #[pymodule(name = "lumagraph")]
 fn lumagraph_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Graph>()?;
     m.add_class::<Session>()?;
     m.add("LumagraphError", m.py().get_type::<LumagraphError>())?;
     Ok(())
