@@ -18,4 +18,6 @@ if [ "${1:-}" = test ]; then
     cargo build --locked --workspace --bins
     export LUMAGRAPH_BIN="${CARGO_TARGET_DIR:-target}/debug/lumagraph"
     "$venv/bin/python" -m pytest -q crates/python/tests
+    # The example of docs/python.md.
+    "$venv/bin/python" examples/python/converge.py --out "${TMPDIR:-/tmp}/lumagraph-converge-python"
 fi

@@ -59,6 +59,8 @@ pub struct Session {
     write_outputs: bool,
     exec: Executor,
     spp: u32,
+    /// What the last run reported (its passes' times).
+    last: Option<FrameReport>,
 }
 
 impl Session {
@@ -117,6 +119,7 @@ impl Session {
             write_outputs: options.write_outputs,
             exec,
             spp: 0,
+            last: None,
         })
     }
 
@@ -133,7 +136,29 @@ impl Session {
             .render(frames, |_, _, _| true)?
             .context("the render stopped")?;
         self.spp = self.spp.max(spp);
+        self.last = Some(report.clone());
         Ok(report)
+    }
+
+    /// Milliseconds per pass (summed by node) in the last run's timed frame, as the
+    /// command line prints them; `None` before a run or where the adapter cannot time
+    /// passes.
+    pub fn timings(&self) -> Option<&[(String, f64)]> {
+        self.last.as_ref()?.pass_ms.as_deref()
+    }
+
+    /// What the graph's nodes measured in the last run (`Difference`'s relMSE, auto
+    /// exposure's EV, the path tracer's paths and rays): `(node, name, value)`.
+    ///
+    /// # Errors
+    /// When a readback fails.
+    pub fn measurements(&mut self) -> Result<Vec<(String, String, f64)>> {
+        Ok(self
+            .exec
+            .measurements()?
+            .into_iter()
+            .map(|(node, m)| (node, m.name.to_owned(), m.value))
+            .collect())
     }
 
     /// The samples per pixel rendered so far.
@@ -169,7 +194,9 @@ impl Session {
             .compile(&graph, &self.keep, self.scene.as_deref())?;
         self.graph = graph;
         if self.exec.update_params(plan.clone())? {
-            return Ok(self.exec.rerun(&[node])?);
+            let report = self.exec.rerun(&[node])?;
+            self.last = Some(report.clone());
+            return Ok(report);
         }
         // Another structure: a new executor, rendered again to the samples so far.
         let ctx = self.exec.context().clone();

@@ -214,12 +214,95 @@ impl Session {
     fn spp(&self) -> u32 {
         self.inner.spp()
     }
+
+    /// What the nodes measured in the last run, by "node.name" (a `Difference` node's
+    /// relMSE, the path tracer's paths and rays, …).
+    #[getter]
+    fn measurements<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let out = PyDict::new(py);
+        for (node, name, value) in self.inner.measurements().map_err(|e| error(&e))? {
+            out.set_item(format!("{node}.{name}"), value)?;
+        }
+        Ok(out)
+    }
+
+    /// Milliseconds per pass (by node) in the last run's timed frame, or `None` where the
+    /// adapter cannot time passes.
+    #[getter]
+    fn timings<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(times) = self.inner.timings() else {
+            return Ok(None);
+        };
+        let out = PyDict::new(py);
+        for (node, ms) in times {
+            out.set_item(node, ms)?;
+        }
+        Ok(Some(out))
+    }
+}
+
+fn param_value<'py>(
+    py: Python<'py>,
+    v: &lumagraph::graph::ParamValue,
+) -> PyResult<Bound<'py, PyAny>> {
+    use lumagraph::graph::ParamValue;
+    Ok(match v {
+        ParamValue::Bool(b) => b.into_pyobject(py)?.to_owned().into_any(),
+        ParamValue::Int(i) => i.into_pyobject(py)?.into_any(),
+        ParamValue::Float(f) => f.into_pyobject(py)?.into_any(),
+        ParamValue::Str(s) => s.into_pyobject(py)?.into_any(),
+    })
+}
+
+/// Every built-in node kind: its name, category, doc, input and output ports (name, type
+/// and doc) and params (name, default and doc).
+#[pyfunction]
+fn nodes(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
+    let registry = lumagraph::graph::Registry::with_builtins();
+    let mut out = Vec::new();
+    for k in registry.kinds() {
+        let d = PyDict::new(py);
+        d.set_item("kind", k.name)?;
+        d.set_item("category", k.category.name())?;
+        d.set_item("doc", k.doc)?;
+        let mut inputs = Vec::new();
+        for i in &k.inputs {
+            let p = PyDict::new(py);
+            p.set_item("name", i.name)?;
+            let types: Vec<String> = i.accepts.iter().map(ToString::to_string).collect();
+            p.set_item("types", types)?;
+            p.set_item("doc", i.doc)?;
+            inputs.push(p);
+        }
+        d.set_item("inputs", inputs)?;
+        let mut outputs = Vec::new();
+        for o in &k.outputs {
+            let p = PyDict::new(py);
+            p.set_item("name", o.name)?;
+            p.set_item("type", o.ty.to_string())?;
+            p.set_item("doc", o.doc)?;
+            outputs.push(p);
+        }
+        d.set_item("outputs", outputs)?;
+        let mut params = Vec::new();
+        for prm in &k.params {
+            let p = PyDict::new(py);
+            p.set_item("name", prm.name)?;
+            p.set_item("default", param_value(py, &prm.ty.default_value())?)?;
+            p.set_item("doc", prm.doc)?;
+            params.push(p);
+        }
+        d.set_item("params", params)?;
+        out.push(d);
+    }
+    Ok(out)
 }
 
 /// Render graphs from Python.
 #[pymodule(name = "lumagraph")]
 fn lumagraph_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Graph>()?;
+    m.add_function(wrap_pyfunction!(nodes, m)?)?;
     m.add_class::<Session>()?;
     m.add("LumagraphError", m.py().get_type::<LumagraphError>())?;
     Ok(())

@@ -105,3 +105,32 @@ def test_a_graph_built_in_code_saves_a_file_the_cli_renders_identically(tmp_path
     lg.Session(g, str(SCENE), out=str(ours), write_outputs=True).render(8)
     for name in ["render.exr", "render.png"]:
         assert (theirs / name).read_bytes() == (ours / name).read_bytes(), name
+
+
+def test_the_node_list_has_every_kind_with_its_ports_and_params():
+    kinds = {k["kind"]: k for k in lg.nodes()}
+    assert {"PathTrace", "Accumulate", "Tonemap", "Output", "Difference"} <= set(kinds)
+    tonemap = kinds["Tonemap"]
+    assert [p["name"] for p in tonemap["inputs"]] == ["color"]
+    assert any(p["name"] == "operator" and p["default"] == "aces" for p in tonemap["params"])
+    assert all(k["doc"] for k in kinds.values())
+
+
+def test_measurements_and_timings_after_a_render(tmp_path):
+    # A Difference node measures the accumulation against the raw frame.
+    g = lg.Graph()
+    g.add_node("PathTrace", "pathtrace", samples_per_frame=4)
+    g.add_node("Accumulate", "accumulate")
+    g.add_node("Difference", "diff", metric="relmse")
+    g.add_node("Output", "out", path="diff.png")
+    g.connect("pathtrace.color", "accumulate.color")
+    g.connect("accumulate.color", "diff.color")
+    g.connect("pathtrace.color", "diff.reference")
+    g.connect("diff.heat", "out.color")
+    s = lg.Session(g, str(SCENE), out=str(tmp_path))
+    s.render(8)
+    m = s.measurements
+    assert list(m) == ["diff.relmse"], m
+    assert m["diff.relmse"] > 0
+    t = s.timings
+    assert t is None or ("pathtrace" in t and all(v >= 0 for v in t.values())), t
