@@ -58,7 +58,6 @@ pub struct Session {
     resources: Resources,
     write_outputs: bool,
     exec: Executor,
-    spp: u32,
     /// What the last run reported (its passes' times).
     last: Option<FrameReport>,
 }
@@ -118,7 +117,6 @@ impl Session {
             resources,
             write_outputs: options.write_outputs,
             exec,
-            spp: 0,
             last: None,
         })
     }
@@ -130,14 +128,30 @@ impl Session {
     /// # Errors
     /// When a node fails; the error names the node.
     pub fn render(&mut self, spp: u32) -> Result<FrameReport> {
+        self.render_with(spp, |_, _| true)?
+            .context("the render stopped")
+    }
+
+    /// [`Session::render`], calling `progress(frames done, frames in all)` a few times a
+    /// second; where it returns `false` the render stops there (`Ok(None)`, nothing
+    /// finished or written), and a later `render` goes on from the frames done.
+    ///
+    /// # Errors
+    /// When a node fails; the error names the node.
+    pub fn render_with(
+        &mut self,
+        spp: u32,
+        mut progress: impl FnMut(u32, u32) -> bool,
+    ) -> Result<Option<FrameReport>> {
         let frames = self.exec.frames_for(spp);
-        let report = self
+        let Some(report) = self
             .exec
-            .render(frames, |_, _, _| true)?
-            .context("the render stopped")?;
-        self.spp = self.spp.max(spp);
+            .render(frames, |_, done, all| progress(done, all))?
+        else {
+            return Ok(None);
+        };
         self.last = Some(report.clone());
-        Ok(report)
+        Ok(Some(report))
     }
 
     /// Milliseconds per pass (summed by node) in the last run's timed frame, as the
@@ -161,9 +175,22 @@ impl Session {
             .collect())
     }
 
-    /// The samples per pixel rendered so far.
-    pub fn spp(&self) -> u32 {
-        self.spp
+    /// The samples per pixel accumulated so far: the frames run since the accumulation
+    /// (re)started times the path tracer's `samples_per_frame` (a render asked for fewer
+    /// than that is already past them, and a stopped one has the frames it ran).
+    pub fn spp(&self) -> u64 {
+        let spf = self
+            .exec
+            .plan()
+            .passes
+            .iter()
+            .find(|p| p.params.has(crate::graph::registry::SAMPLES_PER_FRAME))
+            .map_or(1, |p| {
+                u64::try_from(p.params.int(crate::graph::registry::SAMPLES_PER_FRAME))
+                    .unwrap_or(1)
+                    .max(1)
+            });
+        self.exec.frames() * spf
     }
 
     /// The image on output `"node.port"` as the last frame left it: a port another pass
@@ -199,11 +226,12 @@ impl Session {
             return Ok(report);
         }
         // Another structure: a new executor, rendered again to the samples so far.
+        let spp = self.spp();
         let ctx = self.exec.context().clone();
         self.exec = Executor::with_library(&ctx, plan, &self.resources, &self.library)?;
         self.exec.hold_sinks(!self.write_outputs);
         self.exec.warm_up()?;
-        let spp = std::mem::take(&mut self.spp);
+        let spp = u32::try_from(spp).unwrap_or(u32::MAX);
         self.render(spp.max(1))
     }
 

@@ -185,9 +185,41 @@ impl Session {
     }
 
     /// Renders on to `spp` samples per pixel in all; returns each `Output` node's image
-    /// (what its input port holds), by the node's id.
-    fn render<'py>(&mut self, py: Python<'py>, spp: u32) -> PyResult<Bound<'py, PyDict>> {
-        self.inner.render(spp).map_err(|e| error(&e))?;
+    /// (what its input port holds), by the node's id. With `progress`, prints the frames
+    /// done to standard error as it goes. Ctrl-C stops it between batches of frames
+    /// (`KeyboardInterrupt`); a later `render` goes on from the frames done.
+    #[pyo3(signature = (spp, progress=false))]
+    fn render<'py>(
+        &mut self,
+        py: Python<'py>,
+        spp: u32,
+        progress: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let mut interrupted = None;
+        let done = self
+            .inner
+            .render_with(spp, |done, all| {
+                if progress {
+                    eprint!("\rlumagraph: {done}/{all} frames");
+                }
+                match py.check_signals() {
+                    Ok(()) => true,
+                    Err(e) => {
+                        interrupted = Some(e);
+                        false
+                    }
+                }
+            })
+            .map_err(|e| error(&e))?;
+        if progress {
+            eprintln!();
+        }
+        if let Some(e) = interrupted {
+            return Err(e);
+        }
+        if done.is_none() {
+            return Err(LumagraphError::new_err("the render stopped"));
+        }
         let out = PyDict::new(py);
         for (node, port) in self.inner.outputs() {
             let img = self.inner.read(&port).map_err(|e| error(&e))?;
@@ -209,9 +241,9 @@ impl Session {
         Ok(report.executed)
     }
 
-    /// Samples per pixel rendered so far.
+    /// Samples per pixel accumulated so far.
     #[getter]
-    fn spp(&self) -> u32 {
+    fn spp(&self) -> u64 {
         self.inner.spp()
     }
 

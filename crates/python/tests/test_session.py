@@ -134,3 +134,25 @@ def test_measurements_and_timings_after_a_render(tmp_path):
     assert m["diff.relmse"] > 0
     t = s.timings
     assert t is None or ("pathtrace" in t and all(v >= 0 for v in t.values())), t
+
+
+def test_ctrl_c_stops_a_long_render_and_the_session_goes_on(tmp_path):
+    import signal
+    import time
+
+    s = lg.Session(str(GRAPH), str(SCENE), out=str(tmp_path))
+    # Ctrl-C as a terminal sends it: SIGINT from outside, one second in (a thread could not
+    # send it: the render holds the interpreter).
+    killer = subprocess.Popen(["sh", "-c", f"sleep 1; kill -INT {os.getpid()}"])
+    start = time.monotonic()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            s.render(1 << 16)  # minutes on lavapipe: stopped long before
+    finally:
+        killer.wait()
+    assert time.monotonic() - start < 30
+    stopped_at = s.spp  # the frames run before the stop, 4 samples each
+    assert stopped_at % 4 == 0 and stopped_at < 1 << 16
+    images = s.render(stopped_at + 8)
+    assert images["png"].shape == (256, 256, 4)
+    assert s.spp == stopped_at + 8
