@@ -326,14 +326,7 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
     let stage = progressive::Stage::start(format!("loading {} (meshes, textures)", path.display()));
     let scene = Scene::load(path)?;
     drop(stage);
-    let r = &scene.report;
-    if r.degenerate_triangles + r.non_finite_triangles + r.replaced_normals > 0 {
-        println!(
-            "scene warning: dropped {} zero-area and {} non-finite triangles, replaced {} unusable normals",
-            r.degenerate_triangles, r.non_finite_triangles, r.replaced_normals
-        );
-    }
-    for w in &r.warnings {
+    for w in scene.report.lines() {
         println!("scene warning: {w}");
     }
     let built = Instant::now();

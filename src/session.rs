@@ -60,6 +60,8 @@ pub struct Session {
     exec: Executor,
     /// What the last run reported (its passes' times).
     last: Option<FrameReport>,
+    /// What loading the scene warned of.
+    warnings: Vec<String>,
 }
 
 impl Session {
@@ -78,12 +80,20 @@ impl Session {
     /// # Errors
     /// As [`Session::open`].
     pub fn open_graph(graph: Graph, scene: Option<&Path>, options: SessionOptions) -> Result<Self> {
+        let mut warnings = Vec::new();
         let scene = scene
             .map(|path| -> Result<Arc<GpuScene>> {
-                Ok(Arc::new(GpuScene::build(&Scene::load(path)?)?))
+                let scene = Scene::load(path)?;
+                warnings = scene.report.lines();
+                for w in &warnings {
+                    eprintln!("scene warning: {w}");
+                }
+                Ok(Arc::new(GpuScene::build(&scene)?))
             })
             .transpose()?;
-        Self::with(graph, scene, options)
+        let mut session = Self::with(graph, scene, options)?;
+        session.warnings = warnings;
+        Ok(session)
     }
 
     /// A session of `graph` (loaded or built in code) and `scene` (flattened).
@@ -118,6 +128,7 @@ impl Session {
             write_outputs: options.write_outputs,
             exec,
             last: None,
+            warnings: Vec::new(),
         })
     }
 
@@ -179,18 +190,14 @@ impl Session {
     /// (re)started times the path tracer's `samples_per_frame` (a render asked for fewer
     /// than that is already past them, and a stopped one has the frames it ran).
     pub fn spp(&self) -> u64 {
-        let spf = self
-            .exec
-            .plan()
-            .passes
-            .iter()
-            .find(|p| p.params.has(crate::graph::registry::SAMPLES_PER_FRAME))
-            .map_or(1, |p| {
-                u64::try_from(p.params.int(crate::graph::registry::SAMPLES_PER_FRAME))
-                    .unwrap_or(1)
-                    .max(1)
-            });
-        self.exec.frames() * spf
+        self.exec.frames() * u64::from(self.exec.samples_per_frame())
+    }
+
+    /// What loading the scene warned of (dropped triangles, what the scene's files hold
+    /// that lumagraph does not use), one line each; also printed to standard error as
+    /// `scene warning: …` when the session opens.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     /// The image on output `"node.port"` as the last frame left it: a port another pass

@@ -241,6 +241,12 @@ impl Session {
         Ok(report.executed)
     }
 
+    /// What loading the scene warned of (also printed to standard error), one line each.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.inner.warnings().to_vec()
+    }
+
     /// Samples per pixel accumulated so far.
     #[getter]
     fn spp(&self) -> u64 {

@@ -156,3 +156,37 @@ def test_ctrl_c_stops_a_long_render_and_the_session_goes_on(tmp_path):
     images = s.render(stopped_at + 8)
     assert images["png"].shape == (256, 256, 4)
     assert s.spp == stopped_at + 8
+
+
+def test_scene_warnings_are_printed_and_kept(tmp_path, capfd):
+    # A glTF triangle whose file uses an extension lumagraph does not read: said, not ignored.
+    import base64
+    import json
+    import struct
+
+    data = struct.pack("<9f", -1, -1, 0, 1, -1, 0, 0, 1, 0)
+    gltf = {
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_anisotropy"],
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "buffers": [{"byteLength": len(data),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+        "bufferViews": [{"buffer": 0, "byteLength": len(data)}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [-1, -1, 0], "max": [1, 1, 0]}],
+    }
+    (tmp_path / "tri.gltf").write_text(json.dumps(gltf))
+    scene = tmp_path / "tri.ron"
+    scene.write_text(
+        "(\n    version: 2,\n"
+        "    camera: Perspective(position: (0, 0, 4), target: (0, 0, 0), up: (0, 1, 0), fov_y: 40),\n"
+        '    shapes: [Mesh(name: "tri", path: "tri.gltf")],\n'
+        "    environment: Constant((1, 1, 1)),\n"
+        "    render: (width: 32, height: 32),\n)\n"
+    )
+    s = lg.Session(str(GRAPH), str(scene), out=str(tmp_path / "out"))
+    assert any("KHR_materials_anisotropy" in w for w in s.warnings), s.warnings
+    assert "scene warning:" in capfd.readouterr().err
+    assert s.render(4)["png"].shape == (32, 32, 4)

@@ -370,8 +370,13 @@ impl Executor {
     /// Frames that make `spp` samples per pixel: `spp / samples_per_frame` of the pass
     /// samples come from (rounded up, at least 1); 1 when the plan has no such pass.
     pub fn frames_for(&self, spp: u32) -> u32 {
-        let spf = self
-            .plan
+        spp.div_ceil(self.samples_per_frame()).max(1)
+    }
+
+    /// Samples per pixel a frame adds: the `samples_per_frame` of the pass samples come
+    /// from; 1 when the plan has no such pass.
+    pub fn samples_per_frame(&self) -> u32 {
+        self.plan
             .passes
             .iter()
             .find(|p| p.params.has(lumagraph_graph::registry::SAMPLES_PER_FRAME))
@@ -379,8 +384,7 @@ impl Executor {
                 u32::try_from(p.params.int(lumagraph_graph::registry::SAMPLES_PER_FRAME))
                     .unwrap_or(1)
                     .max(1)
-            });
-        spp.div_ceil(spf).max(1)
+            })
     }
 
     /// Runs frames until `frames` ran since the last reset (counting those a

@@ -466,6 +466,20 @@ impl LoadReport {
         *self == Self::default()
     }
 
+    /// Every warning, one line each: the dropped and repaired triangles counted, then the
+    /// others (what `lumagraph render` and a session print as `scene warning: …`).
+    pub fn lines(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.degenerate_triangles + self.non_finite_triangles + self.replaced_normals > 0 {
+            out.push(format!(
+                "dropped {} zero-area and {} non-finite triangles, replaced {} unusable normals",
+                self.degenerate_triangles, self.non_finite_triangles, self.replaced_normals
+            ));
+        }
+        out.extend(self.warnings.iter().cloned());
+        out
+    }
+
     /// Adds the counts and warnings of `other`.
     pub fn merge(&mut self, other: Self) {
         self.degenerate_triangles += other.degenerate_triangles;
