@@ -15,7 +15,6 @@ mod bench;
 mod converge;
 mod gallery;
 mod gltf_gallery;
-mod plot;
 mod progressive;
 mod split;
 mod tiled;
@@ -513,7 +512,7 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
             graph: args.graph,
             scene: args.scene,
             overrides: args.overrides,
-            key: progressive::key(&graph, scene.as_ref().map(|s| &*s.gpu)),
+            key: crate::session::render_key(&graph, scene.as_ref().map(|s| &*s.gpu)),
             out: args.out,
         };
         return split::render_partial(&mut exec, range, &origin);
@@ -524,7 +523,7 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
             .or(scene.as_ref().map(|s| s.scene.settings.spp))
             .unwrap_or(1);
         let mut checkpoints = args.checkpoints.clone();
-        checkpoints.key = progressive::key(&graph, scene.as_ref().map(|s| &*s.gpu));
+        checkpoints.key = crate::session::render_key(&graph, scene.as_ref().map(|s| &*s.gpu));
         progressive::render(&mut exec, spp, &checkpoints)?
     } else {
         // The first frame includes pipeline compilation inside the driver; time a second one.

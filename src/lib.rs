@@ -15,6 +15,7 @@
 //! (`docs/extending.md`, `examples/custom-node/`).
 
 pub mod cli;
+pub mod converge;
 pub mod session;
 
 pub use lumagraph_editor as editor;

@@ -2,7 +2,8 @@
 //! as images, from a program rather than the command line. It renders what
 //! `lumagraph render` renders (the same frames in the same order, so the same files, byte
 //! for byte), and then goes on: more samples, another param (re-running only what is
-//! downstream of it), a checkpoint.
+//! downstream of it), an edited scene (a moved camera, another material: the accumulation
+//! restarts), a checkpoint to resume from.
 //!
 //! ```no_run
 //! use lumagraph::session::{Session, SessionOptions};
@@ -21,8 +22,11 @@ use anyhow::{Context as _, Result};
 
 use crate::graph::Graph;
 use crate::render::cpu::Image;
-use crate::render::{Executor, FrameReport, GpuContext, NodeLibrary, Resources};
-use crate::scene::{GpuScene, Scene};
+use crate::render::{Checkpoint, Executor, FrameReport, GpuContext, NodeLibrary, Resources};
+use crate::scene::GpuScene;
+use crate::scene::edit::SceneText;
+use crate::scene::file::SceneFile;
+use crate::scene::gpu::GpuCamera;
 
 /// How a [`Session`] is set up.
 #[derive(Clone, Debug)]
@@ -54,6 +58,11 @@ pub struct Session {
     graph: Graph,
     library: Arc<NodeLibrary>,
     scene: Option<Arc<GpuScene>>,
+    /// The scene file's text and values as edited (none for a scene given flattened).
+    scene_text: Option<SceneText>,
+    /// Where [`Session::set_scene`] moved the camera to, the scene being otherwise the
+    /// same (`scene` keeps the file's camera).
+    camera: Option<GpuCamera>,
     keep: Vec<String>,
     resources: Resources,
     write_outputs: bool,
@@ -80,19 +89,30 @@ impl Session {
     /// # Errors
     /// As [`Session::open`].
     pub fn open_graph(graph: Graph, scene: Option<&Path>, options: SessionOptions) -> Result<Self> {
-        let mut warnings = Vec::new();
-        let scene = scene
-            .map(|path| -> Result<Arc<GpuScene>> {
-                let scene = Scene::load(path)?;
-                warnings = scene.report.lines();
-                for w in &warnings {
-                    eprintln!("scene warning: {w}");
-                }
-                Ok(Arc::new(GpuScene::build(&scene)?))
-            })
-            .transpose()?;
-        let mut session = Self::with(graph, scene, options)?;
+        let scene = scene.map(SceneText::load).transpose()?;
+        Self::open_scene(graph, scene, options)
+    }
+
+    /// [`Session::open`] for a graph and a scene file already loaded (and perhaps edited:
+    /// [`crate::scene::edit`]).
+    ///
+    /// # Errors
+    /// As [`Session::open`].
+    pub fn open_scene(
+        graph: Graph,
+        scene: Option<SceneText>,
+        options: SessionOptions,
+    ) -> Result<Self> {
+        let (gpu, warnings) = match &scene {
+            Some(text) => {
+                let (gpu, warnings) = build_scene(text)?;
+                (Some(gpu), warnings)
+            }
+            None => (None, Vec::new()),
+        };
+        let mut session = Self::with(graph, gpu, options)?;
         session.warnings = warnings;
+        session.scene_text = scene;
         Ok(session)
     }
 
@@ -123,6 +143,8 @@ impl Session {
             graph,
             library,
             scene,
+            scene_text: None,
+            camera: None,
             keep: options.keep,
             resources,
             write_outputs: options.write_outputs,
@@ -209,6 +231,30 @@ impl Session {
         Ok(self.exec.read_port(port)?)
     }
 
+    /// The image on output `"node.port"` as a PNG file's bytes, for display: a display
+    /// image (`LdrColor`, after tone mapping) as it is, a linear one sRGB-encoded; both
+    /// clipped to [0, 1], as an `Output` node writes a PNG.
+    ///
+    /// # Errors
+    /// As [`Session::read`].
+    pub fn png(&self, port: &str) -> Result<Vec<u8>> {
+        use crate::graph::{PortType, TexFormat};
+        use crate::render::image_io::{encode_png, to_rgba8};
+        let t = self
+            .exec
+            .plan()
+            .texture_named(port)
+            .with_context(|| format!("no planned texture for {port}"))?;
+        let (w, h) = (t.extent.width, t.extent.height);
+        let rgba8 = if t.format == TexFormat::Rgba8Unorm {
+            // Stored as the PNG holds it.
+            self.exec.read_raw(t.id)?
+        } else {
+            to_rgba8(&self.exec.read(t.id)?, t.ty != PortType::LdrColor)
+        };
+        Ok(encode_png(w, h, &rgba8)?)
+    }
+
     /// Sets param `target` (`"node.param"`) to `value` (as `--set` takes it) and re-runs
     /// the passes it changes: only the node and what is downstream of it, over the
     /// accumulation as it is, or a restarted accumulation where the node is progressive
@@ -234,26 +280,150 @@ impl Session {
         }
         // Another structure: a new executor, rendered again to the samples so far.
         let spp = self.spp();
-        let ctx = self.exec.context().clone();
-        self.exec = Executor::with_library(&ctx, plan, &self.resources, &self.library)?;
-        self.exec.hold_sinks(!self.write_outputs);
-        self.exec.warm_up()?;
+        self.rebuild(plan)?;
         let spp = u32::try_from(spp).unwrap_or(u32::MAX);
         self.render(spp.max(1))
     }
 
+    /// A new executor of `plan` on the same device, at the moved camera if any, warmed up.
+    fn rebuild(&mut self, plan: crate::graph::Plan) -> Result<()> {
+        let ctx = self.exec.context().clone();
+        self.exec = Executor::with_library(&ctx, plan, &self.resources, &self.library)?;
+        self.exec.hold_sinks(!self.write_outputs);
+        if let Some(camera) = &self.camera {
+            self.exec.move_camera(camera);
+        }
+        self.exec.warm_up()?;
+        Ok(())
+    }
+
+    /// The scene file as loaded and edited; `None` for a session without one or given a
+    /// flattened scene ([`Session::with`]).
+    pub fn scene(&self) -> Option<&SceneText> {
+        self.scene_text.as_ref()
+    }
+
+    /// Renders `file` from now on: the scene file's values edited ([`crate::scene::edit`]:
+    /// camera, materials, environment, render settings). The accumulation restarts
+    /// ([`Session::spp`] is 0). Where only the camera changed, the executor keeps its
+    /// pipelines and buffers and only the camera moves; otherwise the scene is built
+    /// again and the graph compiled for it (its size may have changed, and what the
+    /// shaders leave out).
+    ///
+    /// # Errors
+    /// When the session has no scene file, or the edited scene does not load (the error
+    /// names the file and what is wrong); the session then renders the scene as it was.
+    pub fn set_scene(&mut self, file: SceneFile) -> Result<SceneChange> {
+        let current = self
+            .scene_text
+            .as_ref()
+            .context("this session has no scene file to edit")?;
+        if current.file == file {
+            return Ok(SceneChange::Nothing);
+        }
+        let mut edited = current.clone();
+        edited.file = file;
+        let mut same_but_camera = current.file.clone();
+        same_but_camera.camera = edited.file.camera.clone();
+        if same_but_camera == edited.file
+            && let Some(gpu) = &self.scene
+        {
+            let scene = edited.build()?;
+            let camera = gpu.camera_for(&scene.camera);
+            self.camera = (camera != gpu.camera).then_some(camera);
+            self.exec.move_camera(&camera);
+            self.exec.restart();
+            self.scene_text = Some(edited);
+            return Ok(SceneChange::Camera);
+        }
+        let (gpu, warnings) = build_scene(&edited)?;
+        let plan = self.library.compile(&self.graph, &self.keep, Some(&gpu))?;
+        let old = (self.scene.replace(Arc::clone(&gpu)), self.camera.take());
+        self.resources.scene = Some(gpu);
+        if let Err(e) = self.rebuild(plan) {
+            // Back to the scene as it was; its executor is gone, so build that again.
+            self.resources.scene.clone_from(&old.0);
+            (self.scene, self.camera) = old;
+            let plan = self
+                .library
+                .compile(&self.graph, &self.keep, self.scene.as_deref())?;
+            self.rebuild(plan)?;
+            return Err(e);
+        }
+        self.warnings = warnings;
+        self.scene_text = Some(edited);
+        Ok(SceneChange::Scene)
+    }
+
+    /// The key of what this session renders ([`render_key`]): the graph as it stands and
+    /// the scene as edited.
+    fn key(&self) -> u64 {
+        let mut scene = self.scene.as_deref().cloned();
+        if let (Some(s), Some(camera)) = (scene.as_mut(), self.camera) {
+            s.camera = camera;
+        }
+        render_key(&self.graph, scene.as_ref())
+    }
+
+    /// Writes where the render stands to `path` (atomically): the frames run and the
+    /// history of every node that keeps one, as `lumagraph render --checkpoint` writes
+    /// it, so either can go on from it.
+    ///
+    /// # Errors
+    /// When a readback fails or the file cannot be written.
+    pub fn checkpoint(&mut self, path: &Path) -> Result<()> {
+        let key = self.key();
+        self.exec.checkpoint(key)?.save(path)?;
+        Ok(())
+    }
+
+    /// Goes on from the checkpoint at `path` (written by [`Session::checkpoint`] or by
+    /// `lumagraph render`): the next [`Session::render`] renders on from its samples.
+    ///
+    /// # Errors
+    /// When it does not load, or is of another graph, scene or lumagraph version (the
+    /// error says which); the session is then unchanged.
+    pub fn resume(&mut self, path: &Path) -> Result<()> {
+        let from = Checkpoint::load(path)?;
+        from.check(self.key())
+            .map_err(|e| anyhow::anyhow!("cannot resume from {}: {e}", path.display()))?;
+        if from.adapter != self.exec.context().info.name {
+            eprintln!(
+                "warning: the checkpoint {} was made on {}, this is {}: the result may differ \
+                 from an uninterrupted render in the last bits",
+                path.display(),
+                from.adapter,
+                self.exec.context().info.name
+            );
+        }
+        self.exec
+            .restore(&from)
+            .with_context(|| format!("cannot resume from {}", path.display()))?;
+        Ok(())
+    }
+
     /// Each sink (`Output` node) of the plan and the port whose image it writes
-    /// (`"node.port"`, readable with [`Session::read`]).
+    /// (`"node.port"`, readable with [`Session::read`]), in the order of the graph's nodes.
     pub fn outputs(&mut self) -> Vec<(String, String)> {
         let plan = self.exec.plan();
-        plan.passes
+        let mut out: Vec<(String, String)> = plan
+            .passes
             .iter()
             .filter(|p| p.kind.sink)
             .filter_map(|p| {
                 let (_, t) = p.inputs.first()?;
                 Some((p.node.clone(), plan.texture(*t).name.clone()))
             })
-            .collect()
+            .collect();
+        let order = |node: &str| {
+            self.graph
+                .nodes
+                .iter()
+                .position(|n| n.id == node)
+                .unwrap_or(usize::MAX)
+        };
+        out.sort_by_key(|(node, _)| order(node));
+        out
     }
 
     /// The graph as it stands (with the params set since it was opened).
@@ -264,5 +434,103 @@ impl Session {
     /// The executor, for what this API does not cover.
     pub fn executor(&mut self) -> &mut Executor {
         &mut self.exec
+    }
+}
+
+/// What [`Session::set_scene`] changed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SceneChange {
+    /// Nothing: the values were those rendered.
+    Nothing,
+    /// The camera only: it moved, the executor stayed.
+    Camera,
+    /// More than the camera: the scene was built again.
+    Scene,
+}
+
+/// Loads what `text` references and flattens it; returns the scene with the lines loading
+/// warned of (also printed to standard error as `scene warning: …`).
+fn build_scene(text: &SceneText) -> Result<(Arc<GpuScene>, Vec<String>)> {
+    let scene = text.build()?;
+    let warnings = scene.report.lines();
+    for w in &warnings {
+        eprintln!("scene warning: {w}");
+    }
+    Ok((Arc::new(GpuScene::build(&scene)?), warnings))
+}
+
+/// The key of a render, which a checkpoint carries so that only the same render goes on
+/// from it: lumagraph's version, the graph as run (overrides applied, without layout and
+/// comments) and every number of the flattened scene.
+pub fn render_key(graph: &Graph, scene: Option<&GpuScene>) -> u64 {
+    let mut g = graph.clone();
+    g.origin = None;
+    for n in &mut g.nodes {
+        n.pos = None;
+    }
+    let scene = scene.map_or_else(String::new, scene_digest);
+    crate::render::checkpoint::render_key(&g.to_ron(), &scene)
+}
+
+/// Every number of the flattened scene, hashed: what the GPU gets and the CPU data that
+/// shapes the render (the host intersector's corners, the orders, the environment map's
+/// file). Hashing the bytes rather than the scene's `Debug` text keeps a large scene's key
+/// cheap (the Crytek Sponza's text was over a gigabyte and took most of a minute).
+pub(crate) fn scene_digest(s: &GpuScene) -> String {
+    use bytemuck::{bytes_of, cast_slice};
+    let h = crate::render::checkpoint::Fnv::default()
+        .write(bytes_of(&s.header))
+        .write(bytes_of(&s.camera))
+        .write(bytes_of(&s.settings))
+        .write(cast_slice(&s.bvh_nodes))
+        .write(cast_slice(&s.bvh_skips))
+        .write(cast_slice(&s.tri_positions))
+        .write(cast_slice(&s.tri_corners))
+        .write(cast_slice(&s.tri_shading))
+        .write(cast_slice(&s.shapes))
+        .write(cast_slice(&s.materials))
+        .write(cast_slice(&s.lights))
+        .write(cast_slice(&s.light_alias))
+        .write(cast_slice(&s.tri_texcoords))
+        .write(cast_slice(&s.atlas.descriptors))
+        .write(cast_slice(&s.atlas.texels))
+        .write(&s.atlas.page_size.to_le_bytes())
+        .write(&s.atlas.pages.to_le_bytes())
+        .write(&s.vertex_alpha_min)
+        .write(cast_slice(&s.tri_source))
+        .write(cast_slice(&s.shape_source))
+        .write(cast_slice(&s.instances))
+        .write(cast_slice(&s.instance_mesh))
+        .write(cast_slice(&s.mesh_triangles))
+        .write(format!("{:?}", s.environment_map).as_bytes());
+    format!("{:016x}", h.finish())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The key of a render's checkpoint follows the instances: a moved instance (its mesh
+    /// and everything else the same) is another scene.
+    #[test]
+    fn the_scene_key_follows_the_instances() {
+        let text = |x: f32| {
+            format!(
+                "(version: 2, camera: Perspective(position: (0, 0, 9), target: (0, 0, 0), fov_y: 40),
+                  materials: {{ \"m\": () }},
+                  shapes: [Mesh(path: \"CornellBox/CornellBox.gltf\", material: \"m\",
+                                instances: [(), (translate: ({x}, 0, 0))])],
+                  render: (width: 8, height: 8), instancing: On)"
+            )
+        };
+        let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
+        let digest = |x: f32| {
+            let scene = crate::scene::Scene::from_ron(&text(x), &assets).unwrap();
+            let gpu = GpuScene::build(&scene).unwrap();
+            assert_eq!(gpu.instances.len(), 2);
+            scene_digest(&gpu)
+        };
+        assert_eq!(digest(3.0), digest(3.0));
+        assert_ne!(digest(3.0), digest(3.5));
     }
 }

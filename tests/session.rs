@@ -123,3 +123,131 @@ fn a_bad_graph_names_its_file_and_line() {
     assert!(e.contains("broken.ron"), "{e}");
     assert!(e.contains(":4:") || e.contains("line 4"), "{e}");
 }
+
+/// A render checkpointed at 8 spp goes on to 16 spp, in another session or in
+/// `lumagraph render --resume`, to the image a render straight to 16 spp makes, byte for
+/// byte; a checkpoint of another scene is refused, naming the file.
+#[test]
+fn a_checkpoint_goes_on_where_the_render_stopped() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let ck = dir.path().join("at8.checkpoint");
+    let mut first = open(&dir.path().join("first"), false, &[]);
+    first.render(8).unwrap();
+    first.checkpoint(&ck).unwrap();
+    drop(first);
+
+    let straight_dir = dir.path().join("straight");
+    let mut straight = open(&straight_dir, true, &[]);
+    straight.render(16).unwrap();
+    let expected = straight.read("accumulate.color").unwrap();
+    drop(straight);
+
+    let mut resumed = open(&dir.path().join("resumed"), false, &[]);
+    resumed.resume(&ck).unwrap();
+    assert_eq!(resumed.spp(), 8);
+    resumed.render(16).unwrap();
+    assert_eq!(resumed.spp(), 16);
+    assert!(resumed.read("accumulate.color").unwrap().pixels == expected.pixels);
+
+    // The command line goes on from the session's checkpoint too.
+    let cli = dir.path().join("cli");
+    let o = Command::new(env!("CARGO_BIN_EXE_lumagraph"))
+        .args([
+            "render",
+            "graphs/pathtrace.ron",
+            "--scene",
+            "assets/cornell.ron",
+        ])
+        .args(["--spp", "16", "--out", cli.to_str().unwrap()])
+        .args(["--resume", ck.to_str().unwrap()])
+        .current_dir(common::root())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        std::fs::read(cli.join("render.exr")).unwrap()
+            == std::fs::read(straight_dir.join("render.exr")).unwrap(),
+        "the command line's render from the checkpoint differs"
+    );
+
+    // Another scene's render does not take it.
+    let mut other = Session::open(
+        &common::repo("graphs/pathtrace.ron"),
+        Some(&common::repo("assets/cornell_spheres.ron")),
+        SessionOptions::default(),
+    )
+    .unwrap();
+    let e = format!("{:#}", other.resume(&ck).unwrap_err());
+    assert!(e.contains("at8.checkpoint"), "{e}");
+    assert_eq!(other.spp(), 0);
+}
+
+/// Scene edits: a moved camera (the executor kept) renders what a session opened on the
+/// edited file renders, byte for byte; a material edit builds the scene again; both
+/// restart the accumulation; a bad value is refused and the session renders on.
+#[test]
+fn an_edited_scene_renders_as_the_file_with_those_values() {
+    use lumagraph::scene::edit;
+    use lumagraph::session::SceneChange;
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = open(dir.path(), false, &[]);
+    s.render(4).unwrap();
+    let before = s.read("accumulate.color").unwrap();
+
+    let mut moved = s.scene().unwrap().clone();
+    edit::set(&mut moved.file, "camera.position", "(0.4, 0.2, 3.5)").unwrap();
+    edit::set(&mut moved.file, "camera.fov_y", "45").unwrap();
+    assert_eq!(
+        s.set_scene(moved.file.clone()).unwrap(),
+        SceneChange::Camera
+    );
+    assert_eq!(s.spp(), 0);
+    s.render(4).unwrap();
+    let after = s.read("accumulate.color").unwrap();
+    assert!(after.pixels != before.pixels);
+    let mut fresh = Session::open_scene(
+        lumagraph::graph::Graph::load(&common::repo("graphs/pathtrace.ron")).unwrap(),
+        Some(moved.clone()),
+        SessionOptions::default(),
+    )
+    .unwrap();
+    fresh.render(4).unwrap();
+    assert!(
+        fresh.read("accumulate.color").unwrap().pixels == after.pixels,
+        "the moved camera renders otherwise than the edited file"
+    );
+    drop(fresh);
+
+    let mut blue = moved.clone();
+    edit::set(
+        &mut blue.file,
+        "materials.red.base_color",
+        "(0.05, 0.05, 0.6)",
+    )
+    .unwrap();
+    assert_eq!(s.set_scene(blue.file.clone()).unwrap(), SceneChange::Scene);
+    assert_eq!(
+        s.set_scene(blue.file.clone()).unwrap(),
+        SceneChange::Nothing
+    );
+    s.render(4).unwrap();
+    let mean = |img: &lumagraph::render::cpu::Image, c: usize| {
+        img.pixels.iter().map(|p| p[c]).sum::<f32>() / img.pixels.len() as f32
+    };
+    let recoloured = s.read("accumulate.color").unwrap();
+    assert!(mean(&recoloured, 2) > 1.1 * mean(&after, 2) && mean(&recoloured, 0) < mean(&after, 0));
+
+    let mut bad = blue.clone();
+    edit::set(&mut bad.file, "camera.target", "(0.4, 0.2, 3.5)").unwrap();
+    let e = format!("{:#}", s.set_scene(bad.file).unwrap_err());
+    assert!(e.contains("cornell.ron") && e.contains("target"), "{e}");
+    assert_eq!(s.scene().unwrap().file, blue.file);
+    s.render(8).unwrap();
+    assert_eq!(s.spp(), 8);
+}

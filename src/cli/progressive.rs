@@ -8,9 +8,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow, bail};
 
-use crate::graph::Graph;
 use crate::render::{Checkpoint, Executor, FrameReport};
-use crate::scene::GpuScene;
 
 /// Set by the signal handler: stop after the batch of frames running now.
 pub(super) static STOP: AtomicBool = AtomicBool::new(false);
@@ -44,52 +42,6 @@ impl Checkpoints {
             key: 0,
         }
     }
-}
-
-/// The render's key: lumagraph's version, the graph as run (overrides applied, without
-/// layout and comments) and every number of the flattened scene.
-pub(super) fn key(graph: &Graph, scene: Option<&GpuScene>) -> u64 {
-    let mut g = graph.clone();
-    g.origin = None;
-    for n in &mut g.nodes {
-        n.pos = None;
-    }
-    let scene = scene.map_or_else(String::new, scene_digest);
-    crate::render::checkpoint::render_key(&g.to_ron(), &scene)
-}
-
-/// Every number of the flattened scene, hashed: what the GPU gets and the CPU data that
-/// shapes the render (the host intersector's corners, the orders, the environment map's
-/// file). Hashing the bytes rather than the scene's `Debug` text keeps a large scene's key
-/// cheap (the Crytek Sponza's text was over a gigabyte and took most of a minute).
-fn scene_digest(s: &GpuScene) -> String {
-    use bytemuck::{bytes_of, cast_slice};
-    let h = crate::render::checkpoint::Fnv::default()
-        .write(bytes_of(&s.header))
-        .write(bytes_of(&s.camera))
-        .write(bytes_of(&s.settings))
-        .write(cast_slice(&s.bvh_nodes))
-        .write(cast_slice(&s.bvh_skips))
-        .write(cast_slice(&s.tri_positions))
-        .write(cast_slice(&s.tri_corners))
-        .write(cast_slice(&s.tri_shading))
-        .write(cast_slice(&s.shapes))
-        .write(cast_slice(&s.materials))
-        .write(cast_slice(&s.lights))
-        .write(cast_slice(&s.light_alias))
-        .write(cast_slice(&s.tri_texcoords))
-        .write(cast_slice(&s.atlas.descriptors))
-        .write(cast_slice(&s.atlas.texels))
-        .write(&s.atlas.page_size.to_le_bytes())
-        .write(&s.atlas.pages.to_le_bytes())
-        .write(&s.vertex_alpha_min)
-        .write(cast_slice(&s.tri_source))
-        .write(cast_slice(&s.shape_source))
-        .write(cast_slice(&s.instances))
-        .write(cast_slice(&s.instance_mesh))
-        .write(cast_slice(&s.mesh_triangles))
-        .write(format!("{:?}", s.environment_map).as_bytes());
-    format!("{:016x}", h.finish())
 }
 
 /// The first Ctrl-C or SIGTERM asks the render to stop after its current batch of frames
@@ -322,33 +274,4 @@ fn report_speed(exec: &mut Executor, wall: Duration, before: (u64, u64)) -> Resu
         get("dropped_samples")
     );
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The key of a render's checkpoint follows the instances: a moved instance (its mesh
-    /// and everything else the same) is another scene.
-    #[test]
-    fn the_scene_key_follows_the_instances() {
-        let text = |x: f32| {
-            format!(
-                "(version: 2, camera: Perspective(position: (0, 0, 9), target: (0, 0, 0), fov_y: 40),
-                  materials: {{ \"m\": () }},
-                  shapes: [Mesh(path: \"CornellBox/CornellBox.gltf\", material: \"m\",
-                                instances: [(), (translate: ({x}, 0, 0))])],
-                  render: (width: 8, height: 8), instancing: On)"
-            )
-        };
-        let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
-        let digest = |x: f32| {
-            let scene = crate::scene::Scene::from_ron(&text(x), &assets).unwrap();
-            let gpu = GpuScene::build(&scene).unwrap();
-            assert_eq!(gpu.instances.len(), 2);
-            scene_digest(&gpu)
-        };
-        assert_eq!(digest(3.0), digest(3.0));
-        assert_ne!(digest(3.0), digest(3.5));
-    }
 }

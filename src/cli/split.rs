@@ -159,7 +159,7 @@ pub(super) fn merge(args: &MergeArgs<'_>) -> Result<()> {
     let scene_path = args.scene.or(first.scene.as_deref());
     let graph = super::load(graph_path, &first.overrides)?;
     let scene = super::load_scene(scene_path)?;
-    let key = super::progressive::key(&graph, scene.as_ref().map(|s| &*s.gpu));
+    let key = crate::session::render_key(&graph, scene.as_ref().map(|s| &*s.gpu));
     first.checkpoint.check(key).map_err(|e| {
         anyhow!(
             "{} (samples {}) does not fit {}{}: {e}",

@@ -87,7 +87,7 @@ pub(super) fn render_if_needed(
     match args.tiles {
         Some(range) => {
             bar.at = range.first as usize;
-            let key = super::progressive::key(graph, Some(&scene.gpu));
+            let key = crate::session::render_key(graph, Some(&scene.gpu));
             let set = crate::render::tiled::render_set(
                 &mut exec,
                 &tiling,
@@ -115,7 +115,7 @@ pub(super) fn render_if_needed(
             println!("wrote {}", path.display());
         }
         None => {
-            let key = super::progressive::key(graph, Some(&scene.gpu));
+            let key = crate::session::render_key(graph, Some(&scene.gpu));
             let ended = crate::render::tiled::render(
                 &mut exec,
                 &tiling,

@@ -13,14 +13,15 @@
 use std::path::PathBuf;
 
 use numpy::ndarray::Array3;
-use numpy::{IntoPyArray as _, PyArray3};
+use numpy::{IntoPyArray as _, PyArray3, PyReadonlyArray3, PyUntypedArrayMethods as _};
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBytes, PyDict, PyList, PyTuple};
 
 use lumagraph::render::cpu::Image;
-use lumagraph::session::SessionOptions;
+use lumagraph::scene::edit::{self, SceneText};
+use lumagraph::session::{SceneChange, SessionOptions};
 
 create_exception!(
     lumagraph,
@@ -31,6 +32,45 @@ create_exception!(
 
 fn error(e: &anyhow::Error) -> PyErr {
     LumagraphError::new_err(format!("{e:#}"))
+}
+
+fn scene_error(e: &lumagraph::scene::SceneError) -> PyErr {
+    LumagraphError::new_err(e.to_string())
+}
+
+/// An `(h, w, 4)` or `(h, w, 3)` float array as an image (alpha 1 where there is none).
+fn image_of(a: &Bound<'_, PyAny>) -> PyResult<Image> {
+    let a: PyReadonlyArray3<'_, f32> =
+        a.call_method1("astype", ("float32",))?
+            .extract()
+            .map_err(|_| {
+                LumagraphError::new_err("an image is an array of shape (height, width, 3 or 4)")
+            })?;
+    let shape = a.shape();
+    let (h, w, c) = (shape[0], shape[1], shape[2]);
+    if !(c == 3 || c == 4) || h == 0 || w == 0 {
+        return Err(LumagraphError::new_err(format!(
+            "an image is an array of shape (height, width, 3 or 4), not {shape:?}"
+        )));
+    }
+    let view = a.as_array();
+    let pixels = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (y, x)))
+        .map(|(y, x)| {
+            [
+                view[[y, x, 0]],
+                view[[y, x, 1]],
+                view[[y, x, 2]],
+                if c == 4 { view[[y, x, 3]] } else { 1.0 },
+            ]
+        })
+        .collect();
+    let size = |n: usize| u32::try_from(n).map_err(|_| LumagraphError::new_err("image too large"));
+    Ok(Image {
+        width: size(w)?,
+        height: size(h)?,
+        pixels,
+    })
 }
 
 fn array<'py>(py: Python<'py>, img: &Image) -> PyResult<Bound<'py, PyArray3<f32>>> {
@@ -137,6 +177,240 @@ impl Graph {
     }
 }
 
+/// A Python value as RON text: `None`, a bool, an int, a float, a tuple or list of them
+/// (a vector), or a str as written (RON text such as `Constant((1, 1, 1))`).
+fn ron_text(v: &Bound<'_, PyAny>, quote_str: bool) -> PyResult<String> {
+    if v.is_none() {
+        return Ok("None".to_owned());
+    }
+    if let Ok(b) = v.extract::<bool>() {
+        return Ok(b.to_string());
+    }
+    if let Ok(i) = v.extract::<i64>() {
+        return Ok(i.to_string());
+    }
+    if let Ok(f) = v.extract::<f64>() {
+        return Ok(format!("{f:?}"));
+    }
+    if let Ok(text) = v.extract::<String>() {
+        return Ok(if quote_str {
+            ron::to_string(&text).unwrap_or(text)
+        } else {
+            text
+        });
+    }
+    if v.is_instance_of::<PyTuple>() || v.is_instance_of::<PyList>() || v.hasattr("tolist")? {
+        let items: Vec<Bound<'_, PyAny>> = if v.hasattr("tolist")? {
+            v.call_method0("tolist")?.extract()?
+        } else {
+            v.extract()?
+        };
+        let parts = items
+            .iter()
+            .map(|i| ron_text(i, true))
+            .collect::<PyResult<Vec<_>>>()?;
+        return Ok(format!("({})", parts.join(", ")));
+    }
+    Err(LumagraphError::new_err(format!(
+        "a scene value is None, a bool, a number, a str or a tuple of them, not {}",
+        v.get_type().name()?
+    )))
+}
+
+/// RON text as a Python value: numbers, bools, strings, `None` and vectors (tuples) as
+/// themselves; a struct or a variant (a camera, an environment) as its RON text.
+fn py_value<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
+    fn convert<'py>(py: Python<'py>, v: &ron::Value) -> Option<PyResult<Bound<'py, PyAny>>> {
+        use pyo3::types::{PyBool, PyFloat, PyInt, PyString};
+        use ron::Value;
+        let value = match v {
+            Value::Bool(b) => PyBool::new(py, *b).to_owned().into_any(),
+            Value::Number(n) => {
+                let f = n.into_f64();
+                let whole = !matches!(n, ron::Number::F32(_) | ron::Number::F64(_));
+                if whole && f.fract() == 0.0 && f.abs() < 9.0e15 {
+                    #[expect(clippy::cast_possible_truncation, reason = "checked whole")]
+                    PyInt::new(py, f as i64).into_any()
+                } else {
+                    PyFloat::new(py, f).into_any()
+                }
+            }
+            Value::String(s) => PyString::new(py, s).into_any(),
+            Value::Option(None) => py.None().into_bound(py),
+            Value::Option(Some(inner)) => return convert(py, inner),
+            Value::Seq(items) => {
+                let items: Option<PyResult<Vec<_>>> =
+                    items.iter().map(|i| convert(py, i)).collect();
+                return Some(items?.and_then(|items| PyTuple::new(py, items).map(Bound::into_any)));
+            }
+            _ => return None,
+        };
+        Some(Ok(value))
+    }
+    let parsed: Option<ron::Value> = ron::from_str(text).ok();
+    match parsed.as_ref().and_then(|v| convert(py, v)) {
+        Some(v) => v,
+        None => Ok(text.into_pyobject(py)?.into_any()),
+    }
+}
+
+/// A scene file, loaded to be edited: its camera, materials, environment and render
+/// settings, by path (`"camera.fov_y"`, `"materials.red.base_color"`, `"render.width"`).
+#[pyclass(module = "lumagraph")]
+#[derive(Clone)]
+struct Scene {
+    inner: SceneText,
+}
+
+#[pymethods]
+impl Scene {
+    /// Loads a scene file.
+    #[staticmethod]
+    #[expect(
+        clippy::needless_pass_by_value,
+        reason = "Python arguments arrive by value"
+    )]
+    fn load(path: PathBuf) -> PyResult<Self> {
+        let inner = SceneText::load(&path).map_err(|e| scene_error(&e))?;
+        Ok(Self { inner })
+    }
+
+    /// The value at `path`: a number, bool, str, `None` or tuple; a camera or an
+    /// environment as its RON text.
+    fn get<'py>(&self, py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyAny>> {
+        let text = edit::get(&self.inner.file, path).map_err(|e| scene_error(&e))?;
+        py_value(py, &text)
+    }
+
+    /// Sets the value at `path`: a number, bool, `None`, a tuple (a vector or colour), or a
+    /// str (RON text such as `"Constant((1, 1, 1))"`, else a string value).
+    fn set(&mut self, path: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let text = ron_text(value, false)?;
+        let first = edit::set(&mut self.inner.file, path, &text);
+        match first {
+            Ok(()) => Ok(()),
+            Err(e) if value.extract::<String>().is_ok() => {
+                // A plain string value (`"Au"`): quoted.
+                edit::set(&mut self.inner.file, path, &ron_text(value, true)?)
+                    .map_err(|_| scene_error(&e))
+            }
+            Err(e) => Err(scene_error(&e)),
+        }
+    }
+
+    /// The names under `path`: the parts for `""`, the materials for `"materials"`, a
+    /// camera's or a material's fields.
+    #[pyo3(signature = (path=""))]
+    fn fields(&self, path: &str) -> PyResult<Vec<String>> {
+        edit::fields(&self.inner.file, path).map_err(|e| scene_error(&e))
+    }
+
+    /// The names of the scene file's materials.
+    #[getter]
+    fn materials(&self) -> Vec<String> {
+        self.inner.file.materials.keys().cloned().collect()
+    }
+
+    /// The file it was loaded from.
+    #[getter]
+    fn path(&self) -> PathBuf {
+        self.inner.path.clone()
+    }
+
+    /// The file's text with the edited values written in; comments and layout kept.
+    fn to_ron(&self) -> PyResult<String> {
+        self.inner.to_ron().map_err(|e| scene_error(&e))
+    }
+
+    /// Writes [`to_ron`] (atomically) over the file it was loaded from, or to `path`.
+    #[pyo3(signature = (path=None))]
+    #[expect(
+        clippy::needless_pass_by_value,
+        reason = "Python arguments arrive by value"
+    )]
+    fn save(&mut self, path: Option<PathBuf>) -> PyResult<()> {
+        self.inner
+            .save(path.as_deref())
+            .map_err(|e| scene_error(&e))
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Scene.load({:?})", self.inner.path.display().to_string())
+    }
+}
+
+/// A scene given as a path or a `Scene`.
+fn scene_arg(scene: Option<&Bound<'_, PyAny>>) -> PyResult<Option<SceneText>> {
+    let Some(scene) = scene.filter(|s| !s.is_none()) else {
+        return Ok(None);
+    };
+    if let Ok(s) = scene.cast::<Scene>() {
+        return Ok(Some(s.borrow().inner.clone()));
+    }
+    let path: PathBuf = scene.extract()?;
+    SceneText::load(&path)
+        .map(Some)
+        .map_err(|e| scene_error(&e))
+}
+
+/// A graph given as a path or a `Graph`.
+fn graph_arg(graph: &Bound<'_, PyAny>) -> PyResult<lumagraph::graph::Graph> {
+    if let Ok(g) = graph.cast::<Graph>() {
+        return Ok(g.borrow().inner.clone());
+    }
+    let path: PathBuf = graph.extract()?;
+    lumagraph::graph::Graph::load(&path).map_err(|e| LumagraphError::new_err(e.to_string()))
+}
+
+/// An image shown in Jupyter: `lg.Image(array)` of a linear `(h, w, 3 or 4)` array, or a
+/// session's output (`Session.image()`). Shown sRGB-encoded and clipped to [0, 1] (a
+/// tone-mapped output as it is); `array` is the data, unchanged.
+#[pyclass(name = "Image", module = "lumagraph")]
+struct PyImage {
+    png: Vec<u8>,
+    image: Image,
+}
+
+#[pymethods]
+impl PyImage {
+    #[new]
+    fn new(array: &Bound<'_, PyAny>) -> PyResult<Self> {
+        use lumagraph::render::image_io::{encode_png, to_rgba8};
+        let image = image_of(array)?;
+        let png = encode_png(image.width, image.height, &to_rgba8(&image, true))
+            .map_err(|e| LumagraphError::new_err(e.to_string()))?;
+        Ok(Self { png, image })
+    }
+
+    /// The pixels: float32, `(height, width, 4)`.
+    #[getter]
+    fn array<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<f32>>> {
+        array(py, &self.image)
+    }
+
+    /// The PNG Jupyter shows.
+    fn _repr_png_<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        PyBytes::new(py, &self.png)
+    }
+
+    /// Writes the PNG shown to `path`.
+    #[expect(
+        clippy::needless_pass_by_value,
+        reason = "Python arguments arrive by value"
+    )]
+    fn save_png(&self, path: PathBuf) -> PyResult<()> {
+        lumagraph::graph::write_atomic(&path, &self.png)
+            .map_err(|e| LumagraphError::new_err(format!("{}: {e}", path.display())))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<lumagraph.Image {}x{}>",
+            self.image.width, self.image.height
+        )
+    }
+}
+
 /// A graph and its scene on a device, rendered progressively.
 #[pyclass(unsendable, module = "lumagraph")]
 struct Session {
@@ -147,19 +421,15 @@ struct Session {
 impl Session {
     /// `Session(graph, scene=None, out="out", write_outputs=False, keep=[])`
     ///
-    /// Loads the graph (a file, or a `Graph`) and the scene file and sets them up on the
-    /// default adapter.
+    /// Loads the graph (a file, or a `Graph`) and the scene (a file, or a `Scene`) and
+    /// sets them up on the default adapter.
     /// `Output` nodes write their files under `out` only with `write_outputs`; `keep` names
     /// more ports ("node.port") to read back with `read`.
     #[new]
-    #[expect(
-        clippy::needless_pass_by_value,
-        reason = "Python arguments arrive by value"
-    )]
     #[pyo3(signature = (graph, scene=None, out="out", write_outputs=false, keep=Vec::new()))]
     fn new(
         graph: &Bound<'_, PyAny>,
-        scene: Option<PathBuf>,
+        scene: Option<&Bound<'_, PyAny>>,
         out: &str,
         write_outputs: bool,
         keep: Vec<String>,
@@ -170,18 +440,77 @@ impl Session {
             keep,
             ..SessionOptions::default()
         };
-        let opened = if let Ok(g) = graph.cast::<Graph>() {
-            lumagraph::session::Session::open_graph(
-                g.borrow().inner.clone(),
-                scene.as_deref(),
-                options,
-            )
-        } else {
-            let path: PathBuf = graph.extract()?;
-            lumagraph::session::Session::open(&path, scene.as_deref(), options)
-        };
-        let inner = opened.map_err(|e| error(&e))?;
+        let graph = graph_arg(graph)?;
+        let scene = scene_arg(scene)?;
+        let inner = lumagraph::session::Session::open_scene(graph, scene, options)
+            .map_err(|e| error(&e))?;
         Ok(Self { inner })
+    }
+
+    /// A copy of the scene as the session renders it (`None` without one); edit it and
+    /// give it to `set_scene`.
+    #[getter]
+    fn scene(&self) -> Option<Scene> {
+        self.inner.scene().map(|s| Scene { inner: s.clone() })
+    }
+
+    /// Renders `scene` (edited) from now on; the accumulation restarts. Returns what
+    /// changed: `"camera"` (only the camera moved: nothing rebuilt), `"scene"` (built
+    /// again), or `None` (nothing).
+    fn set_scene(&mut self, scene: &Scene) -> PyResult<Option<&'static str>> {
+        let change = self
+            .inner
+            .set_scene(scene.inner.file.clone())
+            .map_err(|e| error(&e))?;
+        Ok(match change {
+            SceneChange::Nothing => None,
+            SceneChange::Camera => Some("camera"),
+            SceneChange::Scene => Some("scene"),
+        })
+    }
+
+    /// Writes where the render stands to `path` (as `lumagraph render --checkpoint` does).
+    #[expect(
+        clippy::needless_pass_by_value,
+        reason = "Python arguments arrive by value"
+    )]
+    fn checkpoint(&mut self, path: PathBuf) -> PyResult<()> {
+        self.inner.checkpoint(&path).map_err(|e| error(&e))
+    }
+
+    /// Goes on from the checkpoint at `path` (of the same graph and scene): the next
+    /// `render` renders on from its samples.
+    #[expect(
+        clippy::needless_pass_by_value,
+        reason = "Python arguments arrive by value"
+    )]
+    fn resume(&mut self, path: PathBuf) -> PyResult<()> {
+        self.inner.resume(&path).map_err(|e| error(&e))
+    }
+
+    /// An output's image for display (the first `Output` node's unless `output` names
+    /// one, or a port "node.port"), as the last render left it.
+    #[pyo3(signature = (output=None))]
+    fn image(&mut self, output: Option<&str>) -> PyResult<PyImage> {
+        let outputs = self.inner.outputs();
+        let port = match output {
+            None => outputs
+                .first()
+                .map(|(_, port)| port.clone())
+                .ok_or_else(|| LumagraphError::new_err("the graph has no Output node"))?,
+            Some(name) => outputs
+                .iter()
+                .find(|(node, _)| node == name)
+                .map_or_else(|| name.to_owned(), |(_, port)| port.clone()),
+        };
+        let png = self.inner.png(&port).map_err(|e| error(&e))?;
+        let image = self.inner.read(&port).map_err(|e| error(&e))?;
+        Ok(PyImage { png, image })
+    }
+
+    /// The first output's image, shown by Jupyter when a session is a cell's value.
+    fn _repr_png_<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        Ok(PyBytes::new(py, &self.image(None)?.png))
     }
 
     /// Renders on to `spp` samples per pixel in all; returns each `Output` node's image
@@ -279,6 +608,88 @@ impl Session {
     }
 }
 
+/// Error against time, as `lumagraph converge` measures it: the graph (a file or a
+/// `Graph`, its `Output` nodes dropped) on the scene (a file or a `Scene`) at 1, 2, 4… spp
+/// until `seconds`, each `Accumulate` and `Denoise` output scored against `reference` (an
+/// EXR file or a linear array) or a render of `reference_spp` samples with another seed.
+/// Returns the rows of `converge.csv`, as dicts (output, spp, seconds, rmse, relmse,
+/// ssim, `gpu_ms`); with `out`, writes `converge.csv` and `converge.png` there.
+#[pyfunction]
+#[pyo3(signature = (graph, scene, reference=None, reference_spp=None, seconds=10.0, variants=Vec::new(), out=None))]
+#[expect(clippy::too_many_arguments, reason = "the command line's options")]
+#[expect(
+    clippy::needless_pass_by_value,
+    reason = "Python arguments arrive by value"
+)]
+fn converge<'py>(
+    py: Python<'py>,
+    graph: &Bound<'py, PyAny>,
+    scene: &Bound<'py, PyAny>,
+    reference: Option<&Bound<'py, PyAny>>,
+    reference_spp: Option<u32>,
+    seconds: f64,
+    variants: Vec<String>,
+    out: Option<PathBuf>,
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    use lumagraph::converge::{Options, Reference};
+    let graph = graph_arg(graph)?;
+    let scene =
+        scene_arg(Some(scene))?.ok_or_else(|| LumagraphError::new_err("converge needs a scene"))?;
+    let reference = match (reference.filter(|r| !r.is_none()), reference_spp) {
+        (Some(r), None) => match r.extract::<PathBuf>() {
+            Ok(path) => Reference::File(path),
+            Err(_) => Reference::Image(image_of(r)?),
+        },
+        (None, Some(spp)) => Reference::Spp(spp),
+        _ => {
+            return Err(LumagraphError::new_err(
+                "give reference (an EXR file or an array) or reference_spp, not both",
+            ));
+        }
+    };
+    let built = scene.build().map_err(|e| scene_error(&e))?;
+    let gpu = std::sync::Arc::new(
+        lumagraph::scene::GpuScene::build(&built).map_err(|e| scene_error(&e))?,
+    );
+    let ctx = lumagraph::render::GpuContext::headless()
+        .map_err(|e| LumagraphError::new_err(e.to_string()))?;
+    let library = lumagraph::render::NodeLibrary::with_builtins();
+    let measured = lumagraph::converge::measure(
+        &ctx,
+        graph,
+        &gpu,
+        &Options {
+            reference,
+            seconds,
+            variants: &variants,
+            library: &library,
+        },
+    )
+    .map_err(|e| error(&e))?;
+    if let Some(out) = out {
+        let (_, no_plot) =
+            lumagraph::converge::write(&out, &measured.rows, None).map_err(|e| error(&e))?;
+        if let Some(why) = no_plot {
+            eprintln!("lumagraph: converge.png not written: {why}");
+        }
+    }
+    measured
+        .rows
+        .iter()
+        .map(|r| {
+            let d = PyDict::new(py);
+            d.set_item("output", &r.output)?;
+            d.set_item("spp", r.spp)?;
+            d.set_item("seconds", r.seconds)?;
+            d.set_item("rmse", r.rmse)?;
+            d.set_item("relmse", r.relmse)?;
+            d.set_item("ssim", r.ssim)?;
+            d.set_item("gpu_ms", r.gpu_ms)?;
+            Ok(d)
+        })
+        .collect()
+}
+
 fn param_value<'py>(
     py: Python<'py>,
     v: &lumagraph::graph::ParamValue,
@@ -342,6 +753,9 @@ fn lumagraph_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Graph>()?;
     m.add_function(wrap_pyfunction!(nodes, m)?)?;
     m.add_class::<Session>()?;
+    m.add_class::<Scene>()?;
+    m.add_class::<PyImage>()?;
+    m.add_function(wrap_pyfunction!(converge, m)?)?;
     m.add("LumagraphError", m.py().get_type::<LumagraphError>())?;
     Ok(())
 }

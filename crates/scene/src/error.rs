@@ -114,6 +114,10 @@ pub enum ErrorKind {
     /// An edited scene could not be written over the text it was read from.
     #[error("cannot write the edited scene: {0}")]
     Unwritable(String),
+    /// An edit by path ([`crate::edit`]) names nothing editable, or its value does not fit:
+    /// the path edited (`camera.fov_y`), then what is wrong.
+    #[error("scene edit {0}")]
+    Edit(String),
 }
 
 impl From<gltf::Error> for ErrorKind {

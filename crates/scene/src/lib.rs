@@ -22,6 +22,7 @@
 
 pub mod bvh;
 pub mod conductor;
+pub mod edit;
 mod error;
 pub mod export;
 pub mod file;

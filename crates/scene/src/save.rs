@@ -90,7 +90,7 @@ fn same<T: PartialEq + Debug>(a: &T, b: &T) -> bool {
 
 /// A value of the scene file, ready to be compared with another and written.
 #[derive(Clone, Debug, PartialEq)]
-enum Val {
+pub(crate) enum Val {
     /// Written as is: a number, string, bool, vector, unit or tuple variant.
     Leaf(String),
     /// `Variant(field: value, …)`, or `(…)` for a struct (`variant` empty).
@@ -104,13 +104,13 @@ enum Val {
 }
 
 #[derive(Clone, Debug, PartialEq)]
-struct Field {
-    name: &'static str,
-    value: Val,
+pub(crate) struct Field {
+    pub(crate) name: &'static str,
+    pub(crate) value: Val,
     /// Equal to what serde fills in when the field is left out: not written anew.
-    default: bool,
+    pub(crate) default: bool,
     /// An `Option` that is `None`: written by leaving the field out.
-    none: bool,
+    pub(crate) none: bool,
 }
 
 /// A field written unless it is `default`.
@@ -158,7 +158,7 @@ fn vec3(v: V3) -> String {
 }
 
 /// A RON string literal.
-fn string(s: &str) -> String {
+pub(crate) fn string(s: &str) -> String {
     ron::to_string(s).unwrap_or_else(|_| {
         let escaped = s.replace('\\', "\\\\").replace('"', "\\\"");
         format!("\"{escaped}\"")
@@ -199,7 +199,7 @@ fn file_value(f: &SceneFile) -> Val {
     }
 }
 
-fn camera_value(c: &CameraDesc) -> Val {
+pub(crate) fn camera_value(c: &CameraDesc) -> Val {
     match c {
         CameraDesc::Perspective {
             position,
@@ -240,7 +240,7 @@ fn camera_value(c: &CameraDesc) -> Val {
     }
 }
 
-fn material_value(m: &MaterialDesc) -> Val {
+pub(crate) fn material_value(m: &MaterialDesc) -> Val {
     let d = MaterialDesc::default();
     Val::Struct {
         variant: "",
@@ -314,7 +314,7 @@ fn material_value(m: &MaterialDesc) -> Val {
     }
 }
 
-fn environment_value(e: &Environment) -> Val {
+pub(crate) fn environment_value(e: &Environment) -> Val {
     match e {
         Environment::None => leaf("None".into()),
         Environment::Constant(c) => leaf(format!("Constant({})", vec3(*c))),
@@ -337,7 +337,7 @@ fn environment_value(e: &Environment) -> Val {
     }
 }
 
-fn render_value(r: &RenderSettings) -> Val {
+pub(crate) fn render_value(r: &RenderSettings) -> Val {
     Val::Struct {
         variant: "",
         fields: vec![
@@ -352,7 +352,7 @@ fn render_value(r: &RenderSettings) -> Val {
 
 /// `v` written anew: structs on one line with their non-default fields; maps on one line,
 /// or one entry a line when `indent` (that of the line the map starts on) is given.
-fn render(v: &Val, indent: Option<&str>, nl: &str) -> String {
+pub(crate) fn render(v: &Val, indent: Option<&str>, nl: &str) -> String {
     match v {
         Val::Leaf(s) => s.clone(),
         Val::Struct { variant, fields } => {

@@ -12,7 +12,7 @@ use std::sync::OnceLock;
 use anyhow::{Result, anyhow, bail};
 use plotters::prelude::*;
 
-use super::converge::Compare;
+use super::Compare;
 
 const FONT_PATHS: &[&str] = &[
     "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
