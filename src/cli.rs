@@ -30,6 +30,7 @@ use clap::{Parser, Subcommand};
 use crate::graph::{Graph, docs};
 use crate::render::{Executor, GpuContext, NodeLibrary, Resources, image_io};
 use crate::scene::{GpuScene, Scene};
+use crate::session::Session;
 
 const EXAMPLES: &str = "\
 Examples:
@@ -524,7 +525,16 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
             .unwrap_or(1);
         let mut checkpoints = args.checkpoints.clone();
         checkpoints.key = crate::session::render_key(&graph, scene.as_ref().map(|s| &*s.gpu));
-        progressive::render(&mut exec, spp, &checkpoints)?
+        let mut session = Session::from_executor(
+            exec,
+            graph,
+            scene.as_ref().map(|s| Arc::clone(&s.gpu)),
+            resources,
+            Arc::clone(args.library),
+        );
+        let report = progressive::render(&mut session, spp, &checkpoints)?;
+        finish(session.executor(), &report, &left_out)?;
+        return Ok(());
     } else {
         // The first frame includes pipeline compilation inside the driver; time a second one.
         let first = exec.run_frame()?;
@@ -536,6 +546,16 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
         );
         report
     };
+    finish(&mut exec, &report, &left_out)
+}
+
+/// What `render` prints at the end: GPU time per pass, measurements, files written and
+/// what the plan left out.
+fn finish(
+    exec: &mut Executor,
+    report: &crate::render::FrameReport,
+    left_out: &[crate::graph::LeftOut],
+) -> Result<()> {
     match &report.pass_ms {
         Some(times) => {
             println!(
@@ -554,7 +574,7 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
     for path in &report.written {
         println!("wrote {}", path.display());
     }
-    for l in &left_out {
+    for l in left_out {
         println!("left out {}: {}", l.what, l.reason);
     }
     Ok(())
@@ -611,7 +631,7 @@ fn print_features(plan: &crate::graph::Plan, scene: &GpuScene, library: &NodeLib
 }
 
 struct RenderArgs<'a> {
-    library: &'a NodeLibrary,
+    library: &'a Arc<NodeLibrary>,
     graph: &'a Path,
     scene: Option<&'a Path>,
     out: &'a Path,

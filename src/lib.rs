@@ -7,7 +7,9 @@
 //! - [`editor`]: the node editor.
 //!
 //! [`session::Session`] renders a graph and its scene from a program: progressively, read
-//! back as images, params changed as it goes.
+//! back as images, params and the scene changed as it goes, checkpointed; the command line
+//! and the editor's render job render through it. [`converge`] measures error against run
+//! time.
 //!
 //! [`cli`] is the `lumagraph` command line (see `lumagraph --help`). A program that adds
 //! node kinds of its own to a [`render::NodeLibrary`] runs it with
@@ -16,9 +18,9 @@
 
 pub mod cli;
 pub mod converge;
-pub mod session;
 
 pub use lumagraph_editor as editor;
 pub use lumagraph_graph as graph;
 pub use lumagraph_render as render;
+pub use lumagraph_render::session;
 pub use lumagraph_scene as scene;

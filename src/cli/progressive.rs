@@ -9,6 +9,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Result, anyhow, bail};
 
 use crate::render::{Checkpoint, Executor, FrameReport};
+use crate::session::Session;
 
 /// Set by the signal handler: stop after the batch of frames running now.
 pub(super) static STOP: AtomicBool = AtomicBool::new(false);
@@ -98,14 +99,15 @@ pub(super) fn print_built(start: Instant) {
     );
 }
 
-/// Warms `exec` up and prints how long it took: drivers compile pipelines at their first
-/// dispatch, and that is kept out of the timed frames.
-pub(super) fn warm_up(exec: &mut Executor) -> Result<()> {
+/// Warms up (`run`: [`Session::warm_up`] or [`Executor::warm_up`]) and prints how long it
+/// took: drivers compile pipelines at their first dispatch, and that is kept out of the
+/// timed frames.
+pub(super) fn warm_up(run: impl FnOnce() -> Result<()>) -> Result<()> {
     let warm = Instant::now();
     let stage = Stage::start(
         "warm-up (the first frame: drivers compile pipelines at their first dispatch)",
     );
-    exec.warm_up()?;
+    run()?;
     drop(stage);
     println!(
         "warm-up (shader compilation): {:.0} ms",
@@ -114,23 +116,14 @@ pub(super) fn warm_up(exec: &mut Executor) -> Result<()> {
     Ok(())
 }
 
-/// Runs the progressive part of the graph to `spp` samples per pixel (going on from a
-/// checkpoint when asked), then the rest once.
-pub(super) fn render(exec: &mut Executor, spp: u32, ck: &Checkpoints) -> Result<FrameReport> {
-    let frames = exec.frames_for(spp);
-    warm_up(exec)?;
+/// Runs the progressive part of the session's graph to `spp` samples per pixel (going on
+/// from a checkpoint when asked), then the rest once.
+pub(super) fn render(session: &mut Session, spp: u32, ck: &Checkpoints) -> Result<FrameReport> {
+    let frames = session.frames_for(spp);
+    warm_up(|| session.warm_up())?;
     if let Some(path) = &ck.resume {
         let from = Checkpoint::load(path)?;
-        from.check(ck.key)
-            .map_err(|e| anyhow!("cannot resume from {}: {e}", path.display()))?;
-        if from.adapter != exec.context().info.name {
-            println!(
-                "warning: the checkpoint was made on {}, this is {}: the result may differ \
-                 from an uninterrupted render in the last bits",
-                from.adapter,
-                exec.context().info.name
-            );
-        }
+        session.resume_from(&from, path)?;
         if from.frames >= u64::from(frames) {
             bail!(
                 "nothing to resume from {}: it has {} frames, and {frames} make the {spp} spp \
@@ -139,14 +132,13 @@ pub(super) fn render(exec: &mut Executor, spp: u32, ck: &Checkpoints) -> Result<
                 from.frames
             );
         }
-        exec.restore(&from)?;
         println!(
             "resuming from {} at frame {} of {frames}",
             path.display(),
             from.frames
         );
     }
-    let before = samples_per_pixel(exec)?;
+    let before = samples_per_pixel(session.executor())?;
     on_signal(
         "writing the samples so far and a checkpoint (press Ctrl-C again to quit without them)",
     );
@@ -164,7 +156,7 @@ pub(super) fn render(exec: &mut Executor, spp: u32, ck: &Checkpoints) -> Result<
     let start = Instant::now();
     let mut last = Instant::now();
     let mut failed = None;
-    let report = exec.render(frames, |exec, done, _| {
+    let report = session.render_with(spp, |exec, done, _| {
         if bar.is_hidden() && start.elapsed() > Duration::from_secs(1) {
             bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
         }
@@ -182,6 +174,7 @@ pub(super) fn render(exec: &mut Executor, spp: u32, ck: &Checkpoints) -> Result<
     if let Some(e) = failed {
         return Err(e.into());
     }
+    let exec = session.executor();
     match report {
         Some(report) => {
             report_speed(exec, start.elapsed(), before)?;

@@ -72,7 +72,7 @@ pub(super) fn render_partial(
             range.end.div_ceil(spf) * spf
         );
     }
-    super::progressive::warm_up(exec)?;
+    super::progressive::warm_up(|| Ok(exec.warm_up()?))?;
     let start = Instant::now();
     exec.start_at_sample(range.first, u64::from(range.first / spf));
     let frames = (range.end - range.first) / spf;

@@ -81,7 +81,7 @@ pub(super) fn render_if_needed(
     }
     let spp = args.spp.unwrap_or(scene.scene.settings.spp);
     let frames = exec.frames_for(spp);
-    super::progressive::warm_up(&mut exec)?;
+    super::progressive::warm_up(|| Ok(exec.warm_up()?))?;
     on_signal("writing the tiles done so far");
     let mut bar = TileBar::new(n, frames);
     match args.tiles {

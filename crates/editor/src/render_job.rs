@@ -1,9 +1,10 @@
 //! Render to file: the graph at the scene's full resolution and a target sample count, on
 //! a thread of its own so the editor keeps running, with progress and cancel.
 //!
-//! The render is what `lumagraph render` does with the same graph, scene and `--spp`
-//! ([`Executor::render`], the same frames in the same order): either every `Output` node
-//! of the graph writes its file into a folder, or one port is written to one file.
+//! The render is what `lumagraph render` does with the same graph, scene and `--spp`: a
+//! [`Session`] over the editor's device renders the same frames in the same order. Either
+//! every `Output` node of the graph writes its file into a folder, or one port is written
+//! to one file.
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -12,6 +13,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use lumagraph_graph::{Edge, Graph, Node, ParamValue, Registry};
+use lumagraph_render::session::Session;
 use lumagraph_render::{Executor, GpuContext, NodeLibrary, Resources};
 use lumagraph_scene::GpuScene;
 
@@ -173,7 +175,7 @@ const PORT_OUTPUT: &str = "render_to_file";
 
 fn run(
     gpu: &GpuContext,
-    library: &NodeLibrary,
+    library: &Arc<NodeLibrary>,
     request: RenderRequest,
     cancel: &AtomicBool,
     set: &Update<'_>,
@@ -224,25 +226,24 @@ fn run(
     let resources = Resources {
         base_dir: base,
         out_dir,
-        scene,
+        scene: scene.clone(),
         ..Resources::default()
     };
-    let mut exec =
-        Executor::with_library(gpu, plan, &resources, library).map_err(|e| e.to_string())?;
-    let history = exec.plan().passes.iter().any(|p| p.kind.history);
-    let frames = if history { exec.frames_for(spp) } else { 1 };
+    let exec = Executor::with_library(gpu, plan, &resources, library).map_err(|e| e.to_string())?;
+    let mut session = Session::from_executor(exec, graph, scene, resources, Arc::clone(library));
+    let frames = session.frames_for(spp);
     set(&|s| {
         s.stage = "compiling shaders";
         s.frames = frames;
     });
-    exec.warm_up().map_err(|e| e.to_string())?;
+    session.warm_up().map_err(|e| e.to_string())?;
     set(&|s| s.stage = "rendering");
-    let report = exec
-        .render(frames, |_, done, _| {
+    let report = session
+        .render_with(spp, |_, done, _| {
             set(&|s| s.done = done);
             !cancel.load(Ordering::Relaxed)
         })
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| format!("{e:#}"))?;
     match report {
         Some(r) => Ok(r.written),
         None => Err("cancelled: nothing written".into()),

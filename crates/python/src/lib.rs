@@ -527,7 +527,7 @@ impl Session {
         let mut interrupted = None;
         let done = self
             .inner
-            .render_with(spp, |done, all| {
+            .render_with(spp, |_, done, all| {
                 if progress {
                     eprint!("\rlumagraph: {done}/{all} frames");
                 }

@@ -38,6 +38,7 @@ pub mod raycast;
 pub mod readback;
 pub mod sampler;
 mod scene_gpu;
+pub mod session;
 pub mod shader;
 pub mod shared;
 pub mod specialize;

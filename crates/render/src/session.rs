@@ -6,7 +6,7 @@
 //! restarts), a checkpoint to resume from.
 //!
 //! ```no_run
-//! use lumagraph::session::{Session, SessionOptions};
+//! use lumagraph_render::session::{Session, SessionOptions};
 //! let mut s = Session::open("graphs/pathtrace.ron".as_ref(), Some("assets/cornell.ron".as_ref()),
 //!     SessionOptions::default())?;
 //! s.render(64)?;
@@ -20,13 +20,13 @@ use std::sync::Arc;
 
 use anyhow::{Context as _, Result};
 
-use crate::graph::Graph;
-use crate::render::cpu::Image;
-use crate::render::{Checkpoint, Executor, FrameReport, GpuContext, NodeLibrary, Resources};
-use crate::scene::GpuScene;
-use crate::scene::edit::SceneText;
-use crate::scene::file::SceneFile;
-use crate::scene::gpu::GpuCamera;
+use crate::cpu::Image;
+use crate::{Checkpoint, Executor, FrameReport, GpuContext, NodeLibrary, Resources};
+use lumagraph_graph::Graph;
+use lumagraph_scene::GpuScene;
+use lumagraph_scene::edit::SceneText;
+use lumagraph_scene::file::SceneFile;
+use lumagraph_scene::gpu::GpuCamera;
 
 /// How a [`Session`] is set up.
 #[derive(Clone, Debug)]
@@ -67,6 +67,8 @@ pub struct Session {
     resources: Resources,
     write_outputs: bool,
     exec: Executor,
+    /// Whether the executor was warmed up ([`Session::warm_up`]).
+    warm: bool,
     /// What the last run reported (its passes' times).
     last: Option<FrameReport>,
     /// What loading the scene warned of.
@@ -94,7 +96,7 @@ impl Session {
     }
 
     /// [`Session::open`] for a graph and a scene file already loaded (and perhaps edited:
-    /// [`crate::scene::edit`]).
+    /// [`lumagraph_scene::edit`]).
     ///
     /// # Errors
     /// As [`Session::open`].
@@ -138,20 +140,67 @@ impl Session {
         };
         let mut exec = Executor::with_library(&ctx, plan, &resources, &library)?;
         exec.hold_sinks(!options.write_outputs);
-        exec.warm_up()?;
-        Ok(Self {
+        let mut session = Self::from_executor(exec, graph, scene, resources, library);
+        session.keep = options.keep;
+        session.write_outputs = options.write_outputs;
+        session.warm_up()?;
+        Ok(session)
+    }
+
+    /// A session over an executor built by the caller (the command line, the editor's
+    /// render job: their own device, registry or plan): `exec` runs `graph`, compiled with
+    /// `library`, with `resources` (whose scene is `scene`). Its sinks write their files as
+    /// the executor is set ([`Executor::hold_sinks`]); nothing is warmed up yet.
+    pub fn from_executor(
+        exec: Executor,
+        graph: Graph,
+        scene: Option<Arc<GpuScene>>,
+        resources: Resources,
+        library: Arc<NodeLibrary>,
+    ) -> Self {
+        Self {
             graph,
             library,
             scene,
             scene_text: None,
             camera: None,
-            keep: options.keep,
+            keep: Vec::new(),
             resources,
-            write_outputs: options.write_outputs,
+            write_outputs: true,
             exec,
+            warm: false,
             last: None,
             warnings: Vec::new(),
-        })
+        }
+    }
+
+    /// Runs the first frame's dispatches once, so that pipelines the driver compiles at
+    /// their first use are compiled before anything is timed ([`Executor::warm_up`]);
+    /// [`Session::render`] does it where it was not done.
+    ///
+    /// # Errors
+    /// When a node fails.
+    pub fn warm_up(&mut self) -> Result<()> {
+        if !self.warm {
+            self.exec.warm_up()?;
+            self.warm = true;
+        }
+        Ok(())
+    }
+
+    /// The frames that make `spp` samples per pixel ([`Executor::frames_for`]) where the
+    /// graph has a sample source or keeps history; 1 where it has neither (a post chain).
+    pub fn frames_for(&self, spp: u32) -> u32 {
+        let plan = self.exec.plan();
+        let progressive = plan
+            .passes
+            .iter()
+            .any(|p| p.kind.history || p.params.has(lumagraph_graph::registry::SAMPLES_PER_FRAME));
+        if progressive {
+            self.exec.frames_for(spp)
+        } else {
+            1
+        }
     }
 
     /// Renders on to `spp` samples per pixel in all (whole frames of the path tracer's
@@ -161,26 +210,25 @@ impl Session {
     /// # Errors
     /// When a node fails; the error names the node.
     pub fn render(&mut self, spp: u32) -> Result<FrameReport> {
-        self.render_with(spp, |_, _| true)?
+        self.render_with(spp, |_, _, _| true)?
             .context("the render stopped")
     }
 
-    /// [`Session::render`], calling `progress(frames done, frames in all)` a few times a
-    /// second; where it returns `false` the render stops there (`Ok(None)`, nothing
-    /// finished or written), and a later `render` goes on from the frames done.
+    /// [`Session::render`], calling `progress(executor, frames done, frames in all)` a few
+    /// times a second; where it returns `false` the render stops there (`Ok(None)`,
+    /// nothing finished or written), and a later `render` goes on from the frames done.
+    /// The executor lets the caller checkpoint between batches.
     ///
     /// # Errors
     /// When a node fails; the error names the node.
     pub fn render_with(
         &mut self,
         spp: u32,
-        mut progress: impl FnMut(u32, u32) -> bool,
+        mut progress: impl FnMut(&mut Executor, u32, u32) -> bool,
     ) -> Result<Option<FrameReport>> {
-        let frames = self.exec.frames_for(spp);
-        let Some(report) = self
-            .exec
-            .render(frames, |_, done, all| progress(done, all))?
-        else {
+        self.warm_up()?;
+        let frames = self.frames_for(spp);
+        let Some(report) = self.exec.render(frames, &mut progress)? else {
             return Ok(None);
         };
         self.last = Some(report.clone());
@@ -238,8 +286,8 @@ impl Session {
     /// # Errors
     /// As [`Session::read`].
     pub fn png(&self, port: &str) -> Result<Vec<u8>> {
-        use crate::graph::{PortType, TexFormat};
-        use crate::render::image_io::{encode_png, to_rgba8};
+        use crate::image_io::{encode_png, to_rgba8};
+        use lumagraph_graph::{PortType, TexFormat};
         let t = self
             .exec
             .plan()
@@ -286,15 +334,15 @@ impl Session {
     }
 
     /// A new executor of `plan` on the same device, at the moved camera if any, warmed up.
-    fn rebuild(&mut self, plan: crate::graph::Plan) -> Result<()> {
+    fn rebuild(&mut self, plan: lumagraph_graph::Plan) -> Result<()> {
         let ctx = self.exec.context().clone();
         self.exec = Executor::with_library(&ctx, plan, &self.resources, &self.library)?;
         self.exec.hold_sinks(!self.write_outputs);
         if let Some(camera) = &self.camera {
             self.exec.move_camera(camera);
         }
-        self.exec.warm_up()?;
-        Ok(())
+        self.warm = false;
+        self.warm_up()
     }
 
     /// The scene file as loaded and edited; `None` for a session without one or given a
@@ -303,7 +351,7 @@ impl Session {
         self.scene_text.as_ref()
     }
 
-    /// Renders `file` from now on: the scene file's values edited ([`crate::scene::edit`]:
+    /// Renders `file` from now on: the scene file's values edited ([`lumagraph_scene::edit`]:
     /// camera, materials, environment, render settings). The accumulation restarts
     /// ([`Session::spp`] is 0). Where only the camera changed, the executor keeps its
     /// pipelines and buffers and only the camera moves; otherwise the scene is built
@@ -356,8 +404,8 @@ impl Session {
     }
 
     /// The key of what this session renders ([`render_key`]): the graph as it stands and
-    /// the scene as edited.
-    fn key(&self) -> u64 {
+    /// the scene as edited; its checkpoints carry it.
+    pub fn key(&self) -> u64 {
         let mut scene = self.scene.as_deref().cloned();
         if let (Some(s), Some(camera)) = (scene.as_mut(), self.camera) {
             s.camera = camera;
@@ -384,11 +432,18 @@ impl Session {
     /// When it does not load, or is of another graph, scene or lumagraph version (the
     /// error says which); the session is then unchanged.
     pub fn resume(&mut self, path: &Path) -> Result<()> {
-        let from = Checkpoint::load(path)?;
+        self.resume_from(&Checkpoint::load(path)?, path)
+    }
+
+    /// [`Session::resume`] from a checkpoint loaded from `path`.
+    ///
+    /// # Errors
+    /// As [`Session::resume`].
+    pub fn resume_from(&mut self, from: &Checkpoint, path: &Path) -> Result<()> {
         from.check(self.key())
             .map_err(|e| anyhow::anyhow!("cannot resume from {}: {e}", path.display()))?;
         if from.adapter != self.exec.context().info.name {
-            eprintln!(
+            println!(
                 "warning: the checkpoint {} was made on {}, this is {}: the result may differ \
                  from an uninterrupted render in the last bits",
                 path.display(),
@@ -397,7 +452,7 @@ impl Session {
             );
         }
         self.exec
-            .restore(&from)
+            .restore(from)
             .with_context(|| format!("cannot resume from {}", path.display()))?;
         Ok(())
     }
@@ -469,7 +524,7 @@ pub fn render_key(graph: &Graph, scene: Option<&GpuScene>) -> u64 {
         n.pos = None;
     }
     let scene = scene.map_or_else(String::new, scene_digest);
-    crate::render::checkpoint::render_key(&g.to_ron(), &scene)
+    crate::checkpoint::render_key(&g.to_ron(), &scene)
 }
 
 /// Every number of the flattened scene, hashed: what the GPU gets and the CPU data that
@@ -478,7 +533,7 @@ pub fn render_key(graph: &Graph, scene: Option<&GpuScene>) -> u64 {
 /// cheap (the Crytek Sponza's text was over a gigabyte and took most of a minute).
 pub(crate) fn scene_digest(s: &GpuScene) -> String {
     use bytemuck::{bytes_of, cast_slice};
-    let h = crate::render::checkpoint::Fnv::default()
+    let h = crate::checkpoint::Fnv::default()
         .write(bytes_of(&s.header))
         .write(bytes_of(&s.camera))
         .write(bytes_of(&s.settings))
@@ -523,9 +578,9 @@ mod tests {
                   render: (width: 8, height: 8), instancing: On)"
             )
         };
-        let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
+        let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets");
         let digest = |x: f32| {
-            let scene = crate::scene::Scene::from_ron(&text(x), &assets).unwrap();
+            let scene = lumagraph_scene::Scene::from_ron(&text(x), &assets).unwrap();
             let gpu = GpuScene::build(&scene).unwrap();
             assert_eq!(gpu.instances.len(), 2);
             scene_digest(&gpu)
