@@ -96,6 +96,8 @@ pub enum Pick {
     GroupFile,
     /// The scene's environment map.
     EnvironmentMap,
+    /// Where to write the live error plot's points (CSV).
+    ErrorCsv,
 }
 
 /// A question waiting in a modal dialog.

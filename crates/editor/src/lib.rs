@@ -17,6 +17,7 @@
 pub mod app;
 pub mod canvas;
 pub mod document;
+pub mod error_plot;
 pub mod files;
 pub mod grouping;
 pub mod inspector;

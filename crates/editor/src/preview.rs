@@ -113,6 +113,9 @@ pub struct Preview {
     /// What the nodes measured on the last frame (`(node id, measurement)`: a `Difference`
     /// node's error, an `AutoExposure` node's exposure).
     pub measurements: Vec<(String, lumagraph_render::Measurement)>,
+    /// Each `Difference` node's error at each frame of this accumulation, against the
+    /// samples and the wall time so far ([`crate::error_plot`]).
+    pub curve: crate::error_plot::ErrorCurve,
     /// Why there is no preview, when there is none.
     pub error: Option<String>,
     /// Counters.
@@ -294,6 +297,7 @@ impl Preview {
             texture_stale: false,
             pass_ms: BTreeMap::new(),
             measurements: Vec::new(),
+            curve: crate::error_plot::ErrorCurve::default(),
             error: None,
             stats: PreviewStats::default(),
             thumbnails_on: false,
@@ -502,6 +506,7 @@ impl Preview {
                 .filter(|_| self.progressive)
                 .map_or(0, |s| u64::from(s.settings.spp));
             self.exec = Some(exec);
+            self.curve.clear();
             self.stats.rebuilds += 1;
             self.stats.restarts += u64::from(self.progressive);
             let report = self.frame()?;
@@ -611,6 +616,14 @@ impl Preview {
         if let Some(exec) = &mut self.exec {
             self.measurements = exec.measurements().map_err(|e| e.to_string())?;
         }
+        let spp = self.samples.filter(|_| self.progressive);
+        self.curve.record(
+            spp,
+            report.wall,
+            self.measurements
+                .iter()
+                .map(|(node, m)| (node.as_str(), m.name, m.value)),
+        );
         self.read_thumbnails()
     }
 

@@ -1252,3 +1252,72 @@ fn node_thumbnails_show_each_output() {
     h.state_mut().preview.set_thumbnails(false);
     assert!(h.state().preview.thumbnails.is_empty());
 }
+
+/// The live error plot on `graphs/compare_reference.ron` (the Cornell box against its
+/// Mitsuba reference, raw and denoised, at full size): each frame of the accumulation
+/// adds one point per `Difference` node, and the points are those nodes' measurements on
+/// those frames; the plot shows beside the preview, and its CSV export has the header of
+/// `converge.csv` and one row per point.
+#[test]
+fn the_live_error_plot_has_the_difference_nodes_measurements() {
+    let Some(ed) = with_config(
+        Some(&repo("graphs/compare_reference.ron")),
+        &EditorConfig {
+            scene: Some(repo("assets/cornell.ron")),
+            preview_max: 256,
+            ..EditorConfig::default()
+        },
+    ) else {
+        return;
+    };
+    let mut h = harness(ed);
+    let mut expected: Vec<(String, u64, f64)> = Vec::new();
+    let mut last_spp = 0;
+    for _ in 0..6 {
+        h.step();
+        let ed = h.state();
+        assert!(ed.errors.is_empty(), "{:?}", ed.errors);
+        let spp = ed.preview.samples.expect("a sample count");
+        if spp == last_spp {
+            continue;
+        }
+        last_spp = spp;
+        for (node, m) in &ed.preview.measurements {
+            if m.name == "relmse" {
+                expected.push((node.clone(), spp, m.value));
+            }
+        }
+    }
+    let ed = h.state();
+    let points: Vec<(String, u64, f64)> = ed
+        .preview
+        .curve
+        .points
+        .iter()
+        .map(|p| (p.node.clone(), p.spp, p.relmse))
+        .collect();
+    // The first frames (before the loop) are in the curve too: compare its end.
+    assert!(expected.len() >= 6, "{expected:?}");
+    assert_eq!(points[points.len() - expected.len()..], expected[..]);
+    assert_eq!(ed.preview.curve.nodes(), ["raw_error", "denoised_error"]);
+    let raw: Vec<f64> = points
+        .iter()
+        .filter(|p| p.0 == "raw_error")
+        .map(|p| p.2)
+        .collect();
+    assert!(raw.last() < raw.first(), "the raw error falls: {raw:?}");
+    let seconds: Vec<f64> = ed.preview.curve.points.iter().map(|p| p.seconds).collect();
+    assert!(seconds.windows(2).all(|w| w[0] <= w[1]), "{seconds:?}");
+    h.get_by_label("error against");
+
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("error.csv");
+    h.state_mut().apply_pick(&Pick::ErrorCsv, &csv);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("output,spp,seconds,rmse,relmse,ssim,gpu_ms")
+    );
+    assert_eq!(lines.count(), h.state().preview.curve.points.len());
+}

@@ -45,6 +45,11 @@ impl Editor {
                 start(self.scene.as_ref().map(|s| s.path.as_path())),
                 vec!["hdr", "exr"],
             ),
+            Pick::ErrorCsv => (
+                "Save the error curve as",
+                start(self.doc.path.as_deref()),
+                vec!["csv"],
+            ),
             Pick::Param(node, param) => {
                 let extensions = self
                     .doc
@@ -86,7 +91,13 @@ impl Editor {
                 .add_file_filter_extensions(&name, extensions.clone())
                 .default_file_filter(&name);
         }
-        if matches!(pick, Pick::SaveGraph | Pick::GroupFile) {
+        if pick == Pick::ErrorCsv {
+            dialog = dialog
+                .add_save_extension("CSV", "csv")
+                .default_save_extension("CSV")
+                .default_file_name("error.csv");
+            dialog.save_file();
+        } else if matches!(pick, Pick::SaveGraph | Pick::GroupFile) {
             let name = if pick == Pick::GroupFile {
                 "group.ron".to_owned()
             } else {
@@ -143,6 +154,13 @@ impl Editor {
                 }
             }
             Pick::GroupFile => self.group_selection(path),
+            Pick::ErrorCsv => {
+                let csv = self.preview.curve.csv();
+                match lumagraph_graph::write_atomic(path, csv.as_bytes()) {
+                    Ok(()) => self.say(format!("wrote {}", path.display()), false),
+                    Err(e) => self.say(format!("{}: {e}", path.display()), true),
+                }
+            }
             Pick::Param(node, param) => {
                 let base = std::path::absolute(self.doc.base_dir()).unwrap_or_default();
                 let value = path

@@ -107,6 +107,9 @@ impl Editor {
                 ui.label(format!("{node}.{}: {:.4e}", m.name, m.value))
                     .on_hover_text("measured by the node on the last frame");
             }
+            if !self.preview.curve.points.is_empty() {
+                self.error_plot(ui);
+            }
             let frame = self.preview.stats.frames;
             let width = ui.available_width();
             self.scope
@@ -136,6 +139,24 @@ impl Editor {
 
     /// Under the preview image: zoom, display exposure and false colour (HDR ports), the
     /// snapshot and compare mode, and the values under the pointer.
+    /// The live error plot ([`crate::error_plot`]) with its export.
+    fn error_plot(&mut self, ui: &mut Ui) {
+        let width = ui.available_width();
+        self.preview.curve.show(ui, width);
+        ui.horizontal(|ui| {
+            if ui
+                .button("save CSV…")
+                .on_hover_text("the points as `lumagraph converge` writes converge.csv")
+                .clicked()
+            {
+                self.open_file_dialog(crate::Pick::ErrorCsv);
+            }
+            if ui.button("copy CSV").clicked() {
+                ui.ctx().copy_text(self.preview.curve.csv());
+            }
+        });
+    }
+
     fn viewer_controls(&mut self, ui: &mut Ui, port: Option<&str>) {
         use crate::viewer::Compare;
         let hdr = self
