@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use egui::emath::TSTransform;
 use egui::{Color32, Pos2, Rect, RichText, Ui, pos2, vec2};
-use egui_snarl::ui::{PinInfo, SnarlPin, SnarlStyle, SnarlViewer, SnarlWidget};
+use egui_snarl::ui::{AnyPins, PinInfo, SnarlPin, SnarlStyle, SnarlViewer, SnarlWidget};
 use egui_snarl::{InPin, InPinId, NodeId, OutPin, OutPinId, Snarl};
 use lumagraph_graph::{Category, Graph, NodeKind, PortType, Registry, split_port_ref};
 
@@ -56,6 +56,12 @@ pub struct Canvas {
     node_rects: HashMap<String, Rect>,
     /// What to frame on the next draw.
     frame: Option<Frame>,
+    /// Where `Shift+A` opened Add node (screen), while it is open.
+    quick_add: Option<Pos2>,
+    /// Each pin's row centre in graph space, as last drawn: `(node, is output, port)`.
+    pin_rows: HashMap<(String, bool, String), f32>,
+    /// The nodes moved by the drag going on.
+    dragged: Vec<String>,
 }
 
 /// What [`Canvas::request_frame`] brings into view.
@@ -247,6 +253,7 @@ impl Canvas {
             search: &mut self.search,
             rects: Vec::new(),
             graph_rects: Vec::new(),
+            pin_rows: Vec::new(),
             frame: frame.map(|r| Self::framing(r, screen)),
             view: None,
         };
@@ -267,6 +274,7 @@ impl Canvas {
         self.node_rects = std::mem::take(&mut viewer.graph_rects)
             .into_iter()
             .collect();
+        self.pin_rows = std::mem::take(&mut viewer.pin_rows).into_iter().collect();
 
         // A plain click selects a node (shift or ctrl adds or removes it); a click on
         // empty canvas clears the selection. Snarl's own rectangle selection is followed
@@ -310,6 +318,8 @@ impl Canvas {
             events.push(CanvasEvent::Select(Vec::new()));
         }
 
+        self.quick_add(ui, doc, canvas_rect, &mut events);
+
         // Positions back into the graph (one undo step per drag).
         let moves: Vec<(String, (f32, f32))> = self
             .snarl
@@ -326,6 +336,23 @@ impl Canvas {
         if !moves.is_empty() {
             doc.move_nodes(&moves);
             self.built_from = Some(structure(&doc.graph));
+            for (id, _) in &moves {
+                if !self.dragged.contains(id) {
+                    self.dragged.push(id.clone());
+                }
+            }
+        }
+        // A single unwired node dropped on a wire goes into it.
+        if ui.input(|i| i.pointer.any_released()) {
+            if let [id] = std::mem::take(&mut self.dragged).as_slice()
+                && let Some(edge) = self.wire_under(&doc.graph, id)
+            {
+                match doc.insert_on_edge(&edge.0, &edge.1, id) {
+                    Ok(()) => self.built_from = None,
+                    Err(why) => events.push(CanvasEvent::Refused(why)),
+                }
+            }
+            self.dragged.clear();
         }
 
         let selected = egui_snarl::ui::get_selected_nodes(canvas_id(), ui.ctx());
@@ -338,6 +365,117 @@ impl Canvas {
             self.last_selection = selected;
         }
         events
+    }
+}
+
+impl Canvas {
+    /// The wire (`(from, to)` ports) under node `id`'s centre, as last drawn, when `id` has
+    /// no wire of its own; the nearest within a few points.
+    fn wire_under(&self, graph: &Graph, id: &str) -> Option<(String, String)> {
+        let split = |p: &str| split_port_ref(p).map(|(n, port)| (n.to_owned(), port.to_owned()));
+        let wired = graph
+            .edges
+            .iter()
+            .filter_map(|e| Some((split(&e.from)?.0, split(&e.to)?.0)))
+            .any(|(a, b)| a == id || b == id);
+        if wired {
+            return None;
+        }
+        let center = self.node_rects.get(id)?.center();
+        let mut best: Option<(f32, (String, String))> = None;
+        for e in &graph.edges {
+            let (Some((a, ap)), Some((b, bp))) = (split(&e.from), split(&e.to)) else {
+                continue;
+            };
+            let (Some(ar), Some(br)) = (self.node_rects.get(&a), self.node_rects.get(&b)) else {
+                continue;
+            };
+            let (Some(ay), Some(by)) = (
+                self.pin_rows.get(&(a.clone(), true, ap)),
+                self.pin_rows.get(&(b.clone(), false, bp)),
+            ) else {
+                continue;
+            };
+            let d = distance_to_wire(center, pos2(ar.right(), *ay), pos2(br.left(), *by));
+            if d < WIRE_HIT && best.as_ref().is_none_or(|(bd, _)| d < *bd) {
+                best = Some((d, (e.from.clone(), e.to.clone())));
+            }
+        }
+        best.map(|(_, edge)| edge)
+    }
+}
+
+/// How near a node's centre must be to a wire to go into it, in graph units.
+const WIRE_HIT: f32 = 14.0;
+
+/// The distance from `p` to the wire from `p0` to `p3`: a cubic Bézier leaving and
+/// entering horizontally, as the canvas draws wires, sampled.
+fn distance_to_wire(p: Pos2, p0: Pos2, p3: Pos2) -> f32 {
+    let k = ((p3.x - p0.x).abs() * 0.5).max(24.0);
+    let (p1, p2) = (p0 + vec2(k, 0.0), p3 - vec2(k, 0.0));
+    (0..=64)
+        .map(|i| {
+            #[expect(clippy::cast_precision_loss, reason = "a sample's parameter")]
+            let t = i as f32 / 64.0;
+            let u = 1.0 - t;
+            let q = p0.to_vec2() * (u * u * u)
+                + p1.to_vec2() * (3.0 * u * u * t)
+                + p2.to_vec2() * (3.0 * u * t * t)
+                + p3.to_vec2() * (t * t * t);
+            (q.to_pos2() - p).length()
+        })
+        .fold(f32::MAX, f32::min)
+}
+
+impl Canvas {
+    /// `Shift+A` over the canvas (Blender's key): Add node at the pointer, the node placed
+    /// there. `Escape` or a click elsewhere closes it.
+    fn quick_add(
+        &mut self,
+        ui: &mut Ui,
+        doc: &mut Document,
+        canvas_rect: Rect,
+        events: &mut Vec<CanvasEvent>,
+    ) {
+        let (pressed, escape, clicked, hover) = ui.input(|i| {
+            (
+                i.modifiers.shift && !i.modifiers.command && i.key_pressed(egui::Key::A),
+                i.key_pressed(egui::Key::Escape),
+                i.pointer.any_click(),
+                i.pointer.hover_pos(),
+            )
+        });
+        if pressed
+            && self.quick_add.is_none()
+            && !ui.ctx().egui_wants_keyboard_input()
+            && let Some(at) = hover.filter(|p| canvas_rect.contains(*p))
+        {
+            self.quick_add = Some(at);
+            self.search.clear();
+            return;
+        }
+        let Some(at) = self.quick_add else { return };
+        let mut picked = None;
+        let area = egui::Area::new(egui::Id::new("quick add node"))
+            .fixed_pos(at)
+            .order(egui::Order::Foreground)
+            .show(ui.ctx(), |ui| {
+                egui::Frame::popup(ui.style()).show(ui, |ui| {
+                    ui.label("Add node");
+                    picked = add_node_menu(ui, doc.registry(), &mut self.search);
+                });
+            });
+        let outside = clicked && hover.is_some_and(|p| !area.response.rect.contains(p));
+        if let Some(kind) = picked {
+            let pos = self.view.map_or(at, |v| v.inverse() * at);
+            match doc.add_node(kind, Some((pos.x, pos.y))) {
+                Ok(id) => events.push(CanvasEvent::Added(id)),
+                Err(e) => events.push(CanvasEvent::Refused(e)),
+            }
+            self.quick_add = None;
+        } else if escape || outside {
+            self.quick_add = None;
+        }
     }
 }
 
@@ -365,6 +503,8 @@ struct Viewer<'a, 'i> {
     rects: Vec<(String, egui::Rect)>,
     /// Each node's rectangle in graph space.
     graph_rects: Vec<(String, egui::Rect)>,
+    /// Each pin's row centre in graph space.
+    pin_rows: Vec<((String, bool, String), f32)>,
     /// A view to take (framing), applied when the snarl asks.
     frame: Option<TSTransform>,
     /// The view the snarl is drawn with.
@@ -393,11 +533,37 @@ impl Viewer<'_, '_> {
 /// The add-node menu: a search field and the registry's kinds grouped by category.
 /// Returns the kind picked.
 pub fn add_node_menu(ui: &mut Ui, reg: &Registry, search: &mut String) -> Option<&'static str> {
+    add_node_menu_of(ui, reg, search, &|_| true)
+}
+
+/// The port of `kind` a wire from (`output`) or to a port of `types` would take: its first
+/// input accepting the output's type, or its first output of a type the input accepts.
+pub fn fitting_port(kind: &NodeKind, types: &[PortType], output: bool) -> Option<&'static str> {
+    if output {
+        kind.inputs
+            .iter()
+            .find(|i| types.iter().any(|t| i.accepts.contains(t)))
+            .map(|i| i.name)
+    } else {
+        kind.outputs
+            .iter()
+            .find(|o| types.contains(&o.ty))
+            .map(|o| o.name)
+    }
+}
+
+/// [`add_node_menu`] listing only the kinds `show` keeps.
+pub fn add_node_menu_of(
+    ui: &mut Ui,
+    reg: &Registry,
+    search: &mut String,
+    show: &dyn Fn(&NodeKind) -> bool,
+) -> Option<&'static str> {
     ui.add(egui::TextEdit::singleline(search).hint_text("search nodes"))
         .request_focus();
     let needle = search.to_lowercase();
     let mut by_cat: BTreeMap<Category, Vec<&NodeKind>> = BTreeMap::new();
-    for k in reg.kinds() {
+    for k in reg.kinds().iter().filter(|k| show(k)) {
         if needle.is_empty()
             || k.name.to_lowercase().contains(&needle)
             || k.doc.to_lowercase().contains(&needle)
@@ -462,6 +628,8 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
             .node(&id)
             .map(|n| n.kind.clone())
             .unwrap_or_default();
+        // The title moves the node when dragged, rather than selecting its text.
+        ui.style_mut().interaction.selectable_labels = false;
         ui.horizontal(|ui| {
             ui.label(RichText::new(&id).strong());
             let weak = ui.weak(&kind);
@@ -496,8 +664,14 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
             return PinInfo::circle();
         };
         let types: Vec<_> = def.accepts.iter().map(|t| t.name()).collect();
-        ui.label(def.name)
-            .on_hover_text(format!("{}\naccepts {}", def.doc, types.join(" or ")));
+        let row = ui
+            .label(def.name)
+            .on_hover_text(format!("{}\naccepts {}", def.doc, types.join(" or ")))
+            .rect;
+        self.pin_rows.push((
+            (snarl[pin.id.node].clone(), false, def.name.to_owned()),
+            row.center().y,
+        ));
         let fill = if def.accepts.len() == 1 {
             port_color(def.accepts[0])
         } else {
@@ -526,14 +700,13 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
         } else {
             def.name.to_owned()
         };
-        if ui
-            .selectable_label(shown, label)
-            .on_hover_text(format!(
-                "{}\nproduces {}\nclick to preview",
-                def.doc, def.ty
-            ))
-            .clicked()
-        {
+        let response = ui.selectable_label(shown, label).on_hover_text(format!(
+            "{}\nproduces {}\nclick to preview",
+            def.doc, def.ty
+        ));
+        self.pin_rows
+            .push(((id, true, def.name.to_owned()), response.rect.center().y));
+        if response.clicked() {
             self.events.push(CanvasEvent::Preview(port));
         }
         PinInfo::circle()
@@ -614,6 +787,37 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
         ui.label("Add node");
         if let Some(kind) = add_node_menu(ui, self.doc.registry(), self.search) {
             match self.doc.add_node(kind, Some((pos.x, pos.y))) {
+                Ok(id) => self.events.push(CanvasEvent::Added(id)),
+                Err(e) => self.events.push(CanvasEvent::Refused(e)),
+            }
+        }
+    }
+
+    fn has_dropped_wire_menu(&mut self, _src_pins: AnyPins, _snarl: &mut Snarl<String>) -> bool {
+        true
+    }
+
+    /// A wire dropped on empty canvas: Add node, listing the kinds with a port that fits
+    /// it; the node picked goes where the wire was dropped, wired to it.
+    fn show_dropped_wire_menu(
+        &mut self,
+        pos: Pos2,
+        ui: &mut Ui,
+        src_pins: AnyPins,
+        snarl: &mut Snarl<String>,
+    ) {
+        let (port, output) = match src_pins {
+            AnyPins::Out(pins) => (pins.first().and_then(|p| self.out_ref(snarl, *p)), true),
+            AnyPins::In(pins) => (pins.first().and_then(|p| self.in_ref(snarl, *p)), false),
+        };
+        let Some(port) = port else { return };
+        let Some(types) = self.doc.port_types(&port, output) else {
+            return;
+        };
+        ui.label(format!("Add node wired to {port}"));
+        let fits = |k: &NodeKind| fitting_port(k, &types, output).is_some();
+        if let Some(kind) = add_node_menu_of(ui, self.doc.registry(), self.search, &fits) {
+            match self.doc.add_wired(kind, (pos.x, pos.y), &port, output) {
                 Ok(id) => self.events.push(CanvasEvent::Added(id)),
                 Err(e) => self.events.push(CanvasEvent::Refused(e)),
             }

@@ -190,6 +190,116 @@ impl Document {
         Ok(id)
     }
 
+    /// The types of port `port` (`"node.port"`): what an output produces, or what an
+    /// input accepts; `None` when there is no such port.
+    pub fn port_types(&self, port: &str, output: bool) -> Option<Vec<lumagraph_graph::PortType>> {
+        let (node, name) = split_port_ref(port)?;
+        let kind = self.registry().get(&self.graph.node(node)?.kind)?;
+        if output {
+            let o = kind.outputs.iter().find(|o| o.name == name)?;
+            Some(vec![o.ty])
+        } else {
+            let i = kind.inputs.iter().find(|i| i.name == name)?;
+            Some(i.accepts.to_vec())
+        }
+    }
+
+    /// Adds a node of `kind` at `pos` wired to `port` (`"node.port"`): from an output
+    /// `port` into the new node's first input that accepts its type, or from the new
+    /// node's first output of a type an input `port` accepts (replacing the wire that
+    /// input had). One undo step; returns the new node's id.
+    ///
+    /// # Errors
+    /// When the kind has no port that fits, or the edge is refused (the compiler's words);
+    /// the graph is then unchanged.
+    pub fn add_wired(
+        &mut self,
+        kind: &str,
+        pos: (f32, f32),
+        port: &str,
+        output: bool,
+    ) -> Result<String, String> {
+        let types = self
+            .port_types(port, output)
+            .ok_or_else(|| format!("no port {port}"))?;
+        let k = self
+            .registry()
+            .get(kind)
+            .cloned()
+            .ok_or_else(|| format!("unknown node kind \"{kind}\""))?;
+        let fit = crate::canvas::fitting_port(&k, &types, output)
+            .ok_or_else(|| format!("{kind} has no port that fits {port}"))?;
+        let before = self.graph.clone();
+        let id = self.unique_id(kind);
+        let mut node = Node::new(id.clone(), kind);
+        node.pos = Some(pos);
+        self.graph.nodes.push(node);
+        let (from, to) = if output {
+            (port.to_owned(), format!("{id}.{fit}"))
+        } else {
+            (format!("{id}.{fit}"), port.to_owned())
+        };
+        if let Some(why) = self.check_edge(&from, &to) {
+            self.graph = before;
+            return Err(why);
+        }
+        let edge = Edge::new(from, to.clone());
+        if let Some(e) = self.graph.edges.iter_mut().find(|e| e.to == to) {
+            *e = edge;
+        } else {
+            self.graph.edges.push(edge);
+        }
+        self.history.record(&before, None);
+        Ok(id)
+    }
+
+    /// Puts node `id` into the wire `from` → `to`: `from` into its first input that takes
+    /// `from`'s type, its first output of a type `to` accepts into `to`. One undo step.
+    ///
+    /// # Errors
+    /// When the node has no such ports (naming the types), or an edge is refused; the
+    /// graph is then unchanged.
+    pub fn insert_on_edge(&mut self, from: &str, to: &str, id: &str) -> Result<(), String> {
+        let kind = self
+            .graph
+            .node(id)
+            .and_then(|n| self.registry().get(&n.kind))
+            .cloned()
+            .ok_or_else(|| format!("no node {id}"))?;
+        let (out_types, in_types) = (
+            self.port_types(from, true).unwrap_or_default(),
+            self.port_types(to, false).unwrap_or_default(),
+        );
+        let input = crate::canvas::fitting_port(&kind, &out_types, true);
+        let output = crate::canvas::fitting_port(&kind, &in_types, false);
+        let (Some(input), Some(output)) = (input, output) else {
+            let names = |t: &[lumagraph_graph::PortType]| {
+                t.iter().map(|t| t.name()).collect::<Vec<_>>().join(" or ")
+            };
+            return Err(format!(
+                "{id} ({}) does not go into the wire {from} -> {to}: it needs an input taking {} and an output {to} accepts ({})",
+                kind.name,
+                names(&out_types),
+                names(&in_types)
+            ));
+        };
+        let before = self.graph.clone();
+        self.graph.edges.retain(|e| !(e.from == from && e.to == to));
+        let (a, b) = (
+            (from.to_owned(), format!("{id}.{input}")),
+            (format!("{id}.{output}"), to.to_owned()),
+        );
+        for (f, t) in [&a, &b] {
+            if let Some(why) = self.check_edge(f, t) {
+                self.graph = before;
+                return Err(why);
+            }
+            self.graph.edges.push(Edge::new(f.clone(), t.clone()));
+        }
+        self.history.record(&before, None);
+        Ok(())
+    }
+
     /// Why an edge `from` → `to` (each `"node.port"`) cannot be made, in the compiler's
     /// words; `None` when it can.
     pub fn check_edge(&self, from: &str, to: &str) -> Option<String> {

@@ -1321,3 +1321,168 @@ fn the_live_error_plot_has_the_difference_nodes_measurements() {
     );
     assert_eq!(lines.count(), h.state().preview.curve.points.len());
 }
+
+/// Wiring by search: a wire dragged from an output pin and dropped on empty canvas opens
+/// Add node listing only the kinds with an input that takes it; the kind picked is placed
+/// where the wire was dropped and wired to it, in one undo step. From an input pin, the
+/// kinds with a fitting output. `Shift+A` opens Add node at the pointer; `Escape` closes it.
+#[test]
+fn a_wire_dropped_on_empty_canvas_adds_a_node_that_fits_it() {
+    use egui::{Key, Modifiers};
+    let Some(mut ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    assert!(ed.doc.disconnect("input.color", "exposure.color"));
+    ed.doc.end_gesture();
+    let mut h = harness(ed);
+    // Pins as drawn at the default zoom (see the snapshot), and empty canvas above them.
+    let tonemap_out = egui::pos2(562.0, 339.0);
+    let exposure_in = egui::pos2(267.0, 339.0);
+    let empty = egui::pos2(450.0, 150.0);
+    let nodes = h.state().doc.graph.nodes.len();
+    drag(&mut h, tonemap_out, empty);
+    h.get_by_label("Add node wired to tonemap.color");
+    // An LDR image: no source (PathTrace has no input), no HDR-only input (Exposure).
+    for absent in ["PathTrace", "Exposure", "ImageInput"] {
+        assert!(
+            h.query_by_role_and_label(Role::Button, absent).is_none(),
+            "{absent} listed for an LDR wire"
+        );
+    }
+    h.get_by_role_and_label(Role::Button, "Output").click();
+    h.run_ok();
+    let ed = h.state_mut();
+    assert_eq!(ed.doc.graph.nodes.len(), nodes + 1);
+    let new = ed.doc.graph.nodes.last().unwrap().clone();
+    assert_eq!(new.kind, "Output");
+    let tonemap_x = ed.doc.graph.node("tonemap").unwrap().pos.unwrap().0;
+    let (x, y) = new.pos.expect("placed");
+    assert!(x < tonemap_x + 60.0 && y < -100.0, "placed at ({x}, {y})");
+    let wired = format!("{}.color", new.id);
+    assert!(
+        ed.doc
+            .graph
+            .edges
+            .iter()
+            .any(|e| e.from == "tonemap.color" && e.to == wired),
+        "{:?}",
+        ed.doc.graph.edges
+    );
+    assert!(ed.doc.undo(), "one undo step");
+    assert_eq!(ed.doc.graph.nodes.len(), nodes);
+    assert!(!ed.doc.graph.edges.iter().any(|e| e.to == wired));
+    h.run_ok();
+
+    // From exposure's free input: the kinds with an HDR output.
+    drag(&mut h, exposure_in, egui::pos2(150.0, 150.0));
+    h.get_by_label("Add node wired to exposure.color");
+    assert!(h.query_by_role_and_label(Role::Button, "Tonemap").is_none());
+    h.get_by_role_and_label(Role::Button, "ImageInput").click();
+    h.run_ok();
+    let ed = h.state();
+    let new = ed.doc.graph.nodes.last().unwrap();
+    assert_eq!(new.kind, "ImageInput");
+    assert!(
+        ed.doc
+            .graph
+            .edges
+            .iter()
+            .any(|e| e.from == format!("{}.color", new.id) && e.to == "exposure.color")
+    );
+
+    // Shift+A at the pointer.
+    let count = h.state().doc.graph.nodes.len();
+    h.hover_at(empty);
+    h.run_ok();
+    h.key_press_modifiers(Modifiers::SHIFT, Key::A);
+    h.run_ok();
+    h.get_by_role_and_label(Role::Button, "Blur");
+    h.key_press(Key::Escape);
+    h.run_ok();
+    assert!(h.query_by_role_and_label(Role::Button, "Blur").is_none());
+    h.hover_at(empty);
+    h.key_press_modifiers(Modifiers::SHIFT, Key::A);
+    h.run_ok();
+    h.get_by_role_and_label(Role::Button, "Blur").click();
+    h.run_ok();
+    let ed = h.state();
+    assert_eq!(ed.doc.graph.nodes.len(), count + 1);
+    let blur = ed.doc.graph.nodes.last().unwrap();
+    assert_eq!(blur.kind, "Blur");
+    let (x, y) = blur.pos.expect("placed");
+    assert!(x < tonemap_x + 60.0 && y < -100.0, "placed at ({x}, {y})");
+    assert_eq!(ed.selected, std::slice::from_ref(&blur.id));
+}
+
+/// A node dragged onto a wire goes into it where the types allow: a Blur dropped on the
+/// exposure → tonemap wire (HDR) ends up between them, in one undo step after the move;
+/// a Tonemap (HDR in, LDR out) dropped on it is refused with the reason.
+#[test]
+fn a_node_dropped_on_a_wire_goes_into_it() {
+    let Some(ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    let mut h = harness(ed);
+    // Added after the graph was framed, so the view is the snapshot's: there graph
+    // coordinates map to the screen by x' = 0.791 x + 98.5, y' = 0.791 y + 309.7 (from
+    // the pins of exposure and tonemap). The node's box is about 105 by 60 graph units.
+    let blur = h
+        .state_mut()
+        .doc
+        .add_node("Blur", Some((300.0, -250.0)))
+        .unwrap();
+    h.state_mut().doc.end_gesture();
+    h.run_ok();
+    let to_screen = |x: f32, y: f32| egui::pos2(0.791 * x + 98.5, 0.791 * y + 309.7);
+    let center = to_screen(345.0, -227.0);
+    let header = to_screen(345.0, -245.0);
+    // The wire between exposure's output (387, 339) and tonemap's input (441, 339).
+    let on_wire = egui::pos2(414.0, 339.0);
+    drag(&mut h, header, header + (on_wire - center));
+    let wired = format!("{blur}.color");
+    let ed = h.state_mut();
+    let edges: Vec<(&str, &str)> = ed
+        .doc
+        .graph
+        .edges
+        .iter()
+        .map(|e| (e.from.as_str(), e.to.as_str()))
+        .collect();
+    assert!(
+        edges.contains(&("exposure.color", wired.as_str())),
+        "{edges:?}"
+    );
+    assert!(
+        edges.contains(&(wired.as_str(), "tonemap.color")),
+        "{edges:?}"
+    );
+    assert!(
+        !edges.contains(&("exposure.color", "tonemap.color")),
+        "{edges:?}"
+    );
+    assert!(ed.errors.is_empty(), "{:?}", ed.errors);
+    assert!(ed.doc.undo());
+    assert!(
+        ed.doc
+            .graph
+            .edges
+            .iter()
+            .any(|e| e.from == "exposure.color" && e.to == "tonemap.color")
+    );
+    assert!(!ed.doc.graph.edges.iter().any(|e| e.to == wired));
+
+    // Types that do not fit: refused, with the reason.
+    let before = ed.doc.graph.edges.clone();
+    let err = ed
+        .doc
+        .insert_on_edge("input.color", "exposure.color", "tonemap")
+        .unwrap_err();
+    assert!(err.contains("does not go into the wire"), "{err}");
+    let tm2 = ed.doc.add_node("Tonemap", Some((300.0, -250.0))).unwrap();
+    let err = ed
+        .doc
+        .insert_on_edge("exposure.color", "tonemap.color", &tm2)
+        .unwrap_err();
+    assert!(err.contains("ldr") || err.contains("hdr"), "{err}");
+    let _ = before;
+}
