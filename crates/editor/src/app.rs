@@ -133,6 +133,10 @@ pub struct Editor {
     pub view: crate::viewer::ImageView,
     /// Selected node ids.
     pub selected: Vec<String>,
+    /// The frame selected (its title clicked), shown in the inspector while no node is.
+    pub selected_frame: Option<usize>,
+    /// Node moves snap to a grid of [`crate::canvas::GRID`] graph units when a drag ends.
+    pub snap: bool,
     /// The port chosen for preview (`"node.port"`); `None` follows the selection.
     pub preview_port: Option<String>,
     /// Compile errors per node id (messages without file locations).
@@ -192,6 +196,8 @@ impl Editor {
             scope: crate::scope::ScopeView::default(),
             view: crate::viewer::ImageView::new(),
             selected: Vec::new(),
+            selected_frame: None,
+            snap: false,
             preview_port: None,
             errors: BTreeMap::new(),
             graph_errors: Vec::new(),
@@ -349,6 +355,9 @@ impl Editor {
         if !typing && ctx.input_mut(|i| i.consume_key(cmd, Key::G)) {
             self.ask_group_selection();
         }
+        if !typing && ctx.input_mut(|i| i.consume_key(cmd, Key::J)) {
+            self.frame_selection();
+        }
         if !typing && ctx.input_mut(|i| i.consume_key(Modifiers::NONE, Key::Tab)) {
             self.toggle_group();
         }
@@ -369,9 +378,6 @@ impl Editor {
             self.message_time = now;
         }
         self.shortcuts(ui);
-        if !ui.input(|i| i.pointer.any_down()) {
-            self.doc.end_gesture();
-        }
         self.poll_files(now);
         let dragging = ui.input(|i| i.pointer.any_down());
         self.apply_scene_edits(dragging);
@@ -429,7 +435,9 @@ impl Editor {
                 pass_ms: &self.preview.pass_ms,
                 preview: port.as_deref(),
                 selected: &self.selected,
+                selected_frame: self.selected_frame,
             };
+            self.canvas.snap = self.snap;
             let events = self.canvas.show(ui, &mut self.doc, &info);
             for e in events {
                 match e {
@@ -441,12 +449,21 @@ impl Editor {
                         self.selected.retain(|s| !ids.contains(s));
                     }
                     CanvasEvent::Added(id) => self.select(vec![id]),
+                    CanvasEvent::SelectFrame(i) => {
+                        self.select(Vec::new());
+                        self.selected_frame = Some(i);
+                    }
                 }
             }
         });
         self.refusal_tooltip(ui, now);
         self.dialogs(ui);
         self.file_dialog_ui(&ui.ctx().clone());
+        // A gesture (a slider or node drag, a snap on release) ends after the frame in which
+        // no pointer is down: its edits are one undo step.
+        if !ui.input(|i| i.pointer.any_down()) {
+            self.doc.end_gesture();
+        }
     }
 
     /// Handles a close request from the window: returns whether to let it close.

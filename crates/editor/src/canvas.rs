@@ -36,6 +36,8 @@ pub enum CanvasEvent {
     Delete(Vec<String>),
     /// A node was added from the menu.
     Added(String),
+    /// The user clicked frame `index`'s title.
+    SelectFrame(usize),
 }
 
 /// The snarl view and what it was built from.
@@ -62,6 +64,16 @@ pub struct Canvas {
     pin_rows: HashMap<(String, bool, String), f32>,
     /// The nodes moved by the drag going on.
     dragged: Vec<String>,
+    /// Snap nodes to a grid of [`GRID`] units when a drag ends.
+    pub snap: bool,
+}
+
+/// The grid nodes snap to, graph units.
+pub const GRID: f32 = 20.0;
+
+/// `p` on the grid.
+fn snapped(p: (f32, f32)) -> (f32, f32) {
+    ((p.0 / GRID).round() * GRID, (p.1 / GRID).round() * GRID)
 }
 
 /// What [`Canvas::request_frame`] brings into view.
@@ -246,6 +258,7 @@ impl Canvas {
             None => None,
         };
         let mut events = Vec::new();
+        let frames = self.frame_boxes(&doc.graph, info.selected_frame);
         let mut viewer = Viewer {
             doc,
             info,
@@ -254,6 +267,7 @@ impl Canvas {
             rects: Vec::new(),
             graph_rects: Vec::new(),
             pin_rows: Vec::new(),
+            frames: &frames,
             frame: frame.map(|r| Self::framing(r, screen)),
             view: None,
         };
@@ -314,7 +328,7 @@ impl Canvas {
             };
             ids.dedup();
             events.push(CanvasEvent::Select(ids));
-        } else if click && !info.selected.is_empty() {
+        } else if click && (!info.selected.is_empty() || info.selected_frame.is_some()) {
             events.push(CanvasEvent::Select(Vec::new()));
         }
 
@@ -342,18 +356,12 @@ impl Canvas {
                 }
             }
         }
-        // A single unwired node dropped on a wire goes into it.
         if ui.input(|i| i.pointer.any_released()) {
-            if let [id] = std::mem::take(&mut self.dragged).as_slice()
-                && let Some(edge) = self.wire_under(&doc.graph, id)
-            {
-                match doc.insert_on_edge(&edge.0, &edge.1, id) {
-                    Ok(()) => self.built_from = None,
-                    Err(why) => events.push(CanvasEvent::Refused(why)),
-                }
-            }
-            self.dragged.clear();
+            self.drag_ended(doc, &mut events);
         }
+
+        // After the snarl's own moves: a frame's drag moves nodes the snarl has not seen.
+        self.frame_titles(ui, doc, &frames, canvas_rect, &mut events);
 
         let selected = egui_snarl::ui::get_selected_nodes(canvas_id(), ui.ctx());
         if selected != self.last_selection && !node_clicked {
@@ -365,6 +373,203 @@ impl Canvas {
             self.last_selection = selected;
         }
         events
+    }
+}
+
+/// A frame as drawn: its box in graph space around its nodes, with its title bar.
+#[derive(Clone, Debug)]
+pub struct FrameBox {
+    /// Its index in the graph's frames.
+    pub index: usize,
+    /// The box, graph space.
+    pub rect: Rect,
+    /// Its title.
+    pub label: String,
+    /// Its comment.
+    pub comment: String,
+    /// Its colour.
+    pub color: Color32,
+    /// Whether it is selected.
+    pub selected: bool,
+}
+
+/// Space between a frame's nodes and its border, graph units.
+const FRAME_PAD: f32 = 14.0;
+/// The height of a frame's title bar (and of each comment line), graph units.
+const FRAME_TITLE: f32 = 22.0;
+/// A frame's colour where it has none.
+const FRAME_COLOR: Color32 = Color32::from_rgb(120, 130, 150);
+
+impl FrameBox {
+    /// The title bar: where a drag moves the frame and a click selects it.
+    pub fn title_rect(&self) -> Rect {
+        Rect::from_min_size(self.rect.min, vec2(self.rect.width(), FRAME_TITLE))
+    }
+
+    fn paint(&self, painter: &egui::Painter, style: &egui::Style) {
+        painter.rect_filled(self.rect, 6.0, self.color.gamma_multiply(0.16));
+        let stroke = if self.selected {
+            egui::Stroke::new(2.0, Color32::from_rgb(90, 160, 255))
+        } else {
+            egui::Stroke::new(1.0, self.color.gamma_multiply(0.8))
+        };
+        painter.rect_stroke(self.rect, 6.0, stroke, egui::StrokeKind::Inside);
+        painter.rect_filled(self.title_rect(), 6.0, self.color.gamma_multiply(0.35));
+        painter.text(
+            self.rect.min + vec2(8.0, FRAME_TITLE * 0.5),
+            egui::Align2::LEFT_CENTER,
+            &self.label,
+            egui::FontId::proportional(14.0),
+            style.visuals.strong_text_color(),
+        );
+        for (i, line) in self.comment.lines().enumerate() {
+            #[expect(clippy::cast_precision_loss, reason = "a line's offset")]
+            let y = FRAME_TITLE * (1.5 + i as f32);
+            painter.text(
+                self.rect.min + vec2(8.0, y),
+                egui::Align2::LEFT_CENTER,
+                line,
+                egui::FontId::proportional(12.0),
+                style.visuals.text_color(),
+            );
+        }
+    }
+}
+
+/// `base` with `color` mixed in, for a node's header colour.
+fn tint(base: Color32, color: Color32) -> Color32 {
+    let mix = |a: u8, b: u8| {
+        let v = (f32::from(a) * 0.55 + f32::from(b) * 0.45).round();
+        #[expect(
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss,
+            reason = "0 to 255"
+        )]
+        let v = v as u8;
+        v
+    };
+    Color32::from_rgb(
+        mix(base.r(), color.r()),
+        mix(base.g(), color.g()),
+        mix(base.b(), color.b()),
+    )
+}
+
+impl Canvas {
+    /// A drag let go: with grid snap, the dragged nodes land on the grid; a single unwired
+    /// node dropped on a wire goes into it.
+    fn drag_ended(&mut self, doc: &mut Document, events: &mut Vec<CanvasEvent>) {
+        if self.snap {
+            let moves: Vec<(String, (f32, f32))> = self
+                .dragged
+                .iter()
+                .filter_map(|id| Some((id.clone(), snapped(doc.graph.node(id)?.pos?))))
+                .collect();
+            doc.move_nodes(&moves);
+        }
+        if let [id] = std::mem::take(&mut self.dragged).as_slice()
+            && let Some(edge) = self.wire_under(&doc.graph, id)
+        {
+            match doc.insert_on_edge(&edge.0, &edge.1, id) {
+                Ok(()) => self.built_from = None,
+                Err(why) => events.push(CanvasEvent::Refused(why)),
+            }
+        }
+        self.dragged.clear();
+    }
+
+    /// Where graph point `p` was on screen when the canvas was last drawn.
+    pub fn to_screen(&self, p: Pos2) -> Option<Pos2> {
+        self.view.map(|v| v * p)
+    }
+
+    /// The graph's frames as drawn: each box around its nodes (as last drawn; a node not
+    /// drawn yet by its position), padded, with room for the title and the comment.
+    pub fn frame_boxes(&self, graph: &Graph, selected: Option<usize>) -> Vec<FrameBox> {
+        graph
+            .frames
+            .iter()
+            .enumerate()
+            .filter_map(|(index, f)| {
+                let rect = f
+                    .nodes
+                    .iter()
+                    .filter_map(|id| {
+                        self.node_rects.get(id).copied().or_else(|| {
+                            let (x, y) = graph.node(id)?.pos?;
+                            Some(Rect::from_min_size(pos2(x, y), NODE_SIZE))
+                        })
+                    })
+                    .reduce(Rect::union)?;
+                #[expect(clippy::cast_precision_loss, reason = "a count of lines")]
+                let lines = f.comment.lines().count() as f32;
+                let rect = Rect::from_min_max(
+                    rect.min - vec2(FRAME_PAD, FRAME_PAD + FRAME_TITLE * (1.0 + lines)),
+                    rect.max + vec2(FRAME_PAD, FRAME_PAD),
+                );
+                Some(FrameBox {
+                    index,
+                    rect,
+                    label: f.label.clone(),
+                    comment: f.comment.clone(),
+                    color: f
+                        .color
+                        .map_or(FRAME_COLOR, |(r, g, b)| Color32::from_rgb(r, g, b)),
+                    selected: selected == Some(index),
+                })
+            })
+            .collect()
+    }
+
+    /// Each frame's title bar on screen: a drag moves the frame (its nodes), a click
+    /// selects it.
+    fn frame_titles(
+        &mut self,
+        ui: &mut Ui,
+        doc: &mut Document,
+        frames: &[FrameBox],
+        canvas_rect: Rect,
+        events: &mut Vec<CanvasEvent>,
+    ) {
+        let Some(view) = self.view else { return };
+        for f in frames {
+            let screen = view * f.title_rect();
+            if !canvas_rect.intersects(screen) {
+                continue;
+            }
+            let area = egui::Area::new(canvas_id().with(("frame title", f.index)))
+                .fixed_pos(screen.min)
+                .order(egui::Order::Middle)
+                .movable(false)
+                .constrain(false)
+                .show(ui.ctx(), |ui| {
+                    ui.allocate_response(screen.size(), egui::Sense::click_and_drag())
+                        .on_hover_cursor(egui::CursorIcon::Grab)
+                });
+            let r = area.inner;
+            if r.clicked() || r.drag_started() {
+                events.push(CanvasEvent::SelectFrame(f.index));
+            }
+            if r.dragged() {
+                let d = r.drag_delta() / view.scaling;
+                if d != egui::Vec2::ZERO {
+                    doc.move_frame(f.index, (d.x, d.y));
+                    self.built_from = None;
+                }
+            }
+            if r.drag_stopped()
+                && self.snap
+                && let Some(frame) = doc.graph.frames.get(f.index)
+            {
+                let moves: Vec<(String, (f32, f32))> = frame
+                    .nodes
+                    .iter()
+                    .filter_map(|id| Some((id.clone(), snapped(doc.graph.node(id)?.pos?))))
+                    .collect();
+                doc.move_nodes(&moves);
+                self.built_from = None;
+            }
+        }
     }
 }
 
@@ -490,6 +695,8 @@ pub struct NodeInfo<'a> {
     pub preview: Option<&'a str>,
     /// Nodes selected in the app (highlighted header).
     pub selected: &'a [String],
+    /// The frame selected in the app (highlighted border).
+    pub selected_frame: Option<usize>,
     /// Pictures of the nodes' outputs (texture, size in points), when they are on.
     pub thumbnails: &'a BTreeMap<String, (egui::TextureId, egui::Vec2)>,
 }
@@ -505,6 +712,8 @@ struct Viewer<'a, 'i> {
     graph_rects: Vec<(String, egui::Rect)>,
     /// Each pin's row centre in graph space.
     pin_rows: Vec<((String, bool, String), f32)>,
+    /// The frames to draw behind the nodes.
+    frames: &'a [FrameBox],
     /// A view to take (framing), applied when the snarl asks.
     frame: Option<TSTransform>,
     /// The view the snarl is drawn with.
@@ -604,6 +813,10 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
         snarl: &Snarl<String>,
     ) -> egui::Frame {
         let id = &snarl[node];
+        let default = match self.doc.graph.node(id).and_then(|n| n.color) {
+            Some((r, g, b)) => default.fill(tint(default.fill, Color32::from_rgb(r, g, b))),
+            None => default,
+        };
         if self.info.errors.contains_key(id) {
             default.stroke(egui::Stroke::new(2.0, Color32::from_rgb(230, 60, 60)))
         } else if self.info.selected.contains(id) {
@@ -770,6 +983,23 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
             .map_or(rect, |t| t * rect);
         self.rects.push((snarl[node].clone(), global));
         self.graph_rects.push((snarl[node].clone(), rect));
+    }
+
+    fn draw_background(
+        &mut self,
+        background: Option<&egui_snarl::ui::BackgroundPattern>,
+        viewport: &Rect,
+        snarl_style: &SnarlStyle,
+        style: &egui::Style,
+        painter: &egui::Painter,
+        _snarl: &Snarl<String>,
+    ) {
+        if let Some(background) = background {
+            background.draw(viewport, snarl_style, style, painter);
+        }
+        for f in self.frames {
+            f.paint(painter, style);
+        }
     }
 
     fn current_transform(&mut self, to_global: &mut TSTransform, _snarl: &mut Snarl<String>) {

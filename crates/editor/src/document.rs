@@ -9,7 +9,7 @@ use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use lumagraph_graph::{Edge, ErrorKind, Graph, Node, ParamValue, Registry, split_port_ref};
+use lumagraph_graph::{Edge, ErrorKind, Graph, Node, ParamValue, Registry, Rgb, split_port_ref};
 use lumagraph_render::NodeLibrary;
 
 use crate::undo::History;
@@ -432,6 +432,10 @@ impl Document {
         }
         self.record(None);
         self.graph.nodes.retain(|n| !ids.contains(&n.id));
+        for f in &mut self.graph.frames {
+            f.nodes.retain(|n| !ids.contains(n));
+        }
+        self.graph.frames.retain(|f| !f.nodes.is_empty());
         let node_of = |r: &str| split_port_ref(r).map(|(n, _)| n.to_owned());
         self.graph.edges.retain(|e| {
             !node_of(&e.from).is_some_and(|n| ids.contains(&n))
@@ -467,6 +471,86 @@ impl Document {
             if let Some(n) = self.graph.node_mut(id) {
                 n.pos = Some(*p);
             }
+        }
+    }
+
+    /// Puts the nodes `ids` in a new frame called `label` (leaving any frame they were
+    /// in; a frame left empty goes); one undo step. Returns the frame's index, `None` when
+    /// no id names a node.
+    pub fn frame_nodes(&mut self, ids: &[String], label: &str) -> Option<usize> {
+        let ids: Vec<String> = ids
+            .iter()
+            .filter(|id| self.graph.node(id).is_some())
+            .cloned()
+            .collect();
+        if ids.is_empty() {
+            return None;
+        }
+        self.record(None);
+        for f in &mut self.graph.frames {
+            f.nodes.retain(|n| !ids.contains(n));
+        }
+        self.graph.frames.retain(|f| !f.nodes.is_empty());
+        self.graph.frames.push(lumagraph_graph::FrameDecl {
+            label: label.to_owned(),
+            comment: String::new(),
+            color: None,
+            nodes: ids,
+        });
+        Some(self.graph.frames.len() - 1)
+    }
+
+    /// Sets frame `index`'s label, comment and colour; successive edits of one frame are
+    /// one undo step until [`Self::end_gesture`] (typing, a colour drag).
+    pub fn set_frame(&mut self, index: usize, label: &str, comment: &str, color: Option<Rgb>) {
+        let Some(f) = self.graph.frames.get(index) else {
+            return;
+        };
+        if f.label == label && f.comment == comment && f.color == color {
+            return;
+        }
+        self.record(Some(&format!("frame {index}")));
+        if let Some(f) = self.graph.frames.get_mut(index) {
+            label.clone_into(&mut f.label);
+            comment.clone_into(&mut f.comment);
+            f.color = color;
+        }
+    }
+
+    /// Removes frame `index` (its nodes stay); one undo step.
+    pub fn remove_frame(&mut self, index: usize) {
+        if index < self.graph.frames.len() {
+            self.record(None);
+            self.graph.frames.remove(index);
+        }
+    }
+
+    /// Moves frame `index` by `delta` (graph units): every node in it moves; a drag is one
+    /// undo step until [`Self::end_gesture`].
+    pub fn move_frame(&mut self, index: usize, delta: (f32, f32)) {
+        let Some(f) = self.graph.frames.get(index) else {
+            return;
+        };
+        let moves: Vec<(String, (f32, f32))> = f
+            .nodes
+            .iter()
+            .filter_map(|id| {
+                let (x, y) = self.graph.node(id)?.pos?;
+                Some((id.clone(), (x + delta.0, y + delta.1)))
+            })
+            .collect();
+        self.move_nodes(&moves);
+    }
+
+    /// Sets the colour of node `id`'s header (`None`: the default); one undo step per node
+    /// until [`Self::end_gesture`].
+    pub fn set_node_color(&mut self, id: &str, color: Option<Rgb>) {
+        if self.graph.node(id).is_none_or(|n| n.color == color) {
+            return;
+        }
+        self.record(Some(&format!("color {id}")));
+        if let Some(n) = self.graph.node_mut(id) {
+            n.color = color;
         }
     }
 

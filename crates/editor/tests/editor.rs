@@ -1486,3 +1486,125 @@ fn a_node_dropped_on_a_wire_goes_into_it() {
     assert!(err.contains("ldr") || err.contains("hdr"), "{err}");
     let _ = before;
 }
+
+/// Frames: Ctrl+J puts the selected nodes in a frame (selected, one undo step); dragging
+/// its title moves its nodes and only them (one undo step); the frame and a node's colour
+/// survive save and load (graph version 4, the file's comments kept), and the command
+/// line's compiler ignores them (the same plan).
+#[test]
+fn a_frame_moves_its_nodes_and_survives_save_and_load() {
+    use egui::{Key, Modifiers};
+    let Some(ed) = editor(None, None) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("g.ron");
+    std::fs::write(&path, shipped_text("post_tonemap.ron")).unwrap();
+    let mut h = harness(ed);
+    h.state_mut().open(&path);
+    h.run_ok();
+    h.state_mut()
+        .select(vec!["exposure".into(), "tonemap".into()]);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::J);
+    h.run_ok();
+    let pos = |h: &egui_kittest::Harness<'static, lumagraph_editor::Editor>, id: &str| {
+        h.state().doc.graph.node(id).unwrap().pos.unwrap()
+    };
+    let ed = h.state();
+    assert_eq!(ed.doc.graph.frames.len(), 1);
+    assert_eq!(ed.doc.graph.frames[0].nodes, ["exposure", "tonemap"]);
+    assert_eq!(ed.selected_frame, Some(0));
+    h.get_by_label("Frame");
+    let before: Vec<(f32, f32)> = ["input", "exposure", "tonemap", "out"]
+        .iter()
+        .map(|id| pos(&h, id))
+        .collect();
+
+    // The title bar's centre on screen, and the zoom.
+    let ed = h.state();
+    let boxes = ed.canvas.frame_boxes(&ed.doc.graph, None);
+    let title = boxes[0].title_rect().center();
+    let on_screen = ed.canvas.to_screen(title).unwrap();
+    let zoom = ed.canvas.to_screen(title + egui::vec2(0.0, 1.0)).unwrap().y - on_screen.y;
+    drag(&mut h, on_screen, on_screen + egui::vec2(0.0, 100.0));
+    let after: Vec<(f32, f32)> = ["input", "exposure", "tonemap", "out"]
+        .iter()
+        .map(|id| pos(&h, id))
+        .collect();
+    assert_eq!(after[0], before[0], "input is not in the frame");
+    assert_eq!(after[3], before[3], "out is not in the frame");
+    for i in [1, 2] {
+        let dy = after[i].1 - before[i].1;
+        assert!((dy - 100.0 / zoom).abs() < 3.0, "moved by {dy}");
+        assert_eq!(after[i].0, before[i].0);
+    }
+    // The drag was one step; the frame another.
+    assert!(h.state_mut().doc.undo());
+    assert_eq!(pos(&h, "exposure"), before[1]);
+    assert_eq!(h.state().doc.graph.frames.len(), 1);
+    assert!(h.state_mut().doc.redo());
+
+    // Label, comment and colour, and a node's colour; saved, loaded, compiled.
+    let ed = h.state_mut();
+    ed.doc
+        .set_frame(0, "grade", "exposure, then the curve", Some((200, 120, 40)));
+    ed.doc.set_node_color("input", Some((40, 160, 90)));
+    h.key_press_modifiers(Modifiers::COMMAND, Key::S);
+    h.run_ok();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("version: 4"), "{text}");
+    let original = shipped_text("post_tonemap.ron");
+    let header: Vec<&str> = original
+        .lines()
+        .take_while(|l| l.starts_with("//"))
+        .collect();
+    assert!(!header.is_empty() && header.iter().all(|l| text.contains(l)));
+    let loaded = Graph::load(&path).unwrap();
+    assert_eq!(loaded, h.state().doc.graph);
+    assert_eq!(loaded.frames[0].label, "grade");
+    assert_eq!(loaded.node("input").unwrap().color, Some((40, 160, 90)));
+    let mut plain = loaded.clone();
+    plain.frames.clear();
+    for n in &mut plain.nodes {
+        n.color = None;
+    }
+    let (a, b) = (
+        compile(&loaded, &[], None).unwrap(),
+        compile(&plain, &[], None).unwrap(),
+    );
+    assert_eq!(format!("{:?}", a.passes), format!("{:?}", b.passes));
+
+    // Deleting a node takes it out of its frame.
+    let ed = h.state_mut();
+    ed.doc.remove_nodes(&["exposure".into()]);
+    assert_eq!(ed.doc.graph.frames[0].nodes, ["tonemap"]);
+}
+
+/// Grid snap (View → Snap to grid): a node let go after a drag lands on the grid, and the
+/// drag with its snap is one undo step.
+#[test]
+fn nodes_snap_to_the_grid_when_let_go() {
+    let Some(ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    let mut h = harness(ed);
+    h.state_mut().snap = true;
+    h.run_ok();
+    let before = h.state().doc.graph.node("tonemap").unwrap().pos.unwrap();
+    // Tonemap's header, a little right of and below the node's corner.
+    let header = h
+        .state()
+        .canvas
+        .to_screen(egui::pos2(before.0 + 75.0, before.1 + 4.0))
+        .unwrap();
+    drag(&mut h, header, header + egui::vec2(37.0, 53.0));
+    let grid = lumagraph_editor::canvas::GRID;
+    let (x, y) = h.state().doc.graph.node("tonemap").unwrap().pos.unwrap();
+    assert!(x != before.0 && y != before.1, "not moved: ({x}, {y})");
+    assert_eq!((x % grid, y % grid), (0.0, 0.0), "({x}, {y}) off the grid");
+    assert!(h.state_mut().doc.undo());
+    assert_eq!(
+        h.state().doc.graph.node("tonemap").unwrap().pos.unwrap(),
+        before
+    );
+}

@@ -18,10 +18,14 @@ use crate::registry::Registry;
 use crate::types::ParamValue;
 
 /// The newest graph file version this build reads and writes. Version 2 added node kinds
-/// declared in the file (`kinds`), version 3 node groups (`groups`, `interface`). A graph
-/// is written with the oldest version that holds it: without either, version 1, which
-/// every build reads.
-pub const VERSION: u32 = 3;
+/// declared in the file (`kinds`), version 3 node groups (`groups`, `interface`), version
+/// 4 the editor's frames and node colours (`frames`, a node's `color`). A graph is written
+/// with the oldest version that holds it: without any of these, version 1, which every
+/// build reads.
+pub const VERSION: u32 = 4;
+
+/// An sRGB colour the editor draws with: `(r, g, b)`, each 0 to 255.
+pub type Rgb = (u8, u8, u8);
 
 /// A node: an instance of a node kind with its params.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -37,6 +41,9 @@ pub struct Node {
     /// Position in the editor's canvas.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pos: Option<(f32, f32)>,
+    /// The colour of its header in the editor (version 4; the compiler ignores it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub color: Option<Rgb>,
 }
 
 impl Node {
@@ -47,6 +54,7 @@ impl Node {
             kind: kind.into(),
             params: BTreeMap::new(),
             pos: None,
+            color: None,
         }
     }
 
@@ -78,6 +86,23 @@ impl Edge {
     }
 }
 
+/// A frame in the editor: a labelled, coloured box drawn around some nodes, with a comment;
+/// moving it moves them (version 4; the compiler ignores it).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrameDecl {
+    /// Its title.
+    pub label: String,
+    /// Text shown in it, under the title.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub comment: String,
+    /// Its colour (a default where none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub color: Option<Rgb>,
+    /// The ids of the nodes it holds; its box is drawn around them.
+    pub nodes: Vec<String>,
+}
+
 /// Splits `"node.port"` at its last dot.
 pub fn split_port_ref(r: &str) -> Option<(&str, &str)> {
     let (node, port) = r.rsplit_once('.')?;
@@ -97,6 +122,8 @@ struct GraphFile {
     nodes: Vec<Node>,
     #[serde(default)]
     edges: Vec<Edge>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    frames: Vec<FrameDecl>,
 }
 
 #[derive(Deserialize)]
@@ -202,6 +229,8 @@ pub struct Graph {
     pub nodes: Vec<Node>,
     /// Edges, in file order.
     pub edges: Vec<Edge>,
+    /// The editor's frames (version 4), in file order.
+    pub frames: Vec<FrameDecl>,
     /// The file the graph was loaded from.
     pub origin: Option<Origin>,
 }
@@ -213,6 +242,7 @@ impl PartialEq for Graph {
             && self.kinds == other.kinds
             && self.nodes == other.nodes
             && self.edges == other.edges
+            && self.frames == other.frames
     }
 }
 
@@ -282,6 +312,7 @@ impl Graph {
             kinds: file.kinds,
             nodes: file.nodes,
             edges: file.edges,
+            frames: file.frames,
             origin: None,
         })
     }
@@ -290,7 +321,9 @@ impl Graph {
     /// edge per line), with the comments of the file it was loaded from where they belong
     /// (see [`crate::layout`]).
     pub fn to_ron(&self) -> String {
-        let version = if !(self.groups.is_empty() && self.interface.is_empty()) {
+        let version = if !self.frames.is_empty() || self.nodes.iter().any(|n| n.color.is_some()) {
+            4
+        } else if !(self.groups.is_empty() && self.interface.is_empty()) {
             3
         } else if !self.kinds.is_empty() {
             2

@@ -249,6 +249,14 @@ pub(crate) fn write(graph: &Graph, version: u32) -> String {
         let key = (e.from.clone(), e.to.clone());
         entry(&mut out, &compact::<Edge>(e), comments.edges.get(&key));
     }
-    out.push_str("    ],\n)\n");
+    out.push_str("    ],\n");
+    if !graph.frames.is_empty() {
+        out.push_str("    frames: [\n");
+        for f in &graph.frames {
+            entry(&mut out, &compact(f), None);
+        }
+        out.push_str("    ],\n");
+    }
+    out.push_str(")\n");
     out
 }

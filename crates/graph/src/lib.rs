@@ -24,7 +24,9 @@ mod types;
 
 pub use compile::{CompileOptions, Params, compile, resolve_params};
 pub use error::{ErrorKind, GraphError, GraphErrors, Pos};
-pub use graph::{Edge, Graph, Node, Origin, VERSION, read_text, split_port_ref, write_atomic};
+pub use graph::{
+    Edge, FrameDecl, Graph, Node, Origin, Rgb, VERSION, read_text, split_port_ref, write_atomic,
+};
 pub use plan::{LeftOut, Pass, Plan, Slot, TextureDesc, TextureId};
 pub use registry::{Category, NodeKind, Registry};
 pub use types::{Extent, ParamType, ParamValue, PortType, TexFormat};

@@ -72,6 +72,8 @@ impl Editor {
                     self.canvas
                         .request_frame(Frame::Nodes(self.selected.clone()));
                 }
+                ui.checkbox(&mut self.snap, "Snap to grid")
+                    .on_hover_text("a node let go after a drag lands on the grid");
                 ui.separator();
                 let mut on = self.preview.thumbnails_on;
                 if ui
@@ -164,6 +166,19 @@ impl Editor {
         }
         ui.separator();
         let any = !self.selected.is_empty();
+        if ui
+            .add_enabled(
+                any,
+                egui::Button::new("Join in new frame").shortcut_text("Ctrl+J"),
+            )
+            .on_hover_text(
+                "a labelled box around the selected nodes; dragging its title moves them",
+            )
+            .clicked()
+        {
+            self.frame_selection();
+            ui.close();
+        }
         if ui
             .add_enabled(any, egui::Button::new("Copy").shortcut_text("Ctrl+C"))
             .clicked()

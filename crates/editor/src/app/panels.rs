@@ -118,20 +118,32 @@ impl Editor {
         ui.separator();
         self.side_tabs(ui, |ed, ui| {
             egui::ScrollArea::vertical().show(ui, |ui| match ed.selected.as_slice() {
-                [] => {
-                    ui.weak("select a node");
-                }
+                [] => match ed.selected_frame {
+                    Some(i) if i < ed.doc.graph.frames.len() => ed.frame_inspector(ui, i),
+                    _ => {
+                        ui.weak("select a node");
+                    }
+                },
                 [one] => {
                     let id = one.clone();
                     let errs = ed.errors.get(&id).cloned();
                     if let Some(inspector::Request::PickFile(param)) =
                         inspector::show(ui, &mut ed.doc, &id, errs.as_ref())
                     {
-                        ed.open_file_dialog(Pick::Param(id, param));
+                        ed.open_file_dialog(Pick::Param(id.clone(), param));
                     }
+                    ui.separator();
+                    node_color(ui, &mut ed.doc, &id);
                 }
                 many => {
                     ui.label(format!("{} nodes selected", many.len()));
+                    if ui
+                        .button("Join in new frame")
+                        .on_hover_text("Ctrl+J: a labelled box around them")
+                        .clicked()
+                    {
+                        ed.frame_selection();
+                    }
                 }
             });
         });
@@ -139,6 +151,52 @@ impl Editor {
 
     /// Under the preview image: zoom, display exposure and false colour (HDR ports), the
     /// snapshot and compare mode, and the values under the pointer.
+    /// A selected frame: its label, comment and colour, its nodes, and removing it.
+    fn frame_inspector(&mut self, ui: &mut Ui, index: usize) {
+        let Some(f) = self.doc.graph.frames.get(index).cloned() else {
+            return;
+        };
+        ui.heading("Frame");
+        let (mut label, mut comment) = (f.label.clone(), f.comment.clone());
+        let mut color = f.color.map_or([120, 130, 150], |(r, g, b)| [r, g, b]);
+        let mut changed = false;
+        egui::Grid::new("frame grid").num_columns(2).show(ui, |ui| {
+            ui.label("label");
+            changed |= ui
+                .add(egui::TextEdit::singleline(&mut label).hint_text("label"))
+                .changed();
+            ui.end_row();
+            ui.label("comment");
+            changed |= ui
+                .add(
+                    egui::TextEdit::multiline(&mut comment)
+                        .hint_text("comment")
+                        .desired_rows(2),
+                )
+                .changed();
+            ui.end_row();
+            ui.label("colour");
+            let picked = ui.color_edit_button_srgb(&mut color).changed();
+            changed |= picked;
+            ui.end_row();
+        });
+        if changed {
+            let color = (f.color.is_some() || color != [120, 130, 150])
+                .then_some((color[0], color[1], color[2]));
+            self.doc.set_frame(index, &label, &comment, color);
+        }
+        ui.label(format!("holds {}", f.nodes.join(", ")))
+            .on_hover_text("dragging the frame's title moves them");
+        if ui
+            .button("Remove frame")
+            .on_hover_text("its nodes stay")
+            .clicked()
+        {
+            self.doc.remove_frame(index);
+            self.selected_frame = None;
+        }
+    }
+
     /// The live error plot ([`crate::error_plot`]) with its export.
     fn error_plot(&mut self, ui: &mut Ui) {
         let width = ui.available_width();
@@ -285,4 +343,20 @@ impl Editor {
             ui.colored_label(Color32::from_rgb(240, 90, 90), e);
         }
     }
+}
+
+/// A node's header colour: a picker, and back to none.
+fn node_color(ui: &mut Ui, doc: &mut crate::document::Document, id: &str) {
+    let current = doc.graph.node(id).and_then(|n| n.color);
+    ui.horizontal(|ui| {
+        ui.label("colour")
+            .on_hover_text("the node's header in the editor; saved in the file");
+        let mut c = current.map_or([128, 128, 128], |(r, g, b)| [r, g, b]);
+        if ui.color_edit_button_srgb(&mut c).changed() {
+            doc.set_node_color(id, Some((c[0], c[1], c[2])));
+        }
+        if current.is_some() && ui.button("none").clicked() {
+            doc.set_node_color(id, None);
+        }
+    });
 }

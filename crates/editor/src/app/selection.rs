@@ -19,6 +19,7 @@ impl Editor {
                 self.preview_port = self.port_for_node(first);
             }
         }
+        self.selected_frame = None;
         self.selected = ids;
     }
 
@@ -103,5 +104,15 @@ impl Editor {
     pub fn delete_selection(&mut self) {
         let ids = std::mem::take(&mut self.selected);
         self.doc.remove_nodes(&ids);
+    }
+
+    /// Puts the selected nodes in a new frame, selected; its label says what it holds until
+    /// renamed.
+    pub fn frame_selection(&mut self) {
+        let label = format!("Frame {}", self.doc.graph.frames.len() + 1);
+        if let Some(i) = self.doc.frame_nodes(&self.selected, &label) {
+            self.select(Vec::new());
+            self.selected_frame = Some(i);
+        }
     }
 }
