@@ -137,6 +137,8 @@ pub struct Editor {
     pub selected_frame: Option<usize>,
     /// Node moves snap to a grid of [`crate::canvas::GRID`] graph units when a drag ends.
     pub snap: bool,
+    /// The preview drawn large, in place of the canvas.
+    pub big_viewer: bool,
     /// The port chosen for preview (`"node.port"`); `None` follows the selection.
     pub preview_port: Option<String>,
     /// Compile errors per node id (messages without file locations).
@@ -198,6 +200,7 @@ impl Editor {
             selected: Vec::new(),
             selected_frame: None,
             snap: false,
+            big_viewer: false,
             preview_port: None,
             errors: BTreeMap::new(),
             graph_errors: Vec::new(),
@@ -355,6 +358,9 @@ impl Editor {
         if !typing && ctx.input_mut(|i| i.consume_key(cmd, Key::G)) {
             self.ask_group_selection();
         }
+        if ctx.input_mut(|i| i.consume_key(cmd, Key::Space)) {
+            self.big_viewer = !self.big_viewer;
+        }
         if !typing && ctx.input_mut(|i| i.consume_key(cmd, Key::J)) {
             self.frame_selection();
         }
@@ -428,6 +434,10 @@ impl Editor {
             .resizable(true)
             .show(ui, |ui| self.side_panel(ui, port.as_deref()));
         egui::CentralPanel::default().show(ui, |ui| {
+            if self.big_viewer && self.preview.linear.is_some() && self.preview.error.is_none() {
+                self.large_viewer(ui, port.as_deref());
+                return;
+            }
             let thumbnails = self.preview.thumbnail_textures(ui.ctx());
             let info = NodeInfo {
                 thumbnails: &thumbnails,

@@ -1608,3 +1608,58 @@ fn nodes_snap_to_the_grid_when_let_go() {
         before
     );
 }
+
+/// The large viewer (Ctrl+Space): the preview takes the canvas's place at several times
+/// the side panel's size, and its readout under the pointer is the port's value computed
+/// on the CPU (the test chart at −3 EV); Ctrl+Space again brings the canvas back.
+#[test]
+fn the_large_viewer_reads_out_the_cpu_value() {
+    use egui::{Key, Modifiers};
+    let Some(ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    let chart = lumagraph_render::image_io::load(&repo("assets/test_chart.exr")).unwrap();
+    let mut h = harness(ed);
+    h.state_mut().select(vec!["exposure".into()]);
+    h.state_mut()
+        .doc
+        .set_param("exposure", "ev", ParamValue::Float(-3.0));
+    h.run_ok();
+    let small = h.state().view.rect.expect("drawn").width();
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Space);
+    h.run_ok();
+    assert!(h.state().big_viewer);
+    let rect = h.state().view.rect.expect("drawn");
+    assert!(
+        rect.width() > 1.5 * small,
+        "{} against {small}",
+        rect.width()
+    );
+    assert!(
+        h.query_by_label("input").is_none(),
+        "the canvas is still drawn"
+    );
+    h.get_by_label("in the large viewer");
+    // Fitted: pixel (x, y) on screen.
+    let fit = (rect.width() / chart.width as f32).min(rect.height() / chart.height as f32);
+    let shown = egui::vec2(chart.width as f32, chart.height as f32) * fit;
+    let origin = rect.center() - shown / 2.0;
+    let (x, y) = (chart.width / 3, chart.height / 2 + 7);
+    h.hover_at(origin + egui::vec2(x as f32 + 0.5, y as f32 + 0.5) * fit);
+    h.run_ok();
+    let r = h.state().view.hover.expect("a readout");
+    assert_eq!((r.x, r.y), (x, y));
+    let want = chart.pixels[(y * chart.width + x) as usize];
+    for c in 0..3 {
+        assert!(
+            (r.rgba[c] - 0.125 * want[c]).abs() <= 1e-5 * want[c].abs().max(1.0),
+            "channel {c}: {} vs 2^-3 × {}",
+            r.rgba[c],
+            want[c]
+        );
+    }
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Space);
+    h.run_ok();
+    assert!(!h.state().big_viewer);
+    h.get_by_label("input");
+}

@@ -72,6 +72,16 @@ impl Editor {
                     self.canvas
                         .request_frame(Frame::Nodes(self.selected.clone()));
                 }
+                if ui
+                    .add(
+                        egui::Button::selectable(self.big_viewer, "Large viewer")
+                            .shortcut_text("Ctrl+Space"),
+                    )
+                    .clicked()
+                {
+                    self.big_viewer = !self.big_viewer;
+                    ui.close();
+                }
                 ui.checkbox(&mut self.snap, "Snap to grid")
                     .on_hover_text("a node let go after a drag lands on the grid");
                 ui.separator();

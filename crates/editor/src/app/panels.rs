@@ -55,7 +55,11 @@ impl Editor {
     }
 
     pub(super) fn side_panel(&mut self, ui: &mut Ui, port: Option<&str>) {
-        ui.heading("Preview");
+        ui.horizontal(|ui| {
+            ui.heading("Preview");
+            ui.toggle_value(&mut self.big_viewer, "⛶ large")
+                .on_hover_text("the viewer in place of the canvas (Ctrl+Space); again to go back");
+        });
         self.scene_line(ui);
         match port {
             Some(p) => ui.weak(p),
@@ -63,6 +67,13 @@ impl Editor {
         };
         if let Some(err) = &self.preview.error {
             ui.colored_label(Color32::from_rgb(240, 90, 90), err);
+        } else if self.big_viewer && self.preview.linear.is_some() {
+            ui.horizontal(|ui| {
+                ui.weak("in the large viewer");
+                if ui.button("⛶ back to the canvas").clicked() {
+                    self.big_viewer = false;
+                }
+            });
         } else if let Some((image, ty)) = &self.preview.linear {
             // Fitted, an image is shown at most at twice its size, in at most 320 points.
             let aspect = image.height as f32 / image.width.max(1) as f32;
@@ -151,6 +162,26 @@ impl Editor {
 
     /// Under the preview image: zoom, display exposure and false colour (HDR ports), the
     /// snapshot and compare mode, and the values under the pointer.
+    /// The large viewer, in place of the canvas: the preview image over the whole central
+    /// area with the viewer's controls (readout, exposure, false colour, compare, scopes).
+    pub(super) fn large_viewer(&mut self, ui: &mut Ui, port: Option<&str>) {
+        let Some((image, ty)) = &self.preview.linear else {
+            return;
+        };
+        ui.horizontal(|ui| {
+            ui.strong(port.unwrap_or_default());
+            if let Some(n) = self.preview.samples {
+                ui.label(format!("{n} spp"));
+            }
+        });
+        // Room for the controls and the readout under the image.
+        let h = (ui.available_height() - 110.0).max(64.0);
+        if let Some(g) = self.view.show(ui, image, *ty, self.preview.stats.frames, h) {
+            self.move_camera(&g);
+        }
+        self.viewer_controls(ui, port);
+    }
+
     /// A selected frame: its label, comment and colour, its nodes, and removing it.
     fn frame_inspector(&mut self, ui: &mut Ui, index: usize) {
         let Some(f) = self.doc.graph.frames.get(index).cloned() else {
@@ -240,6 +271,7 @@ impl Editor {
             if ui.small_button("1:1").clicked() {
                 v.zoom = Some(1.0);
             }
+
             if hdr {
                 ui.add(
                     egui::Slider::new(&mut v.exposure, -10.0..=10.0)
