@@ -74,6 +74,7 @@ impl Editor {
                     self.big_viewer = false;
                 }
             });
+            self.preview_status(ui);
         } else if let Some((image, ty)) = &self.preview.linear {
             // Fitted, an image is shown at most at twice its size, in at most 320 points.
             let aspect = image.height as f32 / image.width.max(1) as f32;
@@ -83,48 +84,7 @@ impl Editor {
                 self.move_camera(&g);
             }
             self.viewer_controls(ui, port);
-            let size = self
-                .preview
-                .image
-                .as_ref()
-                .map(|img| format!("{}×{}", img.width, img.height));
-            ui.horizontal(|ui| {
-                if let Some(size) = size {
-                    ui.weak(size);
-                }
-                if let Some(n) = self.preview.samples {
-                    ui.label(format!("{n} spp"))
-                        .on_hover_text("samples per pixel accumulated so far");
-                }
-                if self.preview.progressive {
-                    let label = if self.preview.paused {
-                        "▶ resume"
-                    } else {
-                        "⏸ pause"
-                    };
-                    if ui.button(label).clicked() {
-                        self.preview.paused = !self.preview.paused;
-                    }
-                    if self
-                        .preview
-                        .samples
-                        .is_some_and(|s| s >= self.preview.target_spp)
-                    {
-                        ui.weak(format!("done (scene spp {})", self.preview.target_spp));
-                    }
-                }
-            });
-            for (node, m) in &self.preview.measurements {
-                ui.label(format!("{node}.{}: {:.4e}", m.name, m.value))
-                    .on_hover_text("measured by the node on the last frame");
-            }
-            if !self.preview.curve.points.is_empty() {
-                self.error_plot(ui);
-            }
-            let frame = self.preview.stats.frames;
-            let width = ui.available_width();
-            self.scope
-                .show(ui, self.preview.image.as_ref(), frame, width);
+            self.preview_status(ui);
         }
         ui.separator();
         self.side_tabs(ui, |ed, ui| {
@@ -162,6 +122,53 @@ impl Editor {
 
     /// Under the preview image: zoom, display exposure and false colour (HDR ports), the
     /// snapshot and compare mode, and the values under the pointer.
+    /// Under the preview (small or large): size, samples, pause, what the nodes measured,
+    /// the live error plot and the scopes.
+    fn preview_status(&mut self, ui: &mut Ui) {
+        let size = self
+            .preview
+            .image
+            .as_ref()
+            .map(|img| format!("{}×{}", img.width, img.height));
+        ui.horizontal(|ui| {
+            if let Some(size) = size {
+                ui.weak(size);
+            }
+            if let Some(n) = self.preview.samples {
+                ui.label(format!("{n} spp"))
+                    .on_hover_text("samples per pixel accumulated so far");
+            }
+            if self.preview.progressive {
+                let label = if self.preview.paused {
+                    "▶ resume"
+                } else {
+                    "⏸ pause"
+                };
+                if ui.button(label).clicked() {
+                    self.preview.paused = !self.preview.paused;
+                }
+                if self
+                    .preview
+                    .samples
+                    .is_some_and(|s| s >= self.preview.target_spp)
+                {
+                    ui.weak(format!("done (scene spp {})", self.preview.target_spp));
+                }
+            }
+        });
+        for (node, m) in &self.preview.measurements {
+            ui.label(format!("{node}.{}: {:.4e}", m.name, m.value))
+                .on_hover_text("measured by the node on the last frame");
+        }
+        if !self.preview.curve.points.is_empty() {
+            self.error_plot(ui);
+        }
+        let frame = self.preview.stats.frames;
+        let width = ui.available_width();
+        self.scope
+            .show(ui, self.preview.image.as_ref(), frame, width);
+    }
+
     /// The large viewer, in place of the canvas: the preview image over the whole central
     /// area with the viewer's controls (readout, exposure, false colour, compare, scopes).
     pub(super) fn large_viewer(&mut self, ui: &mut Ui, port: Option<&str>) {
