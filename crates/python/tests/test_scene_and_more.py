@@ -151,3 +151,18 @@ def test_images_show_in_jupyter_as_png(tmp_path):
     assert im.array[0, 0, 1] == 2.0 and im.array[0, 0, 3] == 1.0
     with pytest.raises(lg.LumagraphError, match="shape"):
         lg.Image(np.zeros((4, 4), np.float32))
+
+
+def test_a_graph_loaded_edited_and_saved_keeps_its_comments(tmp_path):
+    g = lg.Graph.load(str(GRAPH))
+    g.add_node("Blur", "soften", sigma=2.0)
+    g.connect("tonemap.color", "soften.color")
+    out = tmp_path / "edited.ron"
+    g.save(str(out))
+    text = out.read_text()
+    original = GRAPH.read_text()
+    comments = [line for line in original.splitlines() if line.strip().startswith("//")]
+    assert comments and all(c in text for c in comments)
+    assert '(id: "soften", kind: "Blur"' in text
+    again = lg.Graph.load(str(out))
+    assert again.nodes[-1] == "soften"
