@@ -71,9 +71,17 @@ pub struct Canvas {
 /// The grid nodes snap to, graph units.
 pub const GRID: f32 = 20.0;
 
-/// `p` on the grid.
-fn snapped(p: (f32, f32)) -> (f32, f32) {
-    ((p.0 / GRID).round() * GRID, (p.1 / GRID).round() * GRID)
+/// Moves the nodes `ids` onto the grid (an edit only where one is off it).
+fn snap_to_grid(doc: &mut Document, ids: &[String]) {
+    let on_grid = |v: f32| (v / GRID).round() * GRID;
+    let moves: Vec<(String, (f32, f32))> = ids
+        .iter()
+        .filter_map(|id| {
+            let (x, y) = doc.graph.node(id)?.pos?;
+            Some((id.clone(), (on_grid(x), on_grid(y))))
+        })
+        .collect();
+    doc.move_nodes(&moves);
 }
 
 /// What [`Canvas::request_frame`] brings into view.
@@ -460,12 +468,7 @@ impl Canvas {
     /// node dropped on a wire goes into it.
     fn drag_ended(&mut self, doc: &mut Document, events: &mut Vec<CanvasEvent>) {
         if self.snap {
-            let moves: Vec<(String, (f32, f32))> = self
-                .dragged
-                .iter()
-                .filter_map(|id| Some((id.clone(), snapped(doc.graph.node(id)?.pos?))))
-                .collect();
-            doc.move_nodes(&moves);
+            snap_to_grid(doc, &self.dragged);
         }
         if let [id] = std::mem::take(&mut self.dragged).as_slice()
             && let Some(edge) = self.wire_under(&doc.graph, id)
@@ -561,12 +564,8 @@ impl Canvas {
                 && self.snap
                 && let Some(frame) = doc.graph.frames.get(f.index)
             {
-                let moves: Vec<(String, (f32, f32))> = frame
-                    .nodes
-                    .iter()
-                    .filter_map(|id| Some((id.clone(), snapped(doc.graph.node(id)?.pos?))))
-                    .collect();
-                doc.move_nodes(&moves);
+                let ids = frame.nodes.clone();
+                snap_to_grid(doc, &ids);
                 self.built_from = None;
             }
         }

@@ -4,27 +4,15 @@ Run by `bash scripts/python.sh test` (and `bash scripts/test.sh`), which sets LU
 to the command line built from the same checkout."""
 
 import csv
-import os
-import pathlib
 import shutil
 import subprocess
-import zlib
 
 import numpy as np
 import pytest
 
 import lumagraph as lg
 
-ROOT = pathlib.Path(__file__).resolve().parents[3]
-GRAPH = ROOT / "graphs" / "pathtrace.ron"
-SCENE = ROOT / "assets" / "cornell.ron"
-
-
-def cli():
-    path = os.environ.get("LUMAGRAPH_BIN")
-    if not path:
-        pytest.skip("LUMAGRAPH_BIN is not set (scripts/python.sh test sets it)")
-    return str(ROOT / path) if not os.path.isabs(path) else path
+from common import GRAPH, ROOT, SCENE, cli
 
 
 def test_scene_values_read_and_set_by_path():

@@ -6,7 +6,6 @@ Run by `bash scripts/python.sh test` (and `bash scripts/test.sh`), which sets LU
 to the command line built from the same checkout."""
 
 import os
-import pathlib
 import subprocess
 
 import numpy as np
@@ -14,16 +13,7 @@ import pytest
 
 import lumagraph as lg
 
-ROOT = pathlib.Path(__file__).resolve().parents[3]
-GRAPH = ROOT / "graphs" / "pathtrace.ron"
-SCENE = ROOT / "assets" / "cornell.ron"
-
-
-def cli():
-    path = os.environ.get("LUMAGRAPH_BIN")
-    if not path:
-        pytest.skip("LUMAGRAPH_BIN is not set (scripts/python.sh test sets it)")
-    return str(ROOT / path) if not os.path.isabs(path) else path
+from common import GRAPH, ROOT, SCENE, cli
 
 
 def test_a_render_from_python_is_byte_identical_to_the_cli(tmp_path):

@@ -495,15 +495,7 @@ impl Scene {
     /// When a file cannot be read or is invalid; the error names the file, the line and
     /// column when known, and the shape or material concerned.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| {
-            SceneError::new(ErrorKind::Io {
-                what: "scene file",
-                source,
-            })
-            .in_file(path)
-        })?;
-        let base = path.parent().unwrap_or(Path::new("."));
-        Self::from_ron(&text, base).map_err(|e| e.in_file(path))
+        crate::edit::SceneText::load(path)?.build()
     }
 
     /// Parses a scene from RON text; mesh paths are relative to `base_dir`.
