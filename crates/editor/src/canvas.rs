@@ -23,6 +23,9 @@ const AUTO_SPACING: f32 = 220.0;
 /// Each node's id, kind and position: when this changes, the snarl is rebuilt.
 type Layout = Vec<(String, String, Option<(f32, f32)>)>;
 
+/// Each edge's ports and reroute points: when this changes, the snarl is rebuilt.
+type EdgeLayout = Vec<(String, String, Vec<(f32, f32)>)>;
+
 /// What happened on the canvas that the app must act on.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CanvasEvent {
@@ -45,7 +48,7 @@ pub enum CanvasEvent {
 pub struct Canvas {
     snarl: Snarl<String>,
     built_from: Option<Layout>,
-    built_edges: Vec<(String, String)>,
+    built_edges: EdgeLayout,
     auto_pos: HashMap<String, Pos2>,
     last_selection: Vec<NodeId>,
     /// The add-node menu's search text.
@@ -64,6 +67,8 @@ pub struct Canvas {
     pin_rows: HashMap<(String, bool, String), f32>,
     /// The nodes moved by the drag going on.
     dragged: Vec<String>,
+    /// Each reroute point's rectangle in graph space, as last drawn.
+    reroute_rects: HashMap<(usize, usize), Rect>,
     /// Snap nodes to a grid of [`GRID`] units when a drag ends.
     pub snap: bool,
 }
@@ -134,12 +139,26 @@ fn structure(graph: &Graph) -> Layout {
         .collect()
 }
 
-fn edges(graph: &Graph) -> Vec<(String, String)> {
+fn edges(graph: &Graph) -> EdgeLayout {
     graph
         .edges
         .iter()
-        .map(|e| (e.from.clone(), e.to.clone()))
+        .map(|e| (e.from.clone(), e.to.clone(), e.via.clone()))
         .collect()
+}
+
+/// What starts the snarl id of a reroute point: a control character, so no node id is one.
+const REROUTE: &str = "\u{1}reroute ";
+
+/// The snarl id of reroute point `k` of edge `e` (its index in the graph's edges).
+fn reroute_id(e: usize, k: usize) -> String {
+    format!("{REROUTE}{e}.{k}")
+}
+
+/// `(edge index, point index)` of a reroute point's snarl id; `None` for a node's.
+pub fn reroute_of(id: &str) -> Option<(usize, usize)> {
+    let (e, k) = id.strip_prefix(REROUTE)?.split_once('.')?;
+    Some((e.parse().ok()?, k.parse().ok()?))
 }
 
 impl Canvas {
@@ -216,7 +235,7 @@ impl Canvas {
             }
             ids.insert(n.id.clone(), snarl.insert_node(pos, n.id.clone()));
         }
-        for edge in &graph.edges {
+        for (e, edge) in graph.edges.iter().enumerate() {
             let (Some((fnode, fport)), Some((tnode, tport))) =
                 (split_port_ref(&edge.from), split_port_ref(&edge.to))
             else {
@@ -234,11 +253,19 @@ impl Canvas {
             ) else {
                 continue;
             };
+            // Through the edge's reroute points, each a small node of one input and one
+            // output.
+            let mut from = OutPinId {
+                node: ids[fnode],
+                output: o,
+            };
+            for (k, &(x, y)) in edge.via.iter().enumerate() {
+                let r = snarl.insert_node(pos2(x, y), reroute_id(e, k));
+                snarl.connect(from, InPinId { node: r, input: 0 });
+                from = OutPinId { node: r, output: 0 };
+            }
             snarl.connect(
-                OutPinId {
-                    node: ids[fnode],
-                    output: o,
-                },
+                from,
                 InPinId {
                     node: ids[tnode],
                     input: i,
@@ -276,6 +303,7 @@ impl Canvas {
             graph_rects: Vec::new(),
             pin_rows: Vec::new(),
             frames: &frames,
+            reroute_rects: Vec::new(),
             frame: frame.map(|r| Self::framing(r, screen)),
             view: None,
         };
@@ -297,6 +325,9 @@ impl Canvas {
             .into_iter()
             .collect();
         self.pin_rows = std::mem::take(&mut viewer.pin_rows).into_iter().collect();
+        self.reroute_rects = std::mem::take(&mut viewer.reroute_rects)
+            .into_iter()
+            .collect();
 
         // A plain click selects a node (shift or ctrl adds or removes it); a click on
         // empty canvas clears the selection. Snarl's own rectangle selection is followed
@@ -342,40 +373,37 @@ impl Canvas {
 
         self.quick_add(ui, doc, canvas_rect, &mut events);
 
-        // Positions back into the graph (one undo step per drag).
-        let moves: Vec<(String, (f32, f32))> = self
-            .snarl
-            .nodes_pos_ids()
-            .filter(|(_, pos, id)| {
-                let graph_pos = doc.graph.node(id).and_then(|n| n.pos);
-                match graph_pos {
-                    Some((x, y)) => pos2(x, y) != *pos,
-                    None => self.auto_pos.get(*id) != Some(pos),
-                }
-            })
-            .map(|(_, pos, id)| (id.clone(), (pos.x, pos.y)))
-            .collect();
-        if !moves.is_empty() {
-            doc.move_nodes(&moves);
-            self.built_from = Some(structure(&doc.graph));
-            for (id, _) in &moves {
-                if !self.dragged.contains(id) {
-                    self.dragged.push(id.clone());
-                }
-            }
-        }
+        self.take_moves(doc);
         if ui.input(|i| i.pointer.any_released()) {
             self.drag_ended(doc, &mut events);
         }
 
         // After the snarl's own moves: a frame's drag moves nodes the snarl has not seen.
         self.frame_titles(ui, doc, &frames, canvas_rect, &mut events);
+        // A triple click counts too: its second click may have been on the wire.
+        let double = ui.input(|i| {
+            let primary = egui::PointerButton::Primary;
+            i.pointer.button_double_clicked(primary) || i.pointer.button_triple_clicked(primary)
+        });
+        let on_reroute = |p: Pos2| {
+            self.view
+                .is_some_and(|v| self.reroute_rects.values().any(|r| (v * *r).contains(p)))
+        };
+        if double
+            && on_canvas
+            && !node_clicked
+            && let Some(p) = pointer
+            && !on_reroute(p)
+        {
+            self.add_reroute_at(doc, p);
+        }
 
         let selected = egui_snarl::ui::get_selected_nodes(canvas_id(), ui.ctx());
         if selected != self.last_selection && !node_clicked {
             let ids = selected
                 .iter()
                 .filter_map(|n| self.snarl.get_node(*n).cloned())
+                .filter(|id| reroute_of(id).is_none())
                 .collect();
             events.push(CanvasEvent::Select(ids));
             self.last_selection = selected;
@@ -464,6 +492,50 @@ fn tint(base: Color32, color: Color32) -> Color32 {
 }
 
 impl Canvas {
+    /// Where the snarl moved nodes and reroute points this frame, into the graph (one undo
+    /// step per drag); the moved nodes join the drag going on.
+    fn take_moves(&mut self, doc: &mut Document) {
+        // Positions back into the graph (one undo step per drag); reroute points into
+        // their edges.
+        let mut reroutes = Vec::new();
+        let moves: Vec<(String, (f32, f32))> = self
+            .snarl
+            .nodes_pos_ids()
+            .filter(|(_, pos, id)| {
+                if let Some((e, k)) = reroute_of(id) {
+                    let at = doc.graph.edges.get(e).and_then(|ed| ed.via.get(k));
+                    if at.is_some_and(|&(x, y)| pos2(x, y) != *pos) {
+                        reroutes.push((e, k, (pos.x, pos.y)));
+                    }
+                    return false;
+                }
+                let graph_pos = doc.graph.node(id).and_then(|n| n.pos);
+                match graph_pos {
+                    Some((x, y)) => pos2(x, y) != *pos,
+                    None => self.auto_pos.get(*id) != Some(pos),
+                }
+            })
+            .map(|(_, pos, id)| (id.clone(), (pos.x, pos.y)))
+            .collect();
+        for (e, k, pos) in reroutes {
+            let (from, to) = (
+                doc.graph.edges[e].from.clone(),
+                doc.graph.edges[e].to.clone(),
+            );
+            doc.move_reroute(&from, &to, k, pos);
+            self.built_edges = edges(&doc.graph);
+        }
+        if !moves.is_empty() {
+            doc.move_nodes(&moves);
+            self.built_from = Some(structure(&doc.graph));
+            for (id, _) in &moves {
+                if !self.dragged.contains(id) {
+                    self.dragged.push(id.clone());
+                }
+            }
+        }
+    }
+
     /// A drag let go: with grid snap, the dragged nodes land on the grid; a single unwired
     /// node dropped on a wire goes into it.
     fn drag_ended(&mut self, doc: &mut Document, events: &mut Vec<CanvasEvent>) {
@@ -479,6 +551,82 @@ impl Canvas {
             }
         }
         self.dragged.clear();
+    }
+
+    /// A double-click on a wire (`at`, on screen): a reroute point there, splitting the
+    /// stretch of the wire it was on.
+    fn add_reroute_at(&mut self, doc: &mut Document, at: Pos2) {
+        let Some(view) = self.view else { return };
+        let p = view.inverse() * at;
+        let split = |r: &str| split_port_ref(r).map(|(n, port)| (n.to_owned(), port.to_owned()));
+        let half = self
+            .reroute_rects
+            .values()
+            .next()
+            .map_or(vec2(10.0, 10.0), |r| r.size() * 0.5);
+        let mut best: Option<(f32, usize, usize)> = None;
+        for (e, edge) in doc.graph.edges.iter().enumerate() {
+            let (Some((a, ap)), Some((b, bp))) = (split(&edge.from), split(&edge.to)) else {
+                continue;
+            };
+            let (Some(ar), Some(br)) = (self.node_rects.get(&a), self.node_rects.get(&b)) else {
+                continue;
+            };
+            let (Some(ay), Some(by)) = (
+                self.pin_rows.get(&(a.clone(), true, ap)),
+                self.pin_rows.get(&(b.clone(), false, bp)),
+            ) else {
+                continue;
+            };
+            let mut points = vec![pos2(ar.right(), *ay)];
+            for (k, &(x, y)) in edge.via.iter().enumerate() {
+                let center = self
+                    .reroute_rects
+                    .get(&(e, k))
+                    .map_or(pos2(x, y) + half, Rect::center);
+                points.push(center);
+            }
+            points.push(pos2(br.left(), *by));
+            for (i, w) in points.windows(2).enumerate() {
+                let d = distance_to_wire(p, w[0], w[1]);
+                if d < WIRE_HIT && best.is_none_or(|(bd, ..)| d < bd) {
+                    best = Some((d, e, i));
+                }
+            }
+        }
+        if let Some((_, e, index)) = best {
+            let (from, to) = (
+                doc.graph.edges[e].from.clone(),
+                doc.graph.edges[e].to.clone(),
+            );
+            let at = p - half;
+            doc.add_reroute(&from, &to, index, (at.x, at.y));
+        }
+    }
+
+    /// Where the pin of `node`'s port `port` (an output when `output`) was last drawn,
+    /// graph space.
+    pub fn pin_pos(&self, node: &str, output: bool, port: &str) -> Option<Pos2> {
+        let r = self.node_rects.get(node)?;
+        let y = self
+            .pin_rows
+            .get(&(node.to_owned(), output, port.to_owned()))?;
+        Some(pos2(if output { r.right() } else { r.left() }, *y))
+    }
+
+    /// Reroute point `k` of edge `e` as last drawn, graph space.
+    pub fn reroute_rect(&self, e: usize, k: usize) -> Option<Rect> {
+        self.reroute_rects.get(&(e, k)).copied()
+    }
+
+    /// Where the output (`output`) or input pin of reroute point `k` of edge `e` was last
+    /// drawn, graph space.
+    pub fn reroute_pin_pos(&self, e: usize, k: usize, output: bool) -> Option<Pos2> {
+        let r = self.reroute_rects.get(&(e, k))?;
+        let y = self
+            .pin_rows
+            .get(&(reroute_id(e, k), output, String::new()))?;
+        Some(pos2(if output { r.right() } else { r.left() }, *y))
     }
 
     /// Where graph point `p` was on screen when the canvas was last drawn.
@@ -587,7 +735,7 @@ impl Canvas {
         }
         let center = self.node_rects.get(id)?.center();
         let mut best: Option<(f32, (String, String))> = None;
-        for e in &graph.edges {
+        for e in graph.edges.iter().filter(|e| e.via.is_empty()) {
             let (Some((a, ap)), Some((b, bp))) = (split(&e.from), split(&e.to)) else {
                 continue;
             };
@@ -713,6 +861,8 @@ struct Viewer<'a, 'i> {
     pin_rows: Vec<((String, bool, String), f32)>,
     /// The frames to draw behind the nodes.
     frames: &'a [FrameBox],
+    /// Each reroute point's rectangle in graph space: `((edge, point), rect)`.
+    reroute_rects: Vec<((usize, usize), egui::Rect)>,
     /// A view to take (framing), applied when the snarl asks.
     frame: Option<TSTransform>,
     /// The view the snarl is drawn with.
@@ -729,6 +879,37 @@ impl Viewer<'_, '_> {
         let id = snarl.get_node(pin.node)?;
         let port = self.kind(id)?.outputs.get(pin.output)?.name;
         Some(format!("{id}.{port}"))
+    }
+
+    /// The pin of a reroute point (none for a node's): no label, the colour of the type
+    /// its wire carries.
+    fn reroute_pin(&mut self, id: &str, output: bool, ui: &mut Ui) -> Option<PinInfo> {
+        let (e, _) = reroute_of(id)?;
+        let row = ui
+            .allocate_exact_size(vec2(4.0, 12.0), egui::Sense::hover())
+            .0;
+        self.pin_rows
+            .push(((id.to_owned(), output, String::new()), row.center().y));
+        let from = &self.doc.graph.edges.get(e)?.from;
+        let color = self
+            .doc
+            .port_types(from, true)
+            .and_then(|t| t.first().copied())
+            .map_or(Color32::GRAY, port_color);
+        Some(PinInfo::circle().with_fill(color).with_wire_color(color))
+    }
+
+    /// The edge `(from, to)` a wire between snarl nodes `a` and `b` belongs to when either
+    /// is a reroute point.
+    fn rerouted_edge(
+        &self,
+        snarl: &Snarl<String>,
+        a: NodeId,
+        b: NodeId,
+    ) -> Option<(String, String)> {
+        let e = reroute_of(&snarl[a]).or_else(|| reroute_of(&snarl[b]))?.0;
+        let edge = self.doc.graph.edges.get(e)?;
+        Some((edge.from.clone(), edge.to.clone()))
     }
 
     fn in_ref(&self, snarl: &Snarl<String>, pin: InPinId) -> Option<String> {
@@ -800,6 +981,9 @@ pub fn add_node_menu_of(
 
 impl SnarlViewer<String> for Viewer<'_, '_> {
     fn title(&mut self, node: &String) -> String {
+        if reroute_of(node).is_some() {
+            return String::new();
+        }
         node.clone()
     }
 
@@ -812,6 +996,11 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
         snarl: &Snarl<String>,
     ) -> egui::Frame {
         let id = &snarl[node];
+        if reroute_of(id).is_some() {
+            return default
+                .inner_margin(egui::Margin::same(1))
+                .corner_radius(egui::CornerRadius::same(8));
+        }
         let default = match self.doc.graph.node(id).and_then(|n| n.color) {
             Some((r, g, b)) => default.fill(tint(default.fill, Color32::from_rgb(r, g, b))),
             None => default,
@@ -825,6 +1014,21 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
         }
     }
 
+    fn header_frame(
+        &mut self,
+        default: egui::Frame,
+        node: NodeId,
+        _inputs: &[InPin],
+        _outputs: &[OutPin],
+        snarl: &Snarl<String>,
+    ) -> egui::Frame {
+        if reroute_of(&snarl[node]).is_some() {
+            // A reroute point has no title: no header box.
+            return egui::Frame::NONE;
+        }
+        default
+    }
+
     fn show_header(
         &mut self,
         node: NodeId,
@@ -834,6 +1038,9 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
         snarl: &mut Snarl<String>,
     ) {
         let id = snarl[node].clone();
+        if reroute_of(&id).is_some() {
+            return;
+        }
         let kind = self
             .doc
             .graph
@@ -856,10 +1063,16 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
     }
 
     fn inputs(&mut self, node: &String) -> usize {
+        if reroute_of(node).is_some() {
+            return 1;
+        }
         self.kind(node).map_or(0, |k| k.inputs.len())
     }
 
     fn outputs(&mut self, node: &String) -> usize {
+        if reroute_of(node).is_some() {
+            return 1;
+        }
         self.kind(node).map_or(0, |k| k.outputs.len())
     }
 
@@ -869,6 +1082,9 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
         ui: &mut Ui,
         snarl: &mut Snarl<String>,
     ) -> impl SnarlPin + 'static {
+        if let Some(pin) = self.reroute_pin(&snarl[pin.id.node], false, ui) {
+            return pin;
+        }
         let Some(def) = self
             .kind(&snarl[pin.id.node])
             .and_then(|k| k.inputs.get(pin.id.input).cloned())
@@ -899,6 +1115,9 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
         snarl: &mut Snarl<String>,
     ) -> impl SnarlPin + 'static {
         let id = snarl[pin.id.node].clone();
+        if let Some(pin) = self.reroute_pin(&id, true, ui) {
+            return pin;
+        }
         let Some(def) = self
             .kind(&id)
             .and_then(|k| k.outputs.get(pin.id.output).cloned())
@@ -976,6 +1195,10 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
         ui: &mut Ui,
         snarl: &mut Snarl<String>,
     ) {
+        if let Some(at) = reroute_of(&snarl[node]) {
+            self.reroute_rects.push((at, rect));
+            return;
+        }
         let global = ui
             .ctx()
             .layer_transform_to_global(ui.layer_id())
@@ -1066,6 +1289,15 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
         snarl: &mut Snarl<String>,
     ) {
         let id = snarl[node].clone();
+        if let Some((e, k)) = reroute_of(&id) {
+            if ui.button("Remove reroute").clicked()
+                && let Some(edge) = self.doc.graph.edges.get(e).cloned()
+            {
+                self.doc.remove_reroute(&edge.from, &edge.to, k);
+                ui.close();
+            }
+            return;
+        }
         if let Some(k) = self.kind(&id) {
             for o in &k.outputs {
                 if ui.button(format!("Preview {}", o.name)).clicked() {
@@ -1082,6 +1314,22 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
     }
 
     fn connect(&mut self, from: &OutPin, to: &InPin, snarl: &mut Snarl<String>) {
+        if reroute_of(&snarl[to.id.node]).is_some() {
+            self.events.push(CanvasEvent::Refused(
+                "a reroute point carries its own wire only".into(),
+            ));
+            return;
+        }
+        if let Some((e, _)) = reroute_of(&snarl[from.id.node]) {
+            // From a reroute point: another wire from the same output.
+            let source = self.doc.graph.edges.get(e).map(|ed| ed.from.clone());
+            if let (Some(f), Some(t)) = (source, self.in_ref(snarl, to.id))
+                && let Err(why) = self.doc.connect(&f, &t)
+            {
+                self.events.push(CanvasEvent::Refused(why));
+            }
+            return;
+        }
         let (Some(f), Some(t)) = (self.out_ref(snarl, from.id), self.in_ref(snarl, to.id)) else {
             return;
         };
@@ -1095,6 +1343,10 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
     }
 
     fn disconnect(&mut self, from: &OutPin, to: &InPin, snarl: &mut Snarl<String>) {
+        if let Some(edge) = self.rerouted_edge(snarl, from.id.node, to.id.node) {
+            self.doc.disconnect(&edge.0, &edge.1);
+            return;
+        }
         if let (Some(f), Some(t)) = (self.out_ref(snarl, from.id), self.in_ref(snarl, to.id)) {
             self.doc.disconnect(&f, &t);
         }
@@ -1102,6 +1354,10 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
     }
 
     fn drop_outputs(&mut self, pin: &OutPin, snarl: &mut Snarl<String>) {
+        if let Some(edge) = self.rerouted_edge(snarl, pin.id.node, pin.id.node) {
+            self.doc.disconnect(&edge.0, &edge.1);
+            return;
+        }
         if let Some(p) = self.out_ref(snarl, pin.id) {
             self.doc.disconnect_port(&p);
         }
@@ -1109,6 +1365,10 @@ impl SnarlViewer<String> for Viewer<'_, '_> {
     }
 
     fn drop_inputs(&mut self, pin: &InPin, snarl: &mut Snarl<String>) {
+        if let Some(edge) = self.rerouted_edge(snarl, pin.id.node, pin.id.node) {
+            self.doc.disconnect(&edge.0, &edge.1);
+            return;
+        }
         if let Some(p) = self.in_ref(snarl, pin.id) {
             self.doc.disconnect_port(&p);
         }

@@ -474,6 +474,48 @@ impl Document {
         }
     }
 
+    /// Adds a reroute point at `pos` (graph units) to the wire `from` → `to`, as its
+    /// `index`th point; one undo step. The edge (its ports and types) stays as it is.
+    pub fn add_reroute(&mut self, from: &str, to: &str, index: usize, pos: (f32, f32)) {
+        let Some(i) = self.edge_index(from, to) else {
+            return;
+        };
+        self.record(None);
+        let via = &mut self.graph.edges[i].via;
+        via.insert(index.min(via.len()), pos);
+    }
+
+    /// Moves reroute point `index` of the wire `from` → `to` to `pos`; a drag is one undo
+    /// step until [`Self::end_gesture`].
+    pub fn move_reroute(&mut self, from: &str, to: &str, index: usize, pos: (f32, f32)) {
+        let Some(i) = self.edge_index(from, to) else {
+            return;
+        };
+        if self.graph.edges[i].via.get(index).is_none_or(|p| *p == pos) {
+            return;
+        }
+        self.record(Some("move"));
+        self.graph.edges[i].via[index] = pos;
+    }
+
+    /// Removes reroute point `index` of the wire `from` → `to`; one undo step.
+    pub fn remove_reroute(&mut self, from: &str, to: &str, index: usize) {
+        let Some(i) = self.edge_index(from, to) else {
+            return;
+        };
+        if index < self.graph.edges[i].via.len() {
+            self.record(None);
+            self.graph.edges[i].via.remove(index);
+        }
+    }
+
+    fn edge_index(&self, from: &str, to: &str) -> Option<usize> {
+        self.graph
+            .edges
+            .iter()
+            .position(|e| e.from == from && e.to == to)
+    }
+
     /// Puts the nodes `ids` in a new frame called `label` (leaving any frame they were
     /// in; a frame left empty goes); one undo step. Returns the frame's index, `None` when
     /// no id names a node.

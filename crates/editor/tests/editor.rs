@@ -1663,3 +1663,147 @@ fn the_large_viewer_reads_out_the_cpu_value() {
     assert!(!h.state().big_viewer);
     h.get_by_label("input");
 }
+
+/// Reroute points: a double-click on a wire adds one there (the edge, its ports and types,
+/// unchanged: the same plan); the point is a small node that drags, and a wire dragged
+/// from it carries its wire's type: into an input that does not take it it is refused
+/// with the reason, into one that does it is a new edge from the same output. Saved and
+/// loaded with the edge (version 4); undoable.
+#[test]
+#[expect(clippy::too_many_lines, reason = "one user's sequence of steps")]
+fn a_reroute_point_keeps_its_wires_type() {
+    let Some(ed) = editor(None, None) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("g.ron");
+    std::fs::write(&path, shipped_text("post_tonemap.ron")).unwrap();
+    let mut h = common::harness_stepped(ed, 1.0 / 30.0);
+    h.state_mut().open(&path);
+    h.run_ok();
+    let plan_before = format!(
+        "{:?}",
+        compile(&h.state().doc.graph, &[], None).unwrap().passes
+    );
+    let edge = |h: &egui_kittest::Harness<'static, lumagraph_editor::Editor>| {
+        h.state()
+            .doc
+            .graph
+            .edges
+            .iter()
+            .position(|e| e.from == "tonemap.color" && e.to == "out.color")
+            .expect("the tonemap → out wire")
+    };
+    // The middle of the tonemap → out wire, on screen.
+    let t = h.state().doc.graph.node("tonemap").unwrap().pos.unwrap();
+    // Where the canvas drew the two pins.
+    let ed = h.state();
+    let pin_at = |node: &str, output: bool| {
+        let p = ed.canvas.pin_pos(node, output, "color").expect("drawn");
+        ed.canvas.to_screen(p).unwrap()
+    };
+    let (tonemap_out, out_in, exposure_in) = (
+        pin_at("tonemap", true),
+        pin_at("out", false),
+        pin_at("exposure", false),
+    );
+    let mid = tonemap_out + (out_in - tonemap_out) * 0.5;
+    h.hover_at(mid);
+    h.run_ok();
+    // Two clicks a frame apart (a double click is two within 0.3 s).
+    for _ in 0..2 {
+        for pressed in [true, false] {
+            h.event(egui::Event::PointerButton {
+                pos: mid,
+                button: egui::PointerButton::Primary,
+                pressed,
+                modifiers: egui::Modifiers::NONE,
+            });
+        }
+        h.step();
+    }
+    h.run_ok();
+    let e = edge(&h);
+    let ed = h.state();
+    assert_eq!(
+        ed.doc.graph.edges[e].via.len(),
+        1,
+        "{:?}",
+        ed.doc.graph.edges
+    );
+    assert_eq!(
+        format!("{:?}", compile(&ed.doc.graph, &[], None).unwrap().passes),
+        plan_before,
+        "a reroute changes the plan"
+    );
+    // Its output pin, on the right edge of its small node.
+    assert!(ed.canvas.reroute_rect(e, 0).is_some());
+    let pin = ed
+        .canvas
+        .to_screen(ed.canvas.reroute_pin_pos(e, 0, true).expect("drawn"))
+        .unwrap();
+    // ldr_color into exposure's input (hdr_color only): refused, in the compiler's words.
+    let before = h.state().doc.graph.clone();
+    drag(&mut h, pin, exposure_in);
+    let ed = h.state();
+    assert_eq!(ed.doc.graph, before);
+    let (msg, is_err) = ed.message.clone().expect("a refusal");
+    assert!(is_err && msg.contains("produces ldr_color"), "{msg}");
+    // Into a second Output: a new edge from tonemap's output.
+    let out2 = h
+        .state_mut()
+        .doc
+        .add_node("Output", Some((t.0 + 150.0, t.1 + 150.0)))
+        .unwrap();
+    h.state_mut().doc.end_gesture();
+    h.run_ok();
+    let out2_in = {
+        let ed = h.state();
+        let p = ed.canvas.pin_pos(&out2, false, "color").expect("drawn");
+        ed.canvas.to_screen(p).unwrap()
+    };
+    drag(&mut h, pin, out2_in);
+    let wired = format!("{out2}.color");
+    assert!(
+        h.state()
+            .doc
+            .graph
+            .edges
+            .iter()
+            .any(|e| e.from == "tonemap.color" && e.to == wired),
+        "{:?}",
+        h.state().doc.graph.edges
+    );
+    // Dragged, the point moves; the edge stays.
+    let (e, body) = {
+        let ed = h.state();
+        let e = edge(&h);
+        let r = ed.canvas.reroute_rect(e, 0).unwrap();
+        (
+            e,
+            ed.canvas
+                .to_screen(egui::pos2(r.center().x, r.top() + 3.0))
+                .unwrap(),
+        )
+    };
+    let was = h.state().doc.graph.edges[e].via[0];
+    drag(&mut h, body, body + egui::vec2(0.0, 40.0));
+    let now = h.state().doc.graph.edges[edge(&h)].via[0];
+    assert!(
+        now.1 > was.1 + 20.0 && (now.0 - was.0).abs() < 1.0,
+        "{was:?} -> {now:?}"
+    );
+    // Saved and loaded with its point.
+    h.state_mut().save_as(&path).unwrap();
+    let loaded = Graph::load(&path).unwrap();
+    assert_eq!(loaded.edges[edge(&h)].via.len(), 1);
+    assert!(
+        std::fs::read_to_string(&path)
+            .unwrap()
+            .contains("version: 4")
+    );
+    // Undo: the move, the new edge, the output, the reroute.
+    let ed = h.state_mut();
+    assert!(ed.doc.undo() && ed.doc.undo() && ed.doc.undo() && ed.doc.undo());
+    assert!(ed.doc.graph.edges.iter().all(|e| e.via.is_empty()));
+}

@@ -19,7 +19,8 @@ use crate::types::ParamValue;
 
 /// The newest graph file version this build reads and writes. Version 2 added node kinds
 /// declared in the file (`kinds`), version 3 node groups (`groups`, `interface`), version
-/// 4 the editor's frames and node colours (`frames`, a node's `color`). A graph is written
+/// 4 the editor's frames, node colours and reroute points (`frames`, a node's `color`, an
+/// edge's `via`). A graph is written
 /// with the oldest version that holds it: without any of these, version 1, which every
 /// build reads.
 pub const VERSION: u32 = 4;
@@ -67,13 +68,17 @@ impl Node {
 }
 
 /// An edge from an output port to an input port, each written `"node.port"`.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Edge {
     /// Output port, `"node.port"`.
     pub from: String,
     /// Input port, `"node.port"`.
     pub to: String,
+    /// Reroute points the editor draws the wire through, in order from `from` (version 4;
+    /// the compiler ignores them).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub via: Vec<(f32, f32)>,
 }
 
 impl Edge {
@@ -82,6 +87,7 @@ impl Edge {
         Self {
             from: from.into(),
             to: to.into(),
+            via: Vec::new(),
         }
     }
 }
@@ -321,7 +327,10 @@ impl Graph {
     /// edge per line), with the comments of the file it was loaded from where they belong
     /// (see [`crate::layout`]).
     pub fn to_ron(&self) -> String {
-        let version = if !self.frames.is_empty() || self.nodes.iter().any(|n| n.color.is_some()) {
+        let version = if !self.frames.is_empty()
+            || self.nodes.iter().any(|n| n.color.is_some())
+            || self.edges.iter().any(|e| !e.via.is_empty())
+        {
             4
         } else if !(self.groups.is_empty() && self.interface.is_empty()) {
             3

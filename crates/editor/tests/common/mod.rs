@@ -91,8 +91,19 @@ pub fn harness(editor: Editor) -> Harness<'static, Editor> {
     harness_sized(editor, SIZE)
 }
 
+/// [`harness`] whose frames are `step_dt` seconds apart (a quarter second by default;
+/// a double click needs two clicks within 0.3 s).
+#[allow(dead_code, reason = "not every test file uses it")]
+pub fn harness_stepped(editor: Editor, step_dt: f32) -> Harness<'static, Editor> {
+    harness_with(editor, SIZE, step_dt)
+}
+
 /// [`harness`] with a window of `size` points.
 pub fn harness_sized(editor: Editor, size: egui::Vec2) -> Harness<'static, Editor> {
+    harness_with(editor, size, 0.25)
+}
+
+fn harness_with(editor: Editor, size: egui::Vec2, step_dt: f32) -> Harness<'static, Editor> {
     let s = shared().expect("a harness needs the GPU");
     let setup = egui_wgpu::WgpuSetup::Existing(egui_wgpu::WgpuSetupExisting {
         instance: s.instance.clone(),
@@ -102,6 +113,7 @@ pub fn harness_sized(editor: Editor, size: egui::Vec2) -> Harness<'static, Edito
     });
     let mut h = Harness::builder()
         .with_size(size)
+        .with_step_dt(step_dt)
         .with_pixels_per_point(1.0)
         .wgpu_setup(setup)
         .build_ui_state(|ui, editor: &mut Editor| editor.ui(ui), editor);
