@@ -139,6 +139,9 @@ pub struct Editor {
     pub snap: bool,
     /// The preview drawn large, in place of the canvas.
     pub big_viewer: bool,
+    /// The preview drawn large in a window of its own (embedded as an egui window where
+    /// the backend has one window only).
+    pub viewer_window: bool,
     /// The port chosen for preview (`"node.port"`); `None` follows the selection.
     pub preview_port: Option<String>,
     /// Compile errors per node id (messages without file locations).
@@ -201,6 +204,7 @@ impl Editor {
             selected_frame: None,
             snap: false,
             big_viewer: false,
+            viewer_window: false,
             preview_port: None,
             errors: BTreeMap::new(),
             graph_errors: Vec::new(),
@@ -360,6 +364,7 @@ impl Editor {
         }
         if ctx.input_mut(|i| i.consume_key(cmd, Key::Space)) {
             self.big_viewer = !self.big_viewer;
+            self.viewer_window = false;
         }
         if !typing && ctx.input_mut(|i| i.consume_key(cmd, Key::J)) {
             self.frame_selection();
@@ -466,6 +471,23 @@ impl Editor {
                 }
             }
         });
+        if self.viewer_window && self.preview.linear.is_some() {
+            let ctx = ui.ctx().clone();
+            ctx.show_viewport_immediate(
+                egui::ViewportId::from_hash_of("lumagraph viewer"),
+                egui::ViewportBuilder::default()
+                    .with_title("lumagraph viewer")
+                    .with_inner_size([900.0, 640.0]),
+                |ui, _class| {
+                    egui::CentralPanel::default().show(ui, |ui| {
+                        self.large_viewer(ui, port.as_deref());
+                    });
+                    if ui.input(|i| i.viewport().close_requested()) {
+                        self.viewer_window = false;
+                    }
+                },
+            );
+        }
         self.refusal_tooltip(ui, now);
         self.dialogs(ui);
         self.file_dialog_ui(&ui.ctx().clone());

@@ -1807,3 +1807,49 @@ fn a_reroute_point_keeps_its_wires_type() {
     assert!(ed.doc.undo() && ed.doc.undo() && ed.doc.undo() && ed.doc.undo());
     assert!(ed.doc.graph.edges.iter().all(|e| e.via.is_empty()));
 }
+
+/// The viewer in a window of its own (🗗 window): the canvas stays, the side panel says
+/// where the image went, and the window's readout is the CPU value. (The harness has one
+/// window, so egui embeds the viewer's as a window inside it, as on such backends.)
+#[test]
+fn the_viewer_window_reads_out_the_cpu_value() {
+    let Some(ed) = editor(Some(&post_tonemap()), None) else {
+        return;
+    };
+    let chart = lumagraph_render::image_io::load(&repo("assets/test_chart.exr")).unwrap();
+    let mut h = harness(ed);
+    h.state_mut().select(vec!["exposure".into()]);
+    h.state_mut()
+        .doc
+        .set_param("exposure", "ev", ParamValue::Float(-3.0));
+    h.run_ok();
+    h.get_by_label("🗗 window").click();
+    h.run_ok();
+    assert!(h.state().viewer_window && !h.state().big_viewer);
+    h.get_by_label("lumagraph viewer");
+    h.get_by_label("in the viewer window");
+    h.get_by_label("input");
+    let rect = h.state().view.rect.expect("drawn");
+    let fit = (rect.width() / chart.width as f32).min(rect.height() / chart.height as f32);
+    let shown = egui::vec2(chart.width as f32, chart.height as f32) * fit;
+    let origin = rect.center() - shown / 2.0;
+    let (x, y) = (chart.width / 4, chart.height / 2 - 5);
+    h.hover_at(origin + egui::vec2(x as f32 + 0.5, y as f32 + 0.5) * fit);
+    h.run_ok();
+    let r = h.state().view.hover.expect("a readout");
+    assert_eq!((r.x, r.y), (x, y));
+    let want = chart.pixels[(y * chart.width + x) as usize];
+    for c in 0..3 {
+        assert!(
+            (r.rgba[c] - 0.125 * want[c]).abs() <= 1e-5 * want[c].abs().max(1.0),
+            "channel {c}: {} vs 2^-3 × {}",
+            r.rgba[c],
+            want[c]
+        );
+    }
+    // Closed (the embedded window may lie over the side panel's button here).
+    h.get_by_label("🗗 back here");
+    h.state_mut().viewer_window = false;
+    h.run_ok();
+    assert!(h.query_by_label("lumagraph viewer").is_none());
+}

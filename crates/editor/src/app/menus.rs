@@ -80,6 +80,18 @@ impl Editor {
                     .clicked()
                 {
                     self.big_viewer = !self.big_viewer;
+                    self.viewer_window = false;
+                    ui.close();
+                }
+                if ui
+                    .add(egui::Button::selectable(
+                        self.viewer_window,
+                        "Viewer in a window",
+                    ))
+                    .clicked()
+                {
+                    self.viewer_window = !self.viewer_window;
+                    self.big_viewer = false;
                     ui.close();
                 }
                 ui.checkbox(&mut self.snap, "Snap to grid")

@@ -57,8 +57,20 @@ impl Editor {
     pub(super) fn side_panel(&mut self, ui: &mut Ui, port: Option<&str>) {
         ui.horizontal(|ui| {
             ui.heading("Preview");
-            ui.toggle_value(&mut self.big_viewer, "⛶ large")
-                .on_hover_text("the viewer in place of the canvas (Ctrl+Space); again to go back");
+            if ui
+                .toggle_value(&mut self.big_viewer, "⛶ large")
+                .on_hover_text("the viewer in place of the canvas (Ctrl+Space); again to go back")
+                .clicked()
+            {
+                self.viewer_window = false;
+            }
+            if ui
+                .toggle_value(&mut self.viewer_window, "🗗 window")
+                .on_hover_text("the viewer in a window of its own; close it to go back")
+                .clicked()
+            {
+                self.big_viewer = false;
+            }
         });
         self.scene_line(ui);
         match port {
@@ -67,11 +79,18 @@ impl Editor {
         };
         if let Some(err) = &self.preview.error {
             ui.colored_label(Color32::from_rgb(240, 90, 90), err);
-        } else if self.big_viewer && self.preview.linear.is_some() {
+        } else if (self.big_viewer || self.viewer_window) && self.preview.linear.is_some() {
             ui.horizontal(|ui| {
-                ui.weak("in the large viewer");
-                if ui.button("⛶ back to the canvas").clicked() {
-                    self.big_viewer = false;
+                if self.viewer_window {
+                    ui.weak("in the viewer window");
+                    if ui.button("🗗 back here").clicked() {
+                        self.viewer_window = false;
+                    }
+                } else {
+                    ui.weak("in the large viewer");
+                    if ui.button("⛶ back to the canvas").clicked() {
+                        self.big_viewer = false;
+                    }
                 }
             });
             self.preview_status(ui);
