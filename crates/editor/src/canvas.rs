@@ -558,7 +558,6 @@ impl Canvas {
     fn add_reroute_at(&mut self, doc: &mut Document, at: Pos2) {
         let Some(view) = self.view else { return };
         let p = view.inverse() * at;
-        let split = |r: &str| split_port_ref(r).map(|(n, port)| (n.to_owned(), port.to_owned()));
         let half = self
             .reroute_rects
             .values()
@@ -566,19 +565,10 @@ impl Canvas {
             .map_or(vec2(10.0, 10.0), |r| r.size() * 0.5);
         let mut best: Option<(f32, usize, usize)> = None;
         for (e, edge) in doc.graph.edges.iter().enumerate() {
-            let (Some((a, ap)), Some((b, bp))) = (split(&edge.from), split(&edge.to)) else {
+            let Some((start, end)) = self.wire_ends(edge) else {
                 continue;
             };
-            let (Some(ar), Some(br)) = (self.node_rects.get(&a), self.node_rects.get(&b)) else {
-                continue;
-            };
-            let (Some(ay), Some(by)) = (
-                self.pin_rows.get(&(a.clone(), true, ap)),
-                self.pin_rows.get(&(b.clone(), false, bp)),
-            ) else {
-                continue;
-            };
-            let mut points = vec![pos2(ar.right(), *ay)];
+            let mut points = vec![start];
             for (k, &(x, y)) in edge.via.iter().enumerate() {
                 let center = self
                     .reroute_rects
@@ -586,7 +576,7 @@ impl Canvas {
                     .map_or(pos2(x, y) + half, Rect::center);
                 points.push(center);
             }
-            points.push(pos2(br.left(), *by));
+            points.push(end);
             for (i, w) in points.windows(2).enumerate() {
                 let d = distance_to_wire(p, w[0], w[1]);
                 if d < WIRE_HIT && best.is_none_or(|(bd, ..)| d < bd) {
@@ -612,6 +602,14 @@ impl Canvas {
             .pin_rows
             .get(&(node.to_owned(), output, port.to_owned()))?;
         Some(pos2(if output { r.right() } else { r.left() }, *y))
+    }
+
+    /// Where `edge`'s wire leaves its output pin and enters its input pin, as last drawn,
+    /// graph space.
+    fn wire_ends(&self, edge: &lumagraph_graph::Edge) -> Option<(Pos2, Pos2)> {
+        let (a, ap) = split_port_ref(&edge.from)?;
+        let (b, bp) = split_port_ref(&edge.to)?;
+        Some((self.pin_pos(a, true, ap)?, self.pin_pos(b, false, bp)?))
     }
 
     /// Reroute point `k` of edge `e` as last drawn, graph space.
@@ -736,19 +734,10 @@ impl Canvas {
         let center = self.node_rects.get(id)?.center();
         let mut best: Option<(f32, (String, String))> = None;
         for e in graph.edges.iter().filter(|e| e.via.is_empty()) {
-            let (Some((a, ap)), Some((b, bp))) = (split(&e.from), split(&e.to)) else {
+            let Some((start, end)) = self.wire_ends(e) else {
                 continue;
             };
-            let (Some(ar), Some(br)) = (self.node_rects.get(&a), self.node_rects.get(&b)) else {
-                continue;
-            };
-            let (Some(ay), Some(by)) = (
-                self.pin_rows.get(&(a.clone(), true, ap)),
-                self.pin_rows.get(&(b.clone(), false, bp)),
-            ) else {
-                continue;
-            };
-            let d = distance_to_wire(center, pos2(ar.right(), *ay), pos2(br.left(), *by));
+            let d = distance_to_wire(center, start, end);
             if d < WIRE_HIT && best.as_ref().is_none_or(|(bd, _)| d < *bd) {
                 best = Some((d, (e.from.clone(), e.to.clone())));
             }
