@@ -641,7 +641,14 @@ impl Document {
         };
         for e in &clip.edges {
             if let (Some(from), Some(to)) = (rename(&e.from), rename(&e.to)) {
-                self.graph.edges.push(Edge::new(from, to));
+                // Reroute points move with the nodes.
+                let mut edge = Edge::new(from, to);
+                edge.via = e
+                    .via
+                    .iter()
+                    .map(|p| (p.0 + offset.0, p.1 + offset.1))
+                    .collect();
+                self.graph.edges.push(edge);
             }
         }
         new_ids

@@ -176,6 +176,9 @@ fn copy_paste_and_delete() {
     let Some(mut ed) = editor(Some(&post_tonemap()), None) else {
         return;
     };
+    // A reroute point on the copied wire travels with it.
+    ed.doc
+        .add_reroute("exposure.color", "tonemap.color", 0, (330.0, 10.0));
     ed.select(vec!["exposure".into(), "tonemap".into()]);
     let text = ed.copy_selection().unwrap();
     ed.paste(Some(&text));
@@ -185,11 +188,16 @@ fn copy_paste_and_delete() {
     );
     let g = &ed.doc.graph;
     assert_eq!(g.nodes.len(), 6);
-    assert!(
-        g.edges
-            .iter()
-            .any(|e| e.from == "exposure_2.color" && e.to == "tonemap_2.color")
+    let pasted = g
+        .edges
+        .iter()
+        .find(|e| e.from == "exposure_2.color" && e.to == "tonemap_2.color")
+        .expect("the inner wire is pasted");
+    let (a, b) = (
+        g.node("exposure").unwrap().pos.unwrap(),
+        g.node("exposure_2").unwrap().pos.unwrap(),
     );
+    assert_eq!(pasted.via, [(330.0 + b.0 - a.0, 10.0 + b.1 - a.1)]);
     ed.delete_selection();
     assert_eq!(ed.doc.graph.nodes.len(), 4);
     assert_eq!(ed.doc.graph.edges.len(), 3);
