@@ -33,14 +33,12 @@ impl SceneDoc {
     /// # Errors
     /// A message naming the file, with line and column for syntax errors.
     pub fn load(path: &Path) -> Result<Self, String> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| format!("{}: cannot read the scene file: {e}", path.display()))?;
-        let file = SceneFile::from_ron(&text).map_err(|e| e.in_file(path).to_string())?;
+        let read = lumagraph_scene::edit::SceneText::load(path).map_err(|e| e.to_string())?;
         Ok(Self {
-            path: path.to_owned(),
-            text,
-            saved: file.clone(),
-            file,
+            path: read.path,
+            text: read.text,
+            saved: read.file.clone(),
+            file: read.file,
             furnace: false,
         })
     }

@@ -338,9 +338,7 @@ impl SceneText {
     /// When the text cannot be written or the file cannot be (it is then unchanged).
     pub fn save(&mut self, to: Option<&Path>) -> Result<(), SceneError> {
         let target = to.unwrap_or(&self.path).to_owned();
-        let text = self.to_ron()?;
-        lumagraph_graph::write_atomic(&target, text.as_bytes())
-            .map_err(|source| SceneError::new(ErrorKind::Write { source }).in_file(&target))?;
+        let text = crate::save::save(&target, &self.text, &self.file)?;
         if to.is_none() {
             self.text = text;
         }
