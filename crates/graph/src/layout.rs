@@ -4,10 +4,10 @@
 //! edge per line, declarations indented below their list. Comments survive a load → edit →
 //! save when they are where a reader expects them to belong:
 //! - the **header**: comment lines before the graph's opening `(`;
-//! - comment lines directly above a **node** or an **edge** (each on its own line), and a
-//!   comment after one on the same line (`(id: "x", ...), // why`); they stay with that
-//!   node or edge (found by its id, or its two ends), wherever it moves, and go when it is
-//!   deleted.
+//! - comment lines directly above a **node**, an **edge** or a **frame** (each on its own
+//!   line), and a comment after one on the same line (`(id: "x", ...), // why`); they stay
+//!   with that node, edge or frame (found by its id, its two ends, or its label), wherever
+//!   it moves, and go when it is deleted.
 //!
 //! Comments elsewhere (inside a declared kind, between fields) are not kept.
 
@@ -26,6 +26,8 @@ struct Comments {
     nodes: HashMap<String, (Vec<String>, Option<String>)>,
     /// (from, to) → (lines above, comment after on its line).
     edges: HashMap<(String, String), (Vec<String>, Option<String>)>,
+    /// Frame label → (lines above, comment after on its line).
+    frames: HashMap<String, (Vec<String>, Option<String>)>,
 }
 
 /// The first string value after `key:` on `line`.
@@ -72,6 +74,8 @@ impl Comments {
                 out.nodes.insert(id.to_owned(), comments);
             } else if let (Some(from), Some(to)) = (field(t, "from"), field(t, "to")) {
                 out.edges.insert((from.to_owned(), to.to_owned()), comments);
+            } else if let Some(label) = field(t, "label") {
+                out.frames.insert(label.to_owned(), comments);
             }
         }
         out
@@ -253,7 +257,7 @@ pub(crate) fn write(graph: &Graph, version: u32) -> String {
     if !graph.frames.is_empty() {
         out.push_str("    frames: [\n");
         for f in &graph.frames {
-            entry(&mut out, &compact(f), None);
+            entry(&mut out, &compact(f), comments.frames.get(&f.label));
         }
         out.push_str("    ],\n");
     }

@@ -855,3 +855,37 @@ fn the_pass_order_does_not_change_between_compiles() {
         assert_eq!(order(), first);
     }
 }
+
+/// Frames (version 4) keep the comments above them and after them on their line, found by
+/// their label; an unchanged file is written back byte for byte.
+#[test]
+fn frame_comments_survive_an_edit_and_a_save() {
+    let text = r#"(
+    version: 4,
+    nodes: [
+        (id: "input", kind: "ImageInput", params: {"path": "a.exr"}),
+        (id: "out", kind: "Output"),
+    ],
+    edges: [
+        (from: "input.color", to: "out.color", via: [(100.0, 20.0)]),
+    ],
+    frames: [
+        // What comes in.
+        (label: "sources", nodes: ["input"]), // one for now
+    ],
+)
+"#;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("f.ron");
+    std::fs::write(&path, text).unwrap();
+    let mut g = Graph::load(&path).unwrap();
+    assert_eq!(g.to_ron(), text);
+    g.frames[0].nodes.push("out".into());
+    let saved = g.to_ron();
+    assert!(
+        saved.contains(
+            "        // What comes in.\n        (label: \"sources\", nodes: [\"input\", \"out\"]), // one for now\n"
+        ),
+        "{saved}"
+    );
+}
