@@ -376,8 +376,10 @@ impl Session {
         if same_but_camera == edited.file
             && let Some(gpu) = &self.scene
         {
-            let scene = edited.build()?;
-            let camera = gpu.camera_for(&scene.camera);
+            // Only the camera is built: nothing is loaded again for a perspective camera.
+            let camera = lumagraph_scene::Scene::camera_of(&edited.file, edited.base_dir())
+                .map_err(|e| e.in_file(&edited.path))?;
+            let camera = gpu.camera_for(&camera);
             self.camera = (camera != gpu.camera).then_some(camera);
             self.exec.move_camera(&camera);
             self.exec.restart();
@@ -406,11 +408,11 @@ impl Session {
     /// The key of what this session renders ([`render_key`]): the graph as it stands and
     /// the scene as edited; its checkpoints carry it.
     pub fn key(&self) -> u64 {
-        let mut scene = self.scene.as_deref().cloned();
-        if let (Some(s), Some(camera)) = (scene.as_mut(), self.camera) {
-            s.camera = camera;
-        }
-        render_key(&self.graph, scene.as_ref())
+        let scene = self
+            .scene
+            .as_deref()
+            .map(|s| scene_digest(s, self.camera.as_ref().unwrap_or(&s.camera)));
+        key_of(&self.graph, &scene.unwrap_or_default())
     }
 
     /// Writes where the render stands to `path` (atomically): the frames run and the
@@ -518,24 +520,37 @@ fn build_scene(text: &SceneText) -> Result<(Arc<GpuScene>, Vec<String>)> {
 /// from it: lumagraph's version, the graph as run (overrides applied, without layout and
 /// comments) and every number of the flattened scene.
 pub fn render_key(graph: &Graph, scene: Option<&GpuScene>) -> u64 {
-    let mut g = graph.clone();
-    g.origin = None;
-    for n in &mut g.nodes {
-        n.pos = None;
-    }
-    let scene = scene.map_or_else(String::new, scene_digest);
-    crate::checkpoint::render_key(&g.to_ron(), &scene)
+    key_of(
+        graph,
+        &scene.map_or_else(String::new, |s| scene_digest(s, &s.camera)),
+    )
 }
 
-/// Every number of the flattened scene, hashed: what the GPU gets and the CPU data that
-/// shapes the render (the host intersector's corners, the orders, the environment map's
-/// file). Hashing the bytes rather than the scene's `Debug` text keeps a large scene's key
+/// [`render_key`] of `graph` and a scene's digest. What only the editor draws (positions,
+/// colours, frames, reroute points) and the file's comments are left out.
+fn key_of(graph: &Graph, scene: &str) -> u64 {
+    let mut g = graph.clone();
+    g.origin = None;
+    g.frames.clear();
+    for n in &mut g.nodes {
+        n.pos = None;
+        n.color = None;
+    }
+    for e in &mut g.edges {
+        e.via.clear();
+    }
+    crate::checkpoint::render_key(&g.to_ron(), scene)
+}
+
+/// Every number of the flattened scene seen from `camera`, hashed: what the GPU gets and
+/// the CPU data that shapes the render (the host intersector's corners, the orders, the
+/// environment map's file). Hashing the bytes rather than the scene's `Debug` text keeps a large scene's key
 /// cheap (the Crytek Sponza's text was over a gigabyte and took most of a minute).
-pub(crate) fn scene_digest(s: &GpuScene) -> String {
+pub(crate) fn scene_digest(s: &GpuScene, camera: &GpuCamera) -> String {
     use bytemuck::{bytes_of, cast_slice};
     let h = crate::checkpoint::Fnv::default()
         .write(bytes_of(&s.header))
-        .write(bytes_of(&s.camera))
+        .write(bytes_of(camera))
         .write(bytes_of(&s.settings))
         .write(cast_slice(&s.bvh_nodes))
         .write(cast_slice(&s.bvh_skips))
@@ -567,6 +582,35 @@ mod tests {
 
     /// The key of a render's checkpoint follows the instances: a moved instance (its mesh
     /// and everything else the same) is another scene.
+    /// A render's key ignores what only the editor draws (positions, colours, frames,
+    /// reroute points), so a checkpoint survives tidying the graph, and follows params.
+    #[test]
+    fn the_key_ignores_the_editors_drawing() {
+        use lumagraph_graph::{Edge, FrameDecl, Node, ParamValue};
+        let mut g = Graph::new();
+        g.nodes
+            .push(Node::new("a", "ImageInput").with("path", ParamValue::Str("x.exr".into())));
+        g.nodes.push(Node::new("b", "Output"));
+        g.edges.push(Edge::new("a.color", "b.color"));
+        let key = render_key(&g, None);
+        let mut drawn = g.clone();
+        drawn.nodes[0].pos = Some((10.0, 20.0));
+        drawn.nodes[1].color = Some((200, 40, 40));
+        drawn.edges[0].via.push((5.0, 5.0));
+        drawn.frames.push(FrameDecl {
+            label: "f".into(),
+            comment: String::new(),
+            color: None,
+            nodes: vec!["a".into()],
+        });
+        assert_eq!(render_key(&drawn, None), key);
+        let mut other = g.clone();
+        other.nodes[0] = other.nodes[0]
+            .clone()
+            .with("path", ParamValue::Str("y.exr".into()));
+        assert_ne!(render_key(&other, None), key);
+    }
+
     #[test]
     fn the_scene_key_follows_the_instances() {
         let text = |x: f32| {
@@ -583,7 +627,7 @@ mod tests {
             let scene = lumagraph_scene::Scene::from_ron(&text(x), &assets).unwrap();
             let gpu = GpuScene::build(&scene).unwrap();
             assert_eq!(gpu.instances.len(), 2);
-            scene_digest(&gpu)
+            scene_digest(&gpu, &gpu.camera)
         };
         assert_eq!(digest(3.0), digest(3.0));
         assert_ne!(digest(3.0), digest(3.5));

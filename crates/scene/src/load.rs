@@ -516,6 +516,20 @@ impl Scene {
         Self::build(file, "", base_dir)
     }
 
+    /// The camera `file` describes, as [`Scene::from_file`] would build it: a perspective
+    /// camera without loading anything, a glTF file's camera by loading the scene.
+    ///
+    /// # Errors
+    /// As [`Scene::from_file`] for the camera (a bad field, a camera the file lacks).
+    pub fn camera_of(file: &SceneFile, base_dir: &Path) -> Result<Camera, SceneError> {
+        match &file.camera {
+            CameraDesc::Perspective { .. } => Builder::new("", base_dir)
+                .camera(&file.camera)
+                .map_err(|e| e.about("camera")),
+            _ => Ok(Self::from_file(file, base_dir)?.camera),
+        }
+    }
+
     fn build(file: &SceneFile, text: &str, base_dir: &Path) -> Result<Self, SceneError> {
         let started = std::time::Instant::now();
         let mut scene = if file.version == 1 {
