@@ -22,6 +22,24 @@ fn open(out: &std::path::Path, write_outputs: bool, keep: &[&str]) -> Session {
     .unwrap()
 }
 
+/// `lumagraph render graphs/pathtrace.ron --scene assets/cornell.ron --spp 16` into `out`,
+/// with `more` arguments; it must succeed.
+fn cli_render(out: &std::path::Path, more: &[&str]) {
+    let o = Command::new(env!("CARGO_BIN_EXE_lumagraph"))
+        .args([
+            "render",
+            "graphs/pathtrace.ron",
+            "--scene",
+            "assets/cornell.ron",
+        ])
+        .args(["--spp", "16", "--out", out.to_str().unwrap()])
+        .args(more)
+        .current_dir(common::root())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 /// A session's render of `graphs/pathtrace.ron` on the Cornell box at 16 spp writes the
 /// files `lumagraph render` writes for the same graph, scene and spp, byte for byte.
 #[test]
@@ -31,18 +49,7 @@ fn a_session_renders_what_the_cli_renders() {
     }
     let dir = tempfile::tempdir().unwrap();
     let (cli, ours) = (dir.path().join("cli"), dir.path().join("session"));
-    let o = Command::new(env!("CARGO_BIN_EXE_lumagraph"))
-        .args([
-            "render",
-            "graphs/pathtrace.ron",
-            "--scene",
-            "assets/cornell.ron",
-        ])
-        .args(["--spp", "16", "--out", cli.to_str().unwrap()])
-        .current_dir(common::root())
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    cli_render(&cli, &[]);
     let mut s = open(&ours, true, &[]);
     let report = s.render(16).unwrap();
     assert_eq!(s.spp(), 16);
@@ -154,19 +161,7 @@ fn a_checkpoint_goes_on_where_the_render_stopped() {
 
     // The command line goes on from the session's checkpoint too.
     let cli = dir.path().join("cli");
-    let o = Command::new(env!("CARGO_BIN_EXE_lumagraph"))
-        .args([
-            "render",
-            "graphs/pathtrace.ron",
-            "--scene",
-            "assets/cornell.ron",
-        ])
-        .args(["--spp", "16", "--out", cli.to_str().unwrap()])
-        .args(["--resume", ck.to_str().unwrap()])
-        .current_dir(common::root())
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    cli_render(&cli, &["--resume", ck.to_str().unwrap()]);
     assert!(
         std::fs::read(cli.join("render.exr")).unwrap()
             == std::fs::read(straight_dir.join("render.exr")).unwrap(),
