@@ -13,8 +13,10 @@
 
 mod bench;
 mod converge;
+mod frames;
 mod gallery;
 mod gltf_gallery;
+mod info;
 mod progressive;
 mod split;
 mod tiled;
@@ -101,6 +103,16 @@ enum Command {
         allow_outputs_outside: bool,
         #[command(flatten)]
         textures: TextureArgs,
+        /// Render an image sequence: each param holding a frame pattern (`####`, `%04d`,
+        /// `$F4`) takes each frame's number; `7`, `1-100`, `1-100x2` (every second frame),
+        /// or a comma-separated list of these (docs/compositing.md).
+        #[arg(long, value_name = "RANGE", value_parser = parse_frames,
+              conflicts_with_all = ["resume", "checkpoint", "checkpoint_every", "samples", "tiles", "tile"])]
+        frames: Option<FrameList>,
+        /// With `--frames`: skip frames whose input file is missing instead of stopping
+        /// with an error naming it.
+        #[arg(long, requires = "frames")]
+        skip_missing: bool,
     },
     /// Merge partial renders (`render --samples`) of one graph and scene into what a single
     /// render of all their samples writes: checks that they belong together, sums them
@@ -161,6 +173,18 @@ enum Command {
         /// Also list the node kinds this graph file declares.
         #[arg(long)]
         graph: Option<PathBuf>,
+    },
+    /// Describe an image file: an EXR's parts, views, layers (and the port each is read
+    /// onto), channels, windows, colour primaries and attributes.
+    #[command(
+        after_help = "Example:\n  lumagraph info shot/beauty.0001.exr\n  lumagraph info shot/beauty.0001.exr --json"
+    )]
+    Info {
+        /// The image file.
+        file: PathBuf,
+        /// Print JSON instead of words.
+        #[arg(long)]
+        json: bool,
     },
     /// List the GPU adapters wgpu finds (name, kind, backend, driver, ray queries,
     /// timestamps, binding limits) and the one lumagraph would use.
@@ -471,6 +495,9 @@ fn progressive_source(plan: &crate::graph::Plan) -> Option<&crate::graph::Pass> 
 }
 
 fn render(args: &RenderArgs<'_>) -> Result<()> {
+    if let Some((frames, skip_missing)) = &args.frames {
+        return frames::render(args, frames, *skip_missing);
+    }
     let graph = load(args.graph, args.overrides)?;
     let mut scene = load_scene(args.scene)?;
     let plan = args
@@ -648,6 +675,16 @@ struct RenderArgs<'a> {
     outputs_anywhere: bool,
     /// `--fit-textures` and `--texture-memory`.
     textures: TextureArgs,
+    /// `--frames` and `--skip-missing`.
+    frames: Option<(Vec<i64>, bool)>,
+}
+
+/// `--frames`: the frames, in order (a newtype, so that clap takes one value).
+#[derive(Clone, Debug)]
+struct FrameList(Vec<i64>);
+
+fn parse_frames(spec: &str) -> std::result::Result<FrameList, String> {
+    lumagraph_footage::sequence::parse_frames(spec).map(FrameList)
 }
 
 /// How a render fits the scene's textures to the device (`render`'s options).
@@ -769,6 +806,8 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             samples,
             allow_outputs_outside,
             textures,
+            frames,
+            skip_missing,
         } => render(&RenderArgs {
             library,
             graph: &graph,
@@ -782,6 +821,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             samples,
             outputs_anywhere: allow_outputs_outside,
             textures,
+            frames: frames.map(|f| (f.0, skip_missing)),
         }),
         Command::Merge {
             partials,
@@ -868,6 +908,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             library,
         }),
         Command::Export { scene, out } => export(&scene, &out),
+        Command::Info { file, json } => info::info(&file, json),
         Command::TestChart { out } => test_chart(&out),
     }
 }

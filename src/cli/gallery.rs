@@ -106,10 +106,15 @@ fn recipe(
             .iter()
             .find(|p| matches!(p.ty, ParamType::Path { .. }))
             .with_context(|| format!("{} writes no file to show", kind.name))?;
+        // A sink that writes no PNG (an EXR of layers) writes `<kind>.exr`, shown as PNG.
+        let ext = match &path.ty {
+            ParamType::Path { extensions, .. } if !extensions.contains(&"png") => "exr",
+            _ => "png",
+        };
         let n = g.nodes.len() - 1;
         g.nodes[n] = g.nodes[n]
             .clone()
-            .with(path.name, ParamValue::Str(format!("{}.png", kind.name)));
+            .with(path.name, ParamValue::Str(format!("{}.{ext}", kind.name)));
         return Ok((g, String::new(), PortType::LdrColor, 1));
     };
     if out.ty == PortType::HdrColor {
@@ -164,7 +169,14 @@ pub fn run(ctx: &GpuContext, library: &NodeLibrary, out: &Path, only: &[String])
         let report = exec.run_frames(frames, true)?;
         if port.is_empty() {
             for path in report.written {
-                println!("wrote {}", path.display());
+                if path.extension().is_some_and(|e| e == "exr") {
+                    let png = path.with_extension("png");
+                    image_io::save(&png, &image_io::load(&path)?, true)?;
+                    std::fs::remove_file(&path)?;
+                    println!("wrote {} (its EXR's colour layer)", png.display());
+                } else {
+                    println!("wrote {}", path.display());
+                }
             }
             continue;
         }

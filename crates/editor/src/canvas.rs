@@ -119,7 +119,8 @@ pub fn port_color(ty: PortType) -> Color32 {
         PortType::LdrColor => Color32::from_rgb(120, 200, 110),
         PortType::Albedo => Color32::from_rgb(200, 120, 200),
         PortType::Normal => Color32::from_rgb(100, 150, 240),
-        PortType::Depth => Color32::from_rgb(170, 170, 170),
+        PortType::Depth | PortType::Scalar => Color32::from_rgb(170, 170, 170),
+        PortType::Vector => Color32::from_rgb(90, 200, 200),
         _ => Color32::from_rgb(220, 90, 90),
     }
 }

@@ -97,6 +97,7 @@ fn tooltip(def: &ParamDef) -> String {
             default,
             extensions,
         } => format!("file ({}), default \"{default}\"", extensions.join(", ")),
+        ParamType::Text { default } => format!("text, default \"{default}\""),
         _ => String::new(),
     };
     format!("{}\n{range}", def.doc)
@@ -181,6 +182,29 @@ fn value_widget(
                 .on_hover_text(tip)
                 .labelled_by(label);
             picked
+        }
+        ParamType::Text { .. } => {
+            let committed = match current {
+                ParamValue::Str(s) => s.clone(),
+                other => other.to_string(),
+            };
+            // The text being typed lives in egui's memory while the field has focus; it
+            // is set when the edit ends, so typing a layer's name does not reload the
+            // file at every letter.
+            let id = label.with("text");
+            let mut text = ui
+                .data_mut(|d| d.get_temp::<String>(id))
+                .unwrap_or_else(|| committed.clone());
+            let r = ui
+                .add(egui::TextEdit::singleline(&mut text).desired_width(140.0))
+                .on_hover_text(tip)
+                .labelled_by(label);
+            if r.has_focus() {
+                ui.data_mut(|d| d.insert_temp(id, text.clone()));
+            } else {
+                ui.data_mut(|d| d.remove::<String>(id));
+            }
+            (r.lost_focus() && text != committed).then_some(ParamValue::Str(text))
         }
         _ => {
             ui.weak(current.to_string());

@@ -21,6 +21,7 @@ fn param_range(ty: &ParamType) -> String {
             .map(|e| format!(".{e}"))
             .collect::<Vec<_>>()
             .join(" "),
+        ParamType::Text { .. } => "any text".to_owned(),
     }
 }
 

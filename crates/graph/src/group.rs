@@ -295,6 +295,9 @@ fn with_default(ty: &ParamType, value: Option<&ParamValue>) -> ParamType {
             default: intern(&v),
             extensions,
         },
+        (ParamType::Text { .. }, ParamValue::Str(v)) => ParamType::Text {
+            default: intern(&v),
+        },
         _ => ty.clone(),
     }
 }

@@ -22,17 +22,24 @@ pub enum PortType {
     Depth,
     /// Per-pixel variance estimate of a color signal.
     Variance,
+    /// One value per pixel, of any meaning: a depth, a matte, a luminance read from a file.
+    Scalar,
+    /// Up to four values per pixel that are not colour: motion (`u`, `v`), a normal or a
+    /// position read from a file.
+    Vector,
 }
 
 impl PortType {
     /// Every port type, for documentation and menus.
-    pub const ALL: [Self; 6] = [
+    pub const ALL: [Self; 8] = [
         Self::HdrColor,
         Self::LdrColor,
         Self::Albedo,
         Self::Normal,
         Self::Depth,
         Self::Variance,
+        Self::Scalar,
+        Self::Vector,
     ];
 
     /// Short name used in messages and docs.
@@ -44,6 +51,8 @@ impl PortType {
             Self::Normal => "normal",
             Self::Depth => "depth",
             Self::Variance => "variance",
+            Self::Scalar => "scalar",
+            Self::Vector => "vector",
         }
     }
 
@@ -56,15 +65,19 @@ impl PortType {
             Self::Normal => "world-space unit shading normal",
             Self::Depth => "linear depth along the camera ray",
             Self::Variance => "per-pixel variance of a color signal",
+            Self::Scalar => "one value per pixel (a depth, a matte, a luminance)",
+            Self::Vector => "up to four values per pixel that are not colour (motion, a normal)",
         }
     }
 
     /// The texture format a texture of this type is stored in.
     pub fn format(self) -> TexFormat {
         match self {
-            Self::HdrColor | Self::Albedo | Self::Normal | Self::Variance => TexFormat::Rgba32Float,
+            Self::HdrColor | Self::Albedo | Self::Normal | Self::Variance | Self::Vector => {
+                TexFormat::Rgba32Float
+            }
             Self::LdrColor => TexFormat::Rgba8Unorm,
-            Self::Depth => TexFormat::R32Float,
+            Self::Depth | Self::Scalar => TexFormat::R32Float,
         }
     }
 }
@@ -175,6 +188,11 @@ pub enum ParamType {
         /// File extensions the node understands, lower case, without the dot.
         extensions: &'static [&'static str],
     },
+    /// Any text, empty included (a layer's or a view's name).
+    Text {
+        /// Value when the file does not set one.
+        default: &'static str,
+    },
 }
 
 impl ParamType {
@@ -184,7 +202,7 @@ impl ParamType {
             Self::Float { default, .. } => ParamValue::Float(*default),
             Self::Int { default, .. } => ParamValue::Int(*default),
             Self::Bool { default } => ParamValue::Bool(*default),
-            Self::Enum { default, .. } | Self::Path { default, .. } => {
+            Self::Enum { default, .. } | Self::Path { default, .. } | Self::Text { default } => {
                 ParamValue::Str((*default).to_owned())
             }
         }
@@ -198,6 +216,7 @@ impl ParamType {
             Self::Bool { .. } => "bool",
             Self::Enum { .. } => "enum",
             Self::Path { .. } => "path",
+            Self::Text { .. } => "text",
         }
     }
 
@@ -240,6 +259,7 @@ impl ParamType {
                     Ok(value.clone())
                 }
             }
+            (Self::Text { .. }, ParamValue::Str(_)) => Ok(value.clone()),
             _ => Err(format!(
                 "expected {}, found {}",
                 self.name(),

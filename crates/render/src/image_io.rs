@@ -5,7 +5,8 @@
 use std::io::Cursor;
 use std::path::Path;
 
-use exr::prelude::{self as exrp, ReadChannels as _, ReadLayers as _, WritableImage as _};
+use exr::prelude::{self as exrp, WritableImage as _};
+use lumagraph_footage::exr::{self as footage, LayerImage, Selection, Want};
 use lumagraph_graph::{Extent, write_atomic};
 
 use crate::cpu::{Image, srgb_decode, srgb_encode, to_u8};
@@ -37,19 +38,7 @@ fn check_exists(path: &Path) -> Result<()> {
 pub fn dimensions(path: &Path) -> Result<Extent> {
     check_exists(path)?;
     match extension(path).as_str() {
-        "exr" => {
-            let meta = exrp::MetaData::read_from_file(path, false)
-                .map_err(|e| RenderError::image(path, format!("not a readable EXR file: {e}")))?;
-            let header = meta
-                .headers
-                .first()
-                .ok_or_else(|| RenderError::image(path, "EXR file has no layers"))?;
-            let size = header.layer_size;
-            Ok(Extent::new(
-                u32::try_from(size.width()).unwrap_or(u32::MAX),
-                u32::try_from(size.height()).unwrap_or(u32::MAX),
-            ))
-        }
+        "exr" => exr_extent(path, &Selection::default()),
         "hdr" | "png" | "jpg" | "jpeg" => image::image_dimensions(path)
             .map(|(w, h)| Extent::new(w, h))
             .map_err(|e| RenderError::image(path, format!("not a readable image: {e}"))),
@@ -106,50 +95,51 @@ pub fn load(path: &Path) -> Result<Image> {
     }
 }
 
-/// The most pixels an EXR layer may have (16384 × 16384, the largest image devices hold):
-/// the reader allocates the whole image from the header's size before reading any pixel,
-/// so a corrupt size would otherwise ask for terabytes and abort the process.
-pub const MAX_EXR_PIXELS: u64 = 1 << 28;
+/// The most pixels an EXR part may have (16384 × 16384, the largest image devices hold):
+/// readers allocate a part whole from its header's size, so a corrupt size would otherwise
+/// ask for terabytes and abort the process.
+pub const MAX_EXR_PIXELS: u64 = lumagraph_footage::exr::MAX_PIXELS;
+
+/// The size of an EXR layer's image: its part's display window.
+///
+/// # Errors
+/// What [`lumagraph_footage::exr::inspect`] refuses; a selection that names no layer.
+pub fn exr_extent(path: &Path, selection: &Selection) -> Result<Extent> {
+    let info = footage::inspect(path).map_err(footage_error)?;
+    let layer = selection
+        .find(&info)
+        .map_err(|e| RenderError::image(path, e))?;
+    let window = info.parts[layer.part].display_window;
+    Ok(Extent::new(
+        u32::try_from(window.width()).unwrap_or(u32::MAX),
+        u32::try_from(window.height()).unwrap_or(u32::MAX),
+    ))
+}
+
+/// Reads an EXR layer as `want` into its display window (see
+/// [`lumagraph_footage::exr::read_layer`]).
+///
+/// # Errors
+/// What the reader refuses, with the file named.
+pub fn load_exr_layer(path: &Path, selection: &Selection, want: Want) -> Result<LayerImage> {
+    footage::read_layer(path, selection, want).map_err(footage_error)
+}
+
+fn footage_error(e: footage::Error) -> RenderError {
+    RenderError::image(&e.path, e.message)
+}
 
 fn load_exr(path: &Path) -> Result<Image> {
-    let meta = exrp::MetaData::read_from_file(path, false)
-        .map_err(|e| RenderError::image(path, format!("not a readable RGB(A) EXR file: {e}")))?;
-    for header in &meta.headers {
-        let size = header.layer_size;
-        let pixels = (size.width() as u64).saturating_mul(size.height() as u64);
-        if pixels > MAX_EXR_PIXELS {
-            return Err(RenderError::image(
-                path,
-                format!(
-                    "EXR layer of {}×{} pixels is larger than the {MAX_EXR_PIXELS} pixels \
-                     (16384×16384) this reader takes",
-                    size.width(),
-                    size.height()
-                ),
-            ));
-        }
-    }
-    let read = exrp::read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .rgba_channels(
-            |size, _| {
-                Image::filled(
-                    u32::try_from(size.width()).unwrap_or(0),
-                    u32::try_from(size.height()).unwrap_or(0),
-                    [0.0; 4],
-                )
-            },
-            |img: &mut Image, pos, (r, g, b, a): (f32, f32, f32, f32)| {
-                let i = pos.y() * img.width as usize + pos.x();
-                img.pixels[i] = [r, g, b, a];
-            },
-        )
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .map_err(|e| RenderError::image(path, format!("not a readable RGB(A) EXR file: {e}")))?;
-    Ok(read.layer_data.channel_data.pixels)
+    let layer = load_exr_layer(path, &Selection::default(), Want::Rgba)?;
+    Ok(Image {
+        width: u32::try_from(layer.width()).unwrap_or(0),
+        height: u32::try_from(layer.height()).unwrap_or(0),
+        pixels: layer
+            .pixels
+            .chunks_exact(4)
+            .map(|p| [p[0], p[1], p[2], p[3]])
+            .collect(),
+    })
 }
 
 /// Encodes 8-bit RGBA rows as PNG bytes.

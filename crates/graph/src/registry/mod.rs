@@ -11,7 +11,7 @@ mod combine;
 mod denoise;
 mod effects;
 mod input;
-mod output;
+pub mod output;
 mod render;
 mod transform;
 
@@ -438,6 +438,8 @@ const ANY_IMAGE: &[PortType] = &[
     PortType::Normal,
     PortType::Depth,
     PortType::Variance,
+    PortType::Scalar,
+    PortType::Vector,
 ];
 
 /// The param of a progressive source: how many samples per pixel each frame adds. A pass

@@ -1,10 +1,11 @@
-//! Output nodes: files written out of the graph.
+//! Output nodes: files written out of the graph: `Output` (one image, PNG or EXR) and
+//! `MultiLayerOutput` (several images as the layers of one EXR).
 
 use super::{ANY_IMAGE, Category, InputDef, NodeKind, ParamDef, Reach};
-use crate::types::ParamType;
+use crate::types::{ParamType, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
-    vec![output()]
+    vec![output(), multi_layer_output()]
 }
 
 fn output() -> NodeKind {
@@ -24,6 +25,152 @@ fn output() -> NodeKind {
             },
             doc: "file to write, relative to the output folder (`--out`) and inside it",
         }],
+        sink: true,
+        history: false,
+        renders_scene: false,
+        shader: None,
+        example: Vec::new(),
+        reach: Reach::Pixel,
+    }
+}
+
+/// The EXR compressions `MultiLayerOutput` offers (the footage crate's writer takes these
+/// names).
+pub const EXR_COMPRESSIONS: &[(&str, &str)] = &[
+    (
+        "zip",
+        "lossless, 16 scan lines a block (Blender's and Nuke's default)",
+    ),
+    ("piz", "lossless wavelet, best for noisy renders"),
+    ("zips", "lossless, one scan line a block"),
+    ("rle", "lossless run-length, fast and weak"),
+    (
+        "pxr24",
+        "floats rounded to 24 bits (lossy), halves lossless",
+    ),
+    ("none", "uncompressed"),
+];
+
+const SAMPLE_TYPES: &[(&str, &str)] = &[
+    ("half", "16-bit float: colour, normals, albedo"),
+    (
+        "float",
+        "32-bit float: depth, positions, anything needing more than 11 bits",
+    ),
+];
+
+/// How many layers beside `color` a `MultiLayerOutput` takes.
+pub const EXTRA_LAYERS: usize = 4;
+
+/// The params of extra layer `i` (1-based): its name, its channels, its sample type.
+pub const LAYER_PARAMS: [[&str; 3]; EXTRA_LAYERS] = [
+    ["layer1_name", "layer1_channels", "layer1_type"],
+    ["layer2_name", "layer2_channels", "layer2_type"],
+    ["layer3_name", "layer3_channels", "layer3_type"],
+    ["layer4_name", "layer4_channels", "layer4_type"],
+];
+
+/// The input ports of the extra layers.
+pub const LAYER_INPUTS: [&str; EXTRA_LAYERS] = ["layer1", "layer2", "layer3", "layer4"];
+
+/// The layer name and channels a `MultiLayerOutput` gives an input of type `ty` whose
+/// params leave them empty: Blender's names for its passes, and the channels it writes
+/// them with.
+pub fn default_layer(ty: PortType, index: usize) -> (String, &'static str) {
+    match ty {
+        PortType::Albedo => ("DiffCol".into(), "R G B"),
+        PortType::Normal => ("Normal".into(), "X Y Z"),
+        PortType::Depth => ("Depth".into(), "Z"),
+        PortType::Variance => ("Variance".into(), "R G B"),
+        PortType::Vector => ("Vector".into(), "X Y Z W"),
+        PortType::Scalar => (format!("Layer{index}"), "X"),
+        _ => (format!("Layer{index}"), "R G B A"),
+    }
+}
+
+fn multi_layer_output() -> NodeKind {
+    let mut inputs = vec![InputDef::new(
+        "color",
+        ANY_IMAGE,
+        "the main image: the root layer (`R G B A`), or the layer `color_name` names",
+    )];
+    inputs.extend(LAYER_INPUTS.iter().map(|name| {
+        InputDef::new(
+            name,
+            ANY_IMAGE,
+            "another layer of the file (params `layerN_name`, `_channels`, `_type`)",
+        )
+        .optional()
+    }));
+    let mut params = vec![
+        ParamDef {
+            name: "path",
+            ty: ParamType::Path {
+                default: "out.exr",
+                extensions: &["exr"],
+            },
+            doc: "file to write, relative to the output folder (`--out`) and inside it; \
+                  `####` stands for the frame number",
+        },
+        ParamDef {
+            name: "compression",
+            ty: ParamType::Enum {
+                default: "zip",
+                options: EXR_COMPRESSIONS,
+            },
+            doc: "the file's compression",
+        },
+        ParamDef {
+            name: "color_name",
+            ty: ParamType::Text { default: "" },
+            doc: "the main image's layer name; empty: the root layer (`R G B A`, what every \
+                  reader shows first); e.g. `ViewLayer.Combined` as Blender names it",
+        },
+        ParamDef {
+            name: "color_type",
+            ty: ParamType::Enum {
+                default: "half",
+                options: SAMPLE_TYPES,
+            },
+            doc: "the main image's sample type",
+        },
+    ];
+    for [name, channels, ty] in LAYER_PARAMS {
+        params.push(ParamDef {
+            name,
+            ty: ParamType::Text { default: "" },
+            doc: "the layer's name; empty: Blender's name for what is wired in (`DiffCol` \
+                  for an albedo, `Normal`, `Depth`, `Vector`, else `LayerN`)",
+        });
+        params.push(ParamDef {
+            name: channels,
+            ty: ParamType::Text { default: "" },
+            doc: "its channels, by name, separated by spaces (`u v`, `Z`); empty: `R G B A` \
+                  for colour, `R G B` for an albedo, `X Y Z` for a normal, `Z` for a \
+                  depth, `X Y Z W` for a vector, `X` for a scalar; at most as many as the \
+                  image has",
+        });
+        params.push(ParamDef {
+            name: ty,
+            ty: ParamType::Enum {
+                default: "float",
+                options: SAMPLE_TYPES,
+            },
+            doc: "its sample type",
+        });
+    }
+    NodeKind {
+        name: "MultiLayerOutput",
+        category: Category::Output,
+        doc: "Writes its inputs as the named layers of one EXR file (one part, as Blender's \
+              multi-layer EXR and Nuke's Write node do): `color` as the root layer or \
+              `color_name`, up to four more inputs as layers named by their params or, \
+              left empty, as Blender names its passes. Each layer half or float; the \
+              display window the image's; `chromaticities` Rec. 709. Linear input is \
+              written as it is, display-encoded input too.",
+        inputs,
+        outputs: vec![],
+        params,
         sink: true,
         history: false,
         renders_scene: false,

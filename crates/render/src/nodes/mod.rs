@@ -9,6 +9,7 @@ pub mod difference;
 pub(crate) mod gbuffer;
 mod image_input;
 pub mod lut;
+pub(crate) mod multi_layer_output;
 pub mod output;
 pub(crate) mod pathtrace;
 pub mod post_filter;
@@ -420,6 +421,7 @@ pub fn boxed<N: NodeExec + 'static>(node: Result<N>) -> Result<Box<dyn NodeExec>
 /// [`NodeLibrary::with_builtins`](crate::NodeLibrary::with_builtins) starts from them.
 pub static IMPLEMENTATIONS: &[NodeImpl] = &[
     image_input::IMPL,
+    multi_layer_output::IMPL,
     pathtrace::IMPL,
     accumulate::IMPL,
     temporal::IMPL,

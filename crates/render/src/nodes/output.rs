@@ -3,11 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
-use lumagraph_graph::{Extent, Pass, PortType, TexFormat};
+use lumagraph_graph::{Extent, Pass, PortType, TexFormat, TextureId};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::nodes::{HeldImage, NodeExec, NodeImpl, Recording, Resources, boxed, check_writable};
+use crate::nodes::{
+    FrameIo, HeldImage, NodeExec, NodeImpl, Recording, Resources, boxed, check_writable,
+};
 
 /// The `Output` kind.
 pub(crate) const IMPL: NodeImpl = NodeImpl::new("Output", |ctx, pass, resources| {
@@ -19,12 +21,77 @@ pub(crate) struct Output {
     staged: Option<Staged>,
 }
 
-struct Staged {
+/// A texture copied into a readback buffer in the frame, to be read after it.
+pub(crate) struct Staged {
     buffer: wgpu::Buffer,
     padded_row: u32,
     format: TexFormat,
     ty: PortType,
     extent: Extent,
+}
+
+impl Staged {
+    /// Records the copy of texture `id` into a buffer (`reuse`'s, when it is the size).
+    pub(crate) fn record(
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        io: &FrameIo<'_>,
+        id: TextureId,
+        label: &str,
+        reuse: Option<Self>,
+    ) -> Self {
+        let desc = &io.plan.textures[id.0];
+        let texture = io.texture(id);
+        let bpp = u32::try_from(desc.format.bytes_per_pixel()).unwrap_or(16);
+        let padded_row =
+            (desc.extent.width * bpp).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let size = u64::from(padded_row) * u64::from(desc.extent.height);
+        let buffer = match reuse {
+            Some(s) if s.buffer.size() == size => s.buffer,
+            _ => ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+        };
+        encoder.copy_texture_to_buffer(
+            texture.texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row),
+                    rows_per_image: Some(desc.extent.height),
+                },
+            },
+            texture.texture.size(),
+        );
+        Self {
+            buffer,
+            padded_row,
+            format: desc.format,
+            ty: desc.ty,
+            extent: desc.extent,
+        }
+    }
+
+    /// The copied image, once the frame is done.
+    pub(crate) fn read(&self, ctx: &GpuContext) -> Result<HeldImage> {
+        let row = self.extent.width as usize * self.format.bytes_per_pixel() as usize;
+        let size = self.buffer.size();
+        let bytes = crate::readback::map_read(ctx, &self.buffer, size, |b| {
+            b.chunks_exact(self.padded_row as usize)
+                .flat_map(|r| r[..row].to_vec())
+                .collect::<Vec<u8>>()
+        })?;
+        Ok(HeldImage {
+            bytes,
+            format: self.format,
+            ty: self.ty,
+            extent: self.extent,
+        })
+    }
 }
 
 impl Output {
@@ -52,60 +119,19 @@ impl NodeExec for Output {
         let id = pass
             .input("color")
             .ok_or_else(|| RenderError::Gpu("input \"color\" is not bound".into()))?;
-        let desc = &io.plan.textures[id.0];
-        let texture = io.texture(id);
-        let bpp = u32::try_from(desc.format.bytes_per_pixel()).unwrap_or(16);
-        let padded_row =
-            (desc.extent.width * bpp).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let size = u64::from(padded_row) * u64::from(desc.extent.height);
-        let buffer = match self.staged.take() {
-            Some(s) if s.buffer.size() == size => s.buffer,
-            _ => ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(&pass.node),
-                size,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
-        };
-        encoder.copy_texture_to_buffer(
-            texture.texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded_row),
-                    rows_per_image: Some(desc.extent.height),
-                },
-            },
-            texture.texture.size(),
-        );
-        self.staged = Some(Staged {
-            buffer,
-            padded_row,
-            format: desc.format,
-            ty: desc.ty,
-            extent: desc.extent,
-        });
+        self.staged = Some(Staged::record(
+            ctx,
+            encoder,
+            io,
+            id,
+            &pass.node,
+            self.staged.take(),
+        ));
         Ok(())
     }
 
     fn held_image(&mut self, ctx: &GpuContext) -> Result<Option<HeldImage>> {
-        let Some(s) = &self.staged else {
-            return Ok(None);
-        };
-        let row = s.extent.width as usize * s.format.bytes_per_pixel() as usize;
-        let size = s.buffer.size();
-        let bytes = crate::readback::map_read(ctx, &s.buffer, size, |b| {
-            b.chunks_exact(s.padded_row as usize)
-                .flat_map(|r| r[..row].to_vec())
-                .collect::<Vec<u8>>()
-        })?;
-        Ok(Some(HeldImage {
-            bytes,
-            format: s.format,
-            ty: s.ty,
-            extent: s.extent,
-        }))
+        self.staged.as_ref().map(|s| s.read(ctx)).transpose()
     }
 
     fn finish(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<Vec<PathBuf>> {
