@@ -35,8 +35,13 @@ fn root() -> Option<PathBuf> {
     None
 }
 
+/// The reference: `tests/exr/openexr_reference.json`, or `LUMAGRAPH_OPENEXR_REFERENCE`
+/// (one made by `scripts/exr/reference.py --root` over another folder of images).
 fn reference() -> Value {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/exr/openexr_reference.json");
+    let path = std::env::var_os("LUMAGRAPH_OPENEXR_REFERENCE").map_or_else(
+        || Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/exr/openexr_reference.json"),
+        PathBuf::from,
+    );
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
