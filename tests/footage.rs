@@ -191,3 +191,66 @@ fn info_lists_every_part_and_layer() {
     assert_eq!(v["parts"].as_array().unwrap().len(), 10);
     assert_eq!(v["default_view"], "right");
 }
+
+/// `graphs/pathtrace_layers.ron`: the path tracer's image and its AOVs as the layers of
+/// one EXR, named as Blender names its passes, each of the image's size; the depth is a
+/// distance where the normal is a unit vector, and 0 with it elsewhere.
+#[test]
+fn path_tracer_aovs_go_out_as_named_layers() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let out = tempfile::tempdir().unwrap();
+    let (ok, stdout, stderr) = common::cli(&[
+        "render",
+        "graphs/pathtrace_layers.ron",
+        "--scene",
+        "assets/cornell.ron",
+        "--spp",
+        "2",
+        "--out",
+        out.path().to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    let file = out.path().join("layers.exr");
+    let info = exr::inspect(&file).unwrap();
+    let names: Vec<&str> = info.parts[0]
+        .channels
+        .iter()
+        .map(|c| c.name.as_str())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "A",
+            "B",
+            "Depth.Z",
+            "DiffCol.B",
+            "DiffCol.G",
+            "DiffCol.R",
+            "G",
+            "Normal.X",
+            "Normal.Y",
+            "Normal.Z",
+            "R",
+            "Variance.B",
+            "Variance.G",
+            "Variance.R"
+        ]
+    );
+    let depth = read(&file, "Depth", Want::Scalar);
+    let normal = read(&file, "Normal", Want::Vector);
+    assert_eq!((depth.width(), depth.height()), (256, 256));
+    let mut hits = 0;
+    for (i, d) in depth.pixels.iter().enumerate() {
+        let n = &normal.pixels[i * 4..i * 4 + 3];
+        let len = n.iter().map(|v| v * v).sum::<f32>().sqrt();
+        if *d > 0.0 {
+            hits += 1;
+            assert!((len - 1.0).abs() < 1e-3, "pixel {i}: normal {n:?}");
+        } else {
+            assert!(len == 0.0, "pixel {i}: normal {n:?} where nothing was hit");
+        }
+    }
+    assert!(hits > 256 * 200, "{hits} pixels hit");
+}

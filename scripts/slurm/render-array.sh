@@ -54,21 +54,9 @@ if [ "$tasks" -lt 1 ] || [ $((spp % tasks)) -ne 0 ]; then
     echo "render-array: $spp samples do not split into $tasks equal ranges" >&2
     exit 2
 fi
-command -v sbatch >/dev/null || {
-    echo "render-array: sbatch not found (is Slurm's client installed? scripts/slurm/local-cluster.sh)" >&2
-    exit 1
-}
-if [ -z "${LUMAGRAPH:-}" ]; then
-    LUMAGRAPH="$(command -v lumagraph || true)"
-    [ -n "$LUMAGRAPH" ] || LUMAGRAPH="$(cd "$(dirname "$0")/../.." && pwd)/target/release/lumagraph"
-fi
-# Jobs may start in another folder: name the binary absolutely.
-case "$LUMAGRAPH" in */*) LUMAGRAPH="$(cd "$(dirname "$LUMAGRAPH")" && pwd)/$(basename "$LUMAGRAPH")" ;; esac
-[ -x "$LUMAGRAPH" ] || {
-    echo "render-array: $LUMAGRAPH is not an executable (set LUMAGRAPH)" >&2
-    exit 1
-}
-export LUMAGRAPH
+# shellcheck source=scripts/slurm/lib.sh
+. "$(dirname "$0")/lib.sh"
+slurm_setup render-array
 mkdir -p "$out/logs" "$out/parts"
 script="$(cd "$(dirname "$0")" && pwd)/$(basename "$0")"
 # shellcheck disable=SC2086 # SBATCH_ARGS is a list of options

@@ -9,6 +9,7 @@
 //! `selection` handles selection, copy, paste and the previewed port, `panels` draws the
 //! side panel, scene line and status bar, and `menus` the menu bar.
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -131,6 +132,8 @@ pub struct Editor {
     pub scope: crate::scope::ScopeView,
     /// The preview's image viewer: zoom, readout, exposure, A/B compare.
     pub view: crate::viewer::ImageView,
+    /// The frame the preview shows of an image sequence (view state: never saved).
+    pub sequence: crate::sequence::Sequence,
     /// Selected node ids.
     pub selected: Vec<String>,
     /// The frame selected (its title clicked), shown in the inspector while no node is.
@@ -200,6 +203,7 @@ impl Editor {
             preview: Preview::with_library(gpu, Arc::clone(&config.library)),
             scope: crate::scope::ScopeView::default(),
             view: crate::viewer::ImageView::new(),
+            sequence: crate::sequence::Sequence::default(),
             selected: Vec::new(),
             selected_frame: None,
             snap: false,
@@ -243,9 +247,32 @@ impl Editor {
         self.message_time = f64::NAN; // stamped with egui's clock on the next frame
     }
 
+    /// Finds the params with a frame pattern and the frames on disk (see
+    /// [`crate::sequence`]) in the graph the preview runs; says when no frame is found.
+    fn refresh_sequence(&mut self) {
+        let said = match self.group_context() {
+            Some(Ok(c)) => self.sequence.refresh(&c.graph, &c.registry, &c.base),
+            Some(Err(_)) => None,
+            None => {
+                let base = self.doc.base_dir();
+                self.sequence
+                    .refresh(&self.doc.graph, self.doc.registry(), &base)
+            }
+        };
+        if let Some(message) = said {
+            self.say(message, true);
+        }
+    }
+
+    /// `graph` (the document's or, in a group, the graph around it) at the sequence's
+    /// current frame ([`crate::sequence`]).
+    pub fn at_frame<'g>(&self, graph: &'g Graph) -> Cow<'g, Graph> {
+        self.sequence.at(graph)
+    }
+
     /// Recompiles the full graph (with its sinks) for error marks when it changed.
     fn refresh_errors(&mut self) {
-        let mut key = self.doc.graph.clone();
+        let mut key = self.at_frame(&self.doc.graph).into_owned();
         key.origin = None;
         for n in &mut key.nodes {
             n.pos = None;
@@ -273,7 +300,7 @@ impl Editor {
         let context = self.group_context();
         let result = match &context {
             Some(Ok(c)) => library
-                .compile_with(&c.graph, &c.registry, &c.base, &[], scene)
+                .compile_with(&self.at_frame(&c.graph), &c.registry, &c.base, &[], scene)
                 .map(|_| ()),
             Some(Err(e)) => {
                 self.graph_errors.push(e.clone());
@@ -392,6 +419,10 @@ impl Editor {
         self.poll_files(now);
         let dragging = ui.input(|i| i.pointer.any_down());
         self.apply_scene_edits(dragging);
+        self.refresh_sequence();
+        if self.sequence.play(ui.ctx().cumulative_frame_nr()) {
+            ui.ctx().request_repaint();
+        }
         self.refresh_errors();
         let port = self.effective_port();
         let scene = self.scene.as_ref().map(|s| &s.preview);
@@ -399,9 +430,10 @@ impl Editor {
         let ran = match self.group_context() {
             Some(Ok(c)) => {
                 let inner = port.as_deref().map(|p| format!("{}{p}", c.prefix));
+                let graph = self.sequence.at(&c.graph);
                 let ran =
                     self.preview
-                        .update(&c.registry, &c.graph, &c.base, inner.as_deref(), scene);
+                        .update(&c.registry, &graph, &c.base, inner.as_deref(), scene);
                 if let Some(p) = inner.as_deref()
                     && !ran
                     && self.preview.wants_frames()
@@ -410,13 +442,12 @@ impl Editor {
                 }
                 true
             }
-            _ => self.preview.update(
-                self.doc.registry(),
-                &self.doc.graph,
-                &self.doc.base_dir(),
-                port.as_deref(),
-                scene,
-            ),
+            _ => {
+                let base = self.doc.base_dir();
+                let graph = self.sequence.at(&self.doc.graph);
+                self.preview
+                    .update(self.doc.registry(), &graph, &base, port.as_deref(), scene)
+            }
         };
         if let Some(p) = port.as_deref()
             && !ran

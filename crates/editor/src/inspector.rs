@@ -1,9 +1,9 @@
 //! The inspector: one widget per param of the selected node, chosen by the param's type
 //! in the registry: sliders over the declared range (logarithmic for wide positive
 //! ranges), combo boxes for enums, checkboxes for bools, and a path field that checks the
-//! extension (and, for inputs, that the file exists), a `…` button opening the file
-//! dialog, and a `▾` menu listing the matching files near the graph. Every param's doc is
-//! its tooltip.
+//! extension (and, for inputs, that the file exists: for a path with a frame pattern, a
+//! file of the sequence), a `…` button opening the file dialog, and a `▾` menu listing the
+//! matching files near the graph. Every param's doc is its tooltip.
 
 use std::path::Path;
 
@@ -230,10 +230,41 @@ pub fn check_path(
     if !extensions.contains(&ext.as_str()) {
         return Some(format!("use one of: .{}", extensions.join(" .")));
     }
-    if must_exist && !base.join(value).is_file() {
-        return Some(format!("no file {}", base.join(value).display()));
+    let path = base.join(value);
+    if must_exist && lumagraph_footage::sequence::has_pattern(value) {
+        // An image sequence: some frame's file must be there.
+        if !any_frame(&path) {
+            return Some(format!(
+                "no file matches {} (the pattern with a frame's digits in its place)",
+                path.display()
+            ));
+        }
+    } else if must_exist && !path.is_file() {
+        return Some(format!("no file {}", path.display()));
     }
     None
+}
+
+/// Whether a file of the sequence `pattern` (a path whose file name holds a frame pattern)
+/// exists; stops at the first one.
+fn any_frame(pattern: &Path) -> bool {
+    let name = pattern
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let dir = match pattern.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    std::fs::read_dir(dir).is_ok_and(|entries| {
+        entries.flatten().any(|e| {
+            e.file_name()
+                .to_str()
+                .and_then(|n| lumagraph_footage::sequence::frame_of(&name, n))
+                .is_some()
+                && e.path().is_file()
+        })
+    })
 }
 
 fn path_widget(

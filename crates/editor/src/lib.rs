@@ -7,7 +7,8 @@
 //! - [`inspector`]: a widget per param, chosen by the param's type.
 //! - [`preview`]: the selected output rendered on the editor's own wgpu device through
 //!   the render crate's `Executor`; param edits update nodes in place; what its nodes
-//!   measure; [`scope`]: histogram and waveform of the previewed image.
+//!   measure; [`scope`]: histogram and waveform of the previewed image; [`sequence`]:
+//!   the frame control of an image sequence (frame patterns in params).
 //! - [`files`]: open, save (atomic), save as, recent files.
 //! - [`app`]: the window tying them together.
 //!
@@ -25,6 +26,7 @@ pub mod preview;
 pub mod render_job;
 pub mod scene_doc;
 pub mod scope;
+pub mod sequence;
 pub mod undo;
 pub mod viewer;
 

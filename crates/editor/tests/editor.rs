@@ -609,7 +609,8 @@ fn a_file_picked_in_the_dialog_sets_the_path_param() {
         .set_param("input", "path", ParamValue::Str(first.clone()));
     ed.doc.end_gesture();
     ed.select(vec!["input".into()]);
-    let mut h = harness(ed);
+    // Tall enough that the inspector's path row is on screen under ImageInput's doc.
+    let mut h = common::harness_sized(ed, egui::vec2(1100.0, 900.0));
     h.get_by_role_and_label(Role::Button, "…").click();
     h.run_ok();
     let pick = h.state().file_dialog.as_ref().map(|(p, _)| p.clone());
@@ -1860,4 +1861,156 @@ fn the_viewer_window_reads_out_the_cpu_value() {
     h.state_mut().viewer_window = false;
     h.run_ok();
     assert!(h.query_by_label("lumagraph viewer").is_none());
+}
+
+/// An image sequence loaded by pattern plays through a chain with its frame slider:
+/// three 8×6 EXR frames of different constant colours, `ImageInput(path: "seq.####.exr")
+/// → Exposure (+1 EV) → Output`. The frame control finds frames 1–3 on disk; the slider
+/// and the ◀ ▶ steps show each frame's colour (doubled) through the chain, each change a
+/// param update of the one executor re-running `input` and `exposure`; ▶ play advances a
+/// frame per repaint and wraps from 3 to 1. No frame change enters the graph or its undo
+/// history: saving writes the pattern. A pattern with no file says so.
+#[test]
+#[expect(clippy::too_many_lines, reason = "one user's sequence of steps")]
+fn a_sequence_plays_through_a_chain_with_its_frame_slider() {
+    let Some(ed) = editor(None, None) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let colours = [
+        [0.25, 0.5, 1.0, 1.0],
+        [1.0, 0.125, 0.0, 1.0],
+        [0.0, 0.75, 0.375, 1.0],
+    ];
+    for (i, c) in colours.iter().enumerate() {
+        let image = lumagraph_render::cpu::Image::filled(8, 6, *c);
+        let file = dir.path().join(format!("seq.{:04}.exr", i + 1));
+        lumagraph_render::image_io::save(&file, &image, true).unwrap();
+    }
+    // Not frames of `seq.####.exr`: another padding, another name.
+    std::fs::write(dir.path().join("seq.12.exr"), b"").unwrap();
+    std::fs::write(dir.path().join("other.0004.exr"), b"").unwrap();
+    let path = dir.path().join("seq.ron");
+    std::fs::write(
+        &path,
+        r#"(version: 1, nodes: [
+            (id: "input", kind: "ImageInput", params: {"path": "seq.####.exr"}),
+            (id: "exposure", kind: "Exposure", params: {"ev": 1.0}),
+            (id: "out", kind: "Output", params: {"path": "out.####.exr"}),
+        ], edges: [
+            (from: "input.color", to: "exposure.color"),
+            (from: "exposure.color", to: "out.color"),
+        ])"#,
+    )
+    .unwrap();
+    let mut h = harness(ed);
+    h.state_mut().open(&path);
+    h.run_ok();
+    // The previewed image (exposure.color) is frame `frame`'s colour, twice as bright.
+    let shows = |h: &egui_kittest::Harness<'static, lumagraph_editor::Editor>, frame: i64| {
+        let ed = h.state();
+        assert_eq!(ed.sequence.frame, frame);
+        assert!(ed.preview.error.is_none(), "{:?}", ed.preview.error);
+        let (image, _) = ed.preview.linear.as_ref().expect("a preview");
+        assert_eq!((image.width, image.height), (8, 6));
+        let want = colours[usize::try_from(frame - 1).unwrap()];
+        for p in &image.pixels {
+            for c in 0..3 {
+                assert!(
+                    (p[c] - 2.0 * want[c]).abs() < 1e-6,
+                    "frame {frame}: {p:?} against 2 × {want:?}"
+                );
+            }
+        }
+    };
+    {
+        let ed = h.state();
+        assert!(ed.errors.is_empty(), "{:?}", ed.errors);
+        assert!(ed.sequence.is_active(), "{:?}", ed.message);
+        assert_eq!(ed.sequence.frames, [1, 2, 3]);
+        assert_eq!(ed.effective_port().as_deref(), Some("exposure.color"));
+        assert_eq!(ed.preview.stats.rebuilds, 1);
+    }
+    h.get_by_label("3 frames, 1–3");
+    shows(&h, 1);
+    // The inspector takes the pattern as a path to an existing sequence.
+    let check = |p: &str| lumagraph_editor::inspector::check_path(p, &["exr"], dir.path(), true);
+    assert_eq!(check("seq.####.exr"), None);
+    assert_eq!(check("seq.%04d.exr"), None);
+    assert!(check("seq.###.exr").unwrap().contains("no file matches"));
+
+    // ▶ steps to frame 2: a param update through the chain, not a rebuild.
+    let updates = h.state().preview.stats.param_updates;
+    h.get_by_label("▶").click();
+    h.run_ok();
+    shows(&h, 2);
+    let s = &h.state().preview.stats;
+    assert_eq!(s.rebuilds, 1);
+    assert_eq!(s.param_updates, updates + 1);
+    assert_eq!(s.last_update, ["input", "exposure"]);
+
+    // The slider's right end is the last frame; ▶ from there wraps, ◀ goes back.
+    let rect = h.get_by_role_and_label(Role::Slider, "frame").rect();
+    click_at(&mut h, egui::pos2(rect.right() - 2.0, rect.center().y));
+    shows(&h, 3);
+    h.get_by_label("▶").click();
+    h.run_ok();
+    shows(&h, 1);
+    h.get_by_label("◀").click();
+    h.run_ok();
+    shows(&h, 3);
+    let rect = h.get_by_role_and_label(Role::Slider, "frame").rect();
+    click_at(&mut h, egui::pos2(rect.left() + 2.0, rect.center().y));
+    shows(&h, 1);
+
+    // ▶ play: a frame more at each repaint, 3 wrapping to 1.
+    h.get_by_label("▶ play").click();
+    h.step();
+    assert!(h.state().sequence.playing);
+    let mut seen = vec![h.state().sequence.frame];
+    for _ in 0..4 {
+        h.step();
+        let frame = h.state().sequence.frame;
+        shows(&h, frame);
+        seen.push(frame);
+    }
+    for pair in seen.windows(2) {
+        assert_eq!(pair[1], pair[0] % 3 + 1, "frames played: {seen:?}");
+    }
+    eprintln!("played: {seen:?}");
+    h.get_by_label("⏸ pause").click();
+    h.run_ok();
+    let stopped = h.state().sequence.frame;
+    assert!(!h.state().sequence.playing);
+    h.run_ok();
+    assert_eq!(h.state().sequence.frame, stopped);
+    h.get_by_label("▶ play");
+    assert_eq!(h.state().preview.stats.rebuilds, 1);
+
+    // Frames are view state: the graph is as opened, with nothing to undo; saving keeps
+    // the patterns.
+    let ed = h.state_mut();
+    assert!(!ed.doc.is_dirty());
+    assert_eq!(ed.doc.can_undo_redo(), (false, false));
+    ed.save().unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("\"seq.####.exr\""), "{text}");
+    assert!(text.contains("\"out.####.exr\""), "{text}");
+    assert!(!text.contains(".000"), "{text}");
+    assert_eq!(
+        Graph::load(&path).unwrap().node("input").unwrap().params["path"],
+        ParamValue::Str("seq.####.exr".into())
+    );
+
+    // A pattern no file matches: the status line says so.
+    h.state_mut()
+        .doc
+        .set_param("input", "path", ParamValue::Str("none.####.exr".into()));
+    h.run_ok();
+    let ed = h.state();
+    assert!(ed.sequence.frames.is_empty());
+    let (message, error) = ed.message.clone().expect("a status message");
+    assert!(error && message.contains("no frames found"), "{message}");
+    assert!(message.contains("none.####.exr"), "{message}");
+    h.get_by_label("no frames found");
 }

@@ -12,6 +12,9 @@
 //! **Ranges** (`lumagraph render --frames`): `7`; `1-100` (both ends in); `1-100x2`
 //! (every second frame: 1, 3, …, 99); `10-1` (backwards); several joined by commas
 //! (`1-10,20,30-40x5`). Frames are rendered in the order written, each once.
+//!
+//! **On disk**: [`frames_on_disk`] lists the frames whose files exist for a pattern path
+//! (the editor's frame range), reading each name back with [`frame_of`].
 
 /// One frame-number pattern found in a text: where it is and how wide it pads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -149,6 +152,70 @@ fn split_range(range: &str) -> Option<(i64, i64)> {
     Some((first, last))
 }
 
+/// The frame `text` is of `template`: the number that [`substitute`] puts into
+/// `template` to give `text` exactly (every pattern the same frame, padded as it asks:
+/// `f.####.exr` takes `f.0007.exr` as 7 and `f.12345.exr` as 12345, but neither `f.7.exr`
+/// nor `f.00007.exr`); `None` when no frame does, or `template` holds no pattern.
+pub fn frame_of(template: &str, text: &str) -> Option<i64> {
+    let first = find(template, 0)?;
+    let rest = text.strip_prefix(template.get(..first.start)?)?;
+    let sign = usize::from(rest.starts_with('-'));
+    let digits = rest
+        .get(sign..)?
+        .bytes()
+        .take_while(u8::is_ascii_digit)
+        .count();
+    // The longest run of digits first; a shorter one where the pattern is followed by
+    // digits of the name (`####1.exr`).
+    (1..=digits).rev().find_map(|n| {
+        let frame: i64 = rest.get(..sign + n)?.parse().ok()?;
+        (substitute(template, frame) == text).then_some(frame)
+    })
+}
+
+/// The frames whose files exist for `path`, a path whose file name holds a frame
+/// pattern: the files of its folder named as the pattern with a frame's number in its
+/// place (as [`frame_of`] reads them), sorted, each once. An empty folder is the current
+/// one; a file name without a pattern gives no frames.
+///
+/// # Errors
+/// When the folder cannot be read, or when a folder's name holds the pattern (only the
+/// file's name is searched).
+pub fn frames_on_disk(path: &std::path::Path) -> std::io::Result<Vec<i64>> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let dir = path.parent().unwrap_or_else(|| std::path::Path::new(""));
+    if has_pattern(&dir.to_string_lossy()) {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "{}: the frame pattern is in a folder's name; only file names are searched",
+                path.display()
+            ),
+        ));
+    }
+    let dir = if dir.as_os_str().is_empty() {
+        std::path::Path::new(".")
+    } else {
+        dir
+    };
+    let mut frames = Vec::new();
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        let frame = entry.file_name().to_str().and_then(|n| frame_of(&name, n));
+        if let Some(frame) = frame
+            && entry.path().is_file()
+        {
+            frames.push(frame);
+        }
+    }
+    frames.sort_unstable();
+    frames.dedup();
+    Ok(frames)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -201,5 +268,51 @@ mod tests {
             assert!(!e.is_empty(), "{bad}");
         }
         assert!(parse_frames("1-2000000").unwrap_err().contains("more than"));
+    }
+
+    #[test]
+    fn a_name_gives_back_the_frame_that_makes_it() {
+        assert_eq!(frame_of("f.####.exr", "f.0007.exr"), Some(7));
+        assert_eq!(frame_of("f.####.exr", "f.12345.exr"), Some(12345));
+        assert_eq!(frame_of("f.####.exr", "f.-0007.exr"), Some(-7));
+        assert_eq!(frame_of("f.%04d.exr", "f.0042.exr"), Some(42));
+        assert_eq!(frame_of("f.$F.exr", "f.9.exr"), Some(9));
+        assert_eq!(frame_of("a.##/b.####.exr", "a.03/b.0003.exr"), Some(3));
+        assert_eq!(frame_of("f.####1.exr", "f.00071.exr"), Some(7));
+        for wrong in [
+            "f.7.exr",
+            "f.00007.exr",
+            "g.0007.exr",
+            "f.0007.png",
+            "f..exr",
+        ] {
+            assert_eq!(frame_of("f.####.exr", wrong), None, "{wrong}");
+        }
+        assert_eq!(frame_of("a.##/b.####.exr", "a.03/b.0004.exr"), None);
+        assert_eq!(frame_of("plain.exr", "plain.exr"), None);
+    }
+
+    #[test]
+    fn the_frames_on_disk_are_the_files_that_match() {
+        let dir = std::env::temp_dir().join(format!("lumagraph-seq-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("s.0005.exr")).unwrap(); // a folder: not a frame
+        for name in [
+            "s.0003.exr",
+            "s.0001.exr",
+            "s.0010.exr",
+            "s.1.exr",
+            "t.0002.exr",
+        ] {
+            std::fs::write(dir.join(name), b"").unwrap();
+        }
+        assert_eq!(
+            frames_on_disk(&dir.join("s.####.exr")).unwrap(),
+            vec![1, 3, 10]
+        );
+        assert_eq!(frames_on_disk(&dir.join("s.#.exr")).unwrap(), vec![1]);
+        assert!(frames_on_disk(&dir.join("u.####.exr")).unwrap().is_empty());
+        assert!(frames_on_disk(&dir.join("x.##/s.####.exr")).is_err());
+        assert!(frames_on_disk(&dir.join("missing/s.####.exr")).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

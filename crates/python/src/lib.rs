@@ -417,27 +417,71 @@ struct Session {
     inner: lumagraph::session::Session,
 }
 
+impl Session {
+    /// Each `Output` node's image (what its input port holds), by the node's id.
+    fn output_images<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let out = PyDict::new(py);
+        for (node, port) in self.inner.outputs() {
+            let img = self.inner.read(&port).map_err(|e| error(&e))?;
+            out.set_item(node, array(py, &img)?)?;
+        }
+        Ok(out)
+    }
+}
+
+/// The iterator `Session.render_frames` gives: `(frame, images)` a frame.
+#[pyclass(unsendable, module = "lumagraph")]
+struct FrameIter {
+    session: Py<Session>,
+    frames: Vec<i64>,
+    next: usize,
+}
+
+#[pymethods]
+impl FrameIter {
+    fn __iter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    fn __next__<'py>(&mut self, py: Python<'py>) -> PyResult<Option<(i64, Bound<'py, PyDict>)>> {
+        let Some(&frame) = self.frames.get(self.next) else {
+            return Ok(None);
+        };
+        self.next += 1;
+        let mut session = self.session.borrow_mut(py);
+        let images = session.set_frame(py, frame)?;
+        Ok(Some((frame, images)))
+    }
+
+    fn __len__(&self) -> usize {
+        self.frames.len() - self.next
+    }
+}
+
 #[pymethods]
 impl Session {
-    /// `Session(graph, scene=None, out="out", write_outputs=False, keep=[])`
+    /// `Session(graph, scene=None, out="out", write_outputs=False, keep=[], frame=None)`
     ///
     /// Loads the graph (a file, or a `Graph`) and the scene (a file, or a `Scene`) and
     /// sets them up on the default adapter.
     /// `Output` nodes write their files under `out` only with `write_outputs`; `keep` names
-    /// more ports ("node.port") to read back with `read`.
+    /// more ports ("node.port") to read back with `read`. A graph whose params hold a
+    /// frame pattern (`####`, `%04d`, `$F4`) opens at `frame` (see `render_frames`).
     #[new]
-    #[pyo3(signature = (graph, scene=None, out="out", write_outputs=false, keep=Vec::new()))]
+    #[pyo3(signature = (graph, scene=None, out="out", write_outputs=false, keep=Vec::new(), frame=None))]
     fn new(
         graph: &Bound<'_, PyAny>,
         scene: Option<&Bound<'_, PyAny>>,
         out: &str,
         write_outputs: bool,
         keep: Vec<String>,
+        frame: Option<i64>,
     ) -> PyResult<Self> {
         let options = SessionOptions {
             out: PathBuf::from(out),
             write_outputs,
             keep,
+            frame,
             ..SessionOptions::default()
         };
         let graph = graph_arg(graph)?;
@@ -549,12 +593,42 @@ impl Session {
         if done.is_none() {
             return Err(LumagraphError::new_err("the render stopped"));
         }
-        let out = PyDict::new(py);
-        for (node, port) in self.inner.outputs() {
-            let img = self.inner.read(&port).map_err(|e| error(&e))?;
-            out.set_item(node, array(py, &img)?)?;
-        }
-        Ok(out)
+        self.output_images(py)
+    }
+
+    /// The frame a graph with frame patterns is at (`None` for other graphs).
+    #[getter]
+    fn frame(&self) -> Option<i64> {
+        self.inner.frame()
+    }
+
+    /// Moves a graph with frame patterns to `frame` and runs it: each param with a
+    /// pattern takes the frame's number, only what changed reloads, nodes with history see
+    /// the frame before. Returns each `Output` node's image, by the node's id.
+    fn set_frame<'py>(&mut self, py: Python<'py>, frame: i64) -> PyResult<Bound<'py, PyDict>> {
+        self.inner.set_frame(frame).map_err(|e| error(&e))?;
+        self.output_images(py)
+    }
+
+    /// `render_frames(frames)`: an iterator over `(frame, images)` for each frame of
+    /// `frames` (`"1-100x2"` as `lumagraph render --frames` takes it, or a list of
+    /// numbers), `images` each `Output` node's image by the node's id, as `set_frame`
+    /// gives them. A missing input frame raises `LumagraphError` naming it.
+    fn render_frames(slf: Py<Self>, frames: &Bound<'_, PyAny>) -> PyResult<FrameIter> {
+        let frames: Vec<i64> = match frames.extract::<String>() {
+            Ok(spec) => lumagraph::footage::sequence::parse_frames(&spec)
+                .map_err(LumagraphError::new_err)?,
+            Err(_) => frames.extract().map_err(|_| {
+                LumagraphError::new_err(
+                    "frames: a range such as \"1-100x2\", or a list of frame numbers",
+                )
+            })?,
+        };
+        Ok(FrameIter {
+            session: slf,
+            frames,
+            next: 0,
+        })
     }
 
     /// The image on output port "node.port" as the last frame left it.
@@ -753,6 +827,7 @@ fn lumagraph_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Graph>()?;
     m.add_function(wrap_pyfunction!(nodes, m)?)?;
     m.add_class::<Session>()?;
+    m.add_class::<FrameIter>()?;
     m.add_class::<Scene>()?;
     m.add_class::<PyImage>()?;
     m.add_function(wrap_pyfunction!(converge, m)?)?;

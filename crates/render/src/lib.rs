@@ -25,6 +25,7 @@ pub mod embree;
 pub mod env_map;
 mod error;
 mod executor;
+pub mod frames;
 mod host_rays;
 pub mod image_io;
 pub mod kernel;

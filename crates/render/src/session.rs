@@ -21,6 +21,7 @@ use std::sync::Arc;
 use anyhow::{Context as _, Result};
 
 use crate::cpu::Image;
+use crate::frames::FrameParams;
 use crate::{Checkpoint, Executor, FrameReport, GpuContext, NodeLibrary, Resources};
 use lumagraph_graph::Graph;
 use lumagraph_scene::GpuScene;
@@ -40,6 +41,11 @@ pub struct SessionOptions {
     pub keep: Vec<String>,
     /// The node kinds: the built-in ones unless given.
     pub library: Option<Arc<NodeLibrary>>,
+    /// For a graph whose params hold a frame pattern (`####`: [`crate::frames`]), the
+    /// frame to open at; such a graph cannot be opened without one.
+    pub frame: Option<i64>,
+    /// Let `Output` paths be absolute or climb out of `out` (by default they are refused).
+    pub outputs_anywhere: bool,
 }
 
 impl Default for SessionOptions {
@@ -49,8 +55,18 @@ impl Default for SessionOptions {
             write_outputs: false,
             keep: Vec::new(),
             library: None,
+            frame: None,
+            outputs_anywhere: false,
         }
     }
+}
+
+/// A session's sequence: the graph as written (patterns and all), its frame-numbered
+/// params, and the frame it is at.
+struct Sequence {
+    template: Graph,
+    params: FrameParams,
+    frame: i64,
 }
 
 /// A graph and its scene on a device, rendered progressively.
@@ -73,6 +89,8 @@ pub struct Session {
     last: Option<FrameReport>,
     /// What loading the scene warned of.
     warnings: Vec<String>,
+    /// Where the graph holds frame patterns: the sequence and the frame it is at.
+    sequence: Option<Sequence>,
 }
 
 impl Session {
@@ -130,17 +148,40 @@ impl Session {
         let library = options
             .library
             .unwrap_or_else(|| Arc::new(NodeLibrary::with_builtins()));
+        let params = FrameParams::of(&graph, &library.registry_for(&graph)?);
+        let (graph, sequence) = if params.is_empty() {
+            (graph, None)
+        } else {
+            let frame = options.frame.with_context(|| {
+                format!(
+                    "the graph's params hold frame patterns ({}): open it at a frame",
+                    params.describe()
+                )
+            })?;
+            if let Some(missing) = params.missing_at(&graph, frame) {
+                anyhow::bail!("frame {frame}: {} is missing", missing.display());
+            }
+            let at = params.at(&graph, frame);
+            let sequence = Sequence {
+                template: graph,
+                params,
+                frame,
+            };
+            (at, Some(sequence))
+        };
         let plan = library.compile(&graph, &options.keep, scene.as_deref())?;
         let ctx = GpuContext::headless()?;
         let resources = Resources {
             base_dir: graph.base_dir(),
             out_dir: options.out,
+            outputs_anywhere: options.outputs_anywhere,
             scene: scene.clone(),
             ..Resources::default()
         };
         let mut exec = Executor::with_library(&ctx, plan, &resources, &library)?;
         exec.hold_sinks(!options.write_outputs);
         let mut session = Self::from_executor(exec, graph, scene, resources, library);
+        session.sequence = sequence;
         session.keep = options.keep;
         session.write_outputs = options.write_outputs;
         session.warm_up()?;
@@ -171,6 +212,7 @@ impl Session {
             warm: false,
             last: None,
             warnings: Vec::new(),
+            sequence: None,
         }
     }
 
@@ -320,6 +362,11 @@ impl Session {
         let plan = self
             .library
             .compile(&graph, &self.keep, self.scene.as_deref())?;
+        if let Some(seq) = &mut self.sequence {
+            // Later frames keep the edit (a pattern given here is taken as written).
+            seq.template.apply_override(&format!("{target}={value}"))?;
+            seq.params = FrameParams::of(&seq.template, &self.library.registry_for(&seq.template)?);
+        }
         self.graph = graph;
         if self.exec.update_params(plan.clone())? {
             let report = self.exec.rerun(&[node])?;
@@ -483,7 +530,47 @@ impl Session {
         out
     }
 
-    /// The graph as it stands (with the params set since it was opened).
+    /// The frame a graph with frame patterns is at (`None` for other graphs).
+    pub fn frame(&self) -> Option<i64> {
+        self.sequence.as_ref().map(|s| s.frame)
+    }
+
+    /// Moves a graph with frame patterns to frame `frame` and runs it once: each param
+    /// with a pattern takes the frame's number, only the nodes whose params changed
+    /// reload (an `ImageInput` its file) and the graph runs one frame, over the history
+    /// of nodes that keep one (so `TemporalReuse` and `AutoExposure` see the frame
+    /// before); where the frame's images are of another size, the graph is built again
+    /// and history starts over. `Output` nodes write their files where the options say so.
+    ///
+    /// # Errors
+    /// A graph without frame patterns; a frame whose input file is missing (named); a
+    /// node that fails.
+    pub fn set_frame(&mut self, frame: i64) -> Result<FrameReport> {
+        let seq = self
+            .sequence
+            .as_mut()
+            .context("the graph has no param with a frame pattern (`####`, `%04d`, `$F4`)")?;
+        if let Some(missing) = seq.params.missing_at(&seq.template, frame) {
+            anyhow::bail!("frame {frame}: {} is missing", missing.display());
+        }
+        let graph = seq.params.at(&seq.template, frame);
+        let plan = self
+            .library
+            .compile(&graph, &self.keep, self.scene.as_deref())
+            .with_context(|| format!("frame {frame}"))?;
+        seq.frame = frame;
+        self.graph = graph;
+        let report = if self.exec.update_params(plan.clone())? {
+            self.exec.run_frame()?
+        } else {
+            self.rebuild(plan)?;
+            self.exec.run_frame()?
+        };
+        self.last = Some(report.clone());
+        Ok(report)
+    }
+
+    /// The graph as it stands (with the params set since it was opened; at its frame).
     pub fn graph(&self) -> &Graph {
         &self.graph
     }

@@ -73,6 +73,9 @@ impl Editor {
             }
         });
         self.scene_line(ui);
+        if self.sequence.is_active() {
+            self.sequence.ui(ui);
+        }
         match port {
             Some(p) => ui.weak(p),
             None => ui.weak("nothing to preview"),

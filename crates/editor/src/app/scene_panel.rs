@@ -291,6 +291,8 @@ impl Editor {
                 String::new(),
             ),
         };
+        // An image sequence renders the frame the preview shows.
+        let graph = self.at_frame(&graph).into_owned();
         let resolve = |p: &str| -> PathBuf {
             let p = Path::new(p);
             if p.is_absolute() {

@@ -97,14 +97,11 @@ impl Layer {
 
     /// How it is shown in lists: its part's name and its own.
     pub fn label(&self, part: &Part) -> String {
-        let name = if self.name.is_empty() {
-            "(root)"
-        } else {
-            &self.name
-        };
-        match &part.name {
-            Some(p) => format!("{p}: {name}"),
-            None => name.to_owned(),
+        match (&part.name, self.name.is_empty()) {
+            (Some(p), true) => format!("{p:?}"),
+            (Some(p), false) => format!("{p:?}: {}", self.name),
+            (None, true) => "(root)".to_owned(),
+            (None, false) => self.name.clone(),
         }
     }
 }

@@ -19,8 +19,9 @@ fn image_input() -> NodeKind {
               reconstructed, and any part or layer can be chosen (`lumagraph info FILE` lists \
               them): a colour layer comes out on `color`, a one-channel layer (a depth, a \
               matte, a luminance) on `scalar`, a two- to four-channel one (motion, normals) \
-              on `vector`. The path may hold a frame number pattern (`####`, `%04d`, `$F4`) \
-              for `lumagraph render --frames`.",
+              on `vector`. The path may hold a frame number pattern (`####`, `%04d`, `$F4`): \
+              a sequence, run by `lumagraph render --frames`, the editor's frame control \
+              and Python's `render_frames`.",
         inputs: vec![],
         outputs: vec![
             OutputDef::new(
