@@ -12,6 +12,7 @@
 //! ```
 
 mod bench;
+mod color;
 mod converge;
 mod frames;
 mod gallery;
@@ -173,6 +174,17 @@ enum Command {
         /// Also list the node kinds this graph file declares.
         #[arg(long)]
         graph: Option<PathBuf>,
+    },
+    /// List what an OpenColorIO config offers the colour nodes: colour
+    /// spaces, displays and views, looks, the working space's name.
+    #[command(
+        after_help = "Examples:\n  lumagraph color\n  lumagraph color --config ocio://studio-config-latest\n  lumagraph color --config show/config.ocio"
+    )]
+    Color {
+        /// The config, as the nodes' `config` param takes it (empty: $OCIO, else
+        /// OpenColorIO's CG config with ACES 2.0).
+        #[arg(long, default_value = "")]
+        config: String,
     },
     /// Describe an image file: an EXR's parts, views, layers (and the port each is read
     /// onto), channels, windows, colour primaries and attributes.
@@ -790,6 +802,7 @@ fn export(scene: &Path, out: &Path) -> Result<()> {
     Ok(())
 }
 
+#[expect(clippy::too_many_lines, reason = "one arm per subcommand, each a call")]
 fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
     match cli.command {
         Command::Render {
@@ -909,6 +922,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
         }),
         Command::Export { scene, out } => export(&scene, &out),
         Command::Info { file, json } => info::info(&file, json),
+        Command::Color { config } => color::color(&config),
         Command::TestChart { out } => test_chart(&out),
     }
 }

@@ -3,6 +3,7 @@
 //! This facade re-exports the workspace crates so a program can depend on one crate:
 //! - [`graph`]: node kinds, graph files, validation and compilation (no GPU);
 //! - [`scene`]: scene files, glTF/OBJ import, BVH and the GPU layout (no GPU);
+//! - [`color`]: OpenColorIO colour management (configs, processors, their WGSL);
 //! - [`footage`]: EXR files as compositors read them (parts, layers, windows, colour),
 //!   and frame sequences (no GPU);
 //! - [`render`]: the wgpu executor, node implementations and image files;
@@ -21,6 +22,7 @@
 pub mod cli;
 pub mod converge;
 
+pub use lumagraph_color as color;
 pub use lumagraph_editor as editor;
 pub use lumagraph_footage as footage;
 pub use lumagraph_graph as graph;

@@ -246,3 +246,76 @@ fn an_edited_scene_renders_as_the_file_with_those_values() {
     s.render(8).unwrap();
     assert_eq!(s.spp(), 8);
 }
+
+/// A sequence keeps the history of nodes that have one from frame to frame: over three
+/// constant frames of luminance 0.18, 0.72, 0.72, `AutoExposure` (adaptation 0.25) takes
+/// frame 1's target t1 at once, then moves a quarter of the way to frame 2's target t2 a
+/// frame, where a session opened at frame 2 takes t2 at once (the targets as a fresh
+/// session meters them: about 0 and −2 EV, to the histogram's bins).
+#[test]
+fn a_sequence_keeps_history_from_frame_to_frame() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for (frame, value) in [(1, 0.18_f32), (2, 0.72), (3, 0.72)] {
+        let image = lumagraph::render::cpu::Image::filled(8, 6, [value, value, value, 1.0]);
+        let path = dir.path().join(format!("seq.{frame:04}.exr"));
+        lumagraph::render::image_io::save(&path, &image, true).unwrap();
+    }
+    let graph = dir.path().join("seq.ron");
+    std::fs::write(
+        &graph,
+        r#"(
+    version: 1,
+    nodes: [
+        (id: "input", kind: "ImageInput", params: {"path": "seq.####.exr"}),
+        (id: "auto", kind: "AutoExposure"),
+        (id: "out", kind: "Output", params: {"path": "out.####.exr"}),
+    ],
+    edges: [
+        (from: "input.color", to: "auto.color"),
+        (from: "auto.color", to: "out.color"),
+    ],
+)
+"#,
+    )
+    .unwrap();
+    let options = |frame| SessionOptions {
+        out: dir.path().join("out"),
+        frame: Some(frame),
+        ..SessionOptions::default()
+    };
+    let ev = |s: &mut Session| {
+        let m = s.measurements().unwrap();
+        m.iter()
+            .find(|(node, name, _)| node == "auto" && name == "exposure_ev")
+            .map(|(_, _, v)| *v)
+            .unwrap()
+    };
+    let target = |frame| {
+        let mut fresh = Session::open(&graph, None, options(frame)).unwrap();
+        fresh.render(1).unwrap();
+        ev(&mut fresh)
+    };
+    let (t1, t2) = (target(1), target(2));
+    assert!(
+        (t1 - 0.0).abs() < 0.1 && (t2 + 2.0).abs() < 0.1,
+        "{t1} {t2}"
+    );
+    let mut s = Session::open(&graph, None, options(1)).unwrap();
+    s.render(1).unwrap();
+    let mut seen = vec![ev(&mut s)];
+    for frame in [2, 3] {
+        s.set_frame(frame).unwrap();
+        assert_eq!(s.frame(), Some(frame));
+        seen.push(ev(&mut s));
+    }
+    let ev2 = t1 + 0.25 * (t2 - t1);
+    let want = [t1, ev2, ev2 + 0.25 * (t2 - ev2)];
+    for (got, want) in seen.iter().zip(want) {
+        assert!((got - want).abs() < 1e-3, "{seen:?}, want {want:?}");
+    }
+    let e = s.set_frame(4).unwrap_err().to_string();
+    assert!(e.contains("frame 4") && e.contains("seq.0004.exr"), "{e}");
+}

@@ -15,5 +15,6 @@ mod grade;
 mod image_io;
 mod lut;
 mod metrics;
+mod ocio;
 mod resize;
 mod vignette;

@@ -117,6 +117,10 @@ fn value(c: &mut Choices<'_>, kind: &str, ty: &ParamType) -> String {
         ParamType::Bool { .. } => c.word(&["true", "false"]).into(),
         ParamType::Enum { .. } if bad => "\"bogus\"".into(),
         ParamType::Enum { options, .. } => format!("{:?}", c.pick(options).0),
+        // A layer, view or channel name: the default (empty) but now and then one the
+        // file or the image has not.
+        ParamType::Text { .. } if bad => "\"no such\"".into(),
+        ParamType::Text { .. } => "\"\"".into(),
         _ => {
             let paths = match kind {
                 "Output" if bad || c.rarely(12) => ESCAPING_PATHS,
@@ -222,9 +226,12 @@ impl NodeSpec {
                 .iter()
                 .map(|i| (i.name.to_owned(), i.accepts.to_vec(), i.optional))
                 .collect(),
+            // The input files are colour: ImageInput's `scalar` and `vector` ports are
+            // refused with them (a case now and then checks that).
             outputs: kind
                 .outputs
                 .iter()
+                .filter(|o| kind.name != "ImageInput" || o.name == "color" || c.rarely(20))
                 .map(|o| (o.name.to_owned(), o.ty))
                 .collect(),
             params,

@@ -17,6 +17,8 @@ pub(super) fn kinds() -> Vec<NodeKind> {
         lut(),
         vignette(),
         tonemap(),
+        color_space(),
+        display_view(),
     ]
 }
 
@@ -324,4 +326,89 @@ fn tonemap() -> NodeKind {
         example: Vec::new(),
         reach: Reach::Pixel,
     }
+}
+
+/// The `config` param of the OpenColorIO nodes.
+fn ocio_config() -> ParamDef {
+    ParamDef {
+        name: "config",
+        ty: ParamType::Text { default: "" },
+        doc: "the OpenColorIO config: empty for the one the `OCIO` environment variable \
+              names, else OpenColorIO's CG config with ACES 2.0 \
+              (`ocio://cg-config-v4.0.0_aces-v2.0_ocio-v2.5`); `ocio://NAME` for a built-in one \
+              (`ocio://studio-config-latest`); or a `config.ocio` file, relative to the \
+              graph file's folder",
+    }
+}
+
+fn color_space() -> NodeKind {
+    let mut kind = post_node(
+        "ColorSpace",
+        Category::Color,
+        "Converts colour between two colour spaces of an OpenColorIO config (any to any: \
+         ACEScg, ACES2065-1, sRGB encoded, Display P3, a camera's log…), on the GPU with \
+         the shader OpenColorIO generates for the conversion. lumagraph's images are \
+         scene-linear Rec. 709 (the config's `Linear Rec.709 (sRGB)`), the default of both \
+         ends. `lumagraph color` lists a config's colour spaces, displays and views.",
+        vec![
+            ocio_config(),
+            ParamDef {
+                name: "from",
+                ty: ParamType::Text { default: "" },
+                doc: "the colour space the input is in (a name, alias or role of the \
+                      config); empty: the working space, scene-linear Rec. 709",
+            },
+            ParamDef {
+                name: "to",
+                ty: ParamType::Text { default: "" },
+                doc: "the colour space to convert to; empty: the working space",
+            },
+        ],
+    );
+    kind.example = vec![("from", ParamValue::Str("ACEScg".into()))];
+    kind.outputs[0].doc = "the colour in `to`";
+    kind
+}
+
+fn display_view() -> NodeKind {
+    let mut kind = post_node(
+        "DisplayView",
+        Category::Color,
+        "Renders scene-linear colour for a display through an OpenColorIO view, as \
+         Blender's and Nuke's viewers do: `sRGB - Display` with `ACES 2.0 - SDR 100 nits \
+         (Rec.709)`, `Un-tone-mapped`, a config's AgX or Filmic, with its looks. The \
+         output is display-encoded, ready for a PNG. On the GPU with OpenColorIO's shader.",
+        vec![
+            ocio_config(),
+            ParamDef {
+                name: "display",
+                ty: ParamType::Text { default: "" },
+                doc: "the display (`sRGB - Display`, `Display P3 - Display`…); empty: the \
+                      config's default display",
+            },
+            ParamDef {
+                name: "view",
+                ty: ParamType::Text { default: "" },
+                doc: "the view of that display; empty: the display's default view",
+            },
+            ParamDef {
+                name: "looks",
+                ty: ParamType::Text { default: "" },
+                doc: "looks to apply (OpenColorIO's syntax: `+look, -other`); empty: the \
+                      view's own",
+            },
+            ParamDef {
+                name: "from",
+                ty: ParamType::Text { default: "" },
+                doc: "the colour space the input is in; empty: the working space, \
+                      scene-linear Rec. 709",
+            },
+        ],
+    );
+    kind.outputs = vec![OutputDef::new(
+        "color",
+        PortType::LdrColor,
+        "display-encoded colour for `display`",
+    )];
+    kind
 }

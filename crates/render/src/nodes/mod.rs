@@ -10,6 +10,7 @@ pub(crate) mod gbuffer;
 mod image_input;
 pub mod lut;
 pub(crate) mod multi_layer_output;
+pub mod ocio;
 pub mod output;
 pub(crate) mod pathtrace;
 pub mod post_filter;
@@ -422,6 +423,8 @@ pub fn boxed<N: NodeExec + 'static>(node: Result<N>) -> Result<Box<dyn NodeExec>
 pub static IMPLEMENTATIONS: &[NodeImpl] = &[
     image_input::IMPL,
     multi_layer_output::IMPL,
+    ocio::COLOR_SPACE,
+    ocio::DISPLAY_VIEW,
     pathtrace::IMPL,
     accumulate::IMPL,
     temporal::IMPL,

@@ -1,0 +1,185 @@
+//! `ColorSpace` and `DisplayView`: OpenColorIO conversions on the GPU, each the compute
+//! shader `lumagraph_color` generates for its processor (OpenColorIO's own WGSL), with its
+//! LUT textures and uniforms. A param edit builds the program again; the config is loaded
+//! again only when `config` changes.
+
+use lumagraph_color::{ColorConfig, GpuProgram, LutTexture, Processor, Slot};
+use lumagraph_graph::{Pass, PortType};
+
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+use crate::kernel::{Kernel, uniform_buffer};
+use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed};
+
+/// The `ColorSpace` kind.
+pub(crate) const COLOR_SPACE: NodeImpl = NodeImpl::new("ColorSpace", |ctx, pass, resources| {
+    boxed(OcioNode::new(ctx, pass, resources))
+});
+
+/// The `DisplayView` kind.
+pub(crate) const DISPLAY_VIEW: NodeImpl = NodeImpl::new("DisplayView", |ctx, pass, resources| {
+    boxed(OcioNode::new(ctx, pass, resources))
+});
+
+/// The config of `pass` (its `config` param), relative paths from the graph's folder.
+///
+/// # Errors
+/// What [`ColorConfig::load`] refuses.
+pub fn config_of(pass: &Pass, resources: &Resources) -> Result<ColorConfig> {
+    ColorConfig::load(pass.params.str("config"), &resources.base_dir).map_err(color_error)
+}
+
+fn color_error(e: lumagraph_color::Error) -> RenderError {
+    RenderError::Gpu(e.0)
+}
+
+/// The processor a pass of either kind applies.
+///
+/// # Errors
+/// An unknown colour space, display, view or look (the message lists the config's).
+pub fn processor_of(pass: &Pass, config: &ColorConfig) -> Result<Processor> {
+    let p = &pass.params;
+    let processor = if pass
+        .kind
+        .outputs
+        .first()
+        .is_some_and(|o| o.ty == PortType::LdrColor)
+    {
+        config.display_processor(
+            p.str("from"),
+            p.str("display"),
+            p.str("view"),
+            p.str("looks"),
+        )
+    } else {
+        config.processor(p.str("from"), p.str("to"))
+    };
+    processor.map_err(color_error)
+}
+
+struct OcioNode {
+    resources: Resources,
+    config: Option<(String, ColorConfig)>,
+    program: Option<Built>,
+}
+
+/// A processor on the device: its kernel, uniform buffer and LUT textures.
+struct Built {
+    kernel: Kernel,
+    uniforms: Option<wgpu::Buffer>,
+    luts: Vec<wgpu::TextureView>,
+    slots: Vec<Slot>,
+}
+
+impl OcioNode {
+    fn new(ctx: &GpuContext, pass: &Pass, resources: &Resources) -> Result<Self> {
+        let mut node = Self {
+            resources: resources.clone(),
+            config: None,
+            program: None,
+        };
+        node.update(ctx, pass)?;
+        Ok(node)
+    }
+}
+
+fn upload_lut(ctx: &GpuContext, lut: &LutTexture) -> wgpu::TextureView {
+    let size = wgpu::Extent3d {
+        width: lut.size[0],
+        height: lut.size[1],
+        depth_or_array_layers: lut.size[2],
+    };
+    let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("ocio lut"),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: if lut.dimensions == 3 {
+            wgpu::TextureDimension::D3
+        } else {
+            wgpu::TextureDimension::D2
+        },
+        format: if lut.single_channel {
+            wgpu::TextureFormat::R32Float
+        } else {
+            wgpu::TextureFormat::Rgba32Float
+        },
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    ctx.queue.write_texture(
+        texture.as_image_copy(),
+        &lut.bytes,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(lut.bytes_per_row),
+            rows_per_image: Some(lut.size[1]),
+        },
+        size,
+    );
+    texture.create_view(&wgpu::TextureViewDescriptor::default())
+}
+
+fn build(ctx: &GpuContext, label: &str, program: &GpuProgram) -> Result<Built> {
+    Ok(Built {
+        kernel: Kernel::from_source(ctx, label, &program.wgsl)?,
+        uniforms: program
+            .uniforms
+            .as_ref()
+            .map(|bytes| uniform_buffer(ctx, "ocio uniforms", bytes)),
+        luts: program.luts.iter().map(|l| upload_lut(ctx, l)).collect(),
+        slots: program.slots.clone(),
+    })
+}
+
+impl NodeExec for OcioNode {
+    fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
+        let spec = pass.params.str("config").to_owned();
+        if self.config.as_ref().is_none_or(|(s, _)| *s != spec) {
+            self.config = Some((spec, config_of(pass, &self.resources)?));
+        }
+        let Some((_, config)) = &self.config else {
+            return Ok(());
+        };
+        let processor = processor_of(pass, config)?;
+        let format = if pass
+            .kind
+            .outputs
+            .first()
+            .is_some_and(|o| o.ty == PortType::LdrColor)
+        {
+            "rgba8unorm"
+        } else {
+            "rgba32float"
+        };
+        let program = processor.gpu_program(format).map_err(color_error)?;
+        self.program = Some(build(ctx, &pass.node, &program)?);
+        Ok(())
+    }
+
+    fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
+        let (ctx, encoder, io, timer) = rec.parts();
+        let (Some(out), Some(built)) = (pass.output("color"), &self.program) else {
+            return Ok(());
+        };
+        let input = &io.input(pass, "color")?.view;
+        let output = &io.texture(out).view;
+        let mut builder = built.kernel.pass(&pass.node);
+        for slot in &built.slots {
+            builder = match slot {
+                Slot::Uniforms => match &built.uniforms {
+                    Some(b) => builder.uniform(b),
+                    None => {
+                        return Err(RenderError::Gpu(
+                            "OpenColorIO's uniforms are missing".into(),
+                        ));
+                    }
+                },
+                Slot::Lut(i) => builder.read(&built.luts[*i]),
+                Slot::Input => builder.read(input),
+                Slot::Output => builder.write(output),
+            };
+        }
+        builder.dispatch_2d(ctx, encoder, pass.extent, timer)
+    }
+}
