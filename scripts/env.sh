@@ -16,3 +16,8 @@ ray_query_icd="${XDG_CACHE_HOME:-$HOME/.cache}/lumagraph/lavapipe-ray-query/lvp_
 if [ -z "${LUMAGRAPH_RAY_QUERY_ICD:-}" ] && [ -f "$ray_query_icd" ]; then
     export LUMAGRAPH_RAY_QUERY_ICD="$ray_query_icd"
 fi
+# Open Image Denoise, unpacked by scripts/setup.sh: the library the OIDN node loads.
+oidn_lib="${XDG_CACHE_HOME:-$HOME/.cache}/lumagraph/oidn/lib/libOpenImageDenoise.so.2"
+if [ -z "${LUMAGRAPH_OIDN_LIB:-}" ] && [ -f "$oidn_lib" ]; then
+    export LUMAGRAPH_OIDN_LIB="$oidn_lib"
+fi

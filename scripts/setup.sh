@@ -4,7 +4,8 @@
 # resort and the one the tests run on), a C toolchain, Python 3 with its headers and venv
 # (scripts/test.sh makes a test mesh with it; the Python package links it and is tested in a
 # virtual environment), Embree 3 (the path tracer traces its rays with it on CPU adapters; loaded at
-# run time, optional), and Rust through rustup.
+# run time, optional), Rust through rustup, and Intel Open Image Denoise 2 (the OIDN node's
+# library, from the pyoidn wheel on PyPI; loaded at run time, optional).
 # Safe to run again: it only installs what is missing.
 set -euo pipefail
 
@@ -62,6 +63,53 @@ if [ ! -f "$ray_query_dir/lvp_icd.json" ] && grep -q '^VERSION_CODENAME=bookworm
         mv "$ray_query_dir/lvp_icd.json.tmp" "$ray_query_dir/lvp_icd.json"
     else
         echo "setup: could not fetch Mesa 25's lavapipe from bookworm-backports: the ray-query tests will fail (LUMAGRAPH_ALLOW_NO_RAY_QUERY=1 skips them)" >&2
+    fi
+    rm -rf "$work"
+fi
+
+# Open Image Denoise 2 (Intel), which the OIDN denoiser node loads at run time (optional:
+# without it that node fails and says how to get it). The pyoidn wheel on PyPI ships the
+# library; its CPU parts (libOpenImageDenoise, its core with the trained weights, the CPU
+# device and TBB) are unpacked into $oidn_dir/lib, where the library's RPATH ($ORIGIN/../lib)
+# finds them. scripts/env.sh points LUMAGRAPH_OIDN_LIB at it.
+oidn_version=2.5.1
+oidn_dir="${XDG_CACHE_HOME:-$HOME/.cache}/lumagraph/oidn"
+if [ ! -f "$oidn_dir/lib/libOpenImageDenoise.so.2" ]; then
+    echo "setup: fetching Open Image Denoise $oidn_version (the pyoidn wheel from PyPI) into $oidn_dir"
+    work=$(mktemp -d)
+    pip=(python3 -m pip)
+    if ! python3 -m pip --version >/dev/null 2>&1; then
+        # No pip beside the system's Python (Debian's python3-pip is not installed): the one
+        # a virtual environment brings (python3-venv).
+        python3 -m venv "$work/venv" >/dev/null 2>&1 && pip=("$work/venv/bin/python" -m pip)
+    fi
+    if "${pip[@]}" download -q --disable-pip-version-check --no-deps --only-binary=:all: \
+        -d "$work" "pyoidn==$oidn_version" >/dev/null 2>&1 &&
+        python3 - "$work"/pyoidn-*.whl "$work/lib" "$oidn_version" <<'PY'
+import os, sys, zipfile
+wheel, dest, version = sys.argv[1:4]
+wanted = {"libOpenImageDenoise.so.2", f"libOpenImageDenoise_core.so.{version}",
+          f"libOpenImageDenoise_device_cpu.so.{version}", "libtbb.so.12"}
+os.makedirs(dest)
+with zipfile.ZipFile(wheel) as z:
+    for info in z.infolist():
+        name = os.path.basename(info.filename)
+        if info.filename.startswith("pyoidn/oidn/lib/") and name in wanted:
+            with open(os.path.join(dest, name), "wb") as f:
+                f.write(z.read(info))
+            os.chmod(os.path.join(dest, name), 0o755)
+            wanted.discard(name)
+        elif info.filename.endswith("/licenses/LICENSE"):
+            with open(os.path.join(dest, "LICENSE.pyoidn"), "wb") as f:
+                f.write(z.read(info))
+sys.exit(f"not in the wheel: {sorted(wanted)}" if wanted else 0)
+PY
+    then
+        mkdir -p "$oidn_dir"
+        rm -rf "$oidn_dir/lib"
+        mv "$work/lib" "$oidn_dir/lib"
+    else
+        echo "setup: could not fetch Open Image Denoise (pip download pyoidn==$oidn_version): the OIDN node will not run; set LUMAGRAPH_OIDN_LIB to a libOpenImageDenoise.so (2.x) instead" >&2
     fi
     rm -rf "$work"
 fi

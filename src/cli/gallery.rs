@@ -21,10 +21,11 @@ const SOURCE: &str = "assets/hdri/venice_sunset_1k.hdr";
 const SECOND: &str = "assets/test_chart.exr";
 const SCENE: &str = "assets/cornell.ron";
 /// The path-tracing graphs, searched in order for a node of the kind shown.
-const RENDER_GRAPHS: [&str; 3] = [
+const RENDER_GRAPHS: [&str; 4] = [
     "graphs/pathtrace_denoise.ron",
     "graphs/pathtrace_regression.ron",
     "graphs/pathtrace_temporal.ron",
+    "graphs/pathtrace_oidn.ron",
 ];
 const RENDER_FRAMES: u32 = 64;
 
@@ -209,7 +210,8 @@ pub fn markdown(registry: &Registry) -> String {
          chart is a second input) with the params listed, tone-mapped with AgX for display; \
          the nodes of the path-tracing graph show their first output on the Cornell box \
          after 64 frames of `graphs/pathtrace_denoise.ron` (`RegressionDenoise`: of \
-         `graphs/pathtrace_regression.ron`; `TemporalReuse`, which has no camera move to \
+         `graphs/pathtrace_regression.ron`; `OIDN`: of `graphs/pathtrace_oidn.ron`; \
+         `TemporalReuse`, which has no camera move to \
          reuse history across there: of `graphs/pathtrace_temporal.ron`).\n",
     );
     let mut categories: Vec<_> = registry.kinds().iter().map(|k| k.category).collect();

@@ -1,4 +1,4 @@
-//! The denoisers: à-trous, regression, temporal reuse; their suite and numerics.
+//! The denoisers: à-trous, regression, OIDN, temporal reuse; their suite and numerics.
 //!
 //! One test binary per area (`cargo test --test denoise`); one module per subject
 //! (`cargo test --test denoise atrous::`).
@@ -8,6 +8,7 @@ mod common;
 
 mod atrous;
 mod numerics;
+mod oidn;
 mod regression;
 mod suite;
 mod temporal;

@@ -99,6 +99,8 @@ pub enum Pick {
     EnvironmentMap,
     /// Where to write the live error plot's points (CSV).
     ErrorCsv,
+    /// An OpenColorIO config (`config.ocio`) for the viewer's display transform.
+    OcioConfig,
 }
 
 /// A question waiting in a modal dialog.

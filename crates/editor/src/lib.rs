@@ -9,6 +9,8 @@
 //!   the render crate's `Executor`; param edits update nodes in place; what its nodes
 //!   measure; [`scope`]: histogram and waveform of the previewed image; [`sequence`]:
 //!   the frame control of an image sequence (frame patterns in params).
+//! - [`viewer`]: zoom, readout, compare; [`display`]: its OpenColorIO display, view and
+//!   look, applied to what is shown only.
 //! - [`files`]: open, save (atomic), save as, recent files.
 //! - [`app`]: the window tying them together.
 //!
@@ -17,6 +19,7 @@
 
 pub mod app;
 pub mod canvas;
+pub mod display;
 pub mod document;
 pub mod error_plot;
 pub mod files;

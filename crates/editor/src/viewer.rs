@@ -1,9 +1,11 @@
 //! The preview's image viewer: zoom and pan down to single pixels, a readout of the linear
-//! values under the pointer, display-only exposure and false colour for HDR ports, and an
-//! A/B compare of the live image with a pinned snapshot (a wipe, or side by side).
+//! values under the pointer, display-only exposure, false colour and an OpenColorIO display
+//! transform ([`crate::display`]) for HDR ports, and an A/B compare of the live image with a
+//! pinned snapshot (a wipe, or side by side).
 //!
-//! Nothing here changes the graph: exposure and false colour apply to what is shown only,
-//! and the readout reads the port's linear values as the GPU wrote them.
+//! Nothing here changes the graph: exposure, false colour and the display transform apply
+//! to what is shown only, and the readout reads the port's linear values as the GPU wrote
+//! them.
 
 use egui::{Color32, Pos2, Rect, Sense, TextureHandle, TextureOptions, Ui, Vec2, pos2, vec2};
 use lumagraph_graph::PortType;
@@ -182,8 +184,10 @@ pub struct ImageView {
     pub center: Vec2,
     /// Display-only exposure for HDR ports, in stops.
     pub exposure: f32,
-    /// Show HDR ports in false colour (see [`false_color`]).
+    /// Show HDR ports in false colour (see [`false_color`]); over the display transform.
     pub false_colour: bool,
+    /// The OpenColorIO display, view and look HDR ports are shown through (off by default).
+    pub display: crate::display::DisplayTransform,
     /// How the snapshot is shown.
     pub compare: Compare,
     /// Where the wipe's line is, from 0 (left edge) to 1.
@@ -195,9 +199,9 @@ pub struct ImageView {
     /// Where the image was drawn on the last frame (the left half side by side).
     pub rect: Option<Rect>,
     live: Option<TextureHandle>,
-    live_key: Option<(u64, u32, bool, bool)>,
+    live_key: Option<(u64, u32, bool, bool, u64)>,
     snap: Option<TextureHandle>,
-    snap_key: Option<(u32, bool, bool)>,
+    snap_key: Option<(u32, bool, bool, u64)>,
 }
 
 impl std::fmt::Debug for ImageView {
@@ -231,6 +235,23 @@ impl ImageView {
         if self.compare == Compare::Off {
             self.compare = Compare::Wipe;
         }
+    }
+
+    /// What the viewer shows of `image` (of type `ty`): through the display transform when
+    /// one is chosen, the port is not display-encoded and false colour is off; else as
+    /// [`display_rgba`] shows it.
+    pub fn shown_rgba(&mut self, image: &Image, ty: PortType) -> Vec<u8> {
+        if ty != PortType::LdrColor
+            && !self.false_colour
+            && let Some(p) = self.display.processor()
+        {
+            let t = std::time::Instant::now();
+            let rgba = crate::display::encode(image, self.exposure, p);
+            let ms = t.elapsed().as_secs_f64() * 1e3;
+            self.display.last_cost = Some((ms, image.width, image.height));
+            return rgba;
+        }
+        display_rgba(image, ty, self.exposure, self.false_colour)
     }
 
     /// The screen rectangle of the whole image in a view of `view` (fit: as large as fits,
@@ -313,9 +334,16 @@ impl ImageView {
             TextureOptions::LINEAR
         };
         let nearest = options == TextureOptions::NEAREST;
-        let key = (frame, self.exposure.to_bits(), self.false_colour, nearest);
+        let shown = self.display.key();
+        let key = (
+            frame,
+            self.exposure.to_bits(),
+            self.false_colour,
+            nearest,
+            shown,
+        );
         if self.live_key != Some(key) || self.live.is_none() {
-            let rgba = display_rgba(live, ty, self.exposure, self.false_colour);
+            let rgba = self.shown_rgba(live, ty);
             upload(
                 ui.ctx(),
                 &mut self.live,
@@ -326,10 +354,10 @@ impl ImageView {
             );
             self.live_key = Some(key);
         }
-        if let Some(s) = &self.pinned {
-            let key = (self.exposure.to_bits(), self.false_colour, nearest);
+        if let Some(s) = self.pinned.take() {
+            let key = (self.exposure.to_bits(), self.false_colour, nearest, shown);
             if self.snap_key != Some(key) || self.snap.is_none() {
-                let rgba = display_rgba(&s.image, s.ty, self.exposure, self.false_colour);
+                let rgba = self.shown_rgba(&s.image, s.ty);
                 upload(
                     ui.ctx(),
                     &mut self.snap,
@@ -340,6 +368,7 @@ impl ImageView {
                 );
                 self.snap_key = Some(key);
             }
+            self.pinned = Some(s);
         }
 
         // Input.

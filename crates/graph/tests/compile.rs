@@ -489,11 +489,11 @@ fn optional_input_may_stay_unconnected() {
         Edge::new("img.color", "dn.color"),
         Edge::new("dn.color", "out.color"),
     ];
-    // albedo, normal, depth are required: three errors, none for variance.
+    // albedo and normal are required: two errors, none for depth or variance.
     let e = compile_graph(&g).unwrap_err();
     let m = e.to_string();
-    assert_eq!(e.0.len(), 3, "{m}");
-    assert!(!m.contains("variance"), "{m}");
+    assert_eq!(e.0.len(), 2, "{m}");
+    assert!(!m.contains("variance") && !m.contains("depth"), "{m}");
 
     g.nodes.insert(0, Node::new("gb", "GBuffer"));
     g.edges = vec![

@@ -78,6 +78,10 @@ pub enum RenderError {
     /// An output path leaves the output folder (a path from a graph or tile set file).
     #[error("{0}")]
     OutsideOutput(#[from] lumagraph_graph::outputs::OutsideOutput),
+    /// A library a node runs on the host (Open Image Denoise) is missing or failed; the
+    /// message says which, and for a missing one how to get it.
+    #[error("{0}")]
+    External(String),
     /// A node kind could not be added to a [`NodeLibrary`](crate::NodeLibrary); the
     /// message names it.
     #[error("{0}")]

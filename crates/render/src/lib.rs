@@ -13,6 +13,7 @@
 //! - [`custom`]: node kinds declared in graph files, their shaders generated and checked.
 //! - [`embree`]: the path tracer's rays traced on the host with Embree 3, loaded at run
 //!   time (for CPU adapters, where the WGSL BVH traversal is slow).
+//! - [`oidn`]: Intel Open Image Denoise 2, loaded at run time, for the `OIDN` node.
 
 pub mod accel;
 pub mod bsdf_check;
@@ -32,6 +33,7 @@ pub mod kernel;
 mod library;
 pub mod metrics;
 pub mod nodes;
+pub mod oidn;
 pub mod params;
 pub mod partial;
 mod pool;

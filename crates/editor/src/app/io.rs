@@ -50,6 +50,15 @@ impl Editor {
                 start(self.doc.path.as_deref()),
                 vec!["csv"],
             ),
+            Pick::OcioConfig => {
+                let current = Path::new(self.view.display.config_spec());
+                let file = current.extension().is_some_and(|e| e == "ocio");
+                (
+                    "Pick an OpenColorIO config",
+                    start(file.then_some(current)),
+                    vec!["ocio"],
+                )
+            }
             Pick::Param(node, param) => {
                 let extensions = self
                     .doc
@@ -154,6 +163,13 @@ impl Editor {
                 }
             }
             Pick::GroupFile => self.group_selection(path),
+            Pick::OcioConfig => {
+                let spec = path.display().to_string();
+                match self.view.display.load_config(&spec) {
+                    Ok(()) => self.say(format!("viewer: OpenColorIO config {spec}"), false),
+                    Err(e) => self.say(e, true),
+                }
+            }
             Pick::ErrorCsv => {
                 let csv = self.preview.curve.csv();
                 match lumagraph_graph::write_atomic(path, csv.as_bytes()) {

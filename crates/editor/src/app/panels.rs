@@ -283,6 +283,7 @@ impl Editor {
             .as_ref()
             .is_some_and(|(_, ty)| *ty != lumagraph_graph::PortType::LdrColor);
         let v = &mut self.view;
+        let mut request = None;
         ui.horizontal_wrapped(|ui| {
             let zoom = v
                 .zoom
@@ -313,7 +314,17 @@ impl Editor {
                         "luminance in stops around middle grey: blue −6, green 0, red +4, white +6",
                     );
             }
+            // Last: greyed out with what follows in the row on a display-encoded port.
+            request = v.display.menus(ui, hdr);
         });
+        if hdr {
+            self.view.display.error_label(ui);
+        }
+        match request {
+            Some(crate::display::Request::PickConfig) => self.open_file_dialog(Pick::OcioConfig),
+            Some(crate::display::Request::Failed(e)) => self.say(e, true),
+            None => {}
+        }
         ui.horizontal_wrapped(|ui| {
             if ui
                 .button("📌 pin")

@@ -4,7 +4,23 @@ use super::{COLOR_TYPES, Category, InputDef, NodeKind, OutputDef, ParamDef, Reac
 use crate::types::{ParamType, PortType};
 
 pub(super) fn kinds() -> Vec<NodeKind> {
-    vec![denoise(), regression()]
+    vec![denoise(), regression(), oidn()]
+}
+
+/// What a denoiser's albedo guide takes: the G-buffer's, or an EXR layer read as colour.
+pub(crate) const GUIDE_ALBEDO: &[PortType] = &[PortType::Albedo, PortType::HdrColor];
+/// What a denoiser's normal guide takes: the G-buffer's, or an EXR layer read as a vector.
+pub(crate) const GUIDE_NORMAL: &[PortType] = &[PortType::Normal, PortType::Vector];
+/// What a denoiser's depth guide takes: the G-buffer's, or an EXR layer read as a scalar.
+pub(crate) const GUIDE_DEPTH: &[PortType] = &[PortType::Depth, PortType::Scalar];
+
+/// A denoiser's noisy colour input.
+fn noisy_color() -> InputDef {
+    InputDef::new(
+        "color",
+        COLOR_TYPES,
+        "noisy linear color (e.g. Accumulate.color)",
+    )
 }
 
 /// The inputs of a denoiser guided by the G-buffer: the noisy color, the first hit's
@@ -12,26 +28,24 @@ pub(super) fn kinds() -> Vec<NodeKind> {
 /// says what the kind does with it).
 fn guided_inputs(variance: &'static str) -> Vec<InputDef> {
     vec![
-        InputDef::new(
-            "color",
-            COLOR_TYPES,
-            "noisy linear color (e.g. Accumulate.color)",
-        ),
+        noisy_color(),
         InputDef::new(
             "albedo",
-            &[PortType::Albedo],
-            "first-hit albedo (GBuffer or PathTrace); alpha 2 marks emitters",
+            GUIDE_ALBEDO,
+            "first-hit albedo (GBuffer or PathTrace, or an EXR layer); alpha 2 marks emitters",
         ),
         InputDef::new(
             "normal",
-            &[PortType::Normal],
-            "first-hit world-space normal",
+            GUIDE_NORMAL,
+            "first-hit world-space normal (GBuffer, PathTrace, or an EXR layer)",
         ),
         InputDef::new(
             "depth",
-            &[PortType::Depth],
-            "first-hit distance along the camera ray (0: nothing hit)",
-        ),
+            GUIDE_DEPTH,
+            "first-hit distance along the camera ray (0: nothing hit); without it (a \
+             render made elsewhere that has none) depth guides nothing",
+        )
+        .optional(),
         InputDef::new("variance", &[PortType::Variance], variance).optional(),
     ]
 }
@@ -188,5 +202,82 @@ fn regression() -> NodeKind {
         // The window's taps, their 5×5 guide (2 more) and the light-boundary test of the
         // guide's pixels (1 more).
         reach: Reach::Within(|p| u32::try_from(p.int("radius")).unwrap_or(0) + 3),
+    }
+}
+
+/// OIDN 2's quality presets, as its API names them (`OIDN_QUALITY_*`).
+const OIDN_QUALITIES: &[(&str, &str)] = &[
+    ("default", "the library's choice (high on the CPU)"),
+    ("high", "for final frames"),
+    ("balanced", "faster, for interactive rendering"),
+    ("fast", "fastest, for previews"),
+];
+
+fn oidn() -> NodeKind {
+    NodeKind {
+        name: "OIDN",
+        category: Category::Denoise,
+        doc: "Intel Open Image Denoise 2: its `RT` filter, a neural network trained on \
+              path-traced images, run on the CPU. The images go to the host and back around \
+              this node (the inputs are read back, the result uploaded); the result is kept \
+              and uploaded again while the inputs and params do not change. The library is \
+              loaded at run time: `bash scripts/setup.sh` fetches it, or \
+              `LUMAGRAPH_OIDN_LIB` names a libOpenImageDenoise.so (2.x); without it the \
+              node fails saying so.",
+        inputs: vec![
+            noisy_color(),
+            InputDef::new(
+                "albedo",
+                GUIDE_ALBEDO,
+                "first-hit albedo guide (GBuffer or PathTrace, or an EXR layer); rgb only",
+            )
+            .optional(),
+            InputDef::new(
+                "normal",
+                GUIDE_NORMAL,
+                "first-hit normal guide, world or camera space (needs `albedo` too: OIDN \
+                 takes color, color + albedo, or color + albedo + normal)",
+            )
+            .optional(),
+        ],
+        outputs: vec![OutputDef::new(
+            "color",
+            PortType::HdrColor,
+            "denoised linear color (alpha: the input's)",
+        )],
+        params: vec![
+            ParamDef::choice(
+                "quality",
+                "high",
+                OIDN_QUALITIES,
+                "OIDN's quality preset (`quality`)",
+            ),
+            ParamDef {
+                name: "prefilter",
+                ty: ParamType::Bool { default: false },
+                doc: "denoise the albedo and normal guides first, each with an RT filter of \
+                      its own, then the color with them (OIDN's prefiltering, for noisy \
+                      guides such as a path tracer's AOVs); off: the guides are taken as \
+                      they are",
+            },
+            ParamDef {
+                name: "clean_aux",
+                ty: ParamType::Bool { default: true },
+                doc: "tell OIDN the guides are noise-free (`cleanAux`): the G-buffer's are, \
+                      and so are prefiltered ones; off: OIDN's own mode for noisy guides \
+                      (a renderer's AOVs taken as they are)",
+            },
+            ParamDef {
+                name: "hdr",
+                ty: ParamType::Bool { default: true },
+                doc: "the color is HDR, linear and unbounded (OIDN's `hdr`); off: in [0, 1]",
+            },
+        ],
+        sink: false,
+        history: false,
+        renders_scene: false,
+        shader: None,
+        example: Vec::new(),
+        reach: Reach::Image("its network reads far around each pixel"),
     }
 }

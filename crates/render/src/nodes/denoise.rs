@@ -16,9 +16,9 @@
 use lumagraph_graph::{Extent, Pass, TexFormat};
 
 use crate::context::GpuContext;
-use crate::error::Result;
+use crate::error::{RenderError, Result};
 use crate::kernel::{Kernel, uniform_buffer};
-use crate::nodes::{NodeExec, NodeImpl, Recording, boxed};
+use crate::nodes::{NodeExec, NodeImpl, Recording, boxed, constant_r32};
 use crate::pool::{PooledTexture, create};
 
 /// Most passes the registry allows.
@@ -60,6 +60,8 @@ pub(crate) struct Denoise {
     guidance: &'static str,
     extent: Extent,
     ping_pong: Option<(Extent, Vec<PooledTexture>)>,
+    /// A constant depth (1) in place of an unconnected depth guide.
+    no_depth: Option<PooledTexture>,
 }
 
 /// Images of node-owned memory a Denoise pass with `iterations` uses.
@@ -98,6 +100,7 @@ impl Denoise {
             guidance: "",
             extent: pass.extent,
             ping_pong: None,
+            no_depth: None,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -172,6 +175,9 @@ impl NodeExec for Denoise {
             };
             self.ping_pong = Some((extent, (0..images).map(make).collect()));
         }
+        if pass.input("depth").is_none() {
+            constant_r32(ctx, &mut self.no_depth, extent, 1.0);
+        }
         let Some((_, pp)) = &self.ping_pong else {
             return Ok(());
         };
@@ -182,7 +188,13 @@ impl NodeExec for Denoise {
         };
         let albedo = io.input(pass, "albedo")?;
         let normal = io.input(pass, "normal")?;
-        let depth = io.input(pass, "depth")?;
+        // Without a depth guide, a constant depth of 1 (0 would mean nothing was hit):
+        // every depth difference is 0, its weight 1.
+        let depth = match (pass.input("depth"), &self.no_depth) {
+            (Some(t), _) => io.texture(t),
+            (None, Some(z)) => z,
+            (None, None) => return Err(RenderError::Gpu("no depth image".into())),
+        };
         let output = &io.texture(out).view;
         // Pass -1 demodulates into image 0; pass i reads image i % 2 and writes the other
         // one, or the output for the last.

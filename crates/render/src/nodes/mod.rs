@@ -11,6 +11,7 @@ mod image_input;
 pub mod lut;
 pub(crate) mod multi_layer_output;
 pub mod ocio;
+pub(crate) mod oidn;
 pub mod output;
 pub(crate) mod pathtrace;
 pub mod post_filter;
@@ -75,6 +76,44 @@ pub struct HeldImage {
     pub ty: lumagraph_graph::PortType,
     /// Size.
     pub extent: lumagraph_graph::Extent,
+}
+
+/// A one-channel float texture of `extent` holding `value` everywhere, for an optional
+/// input left unconnected: made once in `slot`, again when the size changes.
+pub(crate) fn constant_r32<'s>(
+    ctx: &GpuContext,
+    slot: &'s mut Option<PooledTexture>,
+    extent: Extent,
+    value: f32,
+) -> &'s PooledTexture {
+    if slot.as_ref().is_none_or(|t| t.extent != extent) {
+        let t = crate::pool::create(
+            ctx,
+            "constant",
+            lumagraph_graph::TexFormat::R32Float,
+            extent,
+        );
+        let values = vec![value; extent.pixels() as usize];
+        ctx.queue.write_texture(
+            t.texture.as_image_copy(),
+            bytemuck::cast_slice(&values),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(extent.width * 4),
+                rows_per_image: Some(extent.height),
+            },
+            t.texture.size(),
+        );
+        *slot = Some(t);
+    }
+    slot.get_or_insert_with(|| {
+        crate::pool::create(
+            ctx,
+            "constant",
+            lumagraph_graph::TexFormat::R32Float,
+            extent,
+        )
+    })
 }
 
 /// A named count a node keeps (samples, rays, dropped samples), since its last reset.
@@ -431,6 +470,7 @@ pub static IMPLEMENTATIONS: &[NodeImpl] = &[
     gbuffer::IMPL,
     denoise::IMPL,
     regression::IMPL,
+    oidn::IMPL,
     blur::IMPL,
     bloom::IMPL,
     lut::IMPL,

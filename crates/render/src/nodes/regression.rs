@@ -12,9 +12,9 @@
 use lumagraph_graph::{Extent, Pass, TexFormat};
 
 use crate::context::GpuContext;
-use crate::error::Result;
+use crate::error::{RenderError, Result};
 use crate::kernel::{Kernel, uniform_buffer};
-use crate::nodes::{NodeExec, NodeImpl, Recording, boxed};
+use crate::nodes::{NodeExec, NodeImpl, Recording, boxed, constant_r32};
 use crate::pool::{PooledTexture, create};
 
 /// Scratch images: illumination, features, guide.
@@ -59,6 +59,8 @@ pub(crate) struct RegressionDenoise {
     guided: bool,
     extent: Extent,
     scratch: Option<(Extent, [PooledTexture; 3])>,
+    /// A constant depth (1) in place of an unconnected depth guide.
+    no_depth: Option<PooledTexture>,
 }
 
 impl RegressionDenoise {
@@ -75,6 +77,7 @@ impl RegressionDenoise {
             guided: false,
             extent: pass.extent,
             scratch: None,
+            no_depth: None,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -120,8 +123,18 @@ impl NodeExec for RegressionDenoise {
                 ],
             ));
         }
+        if pass.input("depth").is_none() {
+            constant_r32(ctx, &mut self.no_depth, extent, 1.0);
+        }
         let Some((_, [illumination, features, guide])) = &self.scratch else {
             return Ok(());
+        };
+        // Without a depth guide, a constant depth of 1 (0 would mean nothing was hit): a
+        // constant feature, which the fit's ridge term leaves out.
+        let depth = match (pass.input("depth"), &self.no_depth) {
+            (Some(t), _) => io.texture(t),
+            (None, Some(z)) => z,
+            (None, None) => return Err(RenderError::Gpu("no depth image".into())),
         };
         let color = io.input(pass, "color")?;
         let variance = match pass.input("variance") {
@@ -135,7 +148,7 @@ impl NodeExec for RegressionDenoise {
             .read(&variance.view)
             .read(&albedo.view)
             .read(&io.input(pass, "normal")?.view)
-            .read(&io.input(pass, "depth")?.view)
+            .read(&depth.view)
             .write(&illumination.view)
             .write(&features.view)
             .dispatch_2d(ctx, encoder, extent, timer.as_deref_mut())?;
