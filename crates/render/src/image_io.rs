@@ -5,7 +5,6 @@
 use std::io::Cursor;
 use std::path::Path;
 
-use exr::prelude::{self as exrp, WritableImage as _};
 use lumagraph_footage::exr::{self as footage, LayerImage, Selection, Want};
 use lumagraph_graph::{Extent, write_atomic};
 
@@ -169,49 +168,26 @@ pub fn encode_png(width: u32, height: u32, rgba8: &[u8]) -> Result<Vec<u8>> {
     Ok(out)
 }
 
-/// Encodes an image as EXR bytes: 32-bit float RGBA, or half floats when `half` is set.
+/// Encodes an image as EXR bytes: 32-bit float RGBA, or half floats when `half` is set;
+/// ZIP-compressed, its `chromaticities` Rec. 709 (the one EXR writer,
+/// [`lumagraph_footage::exr::encode_layers`], with the image as the root layer).
 ///
 /// # Errors
 /// When encoding fails.
 pub fn encode_exr(image: &Image, half: bool) -> Result<Vec<u8>> {
-    if image.pixels.len() as u64 != u64::from(image.width) * u64::from(image.height) {
-        return Err(RenderError::image(
-            Path::new("<exr>"),
-            format!(
-                "{} pixels do not make a {}x{} image",
-                image.pixels.len(),
-                image.width,
-                image.height
-            ),
-        ));
-    }
-    let size = (image.width as usize, image.height as usize);
-    let w = image.width as usize;
-    let mut out = Vec::new();
-    let result = if half {
-        let channels = exrp::SpecificChannels::rgba(|exrp::Vec2(x, y): exrp::Vec2<usize>| {
-            let p = image.pixels[y * w + x];
-            (
-                exrp::f16::from_f32(p[0]),
-                exrp::f16::from_f32(p[1]),
-                exrp::f16::from_f32(p[2]),
-                exrp::f16::from_f32(p[3]),
-            )
-        });
-        exrp::Image::from_encoded_channels(size, exrp::Encoding::SMALL_LOSSLESS, channels)
-            .write()
-            .to_buffered(Cursor::new(&mut out))
-    } else {
-        let channels = exrp::SpecificChannels::rgba(|exrp::Vec2(x, y): exrp::Vec2<usize>| {
-            let p = image.pixels[y * w + x];
-            (p[0], p[1], p[2], p[3])
-        });
-        exrp::Image::from_encoded_channels(size, exrp::Encoding::SMALL_LOSSLESS, channels)
-            .write()
-            .to_buffered(Cursor::new(&mut out))
+    let layer = footage::LayerOut {
+        name: String::new(),
+        channels: ["R", "G", "B", "A"].map(str::to_owned).to_vec(),
+        values: image.pixels.iter().flatten().copied().collect(),
+        half,
     };
-    result.map_err(|e| RenderError::image(Path::new("<exr>"), e))?;
-    Ok(out)
+    footage::encode_layers(
+        image.width as usize,
+        image.height as usize,
+        &[layer],
+        footage::Compression::Zip,
+    )
+    .map_err(|e| RenderError::image(Path::new("<exr>"), e))
 }
 
 fn write(path: &Path, bytes: &[u8]) -> Result<()> {

@@ -30,23 +30,8 @@ pub enum Compression {
 }
 
 impl Compression {
-    /// Every compression with its description, by name, for the node's param.
-    pub const OPTIONS: &'static [(&'static str, &'static str)] = &[
-        (
-            "zip",
-            "lossless, 16 scan lines a block (Blender's and Nuke's default)",
-        ),
-        ("piz", "lossless wavelet, best for noisy renders"),
-        ("zips", "lossless, one scan line a block"),
-        ("rle", "lossless run-length, fast and weak"),
-        (
-            "pxr24",
-            "floats rounded to 24 bits (lossy), halves lossless",
-        ),
-        ("none", "uncompressed"),
-    ];
-
-    /// The compression called `name` ([`Compression::OPTIONS`]).
+    /// The compression called `name` (the names of `MultiLayerOutput`'s `compression`
+    /// param).
     pub fn named(name: &str) -> Option<Self> {
         Some(match name {
             "none" => Self::None,

@@ -148,3 +148,16 @@ impl NodeExec for MultiLayerOutput {
         Ok(vec![path])
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use lumagraph_footage::exr::Compression;
+    use lumagraph_graph::registry::output::EXR_COMPRESSIONS;
+
+    #[test]
+    fn every_compression_the_node_offers_is_one_the_writer_takes() {
+        for (name, _) in EXR_COMPRESSIONS {
+            assert!(Compression::named(name).is_some(), "{name}");
+        }
+    }
+}
