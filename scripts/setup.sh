@@ -5,7 +5,8 @@
 # (scripts/test.sh makes a test mesh with it; the Python package links it and is tested in a
 # virtual environment), Embree 3 (the path tracer traces its rays with it on CPU adapters; loaded at
 # run time, optional), Rust through rustup, and Intel Open Image Denoise 2 (the OIDN node's
-# library, from the pyoidn wheel on PyPI; loaded at run time, optional).
+# library, from the pyoidn wheel on PyPI; loaded at run time, optional), and Blender 4.2's
+# colour config (from the bpy wheel on PyPI; optional).
 # Safe to run again: it only installs what is missing.
 set -euo pipefail
 
@@ -110,6 +111,45 @@ PY
         mv "$work/lib" "$oidn_dir/lib"
     else
         echo "setup: could not fetch Open Image Denoise (pip download pyoidn==$oidn_version): the OIDN node will not run; set LUMAGRAPH_OIDN_LIB to a libOpenImageDenoise.so (2.x) instead" >&2
+    fi
+    rm -rf "$work"
+fi
+
+# Blender 4.2's OpenColorIO config (AgX, Filmic, Khronos PBR Neutral: the views Blender
+# users see), for the `blender` config of the colour nodes (optional: without it they say
+# how to get it; LUMAGRAPH_BLENDER_OCIO may name a Blender install's config instead). Blender
+# ships it inside its bpy wheel on PyPI (519 MB); its datafiles/colormanagement folder
+# (24 MB: config.ocio and its LUTs) is unpacked into $blender_dir.
+blender_version=4.2.0
+blender_dir="${XDG_CACHE_HOME:-$HOME/.cache}/lumagraph/blender-ocio/4.2"
+if [ ! -f "$blender_dir/config.ocio" ]; then
+    echo "setup: fetching Blender $blender_version's colour config (from the bpy wheel on PyPI) into $blender_dir"
+    work=$(mktemp -d)
+    pip=(python3 -m pip)
+    if ! python3 -m pip --version >/dev/null 2>&1; then
+        python3 -m venv "$work/venv" >/dev/null 2>&1 && pip=("$work/venv/bin/python" -m pip)
+    fi
+    if "${pip[@]}" download -q --disable-pip-version-check --no-deps --only-binary=:all: \
+        --python-version 3.11 -d "$work" "bpy==$blender_version" >/dev/null 2>&1 &&
+        python3 - "$work"/bpy-*.whl "$work/colormanagement" <<'PY'
+import os, sys, zipfile
+wheel, dest = sys.argv[1:3]
+prefix = "bpy/4.2/datafiles/colormanagement/"
+with zipfile.ZipFile(wheel) as z:
+    names = [n for n in z.namelist() if n.startswith(prefix) and not n.endswith("/")]
+    for name in names:
+        out = os.path.join(dest, name[len(prefix):])
+        os.makedirs(os.path.dirname(out), exist_ok=True)
+        with open(out, "wb") as f:
+            f.write(z.read(name))
+sys.exit(0 if os.path.isfile(os.path.join(dest, "config.ocio")) else "no config.ocio in the wheel")
+PY
+    then
+        mkdir -p "$(dirname "$blender_dir")"
+        rm -rf "$blender_dir"
+        mv "$work/colormanagement" "$blender_dir"
+    else
+        echo "setup: could not fetch Blender's colour config (pip download bpy==$blender_version): the \`blender\` config will not load; set LUMAGRAPH_BLENDER_OCIO to a Blender install's datafiles/colormanagement/config.ocio instead" >&2
     fi
     rm -rf "$work"
 fi

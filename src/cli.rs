@@ -937,25 +937,6 @@ fn test_chart(out: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Mesa's Vulkan device-select layer, loaded with every Vulkan instance, asks Wayland for
-/// its display while it orders the devices. Without a valid `XDG_RUNTIME_DIR` (a render
-/// box, a container, a batch job) libwayland then prints `error: XDG_RUNTIME_DIR is
-/// invalid or not set in the environment.` although nothing failed. lumagraph chooses its
-/// adapter itself, so there the layer is switched off with its own switch
-/// (`NODEVICE_SELECT=1`), unless the user set that variable.
-fn quiet_device_select() {
-    let runtime_dir = std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| Path::new(&d).is_dir());
-    if runtime_dir || std::env::var_os("NODEVICE_SELECT").is_some() {
-        return;
-    }
-    // SAFETY: `main_with` runs at the start of `main`, before the program starts threads
-    // (its docs say so), so nothing reads the environment while it changes.
-    #[expect(unsafe_code, reason = "set_var before any thread starts")]
-    unsafe {
-        std::env::set_var("NODEVICE_SELECT", "1");
-    }
-}
-
 /// Runs the `lumagraph` command line (arguments from the process) with the node kinds of
 /// `library`: they can be rendered, planned, validated, listed by `nodes`, shown by
 /// `gallery` and used in the editor (`edit`). Errors are printed with their causes.
@@ -963,9 +944,9 @@ fn quiet_device_select() {
 /// Returns the process's exit code: success, or failure after an error.
 ///
 /// Call it at the start of `main`, before the program starts threads: it may set one
-/// environment variable for the Vulkan loader (see [`quiet_device_select`]).
+/// environment variable for the Vulkan loader (see [`GpuContext::quiet_device_select`]).
 pub fn main_with(library: NodeLibrary) -> ExitCode {
-    quiet_device_select();
+    GpuContext::quiet_device_select();
     let cli = Cli::parse();
     match run(cli, &Arc::new(library)) {
         Ok(()) => ExitCode::SUCCESS,

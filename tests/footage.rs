@@ -298,3 +298,41 @@ fn a_render_made_elsewhere_is_denoised_from_its_layers() {
     let atrous = measured("atrous_error");
     assert!(atrous < raw * 0.9, "à-trous {atrous} against raw {raw}");
 }
+
+/// The pixels of the OpenEXR project's test images (`TestImages/`) that the OpenColorIO reference
+/// (`tests/color/ocio_testimages.json`) converts are the ones lumagraph reads: each sampled
+/// pixel, as lumagraph's reader gives it (`Y` files as grey), is bit-identical to what
+/// OpenEXR's Python bindings gave the reference script.
+#[test]
+fn the_colour_reference_pixels_are_what_lumagraph_reads() {
+    let Some(images) = images() else {
+        return;
+    };
+    let text = std::fs::read_to_string(common::repo("tests/color/ocio_testimages.json")).unwrap();
+    let reference: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let samples = reference["samples"].as_array().unwrap();
+    let pixels = reference["pixels"].as_array().unwrap();
+    assert_eq!(samples.len(), pixels.len());
+    let mut files = std::collections::BTreeMap::new();
+    for (sample, pixel) in samples.iter().zip(pixels) {
+        let file = sample[0].as_str().unwrap();
+        let image = files
+            .entry(file.to_owned())
+            .or_insert_with(|| read(&images.join("TestImages").join(file), "", Want::Rgba));
+        let (x, y) = (
+            sample[1].as_u64().unwrap() as usize,
+            sample[2].as_u64().unwrap() as usize,
+        );
+        let at = (y * image.width() + x) * 4;
+        for c in 0..3 {
+            let want = pixel[c].as_f64().unwrap() as f32;
+            assert_eq!(
+                image.pixels[at + c].to_bits(),
+                want.to_bits(),
+                "{file} ({x}, {y}) channel {c}: {} read, {want} in the reference",
+                image.pixels[at + c]
+            );
+        }
+    }
+    assert_eq!(files.len(), 10, "{:?}", files.keys().collect::<Vec<_>>());
+}

@@ -319,3 +319,99 @@ fn a_sequence_keeps_history_from_frame_to_frame() {
     let e = s.set_frame(4).unwrap_err().to_string();
     assert!(e.contains("frame 4") && e.contains("seq.0004.exr"), "{e}");
 }
+
+/// A number param written as a frame expression (`ev: "frame - 1"`) takes each frame's
+/// value: through the session's frames and `render --frames`, over a constant input
+/// (0.5 grey), frame f comes out 0.5 · 2^(f − 1); a bad expression is one error naming the
+/// node, the param and the expression.
+#[test]
+fn a_frame_expression_animates_a_number() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let image = lumagraph::render::cpu::Image::filled(4, 3, [0.5, 0.5, 0.5, 1.0]);
+    lumagraph::render::image_io::save(&dir.path().join("grey.exr"), &image, true).unwrap();
+    let write = |ev: &str| {
+        let graph = dir.path().join("anim.ron");
+        std::fs::write(
+            &graph,
+            format!(
+                r#"(
+    version: 1,
+    nodes: [
+        (id: "input", kind: "ImageInput", params: {{"path": "grey.exr"}}),
+        (id: "exposure", kind: "Exposure", params: {{"ev": {ev:?}}}),
+        (id: "out", kind: "Output", params: {{"path": "e.####.exr"}}),
+    ],
+    edges: [
+        (from: "input.color", to: "exposure.color"),
+        (from: "exposure.color", to: "out.color"),
+    ],
+)
+"#
+            ),
+        )
+        .unwrap();
+        graph
+    };
+    let graph = write("frame - 1");
+    let out = dir.path().join("out");
+    let mut s = Session::open(
+        &graph,
+        None,
+        SessionOptions {
+            out: out.clone(),
+            frame: Some(1),
+            ..SessionOptions::default()
+        },
+    )
+    .unwrap();
+    s.render(1).unwrap();
+    for frame in 1..=3_i32 {
+        if frame > 1 {
+            s.set_frame(i64::from(frame)).unwrap();
+        }
+        let got = s.read("exposure.color").unwrap();
+        let want = 0.5 * 2_f32.powi(frame - 1);
+        assert!(
+            (got.pixels[0][0] - want).abs() < 1e-6,
+            "frame {frame}: {:?}",
+            got.pixels[0]
+        );
+    }
+    // The command line, frames 2 and 3.
+    let (ok, _, err) = common::cli(&[
+        "render",
+        graph.to_str().unwrap(),
+        "--frames",
+        "2-3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    for (frame, want) in [(2, 1.0_f32), (3, 2.0)] {
+        let got =
+            lumagraph::render::image_io::load(&out.join(format!("e.{frame:04}.exr"))).unwrap();
+        assert!(
+            (got.pixels[0][0] - want).abs() < 1e-3,
+            "frame {frame}: {:?}",
+            got.pixels[0]
+        );
+    }
+    // A bad expression.
+    let graph = write("fram - 1");
+    let (ok, _, err) = common::cli(&[
+        "render",
+        graph.to_str().unwrap(),
+        "--frames",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(
+        err.contains("exposure") && err.contains("ev") && err.contains("fram - 1"),
+        "{err}"
+    );
+}

@@ -13,6 +13,20 @@ pixels, the configs or the OpenColorIO version:
     python3 -m venv .venv-ocio
     .venv-ocio/bin/pip install opencolorio==2.6.0 numpy
     .venv-ocio/bin/python scripts/ocio/reference.py
+    # the OpenEXR project's TestImages (needs `pip install OpenEXR` too):
+    .venv-ocio/bin/python scripts/ocio/reference.py --testimages
+
+With --blender it writes tests/color/ocio_blender.json: the same conversions of
+the same pixels through Blender 4.2's own config (AgX, Filmic, Khronos PBR
+Neutral; the one scripts/setup.sh unpacks from the bpy 4.2.0 wheel, or
+$LUMAGRAPH_BLENDER_OCIO).
+
+With --testimages it writes tests/color/ocio_testimages.json instead: the same
+conversions, for the CG config only, of pixels sampled from every colour file of
+the OpenEXR project's TestImages (../shared/assets/openexr-images/TestImages, or
+$LUMAGRAPH_OPENEXR_IMAGES/TestImages) as OpenEXR's Python bindings read them:
+30 fixed-seed random pixels per file and its darkest and brightest, finite
+pixels only; "samples" names each pixel's file and position.
 
 (PyOpenColorIO 2.6.0, the wheel on PyPI, was used to write the committed JSON;
 its built-in configs cg-config-v4.0.0_aces-v2.0_ocio-v2.5 and
@@ -292,7 +306,111 @@ def dump(doc: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+# --------------------------------------------------------------------------
+# Samples of the OpenEXR project's TestImages
+
+TESTIMAGES_JSON = REPO / "tests" / "color" / "ocio_testimages.json"
+SAMPLES_PER_FILE = 30
+
+
+def testimages_dir() -> Path:
+    env = os.environ.get("LUMAGRAPH_OPENEXR_IMAGES")
+    root = Path(env) if env else REPO.parent / "shared" / "assets" / "openexr-images"
+    return root / "TestImages"
+
+
+def sample_testimages() -> tuple[list[list[float]], list[list]]:
+    """Pixels of every colour (RGB or Y) file of TestImages, as OpenEXR reads them: per
+    file, SAMPLES_PER_FILE fixed-seed random positions and the darkest and brightest pixel
+    (by the mean of R, G, B); non-finite pixels are left out (OpenColorIO's CPU and GPU
+    paths differ on NaN and infinities). Returns the pixels and [file, x, y] per pixel."""
+    import OpenEXR
+
+    pixels: list[list[float]] = []
+    where: list[list] = []
+    rng = np.random.default_rng(SEED)
+    for path in sorted(testimages_dir().glob("*.exr")):
+        with OpenEXR.File(str(path), separate_channels=True) as f:
+            channels = f.channels()
+            if all(c in channels for c in "RGB"):
+                rgb = np.stack([channels[c].pixels.astype(np.float32) for c in "RGB"], axis=-1)
+            elif list(channels) == ["Y"]:
+                y = channels["Y"].pixels.astype(np.float32)
+                rgb = np.stack([y, y, y], axis=-1)
+            else:
+                print(f"  {path.name}: channels {sorted(channels)}: not colour, skipped")
+                continue
+        h, w, _ = rgb.shape
+        finite = np.isfinite(rgb).all(axis=-1)
+        mean = np.where(finite, rgb.astype(np.float64).mean(axis=-1), np.nan)
+        picks = [np.unravel_index(np.nanargmin(mean), mean.shape),
+                 np.unravel_index(np.nanargmax(mean), mean.shape)]
+        while len(picks) < SAMPLES_PER_FILE + 2:
+            yx = (int(rng.integers(h)), int(rng.integers(w)))
+            if finite[yx]:
+                picks.append(yx)
+        for (py, px) in picks:
+            pixels.append([float(f"{float(v):.9g}") for v in rgb[py, px]])
+            where.append([path.name, int(px), int(py)])
+        print(f"  {path.name}: {w}x{h}, {len(picks)} pixels")
+    return pixels, where
+
+
+def write_testimages() -> None:
+    pixels, where = sample_testimages()
+    key, source, working = CONFIGS[0]
+    doc = {
+        "generator": "scripts/ocio/reference.py --testimages",
+        "opencolorio": OCIO.__version__,
+        "pixels": pixels,
+        "configs": {key: evaluate(key, source, working, np.array(pixels, dtype=np.float32))},
+    }
+    text = dump(doc)
+    text = text.replace('  "pixels":', f'  "samples": {json.dumps(where, separators=(",", ":"))},\n  "pixels":', 1)
+    json.loads(text)
+    TESTIMAGES_JSON.write_text(text)
+    print(f"wrote {TESTIMAGES_JSON.relative_to(REPO)} ({len(text.encode())} bytes)")
+
+
+BLENDER_JSON = REPO / "tests" / "color" / "ocio_blender.json"
+
+
+def blender_config() -> Path:
+    env = os.environ.get("LUMAGRAPH_BLENDER_OCIO")
+    if env:
+        return Path(env)
+    cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+    return cache / "lumagraph" / "blender-ocio" / "4.2" / "config.ocio"
+
+
+def write_blender() -> None:
+    config = blender_config()
+    if not config.is_file():
+        sys.exit(f"no Blender config at {config}: run scripts/setup.sh")
+    pixels = make_pixels()
+    doc = {
+        "generator": "scripts/ocio/reference.py --blender",
+        "opencolorio": OCIO.__version__,
+        "pixels": pixels,
+        "configs": {"blender": evaluate("blender (Blender 4.2's config)", str(config),
+                                        "Linear Rec.709",
+                                        np.array(pixels, dtype=np.float32))},
+    }
+    text = dump(doc)
+    json.loads(text)
+    BLENDER_JSON.write_text(text)
+    print(f"wrote {BLENDER_JSON.relative_to(REPO)} ({len(text.encode())} bytes)")
+
+
 def main() -> None:
+    if "--testimages" in sys.argv[1:]:
+        OCIO.ClearAllCaches()
+        write_testimages()
+        return
+    if "--blender" in sys.argv[1:]:
+        OCIO.ClearAllCaches()
+        write_blender()
+        return
     USER_DIR.mkdir(parents=True, exist_ok=True)
     write_if_changed(USER_DIR / "log_to_lin.spi1d", spi1d_text())
     write_if_changed(USER_DIR / "film_look.cube", cube_text())

@@ -1,6 +1,6 @@
 // Compile-time options of the path tracer. The renderer replaces this file with values for
-// the scene and graph at hand (crates/render/src/specialize.rs); these are the defaults the
-// shader validation test compiles.
+// the scene and graph at hand (crates/render/src/specialize/features.rs); these are the
+// defaults the shader validation test compiles.
 
 // Write first-hit albedo, normal and depth (through the pixel center) to the AOV outputs.
 const WRITE_AOVS: bool = true;
@@ -52,8 +52,9 @@ const HAS_INSTANCES: bool = true;
 const HAS_ALPHA: bool = true;
 
 // The host intersects the rays (CPU adapters with Embree, scenes of triangles without
-// media): each dispatch takes every path one step, between the host's answers (`wave_step`
-// in pathtrace.wgsl), instead of tracing whole paths.
+// media): each dispatch takes every path one step, between the host's answers (the entry
+// points `wave_start`, `wave_misses` and `wave_hits` in pathtrace/wave.wgsl), instead of
+// tracing whole paths.
 const HOST_RAYS: bool = true;
 
 // The paths of a frame are taken one bounce at a time by small kernels (`wave_trace` traces

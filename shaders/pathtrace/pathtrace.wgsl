@@ -103,7 +103,8 @@ const CHUNK_LAST: u32 = 2u;
 // Per pixel of the window: the sum of the frame's samples traced by its earlier dispatches.
 @group(0) @binding(21) var<storage, read_write> chunk_sums: array<vec4f>;
 // With WAVES, the paths in flight and the rays the host or `wave_trace` intersects (a
-// 16-byte stand-in otherwise): see `wave_step`.
+// 16-byte stand-in otherwise): see `wave_start`, `wave_misses` and `wave_hits` in
+// pathtrace/wave.wgsl.
 @group(0) @binding(22) var<storage, read_write> wave: array<vec4<u32>>;
 // The texture atlas: every texture of the scene in the RGBA8 pages of one array texture.
 @group(0) @binding(23) var textures: texture_2d_array<f32>;

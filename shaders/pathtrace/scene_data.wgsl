@@ -2,7 +2,8 @@
 // triangles' and shapes' positions and shading data, read by index from the storage
 // buffers the includer declares. For small scenes the renderer replaces this file with
 // generated code that returns them from `switch` statements with the values written into the
-// shader, so no bounce loads them from memory (see crates/render/src/specialize.rs).
+// shader, so no bounce loads them from memory (see
+// crates/render/src/specialize/codegen.rs).
 // From its includer: the bindings `materials`, `lights`, `light_alias`, `tri_positions`,
 // `tri_shading` and `shapes`.
 #import "pathtrace/scene_types.wgsl"

@@ -18,3 +18,4 @@ mod metrics;
 mod ocio;
 mod resize;
 mod vignette;
+mod working_space;

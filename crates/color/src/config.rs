@@ -34,6 +34,36 @@ pub const WORKING_SPACE_NAMES: &[&str] = &[
     "Linear",
 ];
 
+/// The config name that stands for Blender's own config (AgX, Filmic, Khronos PBR
+/// Neutral): the file `LUMAGRAPH_BLENDER_OCIO` names, else the copy of Blender 4.2's that
+/// `scripts/setup.sh` unpacks into `~/.cache/lumagraph/blender-ocio/4.2/`.
+pub const BLENDER: &str = "blender";
+
+/// Where [`BLENDER`] is.
+///
+/// # Errors
+/// No config there (the message says how to get one).
+pub fn blender_config() -> Result<PathBuf> {
+    let path = match std::env::var_os("LUMAGRAPH_BLENDER_OCIO") {
+        Some(p) if !p.is_empty() => PathBuf::from(p),
+        _ => std::env::var_os("XDG_CACHE_HOME")
+            .filter(|p| !p.is_empty())
+            .map(PathBuf::from)
+            .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
+            .unwrap_or_default()
+            .join("lumagraph/blender-ocio/4.2/config.ocio"),
+    };
+    if path.is_file() {
+        return Ok(path);
+    }
+    Err(Error(format!(
+        "OpenColorIO config {BLENDER}: Blender's config is not at {}: run `bash \
+         scripts/setup.sh` (it unpacks Blender 4.2's from the bpy wheel), or set \
+         LUMAGRAPH_BLENDER_OCIO to a Blender install's datafiles/colormanagement/config.ocio",
+        path.display()
+    )))
+}
+
 /// A loaded OpenColorIO config.
 #[derive(Clone)]
 pub struct ColorConfig {
@@ -54,8 +84,8 @@ impl std::fmt::Debug for ColorConfig {
 
 impl ColorConfig {
     /// The config `spec` names: empty for the one the `OCIO` environment variable names,
-    /// else [`DEFAULT_CONFIG`]; `ocio://NAME` for a built-in one; anything else a
-    /// `config.ocio` file, relative to `base`.
+    /// else [`DEFAULT_CONFIG`]; `ocio://NAME` for a built-in one; [`BLENDER`] for Blender's;
+    /// anything else a `config.ocio` file, relative to `base`.
     ///
     /// # Errors
     /// An unknown built-in name, a file that is missing or not a config (OpenColorIO's
@@ -68,6 +98,11 @@ impl ColorConfig {
             }
         } else {
             (spec.to_owned(), spec.to_owned())
+        };
+        let uri = if uri.trim() == BLENDER {
+            blender_config()?.to_string_lossy().into_owned()
+        } else {
+            uri
         };
         let config = if uri.starts_with("ocio://") {
             Config::create_from_builtin_config(&uri)
@@ -100,9 +135,40 @@ impl ColorConfig {
         })
     }
 
-    /// The config's name for lumagraph's working space, scene-linear Rec. 709.
+    /// The config's name for lumagraph's working space: scene-linear Rec. 709, or what
+    /// [`ColorConfig::with_working_space`] chose.
     pub fn working_space(&self) -> &str {
         &self.working
+    }
+
+    /// The same config with the working space (what an empty colour space name means)
+    /// the first of `names` the config has: a graph's working space
+    /// (`lumagraph_graph::WorkingSpace::ocio_names`).
+    ///
+    /// # Errors
+    /// A config with none of `names` (the message lists them).
+    pub fn with_working_space(mut self, names: &[&str]) -> Result<Self> {
+        self.working = names
+            .iter()
+            .find_map(|n| {
+                self.config
+                    .get_color_space(n)
+                    .map(|cs| cs.name().to_owned())
+            })
+            .ok_or_else(|| {
+                Error(format!(
+                    "OpenColorIO config {} has no colour space for the graph's working space \
+                     (looked for {})",
+                    self.source,
+                    names.join(", ")
+                ))
+            })?;
+        Ok(self)
+    }
+
+    /// The colour space the config's file rules give a file at `path`.
+    pub fn color_space_from_filepath(&self, path: &str) -> String {
+        self.config.color_space_from_filepath(path)
     }
 
     /// The active colour spaces, in the config's order.

@@ -15,7 +15,9 @@
 mod config;
 mod gpu;
 
-pub use config::{ColorConfig, DEFAULT_CONFIG, Error, Result, WORKING_SPACE_NAMES};
+pub use config::{
+    BLENDER, ColorConfig, DEFAULT_CONFIG, Error, Result, WORKING_SPACE_NAMES, blender_config,
+};
 pub use gpu::{GpuProgram, LutTexture, Slot};
 
 use std::sync::Arc;

@@ -60,6 +60,9 @@ pub struct DisplayTransform {
     pub look: Option<String>,
     /// Milliseconds the last image took to transform, and its size.
     pub last_cost: Option<(f64, u32, u32)>,
+    /// The graph's working space, what the images shown are in (the app keeps it the
+    /// document's).
+    pub working_space: lumagraph_graph::WorkingSpace,
     config: Option<(String, Result<ColorConfig, String>)>,
     processor: Option<(u64, Result<Processor, String>)>,
 }
@@ -165,11 +168,18 @@ impl DisplayTransform {
             return 0;
         };
         let mut h = DefaultHasher::new();
-        (&self.config_spec, display, &self.view, &self.look).hash(&mut h);
+        (
+            &self.config_spec,
+            display,
+            &self.view,
+            &self.look,
+            self.working_space,
+        )
+            .hash(&mut h);
         h.finish() | 1
     }
 
-    /// The processor from the working space to the chosen display and view (with the
+    /// The processor from the graph's working space to the chosen display and view (with the
     /// look), made when the choice changed; `None` when off or when it cannot be made
     /// (see [`DisplayTransform::error`]).
     pub fn processor(&mut self) -> Option<&Processor> {
@@ -177,8 +187,11 @@ impl DisplayTransform {
         let key = self.key();
         if self.processor.as_ref().is_none_or(|(k, _)| *k != key) {
             let (view, look) = (self.view.clone(), self.look.clone().unwrap_or_default());
+            let names = self.working_space.ocio_names();
             let made = self.config().and_then(|c| {
-                c.display_processor("", &display, &view, &look)
+                c.clone()
+                    .with_working_space(names)
+                    .and_then(|c| c.display_processor("", &display, &view, &look))
                     .map_err(|e| e.0)
             });
             self.processor = Some((key, made));

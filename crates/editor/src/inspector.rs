@@ -125,6 +125,79 @@ fn value_widget(
     label: egui::Id,
 ) -> Option<ParamValue> {
     let tip = tooltip(def);
+    if let (ParamType::Float { .. } | ParamType::Int { .. }, ParamValue::Str(text)) =
+        (&def.ty, current)
+    {
+        return expression_widget(ui, def, text, &tip, label);
+    }
+    number_or_other(ui, def, current, &tip, label)
+}
+
+/// A number becomes a frame expression from its slider's context menu.
+fn expression_menu(r: &egui::Response, current: &ParamValue) -> Option<ParamValue> {
+    let mut to_expression = None;
+    r.context_menu(|ui| {
+        if ui
+            .button("Frame expression")
+            .on_hover_text("animate it: `frame` (or `$F`) is the frame number")
+            .clicked()
+        {
+            to_expression = Some(ParamValue::Str(current.to_string()));
+            ui.close();
+        }
+    });
+    to_expression
+}
+
+/// A number param written as a frame expression: a text field, with its value at the
+/// default frame (or the error) beside it, and a button back to a plain number.
+fn expression_widget(
+    ui: &mut Ui,
+    def: &ParamDef,
+    text: &str,
+    tip: &str,
+    label: egui::Id,
+) -> Option<ParamValue> {
+    let mut edited = text.to_owned();
+    let r = ui
+        .add(egui::TextEdit::singleline(&mut edited).desired_width(140.0))
+        .on_hover_text(format!(
+            "{tip}\na frame expression: `frame` (or `$F`) is the frame number"
+        ))
+        .labelled_by(label);
+    let value = lumagraph_graph::expr::evaluate(text, lumagraph_graph::expr::DEFAULT_FRAME);
+    match &value {
+        Ok(v) => ui.weak(format!(
+            "= {v} at frame {}",
+            lumagraph_graph::expr::DEFAULT_FRAME
+        )),
+        Err(e) => ui
+            .colored_label(ui.visuals().error_fg_color, "error")
+            .on_hover_text(e),
+    };
+    if ui
+        .small_button("123")
+        .on_hover_text("back to a plain number (its value at the default frame)")
+        .clicked()
+    {
+        let v = value.unwrap_or(0.0);
+        #[expect(clippy::cast_possible_truncation, reason = "a param's small integer")]
+        return Some(match def.ty {
+            ParamType::Int { .. } => ParamValue::Int(v.round() as i64),
+            _ => ParamValue::Float(v),
+        });
+    }
+    (r.lost_focus() && edited != text).then_some(ParamValue::Str(edited))
+}
+
+fn number_or_other(
+    ui: &mut Ui,
+    def: &ParamDef,
+    current: &ParamValue,
+    tip: &str,
+    label: egui::Id,
+) -> Option<ParamValue> {
+    let tip = tip.to_owned();
     match &def.ty {
         ParamType::Float { min, max, .. } => {
             let mut v = current.as_f64().unwrap_or(*min);
@@ -137,6 +210,9 @@ fn value_widget(
                 )
                 .on_hover_text(tip)
                 .labelled_by(label);
+            if let Some(e) = expression_menu(&r, current) {
+                return Some(e);
+            }
             r.changed().then_some(ParamValue::Float(v))
         }
         ParamType::Int { min, max, .. } => {
@@ -148,6 +224,9 @@ fn value_widget(
                 .add(egui::Slider::new(&mut v, *min..=*max))
                 .on_hover_text(tip)
                 .labelled_by(label);
+            if let Some(e) = expression_menu(&r, current) {
+                return Some(e);
+            }
             r.changed().then_some(ParamValue::Int(v))
         }
         ParamType::Bool { .. } => {

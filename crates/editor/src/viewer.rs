@@ -239,7 +239,8 @@ impl ImageView {
 
     /// What the viewer shows of `image` (of type `ty`): through the display transform when
     /// one is chosen, the port is not display-encoded and false colour is off; else as
-    /// [`display_rgba`] shows it.
+    /// [`display_rgba`] shows it (linear colour converted to Rec. 709 first in a graph with
+    /// another working space).
     pub fn shown_rgba(&mut self, image: &Image, ty: PortType) -> Vec<u8> {
         if ty != PortType::LdrColor
             && !self.false_colour
@@ -250,6 +251,21 @@ impl ImageView {
             let ms = t.elapsed().as_secs_f64() * 1e3;
             self.display.last_cost = Some((ms, image.width, image.height));
             return rgba;
+        }
+        if ty != PortType::LdrColor
+            && self.display.working_space != lumagraph_graph::WorkingSpace::Rec709
+        {
+            // Shown sRGB-encoded, which is Rec. 709's encoding: another working space's
+            // colour is converted first (false colour reads luminance in Rec. 709 too).
+            let mut rec709 = image.clone();
+            if lumagraph_render::nodes::ocio::working_to_rec709(
+                self.display.working_space,
+                &mut rec709,
+            )
+            .is_ok()
+            {
+                return display_rgba(&rec709, ty, self.exposure, self.false_colour);
+            }
         }
         display_rgba(image, ty, self.exposure, self.false_colour)
     }

@@ -34,15 +34,30 @@ impl Chromaticities {
     /// Whether these are Rec. 709's primaries and white (to the 1e-4 a file's rounded
     /// values allow).
     pub fn is_rec709(&self) -> bool {
+        self.is_near(&REC709)
+    }
+
+    /// Whether these are `other`'s primaries and white, to 1e-4.
+    pub fn is_near(&self, other: &Self) -> bool {
         let pairs = [
-            (self.red, REC709.red),
-            (self.green, REC709.green),
-            (self.blue, REC709.blue),
-            (self.white, REC709.white),
+            (self.red, other.red),
+            (self.green, other.green),
+            (self.blue, other.blue),
+            (self.white, other.white),
         ];
         pairs
             .iter()
             .all(|(a, b)| (a[0] - b[0]).abs() < 1e-4 && (a[1] - b[1]).abs() < 1e-4)
+    }
+
+    /// The chromaticities of the eight numbers of [`Chromaticities::to_array`].
+    pub fn from_array(a: [f32; 8]) -> Self {
+        Self {
+            red: [a[0], a[1]],
+            green: [a[2], a[3]],
+            blue: [a[4], a[5]],
+            white: [a[6], a[7]],
+        }
     }
 
     /// The eight numbers in the attribute's order: red, green, blue, white, x then y.

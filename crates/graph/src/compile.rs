@@ -167,6 +167,13 @@ pub fn compile(
         plan.aliases = flat.aliases;
         return Ok(plan);
     }
+    let converted;
+    let graph = if graph.working_space == crate::WorkingSpace::default() {
+        graph
+    } else {
+        converted = crate::working_space::with_conversions(graph, registry);
+        &converted
+    };
     let mut errors = Vec::new();
     let checked = check(graph, registry, &mut errors);
     let n = graph.nodes.len();
@@ -588,6 +595,7 @@ fn build_plan(
         slots,
         left_out,
         aliases: Vec::new(),
+        working_space: graph.working_space,
     }
 }
 

@@ -6,7 +6,6 @@
 //! renames it over, so a failed save never leaves a half-written graph.
 
 use std::collections::BTreeMap;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -16,14 +15,16 @@ use crate::error::{ErrorKind, GraphError, Pos};
 use crate::group::{GroupDecl, Interface};
 use crate::registry::Registry;
 use crate::types::ParamValue;
+use crate::working_space::WorkingSpace;
 
 /// The newest graph file version this build reads and writes. Version 2 added node kinds
 /// declared in the file (`kinds`), version 3 node groups (`groups`, `interface`), version
 /// 4 the editor's frames, node colours and reroute points (`frames`, a node's `color`, an
-/// edge's `via`). A graph is written
+/// edge's `via`), version 5 a working space other than Rec. 709 (`working_space`). A graph
+/// is written
 /// with the oldest version that holds it: without any of these, version 1, which every
 /// build reads.
-pub const VERSION: u32 = 4;
+pub const VERSION: u32 = 5;
 
 /// An sRGB colour the editor draws with: `(r, g, b)`, each 0 to 255.
 pub type Rgb = (u8, u8, u8);
@@ -130,6 +131,8 @@ struct GraphFile {
     edges: Vec<Edge>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     frames: Vec<FrameDecl>,
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    working_space: String,
 }
 
 #[derive(Deserialize)]
@@ -237,6 +240,9 @@ pub struct Graph {
     pub edges: Vec<Edge>,
     /// The editor's frames (version 4), in file order.
     pub frames: Vec<FrameDecl>,
+    /// The colour space of its colour images (version 5 when not Rec. 709;
+    /// [`crate::working_space`]).
+    pub working_space: WorkingSpace,
     /// The file the graph was loaded from.
     pub origin: Option<Origin>,
 }
@@ -249,6 +255,7 @@ impl PartialEq for Graph {
             && self.nodes == other.nodes
             && self.edges == other.edges
             && self.frames == other.frames
+            && self.working_space == other.working_space
     }
 }
 
@@ -312,6 +319,17 @@ impl Graph {
                 "node groups (`groups`, `interface`) need `version: 3`".into(),
             )));
         }
+        let working_space = match file.working_space.as_str() {
+            "" => WorkingSpace::default(),
+            name => {
+                if probe.version < 5 {
+                    return Err(GraphError::new(ErrorKind::Source(
+                        "a working space (`working_space`) needs `version: 5`".into(),
+                    )));
+                }
+                WorkingSpace::parse(name).map_err(|e| GraphError::new(ErrorKind::Source(e)))?
+            }
+        };
         Ok(Self {
             interface: file.interface,
             groups: file.groups,
@@ -319,6 +337,7 @@ impl Graph {
             nodes: file.nodes,
             edges: file.edges,
             frames: file.frames,
+            working_space,
             origin: None,
         })
     }
@@ -327,7 +346,9 @@ impl Graph {
     /// edge per line), with the comments of the file it was loaded from where they belong
     /// (see [`crate::layout`]).
     pub fn to_ron(&self) -> String {
-        let version = if !self.frames.is_empty()
+        let version = if self.working_space != WorkingSpace::default() {
+            5
+        } else if !self.frames.is_empty()
             || self.nodes.iter().any(|n| n.color.is_some())
             || self.edges.iter().any(|e| !e.via.is_empty())
         {
@@ -447,33 +468,5 @@ pub fn read_text(path: &Path) -> std::io::Result<String> {
     std::fs::read_to_string(path)
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same folder and a rename,
-/// so readers see either the old file or the whole new one.
-///
-/// # Errors
-/// When the temporary file cannot be created, written or renamed.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".lumagraph-").suffix(".tmp");
-    // Keep the permissions of the file being replaced; a new file gets the usual rw-r--r--
-    // rather than the temporary file's private rw-------.
-    let permissions = match std::fs::metadata(path) {
-        Ok(m) => Some(m.permissions()),
-        #[cfg(unix)]
-        Err(_) => Some(std::os::unix::fs::PermissionsExt::from_mode(0o644)),
-        #[cfg(not(unix))]
-        Err(_) => None,
-    };
-    if let Some(p) = permissions {
-        builder.permissions(p);
-    }
-    let mut tmp = builder.tempfile_in(dir)?;
-    tmp.write_all(bytes)?;
-    tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
-}
+// The one atomic file writer lives in a leaf crate that the scene crate shares.
+pub use lumagraph_files::write_atomic;

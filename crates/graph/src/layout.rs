@@ -214,6 +214,9 @@ pub(crate) fn write(graph: &Graph, version: u32) -> String {
         let _ = writeln!(out, "{line}");
     }
     let _ = writeln!(out, "(\n    version: {version},");
+    if graph.working_space != crate::WorkingSpace::default() {
+        let _ = writeln!(out, "    working_space: {:?},", graph.working_space.name());
+    }
     if !graph.interface.is_empty() {
         let _ = writeln!(
             out,

@@ -13,6 +13,7 @@ mod compile;
 pub mod custom;
 pub mod docs;
 mod error;
+pub mod expr;
 mod graph;
 pub mod group;
 pub mod layout;
@@ -21,6 +22,7 @@ mod plan;
 pub mod registry;
 pub mod tile;
 mod types;
+pub mod working_space;
 
 pub use compile::{CompileOptions, Params, compile, resolve_params};
 pub use error::{ErrorKind, GraphError, GraphErrors, Pos};
@@ -30,3 +32,4 @@ pub use graph::{
 pub use plan::{LeftOut, Pass, Plan, Slot, TextureDesc, TextureId};
 pub use registry::{Category, NodeKind, Registry};
 pub use types::{Extent, ParamType, ParamValue, PortType, TexFormat};
+pub use working_space::WorkingSpace;

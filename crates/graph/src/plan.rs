@@ -125,6 +125,8 @@ pub struct Plan {
     /// Outputs of group nodes (`"glow.color"`) with the inner output each shows
     /// (`"glow/tonemap.output"`); see [`crate::group`].
     pub aliases: Vec<(String, String)>,
+    /// The colour space of the graph's colour images ([`crate::working_space`]).
+    pub working_space: crate::WorkingSpace,
 }
 
 impl Plan {
@@ -169,6 +171,14 @@ fn mib(bytes: u64) -> String {
 
 impl fmt::Display for Plan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.working_space != crate::WorkingSpace::default() {
+            writeln!(
+                f,
+                "working space: {} (the compiler's conversions are the passes named *_to_acescg \
+                 and *_to_rec709)",
+                self.working_space
+            )?;
+        }
         writeln!(f, "passes ({}), in order:", self.passes.len())?;
         let w = self.passes.iter().map(|p| p.node.len()).max().unwrap_or(0);
         let k = self

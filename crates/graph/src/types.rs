@@ -227,6 +227,26 @@ impl ParamType {
     /// A message saying what was expected when the value does not fit.
     pub fn check(&self, value: &ParamValue) -> Result<ParamValue, String> {
         match (self, value) {
+            // A number written as a frame expression: its value at the default frame (a
+            // sequence writes each frame's number in first, `crate::expr::substitute`).
+            (Self::Float { .. }, ParamValue::Str(text)) => {
+                let v = crate::expr::evaluate(text, crate::expr::DEFAULT_FRAME)
+                    .map_err(|e| format!("expected float or a frame expression: {e}"))?;
+                self.check(&ParamValue::Float(v))
+                    .map_err(|e| format!("{text:?} gives {v}: {e}"))
+            }
+            (Self::Int { .. }, ParamValue::Str(text)) => {
+                let v = crate::expr::evaluate(text, crate::expr::DEFAULT_FRAME)
+                    .map_err(|e| format!("expected integer or a frame expression: {e}"))?
+                    .round();
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    reason = "a finite value, range-checked as an integer below"
+                )]
+                let i = v.clamp(i64::MIN as f64, i64::MAX as f64) as i64;
+                self.check(&ParamValue::Int(i))
+                    .map_err(|e| format!("{text:?} gives {v}: {e}"))
+            }
             (Self::Float { min, max, .. }, ParamValue::Float(_) | ParamValue::Int(_)) => {
                 let v = value.as_f64().unwrap_or(f64::NAN);
                 if !v.is_finite() {

@@ -278,7 +278,10 @@ fn param_of_wrong_type() {
     );
     let (k, m) = single_error(&graph_text(&nodes, GOOD_EDGES));
     assert!(matches!(k, ErrorKind::BadParam { .. }), "{m}");
-    assert!(m.contains("expected float, found string"), "{m}");
+    assert!(
+        m.contains("expected float or a frame expression") && m.contains("\"bright\""),
+        "{m}"
+    );
 }
 
 #[test]

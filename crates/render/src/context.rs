@@ -180,11 +180,74 @@ impl GpuContext {
     /// writes the WGSL source and line of every statement into the SPIR-V (for shader
     /// debuggers), which naga does in time quadratic in the source's length; the path
     /// tracer's process then started 0.4–0.6 s slower on lavapipe (three runs each).
+    ///
+    /// It first switches off what would print a bogus error on a machine without a session
+    /// runtime folder ([`Self::quiet_device_select`]).
     pub fn instance_descriptor() -> wgpu::InstanceDescriptor {
+        Self::quiet_device_select();
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = wgpu::Backends::PRIMARY;
         desc.flags = wgpu::InstanceFlags::from_build_config() - wgpu::InstanceFlags::DEBUG;
         desc.with_env()
+    }
+
+    /// Keeps libwayland from printing `error: XDG_RUNTIME_DIR is invalid or not set in the
+    /// environment.` (once per Vulkan instance) where nothing failed: on a render box, in a
+    /// container or a batch job, which have no session runtime folder.
+    ///
+    /// Mesa's Vulkan device-select layer, which the Vulkan loader loads into every instance,
+    /// asks Wayland for its display while it orders the devices (Debian 12's Mesa 22.3 does
+    /// so even without `WAYLAND_DISPLAY`), and libwayland prints that line when
+    /// `XDG_RUNTIME_DIR` is unset or not an absolute path. lumagraph chooses its adapter
+    /// itself, so there the layer is switched off by its own switch, `NODEVICE_SELECT=1`,
+    /// read by the loader when an instance is created. Pointing `XDG_RUNTIME_DIR` at a
+    /// private empty folder silences it too, but that variable is read by everything else
+    /// in the process and its children (D-Bus, audio, the editor's window system), which
+    /// would then look for their sockets there, and the folder would outlive the process;
+    /// `NODEVICE_SELECT` concerns the layer only. Nothing is changed when the user set
+    /// `NODEVICE_SELECT`, or chose a device through the layer (`MESA_VK_DEVICE_SELECT`,
+    /// `DRI_PRIME`), and nothing outside Linux and the BSDs.
+    ///
+    /// It runs once per process: [`Self::instance_descriptor`] calls it before every
+    /// instance lumagraph creates; a program calls it at its start, before it starts threads
+    /// (`lumagraph::cli::main_with` does, and the Python module when it is imported), so the
+    /// variable is set before anything else can read it.
+    pub fn quiet_device_select() {
+        static ONCE: std::sync::Once = std::sync::Once::new();
+        ONCE.call_once(|| {
+            if !cfg!(all(
+                unix,
+                not(any(
+                    target_os = "macos",
+                    target_os = "ios",
+                    target_os = "android"
+                ))
+            )) {
+                return;
+            }
+            let runtime_dir = std::env::var_os("XDG_RUNTIME_DIR")
+                .is_some_and(|d| std::path::Path::new(&d).is_absolute());
+            let chosen = ["NODEVICE_SELECT", "MESA_VK_DEVICE_SELECT", "DRI_PRIME"]
+                .iter()
+                .any(|v| std::env::var_os(v).is_some());
+            if runtime_dir || chosen {
+                return;
+            }
+            // SAFETY: setting a variable races with another thread reading the environment
+            // at the same moment. Rust code reads it under std's environment lock, which
+            // `set_var` takes too; the race left is with C code calling `getenv`. This runs
+            // once, before lumagraph's first instance (so before the Vulkan loader and the
+            // driver's threads exist), and the programs call it first thing: the command
+            // line before it starts a thread, the Python module at import under the GIL
+            // (where `os.environ[...] = ...` would set it just the same). A program that
+            // opens a context while threads of its own read the environment from C, on a
+            // machine without XDG_RUNTIME_DIR, can set NODEVICE_SELECT itself; this then
+            // changes nothing.
+            #[expect(unsafe_code, reason = "set_var once, before the first Vulkan instance")]
+            unsafe {
+                std::env::set_var("NODEVICE_SELECT", "1");
+            }
+        });
     }
 
     /// Opens a device on `adapter` with the features lumagraph uses where available.

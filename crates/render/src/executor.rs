@@ -129,6 +129,12 @@ impl Executor {
         // come back as errors, not as wgpu's panic.
         let memory = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let validation = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        // Nodes that read or write colour with a colour space (ImageInput, the
+        // OpenColorIO nodes, the outputs) take the plan's working space.
+        let paths = &Resources {
+            working_space: plan.working_space,
+            ..paths.clone()
+        };
         let nodes = plan
             .passes
             .iter()
@@ -817,7 +823,8 @@ fn every_frame(plan: &Plan) -> Vec<bool> {
 
 /// Whether two plans run the same passes on the same textures (params aside).
 fn same_structure(a: &Plan, b: &Plan) -> bool {
-    let passes = a.passes.len() == b.passes.len()
+    let passes = a.working_space == b.working_space
+        && a.passes.len() == b.passes.len()
         && a.passes.iter().zip(&b.passes).all(|(p, q)| {
             p.node == q.node
                 && p.kind.name == q.kind.name

@@ -1,5 +1,6 @@
 //! Frame sequences in graphs: the params that hold a frame-number pattern (`####`, `%04d`,
-//! `$F4`: [`lumagraph_footage::sequence`]) and the graph at a given frame.
+//! `$F4`: [`lumagraph_footage::sequence`]) or, for numbers, a frame expression
+//! (`"0.25 * frame"`: [`lumagraph_graph::expr`]), and the graph at a given frame.
 //!
 //! The command line (`render --frames`), the session ([`crate::session::Session::set_frame`],
 //! the Python package's `render_frames`) and the editor's frame control all substitute
@@ -8,7 +9,7 @@
 use std::path::PathBuf;
 
 use lumagraph_footage::sequence;
-use lumagraph_graph::{Graph, ParamType, ParamValue, Registry};
+use lumagraph_graph::{Graph, ParamType, ParamValue, Registry, expr};
 
 /// One param whose value holds a frame pattern.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -21,6 +22,9 @@ pub struct Patterned {
     pub template: String,
     /// Whether it names a file the graph reads (a path param of a node that is no sink).
     pub input_file: bool,
+    /// Whether it is a number param written as a frame expression
+    /// ([`lumagraph_graph::expr`]), not a text with a frame-number pattern.
+    pub expression: bool,
 }
 
 /// Every frame-numbered param of a graph.
@@ -55,12 +59,24 @@ impl FrameParams {
                     continue;
                 };
                 let is_path = matches!(def.ty, ParamType::Path { .. });
-                if sequence::has_pattern(value) {
+                let is_number = matches!(def.ty, ParamType::Float { .. } | ParamType::Int { .. });
+                if is_number {
+                    if expr::uses_frame(value) {
+                        out.params.push(Patterned {
+                            node: node.id.clone(),
+                            param: def.name.to_owned(),
+                            template: value.clone(),
+                            input_file: false,
+                            expression: true,
+                        });
+                    }
+                } else if sequence::has_pattern(value) {
                     out.params.push(Patterned {
                         node: node.id.clone(),
                         param: def.name.to_owned(),
                         template: value.clone(),
                         input_file: is_path && !kind.sink,
+                        expression: false,
                     });
                 } else if kind.sink && is_path {
                     out.fixed_outputs.push((
@@ -91,7 +107,8 @@ impl FrameParams {
         }
         if self.is_empty() {
             return Err(format!(
-                "no param of {name} holds a frame pattern (`####`, `%04d`, `$F4`), so every \
+                "no param of {name} holds a frame pattern (`####`, `%04d`, `$F4`) or a frame \
+                 expression (`\"0.25 * frame\"` in a number), so every \
                  frame would be the same image"
             ));
         }
@@ -113,10 +130,12 @@ impl FrameParams {
         let mut g = graph.clone();
         for p in &self.params {
             if let Some(node) = g.nodes.iter_mut().find(|n| n.id == p.node) {
-                node.params.insert(
-                    p.param.clone(),
-                    ParamValue::Str(sequence::substitute(&p.template, frame)),
-                );
+                let value = if p.expression {
+                    expr::substitute(&p.template, frame)
+                } else {
+                    sequence::substitute(&p.template, frame)
+                };
+                node.params.insert(p.param.clone(), ParamValue::Str(value));
             }
         }
         g

@@ -4,6 +4,7 @@
 
 use std::io::Cursor;
 use std::path::Path;
+use std::sync::{Arc, Mutex, PoisonError};
 
 use lumagraph_footage::exr::{self as footage, LayerImage, Selection, Want};
 use lumagraph_graph::{Extent, write_atomic};
@@ -124,6 +125,49 @@ pub fn load_exr_layer(path: &Path, selection: &Selection, want: Want) -> Result<
     footage::read_layer(path, selection, want).map_err(footage_error)
 }
 
+/// What each image-file source of a graph read, by node and output port: the layer, its
+/// part and header ([`footage::Source`]), recorded when the node loads a file, for the
+/// sinks downstream to write it back as it was (`Output`, `MultiLayerOutput`). Shared by
+/// the nodes of an executor through [`crate::Resources`].
+#[derive(Clone, Debug, Default)]
+pub struct Sources(Arc<Mutex<Vec<SourceEntry>>>);
+
+/// A node, one of its output ports, and what the port holds.
+type SourceEntry = (String, String, Arc<footage::Source>);
+
+impl Sources {
+    fn entries(&self) -> std::sync::MutexGuard<'_, Vec<SourceEntry>> {
+        self.0.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// Records what `node`'s `port` holds: the layer `selection` names of the EXR file at
+    /// `path`, read as `want`; nothing for another kind of file (or one whose header
+    /// cannot be read, which the load has reported).
+    pub fn record(&self, node: &str, port: &str, path: &Path, selection: &Selection, want: Want) {
+        let source = extension(path)
+            .eq("exr")
+            .then(|| {
+                let info = footage::inspect(path).ok()?;
+                let layer = selection.find(&info).ok()?;
+                footage::Source::of(path, &layer, want).ok()
+            })
+            .flatten();
+        let mut entries = self.entries();
+        entries.retain(|(n, p, _)| !(n == node && p == port));
+        if let Some(source) = source {
+            entries.push((node.to_owned(), port.to_owned(), Arc::new(source)));
+        }
+    }
+
+    /// What `node`'s `port` holds, if it was read from an EXR file.
+    pub fn get(&self, node: &str, port: &str) -> Option<Arc<footage::Source>> {
+        self.entries()
+            .iter()
+            .find(|(n, p, _)| n == node && p == port)
+            .map(|(_, _, s)| Arc::clone(s))
+    }
+}
+
 fn footage_error(e: footage::Error) -> RenderError {
     RenderError::image(&e.path, e.message)
 }
@@ -179,7 +223,14 @@ pub fn encode_exr(image: &Image, half: bool) -> Result<Vec<u8>> {
         name: String::new(),
         channels: ["R", "G", "B", "A"].map(str::to_owned).to_vec(),
         values: image.pixels.iter().flatten().copied().collect(),
-        half,
+        samples: vec![
+            if half {
+                footage::SampleKind::Half
+            } else {
+                footage::SampleKind::Float
+            };
+            4
+        ],
     };
     footage::encode_layers(
         image.width as usize,

@@ -322,8 +322,9 @@ impl Session {
     }
 
     /// The image on output `"node.port"` as a PNG file's bytes, for display: a display
-    /// image (`LdrColor`, after tone mapping) as it is, a linear one sRGB-encoded; both
-    /// clipped to [0, 1], as an `Output` node writes a PNG.
+    /// image (`LdrColor`, after tone mapping) as it is, a linear one sRGB-encoded (from
+    /// Rec. 709, converted from the graph's working space); both clipped to [0, 1], as an
+    /// `Output` node writes a PNG.
     ///
     /// # Errors
     /// As [`Session::read`].
@@ -340,7 +341,12 @@ impl Session {
             // Stored as the PNG holds it.
             self.exec.read_raw(t.id)?
         } else {
-            to_rgba8(&self.exec.read(t.id)?, t.ty != PortType::LdrColor)
+            let mut image = self.exec.read(t.id)?;
+            let linear = t.ty != PortType::LdrColor;
+            if linear {
+                crate::nodes::ocio::working_to_rec709(self.exec.plan().working_space, &mut image)?;
+            }
+            to_rgba8(&image, linear)
         };
         Ok(encode_png(w, h, &rgba8)?)
     }

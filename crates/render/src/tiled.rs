@@ -4,14 +4,16 @@
 //! The plan is compiled at the window's size ([`crate::NodeLibrary::compile_window`]); each
 //! tile moves the window ([`Executor::set_origin`]), renders every frame, and its sinks' images
 //! (held, not written: [`Executor::hold_sinks`]) have their cores copied into whole-image
-//! canvases, written once at the end as the `Output` nodes would have. The tile geometry and
-//! the apron are [`lumagraph_graph::tile`]'s: a plan whose nodes all read within a bounded
-//! distance gives cores equal to the whole image's pixels.
+//! canvases, written once at the end as the sinks would have. Only sinks that write one
+//! image file ([`InputDef::image_file`], `Output`) can be merged so; a plan with another sink
+//! is refused. The tile geometry and the apron are [`lumagraph_graph::tile`]'s: a plan whose
+//! nodes all read within a bounded distance gives cores equal to the whole image's pixels.
 
 use std::path::PathBuf;
 
+use lumagraph_graph::registry::InputDef;
 use lumagraph_graph::tile::{Tile, Untileable};
-use lumagraph_graph::{Extent, Plan, TexFormat};
+use lumagraph_graph::{Extent, Plan, TexFormat, TextureId};
 
 use crate::context::{GpuContext, human_bytes};
 use crate::error::{RenderError, Result};
@@ -45,8 +47,8 @@ pub struct Tiling {
 /// [`MEMORY_BUDGET`], with the largest power-of-two tile side that fits both.
 ///
 /// # Errors
-/// A plan that must be tiled but cannot (the node that needs the whole image), or that
-/// cannot be tiled small enough.
+/// A plan that must be tiled but cannot (the node that needs the whole image, or a sink
+/// that writes no single image file), or that cannot be tiled small enough.
 pub fn plan_tiling(
     ctx: &GpuContext,
     plan: &Plan,
@@ -83,6 +85,7 @@ pub fn plan_tiling(
         ),
     };
     let apron = lumagraph_graph::tile::apron(plan).map_err(|e| untileable(&e, &why))?;
+    image_sinks(plan).map_err(|e| untileable(&e, &why))?;
     let per_pixel = bytes.div_ceil(image.pixels().max(1));
     let window = |tile: u32| {
         Extent::new(
@@ -129,6 +132,35 @@ fn untileable(e: &Untileable, why: &str) -> RenderError {
     ))
 }
 
+/// The sinks of `plan` with the texture each writes as its one image file
+/// ([`InputDef::image_file`]), as `(pass index, texture)`; a sink whose marked input is
+/// left unconnected writes nothing and is left out.
+///
+/// # Errors
+/// The first sink that writes no single image file (`MultiLayerOutput` writes several
+/// images into one): a tiled render has nothing to paste its tiles into.
+fn image_sinks(plan: &Plan) -> std::result::Result<Vec<(usize, TextureId)>, Untileable> {
+    let mut sinks = Vec::new();
+    for (p, pass) in plan.passes.iter().enumerate() {
+        if !pass.kind.sink {
+            continue;
+        }
+        let Some(port): Option<&InputDef> = pass.kind.image_file_input() else {
+            return Err(Untileable {
+                node: pass.node.clone(),
+                kind: pass.kind.name.to_owned(),
+                reason: "it does not write one image file for the tiles to be pasted into \
+                         (Output does)"
+                    .to_owned(),
+            });
+        };
+        if let Some(texture) = pass.input(port.name) {
+            sinks.push((p, texture));
+        }
+    }
+    Ok(sinks)
+}
+
 /// One sink's whole-image canvas.
 struct Canvas {
     node: String,
@@ -155,7 +187,8 @@ pub enum Ended {
 /// render (`Ok(None)`, nothing written).
 ///
 /// # Errors
-/// A sink that is not an `Output` node, memory for the canvases, a failing node or file.
+/// A sink that writes no single image file ([`InputDef::image_file`]), memory for the
+/// canvases, a failing node or file.
 pub fn render(
     exec: &mut Executor,
     tiling: &Tiling,
@@ -166,21 +199,10 @@ pub fn render(
 ) -> Result<Ended> {
     exec.hold_sinks(true);
     let mut canvases: Vec<(usize, Canvas, lumagraph_graph::TexFormat)> = Vec::new();
-    for (p, pass) in exec.plan().passes.iter().enumerate() {
-        if !pass.kind.sink {
-            continue;
-        }
-        if pass.kind.name != "Output" {
-            return Err(RenderError::Gpu(format!(
-                "node \"{}\" ({}) writes no image: it cannot run tile by tile",
-                pass.node, pass.kind.name
-            )));
-        }
-        let format = pass
-            .input("color")
-            .map_or(lumagraph_graph::TexFormat::Rgba32Float, |t| {
-                exec.plan().textures[t.0].format
-            });
+    let plan = exec.plan();
+    for (p, texture) in image_sinks(plan).map_err(|e| RenderError::Gpu(e.to_string()))? {
+        let pass = &plan.passes[p];
+        let format = plan.textures[texture.0].format;
         canvases.push((
             p,
             Canvas {
@@ -303,12 +325,13 @@ pub fn render_tiles(
 }
 
 /// Renders tiles `first..end` of `tiling` (see [`render_tiles`]) into a
-/// [`crate::tile_set::TileSet`] of every `Output` node's cores, for `key` (the render's;
-/// [`crate::checkpoint::render_key`]) and a whole image of `whole`; `None` when `progress`
-/// stopped it.
+/// [`crate::tile_set::TileSet`] of every image sink's cores (`Output`'s), for `key` (the
+/// render's; [`crate::checkpoint::render_key`]) and a whole image of `whole`; `None` when
+/// `progress` stopped it.
 ///
 /// # Errors
-/// A sink that is not an `Output` node, a range outside the tiles, a failing node.
+/// A sink that writes no single image file ([`InputDef::image_file`]), a range outside the
+/// tiles, a failing node.
 pub fn render_set(
     exec: &mut Executor,
     tiling: &Tiling,
@@ -326,17 +349,10 @@ pub fn render_set(
     }
     let mut outputs = Vec::new();
     let mut passes = Vec::new();
-    for (p, pass) in exec.plan().passes.iter().enumerate() {
-        if !pass.kind.sink {
-            continue;
-        }
-        let Some(input) = pass.input("color").filter(|_| pass.kind.name == "Output") else {
-            return Err(RenderError::Gpu(format!(
-                "node \"{}\" ({}) writes no image: it cannot run tile by tile",
-                pass.node, pass.kind.name
-            )));
-        };
-        let desc = &exec.plan().textures[input.0];
+    let plan = exec.plan();
+    for (p, input) in image_sinks(plan).map_err(|e| RenderError::Gpu(e.to_string()))? {
+        let pass = &plan.passes[p];
+        let desc = &plan.textures[input.0];
         passes.push(p);
         outputs.push(crate::tile_set::TileOutput {
             node: pass.node.clone(),
@@ -481,4 +497,38 @@ fn paste(
         canvas.bytes[dst..dst + core_row].copy_from_slice(&held.bytes[src..src + core_row]);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use lumagraph_graph::{CompileOptions, Edge, Extent, Graph, Node, ParamValue, Plan, Registry};
+
+    fn plan(sink: &str) -> Plan {
+        let mut g = Graph::new();
+        g.nodes
+            .push(Node::new("in", "ImageInput").with("path", ParamValue::Str("in.exr".into())));
+        g.nodes.push(Node::new("out", sink));
+        g.edges.push(Edge::new("in.color", "out.color"));
+        let options = CompileOptions {
+            source_extent: &|_, _| Ok(Extent::new(8, 8)),
+            keep: &[],
+        };
+        lumagraph_graph::compile(&g, &Registry::with_builtins(), &options).unwrap()
+    }
+
+    /// `Output` writes its `color` as one file, which a tiled render pastes its tiles
+    /// into; `MultiLayerOutput` writes several images into one file and is refused, by
+    /// the kinds' declarations, not their names.
+    #[test]
+    fn only_sinks_that_write_one_image_file_run_tile_by_tile() {
+        let output = plan("Output");
+        let color = output.passes[1].input("color").unwrap();
+        assert_eq!(super::image_sinks(&output), Ok(vec![(1, color)]));
+        let refused = super::image_sinks(&plan("MultiLayerOutput")).unwrap_err();
+        assert_eq!(
+            refused.to_string(),
+            "node \"out\" (MultiLayerOutput) cannot run tile by tile: it does not write one \
+             image file for the tiles to be pasted into (Output does)"
+        );
+    }
 }

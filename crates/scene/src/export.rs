@@ -191,9 +191,9 @@ enum EnvironmentOut {
     },
 }
 
-/// `bytes` to `path` atomically (the repository's one writer, [`lumagraph_graph::write_atomic`]).
+/// `bytes` to `path` atomically (the repository's one writer, [`lumagraph_files::write_atomic`]).
 fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
-    lumagraph_graph::write_atomic(path, bytes).map_err(|source| {
+    lumagraph_files::write_atomic(path, bytes).map_err(|source| {
         SceneError::new(ErrorKind::Io {
             what: "export file",
             source,

@@ -65,7 +65,7 @@ pub struct GpuScene {
     pub vertex_alpha_min: Vec<u8>,
     /// For each GPU triangle, its index in [`Scene::triangles`] (CPU side only).
     pub tri_source: Vec<u32>,
-    /// For each GPU sphere, its index in [`Scene::spheres`] (CPU side only).
+    /// For each GPU shape (`shapes`), its index in [`Scene::shapes`] (CPU side only).
     pub shape_source: Vec<u32>,
     /// The instances of the scene's instanced meshes, in top-level BVH order (uploaded in
     /// `bvh_nodes` after the nodes, two node slots each: see [`crate::bvh`]). Their meshes'

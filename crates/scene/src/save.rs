@@ -71,7 +71,7 @@ pub fn write(original: &str, edited: &SceneFile) -> Result<String, SceneError> {
 /// As [`write()`], and when the file cannot be written; errors name `path`.
 pub fn save(path: &Path, original: &str, edited: &SceneFile) -> Result<String, SceneError> {
     let text = write(original, edited).map_err(|e| e.in_file(path))?;
-    lumagraph_graph::write_atomic(path, text.as_bytes())
+    lumagraph_files::write_atomic(path, text.as_bytes())
         .map_err(|source| SceneError::new(ErrorKind::Write { source }).in_file(path))?;
     Ok(text)
 }

@@ -102,6 +102,7 @@ impl Editor {
             let aspect = image.height as f32 / image.width.max(1) as f32;
             let w = ui.available_width().min(2.0 * image.width as f32);
             let h = (w * aspect).clamp(64.0, 320.0);
+            self.view.display.working_space = self.doc.graph.working_space;
             if let Some(g) = self.view.show(ui, image, *ty, self.preview.stats.frames, h) {
                 self.move_camera(&g);
             }
@@ -205,6 +206,7 @@ impl Editor {
         });
         // Room for the controls and the readout under the image.
         let h = (ui.available_height() - 110.0).max(64.0);
+        self.view.display.working_space = self.doc.graph.working_space;
         if let Some(g) = self.view.show(ui, image, *ty, self.preview.stats.frames, h) {
             self.move_camera(&g);
         }

@@ -11,9 +11,16 @@
 //!
 //! What is not read is said: deep parts are refused naming the part, and everything a
 //! file holds is listed by [`inspect`] (`lumagraph info`).
+//!
+//! Writing: [`assemble`] makes the file to write of display-window images, each with the
+//! [`Source`] it was read from (names, windows, sample types, header attributes that stay
+//! true, and a note naming what does not), and [`encode`] writes it, one part or several.
 
+mod assemble;
 mod layers;
 mod read;
+mod source;
+mod windows;
 mod write;
 
 use std::fmt;
@@ -23,9 +30,15 @@ use exr::meta::BlockDescription;
 use exr::meta::attribute::{AttributeValue, LevelMode, SampleType};
 use exr::meta::header::Header;
 
+pub use assemble::{ImageIn, PartsChoice, Settings, TypeChoice, assemble};
 pub use layers::{Layer, LayerKind, Selection};
-pub use read::{LayerImage, RawChannel, Want, read_channels, read_layer};
-pub use write::{Compression, LayerOut, encode_layers};
+pub use read::{LayerImage, Primaries, RawChannel, Want, read_channels, read_layer, read_layer_in};
+pub use source::{Carried, Source};
+pub use windows::WindowChoice;
+pub use write::{
+    Compression, FileAttributes, FileOut, LayerOut, PartAttributes, PartOut, encode, encode_layers,
+    f32_to_half, half_to_f32,
+};
 
 use crate::color::Chromaticities;
 

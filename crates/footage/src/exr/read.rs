@@ -27,11 +27,12 @@ pub struct RawChannel {
 }
 
 impl RawChannel {
-    /// Sample `i` as a float (a uint converted, exact below 2²⁴).
+    /// Sample `i` as a float (a half exactly, NaN payloads kept; a uint converted, exact
+    /// below 2²⁴).
     pub fn value(&self, i: usize) -> f32 {
         let b = self.bits[i];
         match self.sample {
-            SampleKind::Half => half::f16::from_bits(u16::try_from(b).unwrap_or(0)).to_f32(),
+            SampleKind::Half => super::half_to_f32(u16::try_from(b).unwrap_or(0)),
             SampleKind::Float => f32::from_bits(b),
             #[expect(
                 clippy::cast_precision_loss,
@@ -125,6 +126,29 @@ impl LayerImage {
 /// What [`inspect`] refuses, a selection that names no layer, a layer that does not fit
 /// `want` (the message names the port it fits), a deep part, damaged pixel data.
 pub fn read_layer(path: &Path, selection: &Selection, want: Want) -> Result<LayerImage> {
+    read_layer_in(path, selection, want, Primaries::Rec709)
+}
+
+/// What [`read_layer_in`] does with a colour layer's primaries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Primaries {
+    /// Converted from the file's `chromaticities` to Rec. 709 ([`read_layer`]).
+    Rec709,
+    /// Kept as stored (luminance/chroma still reconstructed with the file's own
+    /// luminance weights): for a colour space the user names, which converts them.
+    AsStored,
+}
+
+/// [`read_layer`], with the colour layer's primaries converted or kept.
+///
+/// # Errors
+/// As [`read_layer`].
+pub fn read_layer_in(
+    path: &Path,
+    selection: &Selection,
+    want: Want,
+    primaries: Primaries,
+) -> Result<LayerImage> {
     let info = inspect(path)?;
     let layer = selection.find(&info).map_err(|e| Error::new(path, e))?;
     let part = &info.parts[layer.part];
@@ -153,9 +177,13 @@ pub fn read_layer(path: &Path, selection: &Selection, want: Want) -> Result<Laye
         ));
     }
     let raw = read_channels(path, &info, layer.part, &layer.channels)?;
-    let (values, channels) = combine(path, part, &layer, &raw, want)?;
+    let (mut values, channels) = combine(path, part, &layer, &raw, want)?;
     let mut notes = Vec::new();
+    if want == Want::Rgba && primaries == Primaries::Rec709 {
+        convert_primaries(path, part, &mut values)?;
+    }
     if want == Want::Rgba
+        && primaries == Primaries::Rec709
         && let Some(c) = part.chromaticities.filter(|c| !c.is_rec709())
     {
         notes.push(format!(
@@ -262,7 +290,7 @@ fn read_flat_part(path: &Path, part: usize) -> Result<Vec<RawChannel>> {
         .collect())
 }
 
-/// The layer's values over the data window: RGBA (converted to Rec. 709), one scalar, or
+/// The layer's values over the data window: RGBA (in the file's primaries), one scalar, or
 /// a vector padded to four.
 fn combine(
     path: &Path,
@@ -309,7 +337,6 @@ fn combine(
                     a,
                 ]);
             }
-            convert_primaries(path, part, &mut out)?;
             Ok((out, 4))
         }
         (Want::Rgba, LayerKind::Luminance { chroma, alpha }) => {
@@ -330,12 +357,11 @@ fn combine(
                 by: by.as_deref(),
                 a: a.as_deref(),
             };
-            let mut out: Vec<f32> = crate::yca::to_rgba(&input, weights)
+            let out: Vec<f32> = crate::yca::to_rgba(&input, weights)
                 .map_err(|e| Error::new(path, format!("{}: {e}", part.label())))?
                 .into_iter()
                 .flatten()
                 .collect();
-            convert_primaries(path, part, &mut out)?;
             Ok((out, 4))
         }
         (Want::Rgba, _) => Err(Error::new(path, "a scalar or vector layer is not colour")),

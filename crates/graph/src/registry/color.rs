@@ -9,14 +9,17 @@ use crate::types::{ParamType, ParamValue, PortType};
 pub(super) fn kinds() -> Vec<NodeKind> {
     vec![
         exposure(),
-        auto_exposure(),
-        white_balance(),
-        cdl(),
+        // Their maths is Rec. 709's (luminance weights, the Planckian white in Rec. 709,
+        // the tone curves' matrices): in an ACEScg graph their colour is converted around
+        // them (`crate::working_space`).
+        auto_exposure().with_rec709_maths(),
+        white_balance().with_rec709_maths(),
+        cdl().with_rec709_maths(),
         contrast(),
         hue_saturation(),
         lut(),
         vignette(),
-        tonemap(),
+        tonemap().with_rec709_maths(),
         color_space(),
         display_view(),
     ]
@@ -328,16 +331,17 @@ fn tonemap() -> NodeKind {
     }
 }
 
-/// The `config` param of the OpenColorIO nodes.
-fn ocio_config() -> ParamDef {
+/// The `config` param of the OpenColorIO nodes (and `ImageInput`'s).
+pub(super) fn ocio_config() -> ParamDef {
     ParamDef {
         name: "config",
         ty: ParamType::Text { default: "" },
         doc: "the OpenColorIO config: empty for the one the `OCIO` environment variable \
               names, else OpenColorIO's CG config with ACES 2.0 \
               (`ocio://cg-config-v4.0.0_aces-v2.0_ocio-v2.5`); `ocio://NAME` for a built-in one \
-              (`ocio://studio-config-latest`); or a `config.ocio` file, relative to the \
-              graph file's folder",
+              (`ocio://studio-config-latest`); `blender` for Blender 4.2's (AgX, Filmic; \
+              unpacked by the set-up, or `LUMAGRAPH_BLENDER_OCIO`); or a `config.ocio` \
+              file, relative to the graph file's folder",
     }
 }
 

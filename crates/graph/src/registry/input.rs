@@ -12,7 +12,7 @@ fn image_input() -> NodeKind {
         name: "ImageInput",
         category: Category::Input,
         doc: "Reads an image file. EXR and Radiance .hdr are taken as linear; PNG and JPEG are \
-              decoded from sRGB to linear. The image sets the size of everything downstream. \
+              decoded from sRGB to linear; `colorspace` names another colour space (OpenColorIO). The image sets the size of everything downstream. \
               An EXR is read as compositors read it: its display window is the image (the \
               data window placed at its offset, transparent black around it), its colour is \
               converted from its `chromaticities` to Rec. 709, luminance/chroma images are \
@@ -62,6 +62,18 @@ fn image_input() -> NodeKind {
                 doc: "EXR: the view of a stereo or multi-view file (`left`, `right`); empty: \
                       the default view",
             },
+            ParamDef {
+                name: "colorspace",
+                ty: ParamType::Text { default: "" },
+                doc: "the colour space of the file's colour, converted into the working space \
+                      on the GPU by OpenColorIO: a colour space (or alias, or role) of the \
+                      config (`ACEScg`, `sRGB - Texture`, `Raw` for none); `file rules`: \
+                      the config's file rules choose by the path; empty: the file says (EXR \
+                      from its `chromaticities`, Rec. 709 without; PNG and JPEG sRGB; HDR \
+                      linear Rec. 709). A named space takes the values as stored, ignoring \
+                      the EXR's `chromaticities`",
+            },
+            super::color::ocio_config(),
         ],
         sink: false,
         history: false,

@@ -96,6 +96,15 @@ pub struct InputDef {
     /// Whether the node runs without it: an unconnected optional input is left out of the
     /// pass (and `plan` says so); every other input of a live node must be connected.
     pub optional: bool,
+    /// Whether the node writes the image on this input, alone, to the file its `path` param
+    /// names (`Output`'s `color`, see [`InputDef::image_file`]). A tiled render holds that
+    /// image instead, pastes each tile's core into one whole image and writes the file
+    /// once; it refuses a sink with no such input.
+    pub image_file: bool,
+    /// Whether the node's maths takes this colour input as scene-linear Rec. 709 (tone
+    /// curves, Rec. 709 luminance weights): in a graph with another working space the
+    /// compiler converts into Rec. 709 before it ([`crate::working_space`]).
+    pub rec709: bool,
 }
 
 impl InputDef {
@@ -106,13 +115,31 @@ impl InputDef {
             accepts,
             doc,
             optional: false,
+            image_file: false,
+            rec709: false,
         }
+    }
+
+    /// The same input, taken as scene-linear Rec. 709 (see [`InputDef::rec709`]).
+    #[must_use]
+    pub const fn rec709(mut self) -> Self {
+        self.rec709 = true;
+        self
     }
 
     /// The same input, optional (see [`InputDef::optional`]).
     #[must_use]
     pub const fn optional(mut self) -> Self {
         self.optional = true;
+        self
+    }
+
+    /// The same input, written by its sink as one image file (see
+    /// [`InputDef::image_file`]); the kind must be a sink with a `path` param, and have
+    /// one such input at most ([`Registry::add`] checks).
+    #[must_use]
+    pub const fn image_file(mut self) -> Self {
+        self.image_file = true;
         self
     }
 }
@@ -177,6 +204,10 @@ pub struct OutputDef {
     pub doc: &'static str,
     /// Its image size.
     pub size: OutputSize,
+    /// Whether this colour output is scene-linear Rec. 709 whatever the graph's working
+    /// space (the path tracer renders in Rec. 709): in a graph with another working space
+    /// the compiler converts it ([`crate::working_space`]).
+    pub rec709: bool,
 }
 
 impl OutputDef {
@@ -187,7 +218,15 @@ impl OutputDef {
             ty,
             doc,
             size: OutputSize::Input,
+            rec709: false,
         }
+    }
+
+    /// The same output, in scene-linear Rec. 709 (see [`OutputDef::rec709`]).
+    #[must_use]
+    pub const fn rec709(mut self) -> Self {
+        self.rec709 = true;
+        self
     }
 
     /// The same output, sized by `size`.
@@ -313,6 +352,24 @@ impl NodeKind {
         self
     }
 
+    /// The same kind, whose maths takes its colour as scene-linear Rec. 709 (tone curves,
+    /// Rec. 709 luminance weights): every colour input and output marked
+    /// [`InputDef::rec709`] / [`OutputDef::rec709`].
+    #[must_use]
+    pub fn with_rec709_maths(mut self) -> Self {
+        for input in &mut self.inputs {
+            if input.accepts.contains(&PortType::HdrColor) {
+                input.rec709 = true;
+            }
+        }
+        for output in &mut self.outputs {
+            if output.ty == PortType::HdrColor {
+                output.rec709 = true;
+            }
+        }
+        self
+    }
+
     /// The same kind with `example` params for the gallery.
     #[must_use]
     pub fn with_example(mut self, example: &[(&'static str, ParamValue)]) -> Self {
@@ -338,6 +395,28 @@ impl NodeKind {
     /// Whether the node has no inputs and so sets the image size itself.
     pub fn is_source(&self) -> bool {
         self.inputs.is_empty()
+    }
+
+    /// The input a sink writes, alone, as the image file its `path` param names
+    /// ([`InputDef::image_file`]); `None` for a kind that writes no such file.
+    pub fn image_file_input(&self) -> Option<&InputDef> {
+        self.inputs.iter().find(|p| p.image_file)
+    }
+
+    /// Why the kind's [`InputDef::image_file`] marks do not hold, if they do not.
+    fn check_image_file(&self) -> Result<(), String> {
+        let marked = self.inputs.iter().filter(|p| p.image_file).count();
+        let has_path = self
+            .param("path")
+            .is_some_and(|p| matches!(p.ty, ParamType::Path { .. }));
+        if marked == 0 || (marked == 1 && self.sink && has_path) {
+            return Ok(());
+        }
+        Err(format!(
+            "node kind \"{}\" marks {marked} input(s) as written to an image file: at most \
+             one, and only on a sink with a `path` param",
+            self.name
+        ))
     }
 }
 
@@ -386,6 +465,7 @@ impl Registry {
                 kind.name, w[0].0, w[0].1
             ));
         }
+        kind.check_image_file()?;
         self.kinds.push(Arc::new(kind));
         Ok(())
     }
@@ -517,4 +597,29 @@ fn builtin_kinds() -> Vec<NodeKind> {
         output::kinds(),
     ]
     .concat()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `Output` declares the input it writes alone as an image file, `MultiLayerOutput`
+    /// (several images in one file) none; a mark where no such file is written is refused.
+    #[test]
+    fn image_file_inputs_are_declared_and_checked() {
+        let r = Registry::with_builtins();
+        let input = |k: &str| r.get(k).unwrap().image_file_input().map(|i| i.name);
+        assert_eq!(input("Output"), Some("color"));
+        assert_eq!(input("MultiLayerOutput"), None);
+        for kind in r.kinds() {
+            assert_eq!(kind.check_image_file(), Ok(()), "{}", kind.name);
+        }
+        let mut marked = post_node("Marked", Category::Color, "a test kind", Vec::new());
+        marked.inputs[0] = marked.inputs[0].clone().image_file();
+        let e = Registry::default().add(marked).unwrap_err();
+        assert!(
+            e.starts_with("node kind \"Marked\" marks 1 input(s)"),
+            "{e}"
+        );
+    }
 }

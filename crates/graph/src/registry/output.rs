@@ -12,19 +12,34 @@ fn output() -> NodeKind {
     NodeKind {
         name: "Output",
         category: Category::Output,
-        doc: "Writes its input to a file: PNG (8-bit sRGB) or EXR (32-bit float RGBA), chosen \
-              by the extension. Linear input is sRGB-encoded (clipped) for PNG and written \
-              as is to EXR; display-encoded input is written as is to both.",
-        inputs: vec![InputDef::new("color", ANY_IMAGE, "image to write")],
+        doc: "Writes its input to a file: PNG (8-bit sRGB) or EXR, chosen by the extension. \
+              Linear input is sRGB-encoded (clipped) for PNG and written as is to EXR; \
+              display-encoded input is written as is to both. An EXR is RGBA, or, when the \
+              input was read from an EXR file (through nodes that pass their first input \
+              on), the layer it was read as: its part name, view, channel names and \
+              display window, and the header attributes that stay true (what does not is \
+              named in a note); `data_window` and `type` choose the rest.",
+        inputs: vec![InputDef::new("color", ANY_IMAGE, "image to write").image_file()],
         outputs: vec![],
-        params: vec![ParamDef {
-            name: "path",
-            ty: ParamType::Path {
-                default: "out.png",
-                extensions: &["png", "exr"],
+        params: vec![
+            ParamDef {
+                name: "path",
+                ty: ParamType::Path {
+                    default: "out.png",
+                    extensions: &["png", "exr"],
+                },
+                doc: "file to write, relative to the output folder (`--out`) and inside it",
             },
-            doc: "file to write, relative to the output folder (`--out`) and inside it",
-        }],
+            ParamDef {
+                name: "type",
+                ty: ParamType::Enum {
+                    default: "float",
+                    options: OUTPUT_SAMPLE_TYPES,
+                },
+                doc: "EXR: the channels' sample type",
+            },
+            data_window_param(),
+        ],
         sink: true,
         history: false,
         renders_scene: false,
@@ -51,13 +66,61 @@ pub const EXR_COMPRESSIONS: &[(&str, &str)] = &[
     ("none", "uncompressed"),
 ];
 
-const SAMPLE_TYPES: &[(&str, &str)] = &[
+/// The sample types the EXR writers offer.
+pub const SAMPLE_TYPES: &[(&str, &str)] = &[
     ("half", "16-bit float: colour, normals, albedo"),
     (
         "float",
         "32-bit float: depth, positions, anything needing more than 11 bits",
     ),
+    (
+        "source",
+        "each channel as the file it was read from stores it (half, float or uint; float \
+         where it was not read from a file)",
+    ),
 ];
+
+/// `Output`'s sample types: float first, its default.
+const OUTPUT_SAMPLE_TYPES: &[(&str, &str)] = &[SAMPLE_TYPES[1], SAMPLE_TYPES[0], SAMPLE_TYPES[2]];
+
+/// The data windows the EXR writers offer.
+pub const DATA_WINDOWS: &[(&str, &str)] = &[
+    ("display", "the display window: every pixel"),
+    (
+        "source",
+        "the data window of the file the input was read from (pixels outside it are \
+         dropped, and the node says how many were not empty)",
+    ),
+    (
+        "auto",
+        "the bounding box of the pixels that are not zero in every channel written (an \
+         auto-crop, as Nuke's Write node makes)",
+    ),
+];
+
+/// How `MultiLayerOutput` lays its layers out in parts.
+pub const PARTS: &[(&str, &str)] = &[
+    (
+        "single",
+        "every layer in one part, as Blender writes multi-layer EXR",
+    ),
+    (
+        "per_layer",
+        "one part a layer, named as the part it was read from or as the layer, as Nuke \
+         writes multi-part EXR",
+    ),
+];
+
+fn data_window_param() -> ParamDef {
+    ParamDef {
+        name: "data_window",
+        ty: ParamType::Enum {
+            default: "display",
+            options: DATA_WINDOWS,
+        },
+        doc: "EXR: the data window written (the display window is the image's)",
+    }
+}
 
 /// How many layers beside `color` a `MultiLayerOutput` takes.
 pub const EXTRA_LAYERS: usize = 4;
@@ -120,11 +183,21 @@ fn multi_layer_output() -> NodeKind {
             },
             doc: "the file's compression",
         },
+        data_window_param(),
+        ParamDef {
+            name: "parts",
+            ty: ParamType::Enum {
+                default: "single",
+                options: PARTS,
+            },
+            doc: "one part, or one part a layer (a multi-part file)",
+        },
         ParamDef {
             name: "color_name",
             ty: ParamType::Text { default: "" },
-            doc: "the main image's layer name; empty: the root layer (`R G B A`, what every \
-                  reader shows first); e.g. `ViewLayer.Combined` as Blender names it",
+            doc: "the main image's layer name; empty: the name it was read with from an EXR \
+                  file, else the root layer (`R G B A`, what every reader shows first); e.g. \
+                  `ViewLayer.Combined` as Blender names it",
         },
         ParamDef {
             name: "color_type",
@@ -139,16 +212,17 @@ fn multi_layer_output() -> NodeKind {
         params.push(ParamDef {
             name,
             ty: ParamType::Text { default: "" },
-            doc: "the layer's name; empty: Blender's name for what is wired in (`DiffCol` \
-                  for an albedo, `Normal`, `Depth`, `Vector`, else `LayerN`)",
+            doc: "the layer's name; empty: the name it was read with from an EXR file, else \
+                  Blender's name for what is wired in (`DiffCol` for an albedo, `Normal`, \
+                  `Depth`, `Vector`, else `LayerN`)",
         });
         params.push(ParamDef {
             name: channels,
             ty: ParamType::Text { default: "" },
-            doc: "its channels, by name, separated by spaces (`u v`, `Z`); empty: `R G B A` \
-                  for colour, `R G B` for an albedo, `X Y Z` for a normal, `Z` for a \
-                  depth, `X Y Z W` for a vector, `X` for a scalar; at most as many as the \
-                  image has",
+            doc: "its channels, by name, separated by spaces (`u v`, `Z`); empty: the \
+                  channels it was read with from an EXR file, else `R G B A` for colour, \
+                  `R G B` for an albedo, `X Y Z` for a normal, `Z` for a depth, `X Y Z W` \
+                  for a vector, `X` for a scalar; at most as many as the image has",
         });
         params.push(ParamDef {
             name: ty,
@@ -162,12 +236,15 @@ fn multi_layer_output() -> NodeKind {
     NodeKind {
         name: "MultiLayerOutput",
         category: Category::Output,
-        doc: "Writes its inputs as the named layers of one EXR file (one part, as Blender's \
-              multi-layer EXR and Nuke's Write node do): `color` as the root layer or \
-              `color_name`, up to four more inputs as layers named by their params or, \
-              left empty, as Blender names its passes. Each layer half or float; the \
-              display window the image's; `chromaticities` Rec. 709. Linear input is \
-              written as it is, display-encoded input too.",
+        doc: "Writes its inputs as the named layers of one EXR file, in one part (as \
+              Blender's multi-layer EXR) or one part a layer (as Nuke's multi-part EXR): \
+              `color` and up to four more inputs, each named by its params, else as it was \
+              read from an EXR file (through nodes that pass their first input on), else \
+              as Blender names its passes (`color` the root layer). Each layer half, float \
+              or as read; the data window the display window, the source's or an \
+              auto-crop; the source's display window and header attributes where they stay \
+              true (what does not is named in a note); `chromaticities` Rec. 709. Linear \
+              input is written as it is, display-encoded input too.",
         inputs,
         outputs: vec![],
         params,

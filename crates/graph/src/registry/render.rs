@@ -22,7 +22,8 @@ fn path_trace() -> NodeKind {
                 "color",
                 PortType::HdrColor,
                 "this frame's radiance estimate",
-            ),
+            )
+            .rec709(),
             OutputDef::new(
                 "albedo",
                 PortType::Albedo,

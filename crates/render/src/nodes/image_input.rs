@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use lumagraph_footage::exr::{Selection, Want};
+use lumagraph_footage::exr::{Primaries, Selection, Want};
 use lumagraph_graph::{Extent, Params, Pass, TexFormat};
 
 use crate::context::GpuContext;
@@ -72,12 +72,40 @@ pub(crate) struct ImageInput {
     loaded: Option<Loaded>,
 }
 
-/// What was loaded (path and selection) and a texture per bound port.
+/// What was loaded (path, selection, colour space) and a texture per bound port.
 struct Loaded {
     path: PathBuf,
     selection: Selection,
+    colorspace: ColorSource,
     textures: Vec<(&'static str, PooledTexture)>,
 }
+
+/// Where the colour of the file comes from: the file itself, or a colour space of an
+/// OpenColorIO config.
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct ColorSource {
+    /// The `colorspace` param: empty for the file's own.
+    space: String,
+    /// The `config` param.
+    config: String,
+}
+
+impl ColorSource {
+    fn of(params: &Params) -> Self {
+        Self {
+            space: params.str("colorspace").trim().to_owned(),
+            config: params.str("config").to_owned(),
+        }
+    }
+
+    /// Whether the file is read as stored, for OpenColorIO to convert.
+    fn named(&self) -> bool {
+        !self.space.is_empty()
+    }
+}
+
+/// The keyword of `colorspace` that lets the config's file rules choose.
+const FILE_RULES: &str = "file rules";
 
 impl ImageInput {
     pub(crate) fn new(ctx: &GpuContext, pass: &Pass, paths: &Resources) -> Result<Self> {
@@ -88,6 +116,132 @@ impl ImageInput {
         node.update(ctx, pass)?;
         Ok(node)
     }
+
+    /// How the file's colour reaches the graph's working space: whether it is read as
+    /// stored (else converted to Rec. 709 by the reader, from an EXR's `chromaticities`
+    /// with OpenEXR's matrices, or a PNG's sRGB), and the colour space OpenColorIO then
+    /// converts it from (none: it is in the working space already). A named colour space
+    /// is read as stored and converted. An EXR tagged with the primaries and white of an
+    /// ACES space (ACEScg's AP1, ACES2065-1's AP0) is read as stored and, unless that is
+    /// the working space, converted by OpenColorIO (with its chromatic adaptation, as ACES
+    /// pipelines convert, so that a file an ACEScg graph writes reads back the same in a
+    /// Rec. 709 one). Anything else in a Rec. 709 graph is the reader's Rec. 709; in
+    /// another, converted from it.
+    fn color_route(
+        &self,
+        path: &Path,
+        selection: &Selection,
+        colorspace: &ColorSource,
+    ) -> (bool, Option<ColorSource>) {
+        use lumagraph_graph::WorkingSpace;
+        let working = self.paths.working_space;
+        let from = |space: &str| ColorSource {
+            space: space.to_owned(),
+            config: lumagraph_graph::working_space::CONVERSION_CONFIG.to_owned(),
+        };
+        if colorspace.named() {
+            return (true, Some(colorspace.clone()));
+        }
+        match aces_tag(path, selection) {
+            Some(space) if space == working.ocio_names()[0] => return (true, None),
+            Some(space) => return (true, Some(from(space))),
+            None => {}
+        }
+        if working == WorkingSpace::Rec709 {
+            return (false, None);
+        }
+        (false, Some(from(WorkingSpace::Rec709.ocio_names()[0])))
+    }
+
+    /// Converts `texture` (the file's colour as stored) from the colour space `source`
+    /// names into the working space, on the GPU, once.
+    fn convert(
+        &self,
+        ctx: &GpuContext,
+        node: &str,
+        path: &Path,
+        source: &ColorSource,
+        texture: PooledTexture,
+    ) -> Result<PooledTexture> {
+        let config = super::ocio::config_for(&source.config, &self.paths)
+            .map_err(|e| RenderError::image(path, e.0))?;
+        let space = if source.space.eq_ignore_ascii_case(FILE_RULES) {
+            config.color_space_from_filepath(&path.to_string_lossy())
+        } else {
+            source.space.clone()
+        };
+        let processor = config
+            .processor(&space, config.working_space())
+            .map_err(|e| RenderError::image(path, format!("colorspace: {}", e.0)))?;
+        eprintln!(
+            "{node}: {}: colour read as {space:?}, converted to {:?} ({})",
+            path.display(),
+            config.working_space(),
+            config.source
+        );
+        if processor.is_no_op() {
+            return Ok(texture);
+        }
+        let size = texture.texture.size();
+        let extent = Extent::new(size.width, size.height);
+        let out = create(ctx, node, TexFormat::Rgba32Float, extent);
+        let program = super::ocio::Built::new(ctx, node, &processor, "rgba32float")?;
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(node) });
+        program.encode(
+            ctx,
+            &mut encoder,
+            node,
+            (&texture.view, &out.view),
+            extent,
+            None,
+        )?;
+        ctx.queue.submit(Some(encoder.finish()));
+        Ok(out)
+    }
+}
+
+/// The primaries and white (an EXR `chromaticities` attribute) of the ACES spaces, with
+/// their names in OpenColorIO's CG config.
+const ACES_TAGS: [([f32; 8], &str); 2] = [
+    (
+        [0.713, 0.293, 0.165, 0.830, 0.128, 0.044, 0.32168, 0.33767],
+        "ACEScg",
+    ),
+    (
+        [0.7347, 0.2653, 0.0, 1.0, 0.0001, -0.077, 0.32168, 0.33767],
+        "ACES2065-1",
+    ),
+];
+
+/// The ACES space whose primaries and white the EXR layer's part is tagged with, if any.
+fn aces_tag(path: &Path, selection: &Selection) -> Option<&'static str> {
+    if !is_exr(path) {
+        return None;
+    }
+    let info = lumagraph_footage::exr::inspect(path).ok()?;
+    let layer = selection.find(&info).ok()?;
+    let tag = info.parts[layer.part].chromaticities?.to_array();
+    ACES_TAGS
+        .iter()
+        .find(|(c, _)| c.iter().zip(tag).all(|(a, b)| (a - b).abs() < 1e-4))
+        .map(|(_, name)| *name)
+}
+
+/// An 8-bit or HDR image as stored, without decoding sRGB (a named colour space does).
+fn load_as_stored(path: &Path) -> Result<crate::cpu::Image> {
+    if !path.is_file() {
+        return crate::image_io::load(path);
+    }
+    let img = image::open(path)
+        .map_err(|e| RenderError::image(path, format!("not a readable image: {e}")))?;
+    let rgba = img.to_rgba32f();
+    Ok(crate::cpu::Image {
+        width: rgba.width(),
+        height: rgba.height(),
+        pixels: rgba.pixels().map(|p| p.0).collect(),
+    })
 }
 
 /// Uploads an image into a new RGBA32F texture.
@@ -129,9 +283,13 @@ fn load(
     ctx: &GpuContext,
     node: &str,
     path: &Path,
-    selection: &Selection,
+    (selection, as_stored): (&Selection, bool),
     want: Want,
 ) -> Result<PooledTexture> {
+    if !is_exr(path) && as_stored {
+        not_exr_selection(path, selection)?;
+        return Ok(upload(ctx, node, &load_as_stored(path)?));
+    }
     if !is_exr(path) {
         not_exr_selection(path, selection)?;
         if want != Want::Rgba {
@@ -145,7 +303,13 @@ fn load(
         }
         return Ok(upload(ctx, node, &crate::image_io::load(path)?));
     }
-    let layer = crate::image_io::load_exr_layer(path, selection, want)?;
+    let primaries = if as_stored {
+        Primaries::AsStored
+    } else {
+        Primaries::Rec709
+    };
+    let layer = lumagraph_footage::exr::read_layer_in(path, selection, want, primaries)
+        .map_err(|e| RenderError::image(&e.path, e.message))?;
     for note in &layer.notes {
         eprintln!("{node}: {}: {note}", path.display());
     }
@@ -165,22 +329,34 @@ impl NodeExec for ImageInput {
     fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
         let path = self.paths.input(pass.params.str("path"));
         let selection = selection(&pass.params);
-        if self
-            .loaded
-            .as_ref()
-            .is_some_and(|l| l.path == path && l.selection == selection)
-        {
+        let colorspace = ColorSource::of(&pass.params);
+        if self.loaded.as_ref().is_some_and(|l| {
+            l.path == path && l.selection == selection && l.colorspace == colorspace
+        }) {
             return Ok(());
         }
         let mut textures = Vec::new();
         for (port, want) in PORTS {
             if pass.output(port).is_some() {
-                textures.push((port, load(ctx, &pass.node, &path, &selection, want)?));
+                let (as_stored, conversion) = if want == Want::Rgba {
+                    self.color_route(&path, &selection, &colorspace)
+                } else {
+                    (false, None)
+                };
+                let mut texture = load(ctx, &pass.node, &path, (&selection, as_stored), want)?;
+                if let Some(from) = &conversion {
+                    texture = self.convert(ctx, &pass.node, &path, from, texture)?;
+                }
+                // What the port holds, for the sinks that write it back.
+                let sources = &self.paths.sources;
+                sources.record(&pass.node, port, &path, &selection, want);
+                textures.push((port, texture));
             }
         }
         self.loaded = Some(Loaded {
             path,
             selection,
+            colorspace,
             textures,
         });
         Ok(())

@@ -41,6 +41,8 @@ pub struct Resources {
     /// Write output paths that are absolute or leave `out_dir` as they are, instead of
     /// refusing them (`lumagraph render --allow-outputs-outside`).
     pub outputs_anywhere: bool,
+    /// The colour space of the graph's colour images (the plan's; set by the executor).
+    pub working_space: lumagraph_graph::WorkingSpace,
     /// The scene, flattened, for nodes that render one.
     pub scene: Option<Arc<lumagraph_scene::GpuScene>>,
     /// Use the general shaders even where a scene-specialized one exists (benchmarks).
@@ -63,6 +65,9 @@ pub struct Resources {
     /// Trace workgroups in image order even on a CPU adapter, where they are otherwise
     /// spread over the image to balance the driver's threads (a test compares the two).
     pub workgroups_in_image_order: bool,
+    /// What the graph's image-file sources read, per output port, for the sinks that
+    /// write it back (filled as they load; see [`crate::image_io::Sources`]).
+    pub sources: crate::image_io::Sources,
 }
 
 /// An image a sink would write: its pixels and what they are.

@@ -1,27 +1,37 @@
-//! `MultiLayerOutput`: several images written as the named layers of one EXR file
-//! (`lumagraph_footage::exr::encode_layers`), each copied to a readback buffer in the
-//! frame like `Output`'s one.
+//! `MultiLayerOutput`: several images written as the named layers of one EXR file, in
+//! one part or one part a layer (`lumagraph_footage::exr::assemble`), each copied to a
+//! readback buffer in the frame like `Output`'s one. An input read from an EXR file is
+//! written as the layer it was read as, unless the params name it otherwise.
 
 use std::path::PathBuf;
 
-use lumagraph_footage::exr::{Compression, LayerOut, encode_layers};
+use lumagraph_footage::exr::{
+    self as footage, Compression, ImageIn, PartsChoice, TypeChoice, WindowChoice,
+};
 use lumagraph_graph::registry::output::{LAYER_INPUTS, LAYER_PARAMS, default_layer};
-use lumagraph_graph::{Pass, PortType, TexFormat, write_atomic};
+use lumagraph_graph::{Pass, PortType};
 
 use crate::context::GpuContext;
-use crate::error::{RenderError, Result};
-use crate::nodes::output::Staged;
-use crate::nodes::{HeldImage, NodeExec, NodeImpl, Recording, Resources, boxed, check_writable};
+use crate::error::Result;
+use crate::nodes::output::{
+    Staged, choice, source_of, upstream, values, working_chromaticities, write_exr,
+};
+use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed, check_writable};
 
 /// The `MultiLayerOutput` kind.
 pub(crate) const IMPL: NodeImpl = NodeImpl::new("MultiLayerOutput", |_, pass, resources| {
     boxed(MultiLayerOutput::new(pass, resources))
 });
 
+/// An input: its port, what the frame copied of it, and the ports it came through.
+type StagedInput = (&'static str, Staged, Vec<(String, &'static str)>);
+
 pub(crate) struct MultiLayerOutput {
     paths: Resources,
-    /// Per bound input: its port and what the frame copied of it.
-    staged: Vec<(&'static str, Staged)>,
+    /// Per bound input: its port, what the frame copied of it, where it came from.
+    staged: Vec<StagedInput>,
+    /// The notes printed last, so a sequence prints each once.
+    said: Vec<String>,
 }
 
 impl MultiLayerOutput {
@@ -30,49 +40,48 @@ impl MultiLayerOutput {
         Ok(Self {
             paths: paths.clone(),
             staged: Vec::new(),
+            said: Vec::new(),
         })
     }
 }
 
-/// The name, channels and sample type of the layer on `port` holding an image of `ty`.
-fn layer_spec(pass: &Pass, port: &str, ty: PortType) -> (String, Vec<String>, bool) {
+/// What the params of the layer on `port` say of an image of `ty`: the name and channels
+/// they give (`None` where left empty), the defaults, and the sample type.
+struct Spec {
+    name: Option<String>,
+    channels: Option<Vec<String>>,
+    default_name: String,
+    default_channels: Vec<String>,
+    sample: TypeChoice,
+}
+
+fn layer_spec(pass: &Pass, port: &str, ty: PortType) -> Result<Spec> {
     let split = |s: &str| s.split_whitespace().map(str::to_owned).collect::<Vec<_>>();
+    let given = |s: &str| (!s.trim().is_empty()).then(|| s.to_owned());
     if port == "color" {
         let channels = if ty == PortType::Scalar || ty == PortType::Depth {
             default_layer(ty, 0).1
         } else {
             "R G B A"
         };
-        return (
-            pass.params.str("color_name").to_owned(),
-            split(channels),
-            pass.params.str("color_type") == "half",
-        );
+        return Ok(Spec {
+            name: given(pass.params.str("color_name")),
+            channels: None,
+            default_name: String::new(),
+            default_channels: split(channels),
+            sample: choice(pass, "color_type", TypeChoice::named)?,
+        });
     }
     let i = LAYER_INPUTS.iter().position(|p| *p == port).unwrap_or(0);
     let [name, channels, kind] = LAYER_PARAMS[i];
     let (default_name, default_channels) = default_layer(ty, i + 1);
-    let name = match pass.params.str(name) {
-        "" => default_name,
-        given => given.to_owned(),
-    };
-    let channels = match pass.params.str(channels).trim() {
-        "" => split(default_channels),
-        given => split(given),
-    };
-    (name, channels, pass.params.str(kind) == "half")
-}
-
-/// The image's values, `components` a pixel (4, or 1 for a one-channel format).
-fn values(image: &HeldImage) -> (Vec<f32>, usize) {
-    match image.format {
-        TexFormat::Rgba32Float => (bytemuck::pod_collect_to_vec(&image.bytes), 4),
-        TexFormat::R32Float => (bytemuck::pod_collect_to_vec(&image.bytes), 1),
-        TexFormat::Rgba8Unorm => (
-            image.bytes.iter().map(|&b| f32::from(b) / 255.0).collect(),
-            4,
-        ),
-    }
+    Ok(Spec {
+        name: given(pass.params.str(name)),
+        channels: given(pass.params.str(channels)).map(|c| split(&c)),
+        default_name,
+        default_channels: split(default_channels),
+        sample: choice(pass, kind, TypeChoice::named)?,
+    })
 }
 
 impl NodeExec for MultiLayerOutput {
@@ -89,11 +98,12 @@ impl NodeExec for MultiLayerOutput {
             };
             let reuse = old
                 .iter()
-                .position(|(p, _)| *p == port)
+                .position(|(p, _, _)| *p == port)
                 .map(|i| old.swap_remove(i).1);
             self.staged.push((
                 port,
                 Staged::record(ctx, encoder, io, id, &pass.node, reuse),
+                upstream(io.plan, id),
             ));
         }
         Ok(())
@@ -104,60 +114,67 @@ impl NodeExec for MultiLayerOutput {
             return Ok(Vec::new());
         }
         let path = self.paths.output(pass.params.str("path"))?;
-        let mut layers = Vec::new();
-        let mut size = None;
-        for (port, staged) in &self.staged {
+        let mut read = Vec::new();
+        for (port, staged, ports) in &self.staged {
             let image = staged.read(ctx)?;
-            let (name, channels, half) = layer_spec(pass, port, image.ty);
+            let spec = layer_spec(pass, port, image.ty)?;
             let (all, components) = values(&image);
-            if channels.is_empty() || channels.len() > components {
-                return Err(RenderError::Gpu(format!(
-                    "input {port:?} holds {components} value{} a pixel: give it 1 to \
-                     {components} channel names, not {:?}",
-                    if components == 1 { "" } else { "s" },
-                    channels.join(" ")
-                )));
-            }
-            let k = channels.len();
-            let values = all
-                .chunks_exact(components)
-                .flat_map(|p| p[..k].iter().copied())
-                .collect();
-            size = Some(image.extent);
-            layers.push(LayerOut {
-                name,
-                channels,
-                values,
-                half,
-            });
+            read.push((
+                *port,
+                spec,
+                all,
+                components,
+                image.extent,
+                source_of(&self.paths, ports),
+            ));
         }
-        let Some(extent) = size else {
-            return Ok(Vec::new());
+        let images: Vec<ImageIn<'_>> = read
+            .iter()
+            .map(|(port, spec, all, components, extent, source)| ImageIn {
+                port,
+                values: all,
+                components: *components,
+                width: extent.width as usize,
+                height: extent.height as usize,
+                name: spec.name.clone(),
+                channels: spec.channels.clone(),
+                default_name: spec.default_name.clone(),
+                default_channels: spec.default_channels.clone(),
+                sample: spec.sample,
+                source: source.as_deref(),
+            })
+            .collect();
+        let settings = footage::Settings {
+            window: choice(pass, "data_window", WindowChoice::named)?,
+            parts: choice(pass, "parts", PartsChoice::named)?,
+            compression: choice(pass, "compression", Compression::named)?,
+            chromaticities: working_chromaticities(&self.paths),
         };
-        let compression = Compression::named(pass.params.str("compression"))
-            .ok_or_else(|| RenderError::Gpu("unknown compression".into()))?;
-        let bytes = encode_layers(
-            extent.width as usize,
-            extent.height as usize,
-            &layers,
-            compression,
-        )
-        .map_err(|e| RenderError::image(&path, e))?;
-        write_atomic(&path, &bytes)
-            .map_err(|e| RenderError::image(&path, format!("cannot write: {e}")))?;
+        let (file, notes) = footage::assemble(&images, &settings)
+            .map_err(|e| crate::error::RenderError::image(&path, e))?;
+        write_exr(&pass.node, &path, &file, notes, &mut self.said)?;
         Ok(vec![path])
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use lumagraph_footage::exr::Compression;
-    use lumagraph_graph::registry::output::EXR_COMPRESSIONS;
+    use lumagraph_footage::exr::{Compression, PartsChoice, TypeChoice, WindowChoice};
+    use lumagraph_graph::registry::output::{DATA_WINDOWS, EXR_COMPRESSIONS, PARTS, SAMPLE_TYPES};
 
     #[test]
-    fn every_compression_the_node_offers_is_one_the_writer_takes() {
+    fn every_choice_the_nodes_offer_is_one_the_writer_takes() {
         for (name, _) in EXR_COMPRESSIONS {
             assert!(Compression::named(name).is_some(), "{name}");
+        }
+        for (name, _) in DATA_WINDOWS {
+            assert!(WindowChoice::named(name).is_some(), "{name}");
+        }
+        for (name, _) in PARTS {
+            assert!(PartsChoice::named(name).is_some(), "{name}");
+        }
+        for (name, _) in SAMPLE_TYPES {
+            assert!(TypeChoice::named(name).is_some(), "{name}");
         }
     }
 }

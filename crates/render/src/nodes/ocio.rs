@@ -26,10 +26,45 @@ pub(crate) const DISPLAY_VIEW: NodeImpl = NodeImpl::new("DisplayView", |ctx, pas
 /// # Errors
 /// What [`ColorConfig::load`] refuses.
 pub fn config_of(pass: &Pass, resources: &Resources) -> Result<ColorConfig> {
-    ColorConfig::load(pass.params.str("config"), &resources.base_dir).map_err(color_error)
+    config_for(pass.params.str("config"), resources).map_err(color_error)
 }
 
-fn color_error(e: lumagraph_color::Error) -> RenderError {
+/// `image`, linear colour in the working space `space`, converted to scene-linear Rec. 709
+/// in place (nothing to do in a Rec. 709 graph): what is sRGB-encoded for a PNG or a
+/// preview, whose encoding is Rec. 709's.
+///
+/// # Errors
+/// The conversion's config cannot be loaded (it is built in).
+pub fn working_to_rec709(
+    space: lumagraph_graph::WorkingSpace,
+    image: &mut crate::cpu::Image,
+) -> Result<()> {
+    use lumagraph_graph::WorkingSpace;
+    if space == WorkingSpace::Rec709 {
+        return Ok(());
+    }
+    let config = ColorConfig::load(
+        lumagraph_graph::working_space::CONVERSION_CONFIG,
+        std::path::Path::new("."),
+    )
+    .map_err(color_error)?;
+    let processor = config
+        .processor(space.ocio_names()[0], WorkingSpace::Rec709.ocio_names()[0])
+        .map_err(color_error)?;
+    processor.apply(bytemuck::cast_slice_mut(&mut image.pixels));
+    Ok(())
+}
+
+/// The config `spec` names ([`ColorConfig::load`]), its working space the graph's.
+///
+/// # Errors
+/// What [`ColorConfig::load`] refuses; a config without the graph's working space.
+pub fn config_for(spec: &str, resources: &Resources) -> lumagraph_color::Result<ColorConfig> {
+    ColorConfig::load(spec, &resources.base_dir)
+        .and_then(|c| c.with_working_space(resources.working_space.ocio_names()))
+}
+
+pub(crate) fn color_error(e: lumagraph_color::Error) -> RenderError {
     RenderError::Gpu(e.0)
 }
 
@@ -64,11 +99,59 @@ struct OcioNode {
 }
 
 /// A processor on the device: its kernel, uniform buffer and LUT textures.
-struct Built {
+pub(crate) struct Built {
     kernel: Kernel,
     uniforms: Option<wgpu::Buffer>,
     luts: Vec<wgpu::TextureView>,
     slots: Vec<Slot>,
+}
+
+impl Built {
+    /// `processor` on the device, writing `format` (`rgba32float` or `rgba8unorm`).
+    ///
+    /// # Errors
+    /// What OpenColorIO's shader generation refuses; a shader that does not compile.
+    pub(crate) fn new(
+        ctx: &GpuContext,
+        label: &str,
+        processor: &Processor,
+        format: &str,
+    ) -> Result<Self> {
+        let program = processor.gpu_program(format).map_err(color_error)?;
+        build(ctx, label, &program)
+    }
+
+    /// Records the conversion of `input` into `output` (both `extent`).
+    ///
+    /// # Errors
+    /// A program whose uniforms are missing.
+    pub(crate) fn encode(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &str,
+        (input, output): (&wgpu::TextureView, &wgpu::TextureView),
+        extent: lumagraph_graph::Extent,
+        timer: Option<&mut crate::timing::GpuTimer>,
+    ) -> Result<()> {
+        let mut builder = self.kernel.pass(label);
+        for slot in &self.slots {
+            builder = match slot {
+                Slot::Uniforms => match &self.uniforms {
+                    Some(b) => builder.uniform(b),
+                    None => {
+                        return Err(RenderError::Gpu(
+                            "OpenColorIO's uniforms are missing".into(),
+                        ));
+                    }
+                },
+                Slot::Lut(i) => builder.read(&self.luts[*i]),
+                Slot::Input => builder.read(input),
+                Slot::Output => builder.write(output),
+            };
+        }
+        builder.dispatch_2d(ctx, encoder, extent, timer)
+    }
 }
 
 impl OcioNode {
@@ -152,8 +235,7 @@ impl NodeExec for OcioNode {
         } else {
             "rgba32float"
         };
-        let program = processor.gpu_program(format).map_err(color_error)?;
-        self.program = Some(build(ctx, &pass.node, &program)?);
+        self.program = Some(Built::new(ctx, &pass.node, &processor, format)?);
         Ok(())
     }
 
@@ -164,22 +246,13 @@ impl NodeExec for OcioNode {
         };
         let input = &io.input(pass, "color")?.view;
         let output = &io.texture(out).view;
-        let mut builder = built.kernel.pass(&pass.node);
-        for slot in &built.slots {
-            builder = match slot {
-                Slot::Uniforms => match &built.uniforms {
-                    Some(b) => builder.uniform(b),
-                    None => {
-                        return Err(RenderError::Gpu(
-                            "OpenColorIO's uniforms are missing".into(),
-                        ));
-                    }
-                },
-                Slot::Lut(i) => builder.read(&built.luts[*i]),
-                Slot::Input => builder.read(input),
-                Slot::Output => builder.write(output),
-            };
-        }
-        builder.dispatch_2d(ctx, encoder, pass.extent, timer)
+        built.encode(
+            ctx,
+            encoder,
+            &pass.node,
+            (input, output),
+            pass.extent,
+            timer,
+        )
     }
 }
