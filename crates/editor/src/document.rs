@@ -596,6 +596,16 @@ impl Document {
         }
     }
 
+    /// Sets the graph's working space (the colour space of its colour images); one undo
+    /// step.
+    pub fn set_working_space(&mut self, space: lumagraph_graph::WorkingSpace) {
+        if self.graph.working_space == space {
+            return;
+        }
+        self.record(None);
+        self.graph.working_space = space;
+    }
+
     /// The nodes `ids` and the edges between them, as a graph (for the clipboard).
     pub fn copy(&self, ids: &[String]) -> Graph {
         let mut g = Graph::new();

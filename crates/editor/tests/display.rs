@@ -332,3 +332,44 @@ fn another_config_is_picked_for_the_viewer() {
     assert_eq!(ed.view.display.config_spec(), user.display().to_string());
     assert!(!ed.doc.is_dirty());
 }
+
+/// Making the graph ACEScg (what Edit ▸ Working space does; one undo step, saved with
+/// the graph): the preview is then in ACEScg, and the viewer converts it to Rec. 709 before its
+/// sRGB encoding, so what is shown does not change (within 2 codes at three pixels).
+#[test]
+fn the_working_space_menu_changes_the_graph_not_what_is_shown() {
+    let Some(ed) = editor(Some(&repo("graphs/post_tonemap.ron")), None) else {
+        return;
+    };
+    let mut h = harness(ed);
+    h.state_mut().select(vec!["exposure".into()]);
+    h.run_ok();
+    let (image, _) = h.state().preview.linear.clone().expect("an image");
+    let view = &mut h.state_mut().view;
+    view.zoom = Some(4.0);
+    view.center = egui::vec2(256.0, 192.0);
+    h.run_ok();
+    let pixels = [(250, 180), (262, 186), (256, 200)];
+    let before = shown(&mut h, image.width, &pixels);
+    h.state_mut()
+        .doc
+        .set_working_space(lumagraph_graph::WorkingSpace::AcesCg);
+    for _ in 0..4 {
+        h.run_ok();
+    }
+    assert_eq!(
+        h.state().doc.graph.working_space,
+        lumagraph_graph::WorkingSpace::AcesCg
+    );
+    let (aces, _) = h.state().preview.linear.clone().expect("an image");
+    assert_ne!(aces.pixels, image.pixels, "the preview is in ACEScg");
+    let after = shown(&mut h, image.width, &pixels);
+    for (a, b) in before.iter().zip(&after) {
+        assert!(close(*a, *b), "{before:?} shown, {after:?} in ACEScg");
+    }
+    assert!(h.state_mut().doc.undo());
+    assert_eq!(
+        h.state().doc.graph.working_space,
+        lumagraph_graph::WorkingSpace::Rec709
+    );
+}

@@ -175,6 +175,20 @@ impl Graph {
     fn nodes(&self) -> Vec<String> {
         self.inner.nodes.iter().map(|n| n.id.clone()).collect()
     }
+
+    /// The colour space of its colour images: `"Linear Rec.709"` (the default) or
+    /// `"ACEScg"`.
+    #[getter]
+    fn working_space(&self) -> &'static str {
+        self.inner.working_space.name()
+    }
+
+    #[setter]
+    fn set_working_space(&mut self, name: &str) -> PyResult<()> {
+        self.inner.working_space = lumagraph::graph::WorkingSpace::parse(name)
+            .map_err(pyo3::exceptions::PyValueError::new_err)?;
+        Ok(())
+    }
 }
 
 /// A Python value as RON text: `None`, a bool, an int, a float, a tuple or list of them

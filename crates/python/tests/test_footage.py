@@ -72,3 +72,30 @@ def test_a_list_of_frames_and_a_bad_range(tmp_path):
     assert [f for f, _ in s.render_frames([3, 1])] == [3, 1]
     with pytest.raises(lg.LumagraphError, match="expected frames"):
         s.render_frames("1..3")
+
+
+def test_a_graph_in_acescg_saves_its_working_space_and_animates_a_number(tmp_path):
+    """A graph's working space and a frame expression, set from Python: saved in the
+    file (version 5), and the exposure's expression takes each frame's number."""
+    g = lg.Graph()
+    assert g.working_space == "Linear Rec.709"
+    g.working_space = "acescg"
+    assert g.working_space == "ACEScg"
+    with pytest.raises(ValueError, match="Rec2020"):
+        g.working_space = "Rec2020"
+    g.add_node("ImageInput", "input", path=str(ROOT / "assets" / "test_chart.exr"))
+    g.add_node("Exposure", "exposure", ev="frame - 1")
+    g.add_node("Output", "out", path="e.####.exr")
+    g.connect("input.color", "exposure.color")
+    g.connect("exposure.color", "out.color")
+    path = tmp_path / "aces.ron"
+    g.save(str(path))
+    text = path.read_text()
+    assert "version: 5" in text and 'working_space: "ACEScg"' in text
+    assert lg.Graph.load(str(path)).working_space == "ACEScg"
+    s = lg.Session(str(path), frame=1, out=str(tmp_path / "out"))
+    seen = {frame: outputs["out"].copy() for frame, outputs in s.render_frames("1-2")}
+    one, two = seen[1], seen[2]
+    lit = one[..., :3] > 1e-3
+    assert lit.any()
+    assert np.allclose(two[..., :3][lit] / one[..., :3][lit], 2.0, rtol=1e-5)

@@ -187,6 +187,23 @@ impl Editor {
             self.doc.redo();
         }
         ui.separator();
+        ui.menu_button("Working space", |ui| {
+            for space in lumagraph_graph::WorkingSpace::ALL {
+                let on = self.doc.graph.working_space == space;
+                if ui
+                    .radio(on, space.name())
+                    .on_hover_text(
+                        "the colour space of the graph's images (docs/compositing.md); \
+                         saved in the graph file",
+                    )
+                    .clicked()
+                {
+                    self.doc.set_working_space(space);
+                    ui.close();
+                }
+            }
+        });
+        ui.separator();
         let any = !self.selected.is_empty();
         if ui
             .add_enabled(
