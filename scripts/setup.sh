@@ -68,6 +68,15 @@ if [ ! -f "$ray_query_dir/lvp_icd.json" ] && grep -q '^VERSION_CODENAME=bookworm
     rm -rf "$work"
 fi
 
+# Sets `pip` to a pip command: the system Python's, or, where it has none (Debian's
+# python3-pip is not installed), the one a virtual environment in $1 brings (python3-venv).
+find_pip() {
+    pip=(python3 -m pip)
+    if ! python3 -m pip --version >/dev/null 2>&1; then
+        python3 -m venv "$1/venv" >/dev/null 2>&1 && pip=("$1/venv/bin/python" -m pip)
+    fi
+}
+
 # Open Image Denoise 2 (Intel), which the OIDN denoiser node loads at run time (optional:
 # without it that node fails and says how to get it). The pyoidn wheel on PyPI ships the
 # library; its CPU parts (libOpenImageDenoise, its core with the trained weights, the CPU
@@ -78,12 +87,7 @@ oidn_dir="${XDG_CACHE_HOME:-$HOME/.cache}/lumagraph/oidn"
 if [ ! -f "$oidn_dir/lib/libOpenImageDenoise.so.2" ]; then
     echo "setup: fetching Open Image Denoise $oidn_version (the pyoidn wheel from PyPI) into $oidn_dir"
     work=$(mktemp -d)
-    pip=(python3 -m pip)
-    if ! python3 -m pip --version >/dev/null 2>&1; then
-        # No pip beside the system's Python (Debian's python3-pip is not installed): the one
-        # a virtual environment brings (python3-venv).
-        python3 -m venv "$work/venv" >/dev/null 2>&1 && pip=("$work/venv/bin/python" -m pip)
-    fi
+    find_pip "$work"
     if "${pip[@]}" download -q --disable-pip-version-check --no-deps --only-binary=:all: \
         -d "$work" "pyoidn==$oidn_version" >/dev/null 2>&1 &&
         python3 - "$work"/pyoidn-*.whl "$work/lib" "$oidn_version" <<'PY'
@@ -125,10 +129,7 @@ blender_dir="${XDG_CACHE_HOME:-$HOME/.cache}/lumagraph/blender-ocio/4.2"
 if [ ! -f "$blender_dir/config.ocio" ]; then
     echo "setup: fetching Blender $blender_version's colour config (from the bpy wheel on PyPI) into $blender_dir"
     work=$(mktemp -d)
-    pip=(python3 -m pip)
-    if ! python3 -m pip --version >/dev/null 2>&1; then
-        python3 -m venv "$work/venv" >/dev/null 2>&1 && pip=("$work/venv/bin/python" -m pip)
-    fi
+    find_pip "$work"
     if "${pip[@]}" download -q --disable-pip-version-check --no-deps --only-binary=:all: \
         --python-version 3.11 -d "$work" "bpy==$blender_version" >/dev/null 2>&1 &&
         python3 - "$work"/bpy-*.whl "$work/colormanagement" <<'PY'

@@ -13,20 +13,7 @@ use std::path::{Path, PathBuf};
 use lumagraph::footage::exr::{self, Selection, Want};
 
 fn images() -> Option<PathBuf> {
-    let dir = std::env::var_os("LUMAGRAPH_OPENEXR_IMAGES").map_or_else(
-        || common::repo("../shared/assets/openexr-images"),
-        PathBuf::from,
-    );
-    if dir.is_dir() {
-        return Some(dir.canonicalize().unwrap());
-    }
-    assert!(
-        std::env::var_os("CI").is_none(),
-        "the OpenEXR sample images are not at {} (set LUMAGRAPH_OPENEXR_IMAGES)",
-        dir.display()
-    );
-    eprintln!("skipped: no OpenEXR sample images at {}", dir.display());
-    None
+    lumagraph::footage::testing::openexr_images(&common::repo("../shared/assets/openexr-images"))
 }
 
 /// A graph file in `dir`: beauty, depth and forward motion of the Beachball sequence into

@@ -2,24 +2,12 @@
 
 use std::path::Path;
 
-use lumagraph::footage::exr::{self, Layer, LayerKind, SampleKind, Selection, Want, Window};
+use lumagraph::footage::exr::{self, Layer, LayerKind, Selection, Want, Window};
 use serde_json::Value;
-
-use crate::sha256::sha256;
 
 /// A channel's samples hashed as the reference hashes them (little-endian, as stored).
 pub(crate) fn channel_hash(channel: &exr::RawChannel) -> String {
-    let bytes: Vec<u8> = match channel.sample {
-        SampleKind::Half => channel
-            .bits
-            .iter()
-            .flat_map(|&b| u16::try_from(b).unwrap().to_le_bytes())
-            .collect(),
-        SampleKind::Float | SampleKind::Uint => {
-            channel.bits.iter().flat_map(|b| b.to_le_bytes()).collect()
-        }
-    };
-    sha256(&bytes)
+    lumagraph::footage::testing::channel_sha256(channel)
 }
 
 pub(crate) fn window(v: &Value) -> Window {

@@ -19,7 +19,6 @@
 mod checks;
 #[path = "../common/mod.rs"]
 mod common;
-mod sha256;
 
 use std::path::{Path, PathBuf};
 
@@ -31,20 +30,7 @@ use serde_json::{Value, json};
 use checks::{Kind, check_part, expect, selection_of};
 
 fn images() -> Option<PathBuf> {
-    let dir = std::env::var_os("LUMAGRAPH_OPENEXR_IMAGES").map_or_else(
-        || common::repo("../shared/assets/openexr-images"),
-        PathBuf::from,
-    );
-    if dir.is_dir() {
-        return Some(dir.canonicalize().unwrap());
-    }
-    assert!(
-        std::env::var_os("CI").is_none(),
-        "the OpenEXR sample images are not at {} (set LUMAGRAPH_OPENEXR_IMAGES)",
-        dir.display()
-    );
-    eprintln!("skipped: no OpenEXR sample images at {}", dir.display());
-    None
+    lumagraph::footage::testing::openexr_images(&common::repo("../shared/assets/openexr-images"))
 }
 
 /// Runs `graph` (its files relative to `out`), returning the first line of an error.

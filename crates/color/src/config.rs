@@ -22,17 +22,11 @@ pub type Result<T> = std::result::Result<T, Error>;
 /// release to the next: 2.6 made it the v5.0.0 config).
 pub const DEFAULT_CONFIG: &str = "ocio://cg-config-v4.0.0_aces-v2.0_ocio-v2.5";
 
-/// Names of lumagraph's working space (scene-linear Rec. 709) in the configs users bring:
-/// OpenColorIO's CG and studio configs (and their aliases), the ACES 1.x configs, Blender's.
-pub const WORKING_SPACE_NAMES: &[&str] = &[
-    "Linear Rec.709 (sRGB)",
-    "lin_rec709_srgb",
-    "lin_rec709",
-    "Utility - Linear - sRGB",
-    "Utility - Linear - Rec.709",
-    "Linear Rec.709",
-    "Linear",
-];
+/// Names of lumagraph's default working space (scene-linear Rec. 709) in the configs users
+/// bring: OpenColorIO's CG and studio configs (and their aliases), the ACES 1.x configs,
+/// Blender's (`lumagraph_graph::WorkingSpace::ocio_names`, where a graph's other working
+/// spaces are named too).
+pub const WORKING_SPACE_NAMES: &[&str] = lumagraph_graph::WorkingSpace::Rec709.ocio_names();
 
 /// The config name that stands for Blender's own config (AgX, Filmic, Khronos PBR
 /// Neutral): the file `LUMAGRAPH_BLENDER_OCIO` names, else the copy of Blender 4.2's that

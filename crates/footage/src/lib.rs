@@ -10,6 +10,8 @@
 //!   linear Rec. 709.
 //! - [`sequence`]: frame numbers in paths (`####`, `%04d`, `$F4`) and frame ranges
 //!   (`1-100x2`).
+//! - [`testing`]: for the tests held to OpenEXR's reader: where its sample images are, a
+//!   channel's hash.
 //!
 //! Nothing here touches a GPU.
 
@@ -17,4 +19,5 @@ pub mod color;
 pub mod exr;
 pub mod sequence;
 pub mod subsampled;
+pub mod testing;
 pub mod yca;

@@ -13,26 +13,14 @@
 
 use std::path::{Path, PathBuf};
 
-use lumagraph_footage::exr::{self, SampleKind, Selection, Want};
+use lumagraph_footage::exr::{self, Selection, Want};
 use lumagraph_footage::yca;
 use serde_json::Value;
-use sha2::{Digest as _, Sha256};
 
 fn root() -> Option<PathBuf> {
-    let dir = std::env::var_os("LUMAGRAPH_OPENEXR_IMAGES").map_or_else(
-        || Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/openexr-images"),
-        PathBuf::from,
-    );
-    if dir.is_dir() {
-        return Some(dir);
-    }
-    assert!(
-        std::env::var_os("CI").is_none(),
-        "the OpenEXR sample images are not at {} (set LUMAGRAPH_OPENEXR_IMAGES)",
-        dir.display()
-    );
-    eprintln!("skipped: no OpenEXR sample images at {}", dir.display());
-    None
+    lumagraph_footage::testing::openexr_images(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/openexr-images"),
+    )
 }
 
 /// The reference: `tests/exr/openexr_reference.json`, or `LUMAGRAPH_OPENEXR_REFERENCE`
@@ -46,14 +34,7 @@ fn reference() -> Value {
 }
 
 fn sha256(channel: &exr::RawChannel) -> String {
-    let mut hash = Sha256::new();
-    for &b in &channel.bits {
-        match channel.sample {
-            SampleKind::Half => hash.update(u16::try_from(b).unwrap().to_le_bytes()),
-            SampleKind::Float | SampleKind::Uint => hash.update(b.to_le_bytes()),
-        }
-    }
-    hash.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    lumagraph_footage::testing::channel_sha256(channel)
 }
 
 fn window(v: &Value) -> [i64; 4] {

@@ -151,20 +151,9 @@ fn parts_windows_and_types_are_read_back() {
 }
 
 fn images() -> Option<PathBuf> {
-    let dir = std::env::var_os("LUMAGRAPH_OPENEXR_IMAGES").map_or_else(
-        || Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/openexr-images"),
-        PathBuf::from,
-    );
-    if dir.is_dir() {
-        return Some(dir);
-    }
-    assert!(
-        std::env::var_os("CI").is_none(),
-        "the OpenEXR sample images are not at {} (set LUMAGRAPH_OPENEXR_IMAGES)",
-        dir.display()
-    );
-    eprintln!("skipped: no OpenEXR sample images at {}", dir.display());
-    None
+    lumagraph_footage::testing::openexr_images(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/openexr-images"),
+    )
 }
 
 /// A layer read and written back with its source (data window and types `source`), on

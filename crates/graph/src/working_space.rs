@@ -63,7 +63,7 @@ impl WorkingSpace {
 
     /// Its names in OpenColorIO configs (the CG and studio configs, ACES 1.x, Blender's),
     /// in the order they are looked for.
-    pub fn ocio_names(self) -> &'static [&'static str] {
+    pub const fn ocio_names(self) -> &'static [&'static str] {
         match self {
             Self::Rec709 => &[
                 "Linear Rec.709 (sRGB)",
