@@ -55,7 +55,7 @@ struct Frame {
     chunk_count: u32,
     // CHUNK_FIRST | CHUNK_LAST.
     chunk_flags: u32,
-    // With WAVES: WAVE_STEP or WAVE_FINISH (wave.wgsl); the first slot of the batch of
+    // With WAVES: WAVE_STEP or WAVE_FINISH (pathtrace/shared.wgsl); the first slot of the batch of
     // slots being traced, how many slots `wave`'s sections hold, and how many of the step's
     // listed slots `wave_misses` takes (`wave_hits` the rest); with WAVEFRONT, which of the
     // two lists is the step's.
@@ -66,8 +66,7 @@ struct Frame {
     wave_list: u32,
 }
 
-const CHUNK_FIRST: u32 = 1u;
-const CHUNK_LAST: u32 = 2u;
+// `Frame::chunk_flags`: CHUNK_FIRST, CHUNK_LAST (pathtrace/shared.wgsl, generated).
 
 @group(0) @binding(0) var output: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(1) var<uniform> frame: Frame;

@@ -39,9 +39,8 @@
 //               (`frame.wave_list` is the step's); the slots whose ray missed (or that only
 //               await a shadow ray) from the start, those whose ray hit from the end. List l
 //               counts them in `stats[WAVE_COUNTS_AT + 2 l]` and the word after it.
-const WAVE_STEP: u32 = 1u;
-// Writes the pixels' means from `chunk_sums` (and the AOVs): recorded with the graph.
-const WAVE_FINISH: u32 = 2u;
+// `Frame::wave`: WAVE_STEP, a step; WAVE_FINISH, the pass writing the pixels' means from
+// `chunk_sums` (and the AOVs), recorded with the graph (pathtrace/shared.wgsl, generated).
 
 // Slot flags: a shadow ray is out; the path ended (its last shadow ray still out); the
 // pixel traced all its samples.

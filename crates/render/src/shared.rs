@@ -43,6 +43,15 @@ pub const WAVE_COUNTS_AT: u32 = 4;
 pub const WAVE_FINISH_ME: f32 = -2.0;
 /// A `t_near` or `t_far` saying there is no such ray.
 pub const WAVE_NO_RAY: f32 = -1.0;
+/// `Frame::chunk_flags`: the frame's first dispatch (starts the sums).
+pub const CHUNK_FIRST: u32 = 1;
+/// `Frame::chunk_flags`: the frame's last dispatch (writes the mean).
+pub const CHUNK_LAST: u32 = 2;
+/// `Frame::wave` (`pathtrace/wave.wgsl`): a step of a frame's paths (its entry points
+/// `wave_start`, `wave_misses`, `wave_hits`).
+pub const WAVE_STEP: u32 = 1;
+/// `Frame::wave`: the pass writing the pixels' means from `chunk_sums` (and the AOVs).
+pub const WAVE_FINISH: u32 = 2;
 
 /// The share of light selection spread uniformly over the lights (the rest by power):
 /// the alias table (`lumagraph_scene::light_selection`) and the shader's pdf of choosing a
@@ -86,6 +95,10 @@ pub fn wgsl() -> String {
         ("WAVE_COUNTS_AT", WAVE_COUNTS_AT),
         ("ACCEL_TRIANGLES", ACCEL_TRIANGLES),
         ("ACCEL_SHAPES", ACCEL_SHAPES),
+        ("CHUNK_FIRST", CHUNK_FIRST),
+        ("CHUNK_LAST", CHUNK_LAST),
+        ("WAVE_STEP", WAVE_STEP),
+        ("WAVE_FINISH", WAVE_FINISH),
     ] {
         let _ = writeln!(out, "const {name}: u32 = {value}u;");
     }

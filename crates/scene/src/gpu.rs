@@ -57,6 +57,9 @@ pub const LIGHT_SPOT: u32 = 8;
 /// [`GpuLight::flags`]: a directional light travelling along unit `e1`, irradiance
 /// `emission`.
 pub const LIGHT_DIRECTIONAL: u32 = 16;
+/// [`GpuLight::flags`]: the lights with no area, never hit, sampled with a delta pdf
+/// (point, spot, directional).
+pub const LIGHT_DELTA: u32 = LIGHT_POINT | LIGHT_SPOT | LIGHT_DIRECTIONAL;
 
 /// [`GpuSettings::env_kind`]: black environment.
 pub const ENV_NONE: u32 = 0;

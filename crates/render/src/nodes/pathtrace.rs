@@ -11,6 +11,7 @@ use wgpu::util::DeviceExt as _;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::kernel::{Kernel, uniform_buffer};
+use crate::shared::{CHUNK_FIRST, CHUNK_LAST, WAVE_FINISH, WAVE_STEP};
 use lumagraph_graph::TexFormat;
 
 use crate::host_rays::{HostCounts, HostRays, WaveStep};
@@ -134,11 +135,6 @@ crate::param_block! {
 /// 9 % fewer rays (truncated traversals), 32 a few. A frame of more samples is traced in
 /// dispatches of at most this many, summed in a buffer, with the same sample indices.
 pub(crate) const CPU_SAMPLES_PER_DISPATCH: [u32; 2] = [8, 256];
-
-/// `Frame::chunk_flags`: the frame's first dispatch (starts the sums), its last (writes the
-/// mean).
-const CHUNK_FIRST: u32 = 1;
-const CHUNK_LAST: u32 = 2;
 
 crate::param_block! {
     /// The adaptive sampling pass's params (`pathtrace/adaptive.wgsl`).
@@ -727,11 +723,6 @@ impl PathTrace {
         }
     }
 }
-
-/// `Frame::wave` (`pathtrace/wave.wgsl`): a step of a frame's paths (its entry points
-/// `wave_start`, `wave_misses`, `wave_hits`), the pass writing the means.
-const WAVE_STEP: u32 = 1;
-const WAVE_FINISH: u32 = 2;
 
 /// The path tracer's entry points for host intersection's steps (see [`WaveStep`]).
 const WAVE_ENTRIES: [&str; 3] = ["wave_start", "wave_misses", "wave_hits"];
