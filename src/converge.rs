@@ -5,11 +5,15 @@
 //! checkpoints fall at 1, 2, 4, 8… spp. At each checkpoint:
 //! - the progressive part (path tracing + accumulation) has run for `render` seconds, wall
 //!   time, summed over every batch so far (shader compilation excluded by a warm-up);
-//! - the rest of the graph (G-buffer, every `Denoise`) then runs once on its own
-//!   ([`Executor::run_tail`]), wall time `tail`, with its GPU time per pass;
+//! - the rest of the graph (G-buffer, every denoiser) then runs once on its own
+//!   ([`Executor::run_tail`]), wall time `tail`, with its time per pass (by node);
 //! - each `Accumulate` output (named by node id) is scored at `render` seconds, each
-//!   `Denoise` output at `render + tail` seconds: what a render that stopped here and then
-//!   denoised would have cost. Readbacks and scoring are not timed.
+//!   denoiser's output (`Denoise`, `RegressionDenoise`, `OIDN`: the nodes of the denoise
+//!   category) at `render + tail − others`, where `others` is the time of the tail's nodes
+//!   that the output does not depend on (the other denoisers of a graph that has several,
+//!   the nodes after it): what a render that stopped here and then ran this denoiser
+//!   would have cost. Without times per pass, `others` is 0. Readbacks and scoring are
+//!   not timed.
 //!
 //! Scores against the reference: RMSE, relMSE (`metrics::relmse`, as Mitsuba's CSVs) and mean
 //! SSIM on clipped luminance (`metrics::ssim`). The reference is a file, or rendered first
@@ -108,7 +112,8 @@ pub struct Row {
     pub output: String,
     /// Samples per pixel.
     pub spp: u32,
-    /// Wall seconds: rendering so far, plus the denoising for a denoised output.
+    /// Wall seconds: rendering so far, plus, for a denoised output, the part run after
+    /// rendering less the nodes it does not depend on (see the module docs).
     pub seconds: f64,
     /// Against the reference.
     pub rmse: f64,
@@ -116,13 +121,63 @@ pub struct Row {
     pub relmse: f64,
     /// Mean SSIM on clipped luminance.
     pub ssim: f64,
-    /// GPU ms of this output's Denoise passes (none for raw).
+    /// Ms per frame of this output's denoiser passes (none for raw): GPU timestamps, or on
+    /// a CPU adapter the wall time of each pass submitted alone.
     pub gpu_ms: Option<f64>,
 }
 
+/// An output scored at every checkpoint.
+struct Scored {
+    /// `node.color`.
+    port: String,
+    /// The node (a denoiser or an accumulation).
+    node: String,
+    /// A denoiser's output (else a raw accumulation's).
+    denoised: bool,
+    /// The nodes the output depends on, itself included: the tail's other nodes are not
+    /// charged to it.
+    upstream: Vec<String>,
+}
+
+impl Scored {
+    /// Seconds of the tail charged to this output: the tail's wall time less the time of
+    /// the tail's nodes (`pass_ms`) it does not depend on; none for a raw output.
+    fn tail_seconds(&self, tail_secs: f64, pass_ms: &[(String, f64)]) -> f64 {
+        if !self.denoised {
+            return 0.0;
+        }
+        let others: f64 = pass_ms
+            .iter()
+            .filter(|(n, _)| !self.upstream.contains(n))
+            .map(|(_, ms)| ms / 1000.0)
+            .sum();
+        (tail_secs - others).max(0.0)
+    }
+}
+
+/// The ids of the nodes `node` depends on in `graph`, itself included.
+fn upstream(graph: &Graph, node: &str) -> Vec<String> {
+    let mut found = vec![node.to_owned()];
+    let mut i = 0;
+    while let Some(id) = found.get(i).cloned() {
+        for e in &graph.edges {
+            let to = crate::graph::split_port_ref(&e.to).map(|(n, _)| n);
+            let from = crate::graph::split_port_ref(&e.from).map(|(n, _)| n);
+            if let (Some(to), Some(from)) = (to, from)
+                && to == id
+                && !found.iter().any(|f| f == from)
+            {
+                found.push(from.to_owned());
+            }
+        }
+        i += 1;
+    }
+    found
+}
+
 /// The graph without sinks (groups flattened, so theirs too), 1 spp per frame; returns it
-/// with the ports scored, as `(port, is_denoised)`.
-fn prepare(graph: &mut Graph, library: &NodeLibrary) -> Result<Vec<(String, bool)>> {
+/// with the outputs scored.
+fn prepare(graph: &mut Graph, library: &NodeLibrary) -> Result<Vec<Scored>> {
     let flat = crate::graph::group::flatten(graph, &library.registry_for(graph)?)?;
     *graph = flat.graph;
     let registry = flat.registry;
@@ -143,7 +198,18 @@ fn prepare(graph: &mut Graph, library: &NodeLibrary) -> Result<Vec<(String, bool
     if !ports.iter().any(|(_, d)| !d) {
         bail!("the graph has no Accumulate node: nothing to converge");
     }
-    Ok(ports)
+    Ok(ports
+        .into_iter()
+        .map(|(port, denoised)| {
+            let node = port.split('.').next().unwrap_or(&port).to_owned();
+            Scored {
+                upstream: upstream(graph, &node),
+                port,
+                node,
+                denoised,
+            }
+        })
+        .collect())
 }
 
 fn executor(
@@ -189,6 +255,35 @@ fn render_reference(
     Ok((exec.read_port(port)?, note))
 }
 
+/// An executor for `graph`, checked against the reference's size and warmed up.
+fn start(
+    ctx: &GpuContext,
+    library: &NodeLibrary,
+    graph: &Graph,
+    keep: &[String],
+    scene: &Arc<GpuScene>,
+    reference: &Image,
+) -> Result<Executor> {
+    let mut exec = executor(ctx, library, graph, keep, scene)?;
+    let extent = exec.plan().passes.first().map(|p| p.extent);
+    if extent.is_some_and(|e| (e.width, e.height) != (reference.width, reference.height)) {
+        bail!(
+            "the reference is {}x{}, the render {}",
+            reference.width,
+            reference.height,
+            extent.map_or_else(String::new, |e| e.to_string())
+        );
+    }
+    exec.warm_up()?;
+    // The warm-up ran the first frame, as the first checkpoint will again: a node that
+    // keeps its result over unchanged inputs (OIDN) would upload it there instead of
+    // filtering, and its time would be that of an upload. Two frames more leave other
+    // inputs behind.
+    exec.run_frames(2, true)?;
+    exec.restart();
+    Ok(exec)
+}
+
 /// Measures `graph` (its overrides applied; its `Output` nodes are dropped) on `scene`:
 /// checkpoints at 1, 2, 4… spp until the time budget, each output scored at each.
 ///
@@ -204,8 +299,8 @@ pub fn measure(
     let ports = prepare(&mut graph, args.library)?;
     let raw_port = ports
         .iter()
-        .find(|(_, d)| !d)
-        .map(|(p, _)| p.clone())
+        .find(|o| !o.denoised)
+        .map(|o| o.port.clone())
         .unwrap_or_default();
     let mut reference_note = None;
     let reference = match &args.reference {
@@ -218,7 +313,7 @@ pub fn measure(
             image
         }
     };
-    let keep: Vec<String> = ports.iter().map(|(p, _)| p.clone()).collect();
+    let keep: Vec<String> = ports.iter().map(|o| o.port.clone()).collect();
     let mut runs = Vec::new();
     for variant in std::iter::once(None).chain(args.variants.iter().map(Some)) {
         let (label, g) = match variant {
@@ -233,17 +328,7 @@ pub fn measure(
                 (Some(label), g)
             }
         };
-        let mut exec = executor(ctx, args.library, &g, &keep, scene)?;
-        let extent = exec.plan().passes.first().map(|p| p.extent);
-        if extent.is_some_and(|e| (e.width, e.height) != (reference.width, reference.height)) {
-            bail!(
-                "the reference is {}x{}, the render {}",
-                reference.width,
-                reference.height,
-                extent.map_or_else(String::new, |e| e.to_string())
-            );
-        }
-        exec.warm_up()?;
+        let exec = start(ctx, args.library, &g, &keep, scene, &reference)?;
         runs.push(Run {
             label,
             exec,
@@ -267,20 +352,21 @@ pub fn measure(
             let tail = exec.run_tail()?;
             let tail_secs = tail.wall.as_secs_f64();
             let pass_ms = tail.pass_ms.unwrap_or_default();
-            for (port, denoised) in &ports {
-                let image = exec.read_port(port)?;
-                let node = port.split('.').next().unwrap_or(port);
+            for o in &ports {
+                let image = exec.read_port(&o.port)?;
+                let node = &o.node;
                 rows.push(Row {
                     output: run
                         .label
                         .as_ref()
-                        .map_or_else(|| node.to_owned(), |l| format!("{l}: {node}")),
+                        .map_or_else(|| node.clone(), |l| format!("{l}: {node}")),
                     spp,
-                    seconds: run.render_secs + if *denoised { tail_secs } else { 0.0 },
+                    seconds: run.render_secs + o.tail_seconds(tail_secs, &pass_ms),
                     rmse: metrics::rmse(&image, &reference),
                     relmse: metrics::relmse(&image, &reference),
                     ssim: metrics::ssim(&image, &reference),
-                    gpu_ms: denoised
+                    gpu_ms: o
+                        .denoised
                         .then(|| pass_ms.iter().find(|(n, _)| n == node).map(|(_, ms)| *ms))
                         .flatten(),
                 });
@@ -416,7 +502,65 @@ pub fn read_compare(path: &Path) -> Result<Compare> {
 
 #[cfg(test)]
 mod tests {
-    use super::time_to;
+    use super::{Scored, time_to, upstream};
+    use crate::graph::{Edge, Graph, Node};
+
+    /// Two denoisers on one accumulation, an `Exposure` after the first: each denoised
+    /// output is charged the tail less the passes it does not depend on.
+    #[test]
+    fn a_denoised_output_is_charged_its_own_passes_only() {
+        let graph = Graph {
+            nodes: ["pt", "acc", "gb", "atrous", "oidn", "post"]
+                .into_iter()
+                .map(|id| Node::new(id, "Any"))
+                .collect(),
+            edges: [
+                ("pt.color", "acc.color"),
+                ("acc.color", "atrous.color"),
+                ("gb.albedo", "atrous.albedo"),
+                ("acc.color", "oidn.color"),
+                ("gb.albedo", "oidn.albedo"),
+                ("atrous.color", "post.color"),
+            ]
+            .into_iter()
+            .map(|(from, to)| Edge::new(from, to))
+            .collect(),
+            ..Graph::default()
+        };
+        let mut up = upstream(&graph, "atrous");
+        up.sort();
+        assert_eq!(up, ["acc", "atrous", "gb", "pt"]);
+        let scored = |node: &str, denoised| Scored {
+            port: format!("{node}.color"),
+            node: node.to_owned(),
+            denoised,
+            upstream: upstream(&graph, node),
+        };
+        let pass_ms = [
+            ("gb".to_owned(), 2.0),
+            ("atrous".to_owned(), 70.0),
+            ("oidn".to_owned(), 200.0),
+            ("post".to_owned(), 5.0),
+        ];
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        // 0.3 s of tail: the à-trous output is not charged OIDN's 200 ms nor the 5 ms after
+        // it; OIDN's output not the à-trous 70 ms nor those 5 ms.
+        assert!(close(
+            scored("atrous", true).tail_seconds(0.3, &pass_ms),
+            0.095
+        ));
+        assert!(close(
+            scored("oidn", true).tail_seconds(0.3, &pass_ms),
+            0.225
+        ));
+        assert!(close(scored("acc", false).tail_seconds(0.3, &pass_ms), 0.0));
+        // Without times per pass, the whole tail; never below 0.
+        assert!(close(scored("oidn", true).tail_seconds(0.3, &[]), 0.3));
+        assert!(close(
+            scored("atrous", true).tail_seconds(0.1, &pass_ms),
+            0.0
+        ));
+    }
 
     #[test]
     fn time_to_interpolates_log_log_at_the_first_crossing() {

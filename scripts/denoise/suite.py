@@ -12,7 +12,7 @@ goes into tests/reference/denoise/:
   baseline.csv        per scene and spp (4, 16, 64): relMSE of lumagraph's raw accumulation, of
                       its a-trous Denoise and its RegressionDenoise, of OIDN 2.5 (RT filter, hdr, albedo + normal) on the
                       same accumulation with lumagraph's G-buffer albedo and normal (cleanAux;
-                      and with cleanAux off, OIDN prefiltering them), of OIDN on the colour
+                      and with cleanAux off, OIDN's mode for noisy ones), of OIDN on the colour
                       alone, and OIDN's CPU seconds per frame
   suite.json          per scene: scene file, reference file, reference spp, the reference's own
                       error and how it was made; OIDN timings at 256x256 and 1920x1080
@@ -24,12 +24,14 @@ Steps (default: all, in this order; each can run alone):
   mitsuba    NAME_converge.csv (Mitsuba at 1, 2, 4 .. 256 spp, then OIDN on each; FLIP
              columns need flip-evaluator)
   inputs     lumagraph's accumulation (graphs/denoise_inputs.ron: the default graph with the
-             accumulation, G-buffer albedo and normal as outputs) at 4, 16, 64 spp, seed 0; OIDN
-             on them; baseline.csv (the raw and a-trous figures are scored here and checked
-             against `lumagraph converge` at the same spp by the next step)
+             accumulation, G-buffer albedo and normal as outputs, and its OIDN node's output,
+             so the graph needs the library `bash scripts/setup.sh` fetches) at 4, 16, 64 spp,
+             seed 0; pyoidn on them; baseline.csv (the raw and denoised figures are scored here
+             and checked against `lumagraph converge` at the same spp by the next step)
   converge   `lumagraph converge` per scene (--seconds, into --converge-out): the plots
-             docs/images/denoise_NAME.png, and the check that baseline.csv's raw and a-trous
-             figures are converge's
+             docs/images/denoise_NAME.png, and the check that baseline.csv's raw, a-trous and
+             regression figures are converge's, and its pyoidn figure the OIDN node's
+             (scripts/denoise/table.py prints the docs' table from the same runs)
   timing     OIDN CPU time per frame at 256x256 and 1920x1080 (median of --runs)
 
 Usage (from the repository root; Mitsuba 3.9.1 and pyoidn 2.5 in a venv):
@@ -233,7 +235,8 @@ def step_refs(names, a):
 
 def oidn(color, albedo=None, normal=None, clean_aux=True):
     """OIDN 2.5 RT filter on the CPU, hdr, quality high; with `clean_aux` the auxiliary
-    images are taken as noise-free (cleanAux), else OIDN prefilters them."""
+    images are taken as noise-free (cleanAux), else as noisy (OIDN's mode for noisy guides,
+    which does not filter them first: that is the OIDN node's `prefilter`)."""
     import pyoidn
     f32 = lambda x: None if x is None else np.ascontiguousarray(x, dtype=np.float32)
     return pyoidn.denoise(f32(color), f32(albedo), f32(normal), hdr=True,
@@ -341,7 +344,7 @@ def step_inputs(names, a):
                  "oidn_noaov_relmse": mk.relmse(noaov, ref),
                  "oidn_seconds": seconds}
             print(f"  {name} {spp} spp: raw {r['raw_relmse']:.3e}, a-trous "
-                  f"{r['atrous_relmse']:.3e}, regression {r['regression_relmse']:.3e}, OIDN {r['oidn_relmse']:.3e} (aux prefiltered "
+                  f"{r['atrous_relmse']:.3e}, regression {r['regression_relmse']:.3e}, OIDN {r['oidn_relmse']:.3e} (noisy-aux mode "
                   f"{r['oidn_prefilter_relmse']:.3e}, no AOVs "
                   f"{r['oidn_noaov_relmse']:.3e}), OIDN {seconds:.3f} s", flush=True)
             rows.append(r)
@@ -363,8 +366,9 @@ def step_inputs(names, a):
                      "RegressionDenoise.color",
         "oidn": "OIDN 2.5.1 (pyoidn), RT filter, hdr, quality high, CPU; with lumagraph's "
                 "GBuffer albedo and normal (first hit, noise-free: cleanAux) on the same "
-                "accumulation; oidn_prefilter: the same with cleanAux off (OIDN prefilters "
-                "the aux images); oidn_noaov: colour alone; oidn_seconds: median of 3 calls "
+                "accumulation; oidn_prefilter: the same with cleanAux off (OIDN's mode for "
+                "noisy aux images, the node's clean_aux: false; it does not filter them "
+                "first); oidn_noaov: colour alone; oidn_seconds: median of 3 calls "
                 "of the first (filter built before)",
         "relmse": "mean over pixels and RGB of (x - ref)^2 / (ref^2 + 1e-2)",
     }
@@ -403,9 +407,10 @@ def step_timing(names, a):
 
 
 def step_converge(names, a):
-    """`lumagraph converge` per scene of the inputs graph (raw, a-trous and regression curves):
-    the plot (docs/images/denoise_NAME.png) and a check that baseline.csv's figures are what
-    converge scores at those spp."""
+    """`lumagraph converge` per scene of the inputs graph (raw, a-trous, regression and OIDN
+    node curves): the plot (docs/images/denoise_NAME.png) and a check that baseline.csv's
+    figures are what converge scores at those spp (pyoidn's against the OIDN node's: the
+    same library on the same accumulation)."""
     import shutil
     with open(os.path.join(OUT, "baseline.csv")) as f:
         base = list(csv.DictReader(f))
@@ -430,7 +435,7 @@ def step_converge(names, a):
                 continue
             spp = int(r["spp"])
             for col, port in (("raw_relmse", "accumulate"), ("atrous_relmse", "denoise"),
-                              ("regression_relmse", "regression")):
+                              ("regression_relmse", "regression"), ("oidn_relmse", "oidn")):
                 if (port, spp) not in conv:
                     print(f"  {name}: converge stopped before {spp} spp")
                     continue

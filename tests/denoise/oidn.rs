@@ -14,7 +14,7 @@ use lumagraph::render::oidn::Oidn;
 use lumagraph::render::{Executor, Resources, compile, image_io, metrics};
 
 /// Whether OIDN loads here; panics saying how to get it unless `LUMAGRAPH_ALLOW_NO_OIDN=1`.
-fn oidn_here() -> bool {
+pub(crate) fn oidn_here() -> bool {
     match Oidn::load() {
         Ok(oidn) => {
             eprintln!("OIDN {} from {}", oidn.version(), oidn.library());

@@ -197,7 +197,10 @@ impl NodeExec for OidnNode {
     }
 
     fn reset(&mut self) {
+        // A restarted accumulation is filtered again, even where it comes out the same
+        // (a warm-up frame, then the render): its time is then what a filtering costs.
         self.runs = 0;
+        self.last = None;
     }
 
     fn submits_own(&self) -> bool {
