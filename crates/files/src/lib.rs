@@ -1,11 +1,47 @@
-//! Writing files so that readers never see half of one: [`write_atomic`], the one writer
-//! every lumagraph crate saves through (graphs, scenes, images, checkpoints, lists).
+//! Files as the graph and the scene crates both handle them: [`write_atomic`], the one
+//! writer every lumagraph crate saves through (graphs, scenes, images, checkpoints, lists),
+//! so that readers never see half of a file; and where in a file an error is ([`Pos`],
+//! [`write_location`]), said the same way for graphs and scenes.
 //!
 //! A leaf crate with no lumagraph dependency, so that crates which do not depend on each
 //! other (the graph and the scene) can share it.
 
+use std::fmt;
 use std::io::Write as _;
 use std::path::Path;
+
+/// A line and column in a text file, both starting at 1.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Pos {
+    /// Line, from 1.
+    pub line: usize,
+    /// Column, from 1.
+    pub col: usize,
+}
+
+/// Writes where an error is, as compilers do: `FILE:LINE:COL: ` (the position only with a
+/// file), then `WHAT: ` (the node, the shape or the material it concerns), each where known.
+///
+/// # Errors
+/// What the formatter returns.
+pub fn write_location(
+    f: &mut fmt::Formatter<'_>,
+    file: Option<&Path>,
+    pos: Option<Pos>,
+    what: Option<&str>,
+) -> fmt::Result {
+    if let Some(file) = file {
+        write!(f, "{}", file.display())?;
+        if let Some(pos) = pos {
+            write!(f, ":{}:{}", pos.line, pos.col)?;
+        }
+        f.write_str(": ")?;
+    }
+    if let Some(what) = what {
+        write!(f, "{what}: ")?;
+    }
+    Ok(())
+}
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename,
 /// so readers see either the old file or the whole new one.

@@ -4,14 +4,7 @@
 use std::fmt;
 use std::path::PathBuf;
 
-/// A line and column in a scene file, both starting at 1.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Pos {
-    /// Line, from 1.
-    pub line: usize,
-    /// Column, from 1.
-    pub col: usize,
-}
+pub use lumagraph_files::Pos;
 
 /// What went wrong.
 #[derive(Debug, thiserror::Error)]
@@ -186,16 +179,7 @@ impl<E: Into<ErrorKind>> From<E> for SceneError {
 
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if let Some(file) = &self.file {
-            write!(f, "{}", file.display())?;
-            if let Some(pos) = self.pos {
-                write!(f, ":{}:{}", pos.line, pos.col)?;
-            }
-            f.write_str(": ")?;
-        }
-        if let Some(item) = &self.item {
-            write!(f, "{item}: ")?;
-        }
+        lumagraph_files::write_location(f, self.file.as_deref(), self.pos, self.item.as_deref())?;
         write!(f, "{}", self.kind)
     }
 }
