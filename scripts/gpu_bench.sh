@@ -5,7 +5,7 @@
 #   - paths/s of the path tracer's shader variants (`lumagraph bench`): the specialized
 #     shader, the general one, the megakernel against the wavefront (bench measures the one
 #     the specialized shader is not), and the specialized one through the 8-wide BVH
-#     (LUMAGRAPH_BVH=wide) with the binary BVH's beside it; traversal alone
+#     (--intersector wide) with the binary BVH's beside it; traversal alone
 #     (`bench --traversal`: primary and diffuse closest-hit queries, both BVHs);
 #   - the wall time of a 15 000-spp render through graphs/pathtrace.ron (the figure seed
 #     renderers give), or, where that would not fit the time left, the time of a shorter
@@ -104,10 +104,10 @@ run_scene() {
     local front
     front=$(grep -m1 -oE 'megakernel / wavefront: [0-9.]+x' "$work/bench.txt" | grep -oE '[0-9.]+x')
     [ -n "$mps" ] || { say "== $name: bench printed no paths/s"; rows+=("| $name | failed | | | | | | | | |"); return; }
-    # The 8-wide BVH (LUMAGRAPH_BVH=wide), which bench measures with the binary BVH after it:
+    # The 8-wide BVH (--intersector wide), which bench measures with the binary BVH after it:
     # two pairs for the wide-against-binary ratio (the binary figure above, and this one).
-    say "== $name: bench with the 8-wide BVH (LUMAGRAPH_BVH=wide), then the binary one"
-    LUMAGRAPH_BVH=wide timeout $(( $(left) > 60 ? $(left) : 60 )) "$lg" bench --scene "$scene" \
+    say "== $name: bench with the 8-wide BVH (--intersector wide), then the binary one"
+    timeout $(( $(left) > 60 ? $(left) : 60 )) "$lg" bench --scene "$scene" --intersector wide \
         --spp "$bench_spp" --runs 3 --specialized-only 2>&1 | tee -a "$log" | tee "$work/bench2.txt"
     local wide binary2 ratio=""
     wide=$(grep -m1 -oE '[0-9.]+ M paths/s' "$work/bench2.txt" | grep -oE '^[0-9.]+')

@@ -12,6 +12,7 @@
 //! ```
 
 mod bench;
+mod choice;
 mod color;
 mod converge;
 mod frames;
@@ -104,6 +105,8 @@ enum Command {
         allow_outputs_outside: bool,
         #[command(flatten)]
         textures: TextureArgs,
+        #[command(flatten)]
+        choice: choice::Choice,
         /// Render an image sequence: each param holding a frame pattern (`####`, `%04d`,
         /// `$F4`) takes each frame's number; `7`, `1-100`, `1-100x2` (every second frame),
         /// or a comma-separated list of these (docs/compositing.md).
@@ -153,6 +156,8 @@ enum Command {
         /// Override a param: `node.param=value`.
         #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
         overrides: Vec<String>,
+        #[command(flatten)]
+        choice: choice::Choice,
     },
     /// Check a graph file without rendering it; prints every error found.
     #[command(after_help = "Example:\n  lumagraph validate graphs/post_tonemap.ron")]
@@ -224,6 +229,8 @@ enum Command {
         /// of closest-hit queries, no shading).
         #[arg(long, conflicts_with = "specialized_only")]
         traversal: bool,
+        #[command(flatten)]
+        choice: choice::Choice,
     },
     /// Render one image per node kind into OUT/gallery/ and the page that shows them,
     /// OUT/gallery.md (the docs' node gallery).
@@ -530,7 +537,7 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
         out_dir: args.out.to_owned(),
         outputs_anywhere: args.outputs_anywhere,
         scene: scene.as_ref().map(|s| Arc::clone(&s.gpu)),
-        ..Resources::default()
+        ..args.choice.apply(Resources::default())
     };
     if let Some(done) =
         tiled::render_if_needed(args, &graph, scene.as_ref(), &plan, &ctx, &resources)?
@@ -619,56 +626,6 @@ fn finish(
     Ok(())
 }
 
-/// The shader features of every pass specialized to the scene: compiled in, and left out
-/// with why, for the adapter `render` would use (found without opening a device).
-fn print_features(plan: &crate::graph::Plan, scene: &GpuScene, library: &NodeLibrary) {
-    let specialized: Vec<_> = plan
-        .passes
-        .iter()
-        .filter_map(|p| {
-            library
-                .implementation(&p.kind)
-                .and_then(|i| i.features)
-                .map(|f| (p, f))
-        })
-        .collect();
-    if specialized.is_empty() {
-        return;
-    }
-    let traits = match GpuContext::default_adapter_traits() {
-        Ok((info, traits)) => {
-            println!(
-                "adapter: {} ({:?}{}); the shader choices below are made for it",
-                info.name,
-                info.device_type,
-                if traits.ray_query_limit.is_some() {
-                    ", ray queries"
-                } else {
-                    ""
-                }
-            );
-            traits
-        }
-        Err(e) => {
-            println!("adapter: none found ({e}); shader choices shown for a CPU one");
-            crate::render::specialize::AdapterTraits {
-                cpu: true,
-                ray_query_limit: None,
-            }
-        }
-    };
-    for (pass, features) in specialized {
-        let features = features(pass, scene, traits);
-        println!("shader features of {} for this scene:", pass.node);
-        for included in [true, false] {
-            println!("  {}:", if included { "compiled in" } else { "left out" });
-            for (f, d) in features.iter().filter(|(_, d)| d.included == included) {
-                println!("    {:<28} {}", f.label(), d.reason);
-            }
-        }
-    }
-}
-
 struct RenderArgs<'a> {
     library: &'a Arc<NodeLibrary>,
     graph: &'a Path,
@@ -689,6 +646,8 @@ struct RenderArgs<'a> {
     textures: TextureArgs,
     /// `--frames` and `--skip-missing`.
     frames: Option<(Vec<i64>, bool)>,
+    /// `--intersector` and `--schedule`.
+    choice: choice::Choice,
 }
 
 /// `--frames`: the frames, in order (a newtype, so that clap takes one value).
@@ -719,6 +678,7 @@ fn plan(
     graph: &Path,
     scene: Option<&Path>,
     overrides: &[String],
+    choice: choice::Choice,
 ) -> Result<()> {
     let g = load(graph, overrides)?;
     let scene = load_scene(scene)?;
@@ -737,10 +697,10 @@ fn plan(
             println!("  {:<16} {bytes:>10} bytes ({mib:.2} MiB): {what}", p.node);
         }
     }
-    if let Some(scene) = &scene {
-        print_features(&plan, &scene.gpu, library);
+    match &scene {
+        Some(scene) => choice::print_features(&plan, &scene.gpu, library, choice),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// `lumagraph validate`: compiles the graph and says how many passes it has.
@@ -819,6 +779,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             samples,
             allow_outputs_outside,
             textures,
+            choice,
             frames,
             skip_missing,
         } => render(&RenderArgs {
@@ -835,6 +796,7 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             outputs_anywhere: allow_outputs_outside,
             textures,
             frames: frames.map(|f| (f.0, skip_missing)),
+            choice,
         }),
         Command::Merge {
             partials,
@@ -856,7 +818,8 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             graph,
             scene,
             overrides,
-        } => plan(library, &graph, scene.as_deref(), &overrides),
+            choice,
+        } => plan(library, &graph, scene.as_deref(), &overrides, choice),
         Command::Validate { graph, scene } => validate(library, &graph, scene.as_deref()),
         Command::Nodes { markdown, graph } => nodes(library, markdown, graph.as_deref()),
         Command::Gallery { out, kinds } => {
@@ -879,9 +842,10 @@ fn run(cli: Cli, library: &Arc<NodeLibrary>) -> Result<()> {
             runs,
             specialized_only,
             traversal,
+            choice,
         } => {
             let loaded = load_scene(Some(&scene))?.context("no scene")?;
-            bench::run(&loaded.gpu, spp, runs, specialized_only, traversal)
+            bench::run(&loaded.gpu, spp, runs, specialized_only, traversal, choice)
         }
         Command::Edit {
             graph,

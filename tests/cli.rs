@@ -531,6 +531,46 @@ fn converge_writes_csv_and_plot() {
     }
 }
 
+/// `--intersector` and `--schedule` on `plan` (and the `PathTrace` params, which win): the
+/// choice is printed with why, and one the scene cannot have is an error naming why.
+#[test]
+fn plan_shows_the_intersector_asked_for_or_refuses_it() {
+    let plan = |extra: &[&str]| {
+        let mut args = vec!["plan", "graphs/pathtrace.ron", "--scene"];
+        args.extend_from_slice(extra);
+        let o = lumagraph(&args);
+        let (stdout, stderr) = text(&o);
+        (o.status.success(), stdout, stderr)
+    };
+    let (ok, stdout, stderr) = plan(&["assets/cornell.ron", "--intersector", "wide"]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("  intersector: wide (asked for)"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("  schedule: megakernel ("), "{stdout}");
+    let (ok, stdout, stderr) = plan(&[
+        "assets/cornell.ron",
+        "--intersector",
+        "wide",
+        "--set",
+        "pathtrace.intersector=binary",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("  intersector: binary ("), "{stdout}");
+    let (ok, _, stderr) = plan(&["assets/cornell_spheres.ron", "--intersector", "host"]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("host intersection, cannot trace this scene here: analytic shapes"),
+        "{stderr}"
+    );
+    let (ok, _, stderr) = plan(&["assets/cornell.ron", "--schedule", "sideways"]);
+    assert!(
+        !ok && stderr.contains("auto, megakernel or wavefront"),
+        "{stderr}"
+    );
+}
+
 #[test]
 fn plan_lists_shader_features_for_the_scene() {
     let o = lumagraph(&[

@@ -161,7 +161,11 @@ pub fn run(
     runs: u32,
     specialized_only: bool,
     traversal: bool,
+    choice: super::choice::Choice,
 ) -> Result<()> {
+    // What `--intersector` and `--schedule` (or their environment variables) ask for; the
+    // variants compared with it ask for their own.
+    let asked = choice.apply(Resources::default());
     if traversal {
         return self::traversal(scene, runs);
     }
@@ -171,14 +175,14 @@ pub fn run(
         "{}x{}, {} bounces, {spp} spp per run, best of {runs}:",
         scene.settings.width, scene.settings.height, scene.settings.max_bounces
     );
-    let special = measure(&ctx, scene, Resources::default(), spp, runs)?;
+    let special = measure(&ctx, scene, asked.clone(), spp, runs)?;
     print("specialized", &special);
     // Where the specialized shader walks the 8-wide BVH, the binary one beside it (the
-    // specialized shader as LUMAGRAPH_BVH=binary runs it).
+    // specialized shader as `--intersector binary` runs it).
     let binary = if special.on(Feature::WideBvh) {
         let binary = Resources {
             intersector: Intersector::BinaryBvh,
-            ..Resources::default()
+            ..asked.clone()
         };
         let binary = measure(&ctx, scene, binary, spp, runs)?;
         print("binary BVH", &binary);
@@ -192,7 +196,7 @@ pub fn run(
     };
     // The wavefront beside the megakernel (or the megakernel beside the wavefront, where
     // the specialized shader is one), where the scene allows it: the specialized shader as
-    // LUMAGRAPH_WAVEFRONT=on or off runs it.
+    // `--schedule wavefront` or `megakernel` runs it.
     if !special.on(Feature::HostRays) {
         use crate::render::specialize::Schedule;
         let front = special.on(Feature::Wavefront);
@@ -202,10 +206,17 @@ pub fn run(
             } else {
                 Schedule::Wavefront
             },
-            ..Resources::default()
+            ..asked.clone()
         };
-        let other = measure(&ctx, scene, other, spp, runs)?;
-        if other.on(Feature::Wavefront) != front {
+        // The wavefront cannot take every scene: then there is nothing to compare.
+        let other = match measure(&ctx, scene, other, spp, runs) {
+            Ok(other) => Some(other),
+            Err(e) => {
+                println!("  (no other schedule: {e})");
+                None
+            }
+        };
+        if let Some(other) = other.filter(|o| o.on(Feature::Wavefront) != front) {
             let (mega, wave) = if front {
                 print("megakernel", &other);
                 (&other, &special)

@@ -63,6 +63,8 @@ pub(super) fn render(args: &RenderArgs<'_>, frames: &[i64], skip_missing: bool) 
                     library: Some(Arc::clone(args.library)),
                     frame: Some(frame),
                     outputs_anywhere: args.outputs_anywhere,
+                    intersector: args.choice.intersector(),
+                    schedule: args.choice.schedule(),
                     ..SessionOptions::default()
                 };
                 let mut s = Session::with(graph.clone(), None, options)

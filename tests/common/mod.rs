@@ -102,8 +102,16 @@ pub fn executor(
     let ctx = gpu()?;
     let keep: Vec<String> = keep.iter().map(|&k| k.to_owned()).collect();
     let plan = compile(graph, &keep, Some(scene)).unwrap();
+    // `LUMAGRAPH_RAY_QUERY=on` runs these renders through ray queries, as
+    // `lumagraph render --intersector rays` does (docs/pathtracer.md: the reference suite).
+    let intersector = if std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "on") {
+        lumagraph::render::specialize::Intersector::RayQueries
+    } else {
+        lumagraph::render::specialize::Intersector::Auto
+    };
     let resources = Resources {
         scene: Some(std::sync::Arc::clone(scene)),
+        intersector,
         ..Resources::default()
     };
     Some(Executor::new(ctx, plan, &resources).unwrap())

@@ -125,7 +125,7 @@ pub(super) fn albedos(
 /// scene, BVH traversal, as GPUs do, and with the wall in 64 quads host intersection, as
 /// lavapipe runs larger scenes with Embree) and of the G-buffer raster against the material
 /// the CPU mirror's traversal finds through the pixel centre, and through the 8-wide BVH
-/// (`LUMAGRAPH_BVH=wide`). Measured: every pixel agrees
+/// (`--intersector wide`). Measured: every pixel agrees
 /// (0 of 4096); asserted: at most 0.5 % differ (texel edges that rounding puts on either
 /// side), and the cut-out squares are half the quad's pixels within 10 %.
 #[test]

@@ -1,4 +1,4 @@
-//! The wavefront (`Schedule::Wavefront`, `LUMAGRAPH_WAVEFRONT=on`): the paths of a frame
+//! The wavefront (`Schedule::Wavefront`, `--schedule wavefront`): the paths of a frame
 //! taken one bounce at a time by the steps of `pathtrace/wave.wgsl`, each step's rays traced
 //! on the device by `wave_trace` through the intersector the megakernel uses, with the same
 //! rules for rays leaving a surface. Same random numbers, same arithmetic, same hits: the
@@ -131,7 +131,7 @@ fn the_wavefront_is_used_where_asked_for_or_measured_faster() {
         let why = f.reason(Feature::Wavefront);
         assert!(!f.on(Feature::Wavefront), "{why}");
         assert!(
-            why.contains(what) && why.contains("LUMAGRAPH_WAVEFRONT=on"),
+            why.contains(what) && why.contains("--schedule wavefront"),
             "{why}"
         );
     }

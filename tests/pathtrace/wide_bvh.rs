@@ -1,7 +1,7 @@
 //! The 8-wide compressed BVH (`plan`: "8-wide BVH"; `crates/render/src/wide_bvh.rs`,
 //! `shaders/pathtrace/wide_bvh.wgsl`): CPU adapters traverse it where they traverse a BVH
 //! in WGSL, GPU adapters the binary BVH, each as measured faster there
-//! (`docs/benchmarks.md`); `LUMAGRAPH_BVH=wide` or `binary` (or a test's resources) asks for
+//! (`docs/benchmarks.md`); `--intersector wide` or `binary` (or a test's resources) asks for
 //! one. Its hits are the binary BVH's: the same exact tests on the same primitives.
 
 use crate::common;
@@ -20,7 +20,7 @@ fn scene(rel: &str) -> GpuScene {
 /// The choice, without a device: a CPU adapter walks the wide BVH where it traverses one in
 /// WGSL (not where it intersects a small scene inline or on the host), a GPU adapter the
 /// binary one, and neither where ray queries trace the scene; `Intersector::WideBvh` /
-/// `BinaryBvh` (`LUMAGRAPH_BVH=wide` / `binary`) ask for either, over inline, host and ray
+/// `BinaryBvh` (`--intersector wide` / `binary`) ask for either, over inline, host and ray
 /// queries alike; the general shader never uses it. The shader traverses the wide BVH (`wide_bvh.wgsl`)
 /// exactly where it is chosen, and the plan's reasons name the measurements.
 #[test]

@@ -481,8 +481,12 @@ impl Session {
     /// `Output` nodes write their files under `out` only with `write_outputs`; `keep` names
     /// more ports ("node.port") to read back with `read`. A graph whose params hold a
     /// frame pattern (`####`, `%04d`, `$F4`) opens at `frame` (see `render_frames`).
+    /// `intersector` (`"auto"`, `"inline"`, `"host"`, `"binary"`, `"wide"`, `"rays"`) and
+    /// `schedule` (`"auto"`, `"megakernel"`, `"wavefront"`) ask the path tracer for one, as
+    /// `lumagraph render --intersector` and `--schedule` do.
     #[new]
-    #[pyo3(signature = (graph, scene=None, out="out", write_outputs=false, keep=Vec::new(), frame=None))]
+    #[pyo3(signature = (graph, scene=None, out="out", write_outputs=false, keep=Vec::new(), frame=None, intersector="auto", schedule="auto"))]
+    #[expect(clippy::too_many_arguments, reason = "Python keyword arguments")]
     fn new(
         graph: &Bound<'_, PyAny>,
         scene: Option<&Bound<'_, PyAny>>,
@@ -490,12 +494,19 @@ impl Session {
         write_outputs: bool,
         keep: Vec<String>,
         frame: Option<i64>,
+        intersector: &str,
+        schedule: &str,
     ) -> PyResult<Self> {
+        use lumagraph::render::specialize::{Intersector, Schedule};
         let options = SessionOptions {
             out: PathBuf::from(out),
             write_outputs,
             keep,
             frame,
+            intersector: Intersector::from_name(intersector)
+                .map_err(pyo3::exceptions::PyValueError::new_err)?,
+            schedule: Schedule::from_name(schedule)
+                .map_err(pyo3::exceptions::PyValueError::new_err)?,
             ..SessionOptions::default()
         };
         let graph = graph_arg(graph)?;

@@ -522,32 +522,3 @@ pub fn human_bytes(bytes: u64) -> String {
 pub fn ray_queries_turned_off() -> bool {
     std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "off" || v == "0")
 }
-
-/// The intersector the environment asks for: `LUMAGRAPH_RAY_QUERY=on` the device's ray
-/// queries wherever they can trace the scene, even on a CPU adapter; `LUMAGRAPH_BVH=wide`
-/// or `binary` the 8-wide or the binary BVH in WGSL ([`crate::wide_bvh`]), even where the
-/// scene would be intersected inline or on the host. Otherwise
-/// [`Intersector::Auto`](crate::specialize::Intersector::Auto).
-pub fn intersector_asked_for() -> crate::specialize::Intersector {
-    use crate::specialize::Intersector;
-    if std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "on" || v == "1") {
-        return Intersector::RayQueries;
-    }
-    match std::env::var("LUMAGRAPH_BVH").as_deref() {
-        Ok("wide") => Intersector::WideBvh,
-        Ok("binary") => Intersector::BinaryBvh,
-        _ => Intersector::Auto,
-    }
-}
-
-/// The schedule the environment asks for: `LUMAGRAPH_WAVEFRONT=on` the wavefront
-/// ([`crate::wavefront`]) wherever it can trace the scene, `off` the megakernel. Otherwise
-/// [`Schedule::Auto`](crate::specialize::Schedule::Auto).
-pub fn schedule_asked_for() -> crate::specialize::Schedule {
-    use crate::specialize::Schedule;
-    match std::env::var("LUMAGRAPH_WAVEFRONT").as_deref() {
-        Ok("on" | "1") => Schedule::Wavefront,
-        Ok("off" | "0") => Schedule::Megakernel,
-        _ => Schedule::Auto,
-    }
-}

@@ -46,6 +46,11 @@ pub struct SessionOptions {
     pub frame: Option<i64>,
     /// Let `Output` paths be absolute or climb out of `out` (by default they are refused).
     pub outputs_anywhere: bool,
+    /// The path tracer's intersector ([`Resources::intersector`]; `Auto`: the scene and
+    /// the adapter decide).
+    pub intersector: crate::specialize::Intersector,
+    /// The path tracer's schedule ([`Resources::schedule`]).
+    pub schedule: crate::specialize::Schedule,
 }
 
 impl Default for SessionOptions {
@@ -57,6 +62,8 @@ impl Default for SessionOptions {
             library: None,
             frame: None,
             outputs_anywhere: false,
+            intersector: crate::specialize::Intersector::Auto,
+            schedule: crate::specialize::Schedule::Auto,
         }
     }
 }
@@ -176,6 +183,8 @@ impl Session {
             out_dir: options.out,
             outputs_anywhere: options.outputs_anywhere,
             scene: scene.clone(),
+            intersector: options.intersector,
+            schedule: options.schedule,
             ..Resources::default()
         };
         let mut exec = Executor::with_library(&ctx, plan, &resources, &library)?;

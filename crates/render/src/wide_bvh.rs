@@ -187,7 +187,7 @@ pub fn upload(ctx: &GpuContext, bvh: &WideBvh) -> Result<wgpu::Buffer> {
             adapter: ctx.info.name.clone(),
             message: format!(
                 "{} in one storage buffer, over the adapter's largest storage binding of {}; \
-                 LUMAGRAPH_BVH=binary traverses the binary BVH",
+                 `--intersector binary` traverses the binary BVH",
                 crate::human_bytes(bvh.bytes),
                 crate::human_bytes(binding)
             ),

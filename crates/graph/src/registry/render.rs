@@ -85,6 +85,8 @@ fn path_trace() -> NodeKind {
             replicates_param(),
             adaptive_error_param(),
             adaptive_min_spp_param(),
+            intersector_param(),
+            schedule_param(),
             ParamDef {
                 name: "strategy",
                 ty: ParamType::Enum {
@@ -145,6 +147,64 @@ fn adaptive_error_param() -> ParamDef {
           stops pixels near a relMSE of 4e-4); 0 is off. On, the \
           frames alternate two Sobol replicates (as `replicates: 2`) and skipped \
           pixels output alpha 0, which Accumulate does not add (docs/pathtracer.md)",
+    }
+}
+
+/// `PathTrace`'s `intersector` param.
+fn intersector_param() -> ParamDef {
+    ParamDef {
+        name: "intersector",
+        ty: ParamType::Enum {
+            default: "auto",
+            options: &[
+                (
+                    "auto",
+                    "the scene and the adapter decide (or `lumagraph render --intersector`)",
+                ),
+                (
+                    "inline",
+                    "every primitive tested in code written for the scene (at most 64)",
+                ),
+                (
+                    "host",
+                    "Embree on the host's threads (CPU adapters, triangle scenes)",
+                ),
+                ("binary", "the binary BVH in WGSL (traces everything)"),
+                ("wide", "the 8-wide BVH in WGSL (flat scenes)"),
+                (
+                    "rays",
+                    "the device's ray queries (devices that have them, flat scenes)",
+                ),
+            ],
+        },
+        doc: "how rays find what they hit; when not `auto` it wins over `--intersector`, and one \
+          that cannot trace the scene on this adapter stops the render with the reason (the \
+          support matrix in docs/pathtracer.md). Images are the same whichever traces",
+    }
+}
+
+/// `PathTrace`'s `schedule` param.
+fn schedule_param() -> ParamDef {
+    ParamDef {
+        name: "schedule",
+        ty: ParamType::Enum {
+            default: "auto",
+            options: &[
+                (
+                    "auto",
+                    "the scene and the adapter decide (or `lumagraph render --schedule`)",
+                ),
+                ("megakernel", "one invocation traces a pixel's whole paths"),
+                (
+                    "wavefront",
+                    "the paths taken one bounce at a time by small kernels (triangle scenes \
+                     without media or adaptive sampling, through a WGSL BVH or ray queries)",
+                ),
+            ],
+        },
+        doc: "how the path tracer's work is laid out on the device; when not `auto` it wins \
+          over `--schedule`, and a wavefront that cannot take the scene stops the render \
+          with the reason",
     }
 }
 

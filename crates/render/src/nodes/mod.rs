@@ -54,13 +54,15 @@ pub struct Resources {
     /// host, no spreading of workgroups, ray queries only where `intersector` asks for them)
     /// even on a CPU adapter: tests run what GPUs run on lavapipe.
     pub as_gpu_adapter: bool,
-    /// The path tracer's intersector, where a test or a benchmark asks for one
-    /// ([`crate::specialize::Intersector`]; `Auto`, the default: the scene, the adapter and
-    /// `LUMAGRAPH_BVH` / `LUMAGRAPH_RAY_QUERY` decide).
+    /// The path tracer's intersector, where the command line (`--intersector`), a test or a
+    /// benchmark asks for one ([`crate::specialize::Intersector`]; `Auto`, the default: the
+    /// scene and the adapter decide). A `PathTrace` node's `intersector` param, when not
+    /// `auto`, wins over it. One that cannot trace the scene is an error when the node is
+    /// built, never a silent fallback.
     pub intersector: crate::specialize::Intersector,
-    /// The path tracer's schedule, where a test or a benchmark asks for one
-    /// ([`crate::specialize::Schedule`]; `Auto`, the default: the adapter and
-    /// `LUMAGRAPH_WAVEFRONT` decide).
+    /// The path tracer's schedule, where the command line (`--schedule`), a test or a
+    /// benchmark asks for one ([`crate::specialize::Schedule`]; `Auto`, the default: the
+    /// scene and the adapter decide). The node's `schedule` param, when not `auto`, wins.
     pub schedule: crate::specialize::Schedule,
     /// Trace workgroups in image order even on a CPU adapter, where they are otherwise
     /// spread over the image to balance the driver's threads (a test compares the two).
@@ -366,13 +368,16 @@ pub trait NodeExec {
     }
 }
 
-/// What a pass of a kind specialized to the scene compiles in and leaves out, on an adapter
-/// with these traits (a CPU one or a GPU, with or without ray queries).
+/// What a pass of a kind specialized to the scene compiles in and leaves out, with these
+/// resources (the intersector and schedule asked for) on an adapter with these traits (a CPU
+/// one or a GPU, with or without ray queries); and why the pass would refuse to render, if
+/// it would (an intersector or schedule asked for that cannot trace the scene there).
 pub type ShaderFeatures = fn(
     &Pass,
     &lumagraph_scene::GpuScene,
+    &Resources,
     crate::specialize::AdapterTraits,
-) -> crate::specialize::Features;
+) -> (crate::specialize::Features, Option<String>);
 
 /// The size of the image a source produces from its params (paths relative to the folder
 /// given), or why it cannot tell.
@@ -396,7 +401,7 @@ pub struct NodeImpl {
     /// its params (paths relative to the folder given), or why it cannot tell.
     pub source_extent: Option<SourceExtent>,
     /// For a kind whose shader is specialized to the scene: what a pass of it compiles in
-    /// and leaves out for `scene` (with the default resources), for `lumagraph plan`.
+    /// and leaves out for `scene` (with the resources given), for `lumagraph plan`.
     /// The adapter's traits say whether it is a CPU one (lavapipe), where other choices
     /// pay, and whether it has ray queries.
     pub features: Option<ShaderFeatures>,

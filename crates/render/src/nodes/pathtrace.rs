@@ -14,7 +14,7 @@ use crate::kernel::{Kernel, uniform_buffer};
 use crate::shared::{CHUNK_FIRST, CHUNK_LAST, WAVE_FINISH, WAVE_STEP};
 use lumagraph_graph::TexFormat;
 
-use crate::host_rays::{HostCounts, HostRays, WaveStep};
+use crate::host_rays::{HostCounts, WaveStep};
 use crate::kernel::PassBuilder;
 use crate::nodes::{Counter, FrameIo, NodeExec, NodeImpl, Recording, Resources, boxed};
 use crate::pool::{PooledTexture, create};
@@ -27,12 +27,19 @@ use crate::specialize::{Feature, Features};
 /// ([`crate::shared::WAVE_COUNTS_AT`]).
 const STATS: u64 = 8;
 
+mod backend;
+
+use backend::Backend;
+
 /// The `PathTrace` kind.
 pub(crate) const IMPL: NodeImpl = NodeImpl::new("PathTrace", |ctx, pass, resources| {
     boxed(PathTrace::new(ctx, pass, resources))
 })
-.with_features(|pass, scene, traits| {
-    crate::specialize::Features::decide(scene, options(pass, &Resources::default(), traits))
+.with_features(|pass, scene, resources, traits| {
+    let options = options(pass, resources, traits);
+    let features = crate::specialize::Features::decide(scene, options);
+    let refusal = crate::specialize::support::refusal(scene, options, &features);
+    (features, refusal)
 })
 .owning(|pass| {
     adaptive_on(pass).then(|| {
@@ -52,18 +59,31 @@ fn adaptive_on(pass: &Pass) -> bool {
 
 /// How a pass's shader is specialized: to the scene unless the resources ask for the
 /// general shader, to the kind of adapter, with first-hit AOVs when something reads them.
-/// `resources.as_gpu_adapter` has it decided as on a GPU adapter, `resources.intersector`
-/// (else `LUMAGRAPH_BVH` or `LUMAGRAPH_RAY_QUERY`) asks for an intersector.
+/// `resources.as_gpu_adapter` has it decided as on a GPU adapter. The pass's `intersector`
+/// and `schedule` params, where not `auto`, ask for an intersector and a schedule; else
+/// `resources.intersector` and `resources.schedule` (`--intersector`, `--schedule`) do.
 fn options(
     pass: &Pass,
     resources: &Resources,
     traits: crate::specialize::AdapterTraits,
 ) -> crate::specialize::PathTraceOptions {
-    use crate::specialize::Intersector;
+    use crate::specialize::{Intersector, Schedule};
     let cpu_adapter = traits.cpu && !resources.as_gpu_adapter;
-    let intersector = match resources.intersector {
-        Intersector::Auto => crate::context::intersector_asked_for(),
-        asked => asked,
+    let param = |name: &str| {
+        if pass.params.has(name) {
+            pass.params.str(name).to_owned()
+        } else {
+            "auto".to_owned()
+        }
+    };
+    // The registry's options are exactly the names, so an unknown one cannot reach here.
+    let intersector = match Intersector::from_name(&param("intersector")) {
+        Ok(Intersector::Auto) | Err(_) => resources.intersector,
+        Ok(asked) => asked,
+    };
+    let schedule = match Schedule::from_name(&param("schedule")) {
+        Ok(Schedule::Auto) | Err(_) => resources.schedule,
+        Ok(asked) => asked,
     };
     crate::specialize::PathTraceOptions {
         ray_query_limit: traits
@@ -79,11 +99,22 @@ fn options(
             .any(|p| pass.output(p).is_some()),
         adaptive: adaptive_on(pass),
         host_rays: cpu_adapter && crate::embree::Embree::load().is_ok(),
-        schedule: match resources.schedule {
-            crate::specialize::Schedule::Auto => crate::context::schedule_asked_for(),
-            asked => asked,
-        },
+        schedule,
     }
+}
+
+/// The shader source and features for `scene` and `options`, or why the intersector or
+/// schedule they ask for cannot trace it ([`crate::specialize::support::refusal`]).
+fn specialized(
+    scene: &lumagraph_scene::GpuScene,
+    options: crate::specialize::PathTraceOptions,
+) -> Result<(String, Features)> {
+    let specialization = crate::specialize::Specialization::new(scene, options);
+    if let Some(why) = crate::specialize::support::refusal(scene, options, &specialization.features)
+    {
+        return Err(RenderError::Unsupported(why));
+    }
+    Ok((specialization.source()?, specialization.features))
 }
 
 crate::param_block! {
@@ -307,8 +338,8 @@ pub(crate) struct PathTrace {
     /// Per pixel of the window, the sum of a frame's samples traced so far while it takes
     /// several dispatches (a 16-byte stand-in until one does).
     chunk_sums: wgpu::Buffer,
-    /// Host intersection's state, when the plan says "host intersection".
-    host: Option<HostRays>,
+    /// What traces the rays (the plan's intersector), with its state.
+    backend: Backend,
     /// Host intersection's steps and times since the last reset (its rays go to `rays`).
     host_counts: HostCounts,
     /// The `wave` binding's stand-in without host intersection or the wavefront.
@@ -317,12 +348,6 @@ pub(crate) struct PathTrace {
     wavefront: Option<crate::wavefront::Wavefront>,
     /// The frame `submit_own` traced in steps, whose finish `record` records.
     traced: Option<Frame>,
-    /// The scene's acceleration structure, where the plan says "ray queries", and how long
-    /// it took to build.
-    accel: Option<(crate::accel::SceneAccel, std::time::Duration)>,
-    /// The 8-wide BVH's buffer, where the plan says "8-wide BVH" (bound in the binary
-    /// BVH's place), with its node count, depth, size and build time.
-    wide: Option<(wgpu::Buffer, crate::wide_bvh::WideBvh, std::time::Duration)>,
 }
 
 impl PathTrace {
@@ -331,9 +356,7 @@ impl PathTrace {
             RenderError::Gpu("PathTrace needs a scene (lumagraph render --scene FILE)".into())
         })?;
         let opts = options(pass, resources, ctx.traits());
-        let specialization = crate::specialize::Specialization::new(&scene, opts);
-        let source = specialization.source()?;
-        let features = specialization.features;
+        let (source, features) = specialized(&scene, opts)?;
         let samples_per_dispatch = if !ctx.is_cpu() {
             u32::MAX
         } else if features.on(Feature::InlineIntersection) {
@@ -341,32 +364,7 @@ impl PathTrace {
         } else {
             CPU_SAMPLES_PER_DISPATCH[0]
         };
-        let host = if features.on(Feature::HostRays) {
-            Some(HostRays::new(ctx, &scene)?)
-        } else {
-            None
-        };
-        let accel = if features.on(Feature::RayQueries) {
-            let start = std::time::Instant::now();
-            let a = crate::accel::SceneAccel::build(ctx, &scene)?;
-            Some((a, start.elapsed()))
-        } else {
-            None
-        };
-        let wide = if features.on(Feature::WideBvh) {
-            let start = std::time::Instant::now();
-            let mut bvh = crate::wide_bvh::WideBvh::build(&scene).map_err(|e| {
-                RenderError::Gpu(format!(
-                    "{e} (LUMAGRAPH_BVH=binary traverses the binary BVH)"
-                ))
-            })?;
-            let took = start.elapsed();
-            let buffer = crate::wide_bvh::upload(ctx, &bvh)?;
-            bvh.records = Vec::new();
-            Some((buffer, bvh, took))
-        } else {
-            None
-        };
+        let backend = Backend::new(ctx, &scene, &features)?;
         let wavefront = features
             .on(Feature::Wavefront)
             .then(|| crate::wavefront::Wavefront::new(ctx));
@@ -442,12 +440,10 @@ impl PathTrace {
             host_counts: HostCounts::default(),
             samples_per_dispatch,
             chunk_sums: storage(ctx, "pathtrace chunk sums", 16),
-            host,
+            backend,
             wave_stand_in: storage(ctx, "pathtrace wave stand-in", 16),
             wavefront,
             traced: None,
-            accel,
-            wide,
         };
         node.update(ctx, pass)?;
         Ok(node)
@@ -515,7 +511,7 @@ impl PathTrace {
             .pass(name)
             .write(color)
             .uniform(&self.frame)
-            .buffer(self.wide.as_ref().map_or(&b.bvh_nodes, |(w, _, _)| w))
+            .buffer(self.backend.bvh_nodes(&b.bvh_nodes))
             .buffer(&b.tri_positions)
             .buffer(&b.tri_shading)
             .buffer(&b.shapes)
@@ -537,8 +533,8 @@ impl PathTrace {
             .buffer(sums)
             .buffer(wave)
             .read(&b.textures);
-        match &self.accel {
-            Some((accel, _)) => pass.accel(&accel.tlas),
+        match self.backend.accel() {
+            Some(accel) => pass.accel(&accel.tlas),
             None => pass,
         }
     }
@@ -582,7 +578,9 @@ impl PathTrace {
         pass: &Pass,
         frame: Frame,
     ) -> Result<()> {
-        let Some(mut host) = self.host.take() else {
+        let backend = std::mem::replace(&mut self.backend, Backend::Wgsl);
+        let Backend::Host(mut host) = backend else {
+            self.backend = backend;
             return Ok(());
         };
         host.fit(ctx, pass.extent);
@@ -613,7 +611,7 @@ impl PathTrace {
             }
             Ok(())
         });
-        self.host = Some(host);
+        self.backend = Backend::Host(host);
         result
     }
 
@@ -630,7 +628,7 @@ impl PathTrace {
     ) -> Result<()> {
         let sums = self.steps_sums(ctx, pass);
         let views = self.views(pass, io);
-        let wave = match (&self.host, &self.wavefront) {
+        let wave = match (self.backend.host(), &self.wavefront) {
             (Some(host), _) => host.wave().clone(),
             (None, Some(front)) => front.wave().clone(),
             (None, None) => return Ok(()),
@@ -716,7 +714,7 @@ impl PathTrace {
         pass: &Pass,
         frame: Frame,
     ) -> Result<()> {
-        if self.host.is_some() {
+        if self.backend.host().is_some() {
             self.trace_host(ctx, io, pass, frame)
         } else {
             self.trace_wavefront(ctx, io, pass, frame)
@@ -844,7 +842,7 @@ impl NodeExec for PathTrace {
     }
 
     fn submits_own(&self) -> bool {
-        self.host.is_some() || self.wavefront.is_some()
+        self.backend.host().is_some() || self.wavefront.is_some()
     }
 
     fn submit_own(&mut self, ctx: &GpuContext, pass: &Pass, io: &FrameIo<'_>) -> Result<()> {
@@ -869,7 +867,7 @@ impl NodeExec for PathTrace {
                 timer.as_deref_mut(),
             )?;
         }
-        if self.host.is_some() || self.wavefront.is_some() {
+        if self.submits_own() {
             let frame = match self.traced.take() {
                 Some(frame) => frame,
                 None => {
@@ -920,28 +918,7 @@ impl NodeExec for PathTrace {
 
     fn notes(&self) -> Vec<String> {
         let mut notes = vec![format!("shader: {}", self.features.summary())];
-        if let Some(host) = &self.host {
-            notes.push(host.note.clone());
-        }
-        if let Some((accel, took)) = &self.accel {
-            notes.push(format!(
-                "ray queries: acceleration structure over {} triangles and {} spheres ({} of \
-                 boxes) built in {:.1} ms",
-                self.scene.tri_positions.len(),
-                self.scene.shapes.len(),
-                crate::human_bytes(accel.input_bytes),
-                took.as_secs_f64() * 1e3
-            ));
-        }
-        if let Some((_, bvh, took)) = &self.wide {
-            notes.push(format!(
-                "8-wide BVH: {} nodes, {} deep, {} built in {:.1} ms",
-                bvh.nodes,
-                bvh.depth,
-                crate::human_bytes(bvh.bytes),
-                took.as_secs_f64() * 1e3
-            ));
-        }
+        notes.extend(self.backend.note(&self.scene));
         if self.firefly_clamp > 0.0 {
             notes.push(format!(
                 "firefly clamp ON: each sample's channels are scaled to at most {} (biased: energy is lost)",
@@ -1023,7 +1000,7 @@ impl NodeExec for PathTrace {
         )?;
         self.dropped += u64::from(v[0]);
         self.rays += u64::from(v[1]) | (u64::from(v[2]) << 32);
-        if let Some(host) = &mut self.host {
+        if let Backend::Host(host) = &mut self.backend {
             self.host_counts += host.take_counts();
             self.rays += std::mem::take(&mut self.host_counts.rays);
         }
@@ -1033,7 +1010,7 @@ impl NodeExec for PathTrace {
             Counter::new("dropped_samples", self.dropped),
             Counter::new("rays", self.rays),
         ];
-        if self.host.is_some() {
+        if self.backend.host().is_some() {
             let h = self.host_counts;
             counters.extend([
                 Counter::new("host_steps", h.steps),

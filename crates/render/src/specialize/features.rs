@@ -14,7 +14,9 @@ use lumagraph_scene::{
     MATERIAL_ALPHA_MASK, MATERIAL_INDEX_MATCHED, MATERIAL_MEDIUM,
 };
 
-use super::{INLINE_MAX_MATERIALS, INLINE_MAX_PRIMITIVES, Intersector, PathTraceOptions, codegen};
+use super::{
+    INLINE_MAX_MATERIALS, INLINE_MAX_PRIMITIVES, Intersector, PathTraceOptions, Schedule, codegen,
+};
 
 /// One part of the path tracer that a shader compiles in or leaves out.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -23,7 +25,7 @@ pub enum Feature {
     BvhTraversal,
     /// The WGSL traversal walks the 8-wide compressed BVH ([`crate::wide_bvh`],
     /// `pathtrace/wide_bvh.wgsl`) instead of the binary stackless one: on CPU adapters,
-    /// where it measured faster, and where asked (`LUMAGRAPH_BVH=wide`); GPU adapters keep
+    /// where it measured faster, and where asked (`--intersector wide`); GPU adapters keep
     /// the binary one, which measured faster there.
     WideBvh,
     /// Intersection through the device's ray queries: its acceleration structure finds the
@@ -231,6 +233,40 @@ impl Features {
         Feature::ALL.into_iter().zip(&self.decisions)
     }
 
+    /// The intersector these features trace with (never [`Intersector::Auto`]).
+    pub fn intersector(&self) -> Intersector {
+        if self.on(Feature::InlineIntersection) {
+            Intersector::Inline
+        } else if self.on(Feature::HostRays) {
+            Intersector::Host
+        } else if self.on(Feature::RayQueries) {
+            Intersector::RayQueries
+        } else if self.on(Feature::WideBvh) {
+            Intersector::WideBvh
+        } else {
+            Intersector::BinaryBvh
+        }
+    }
+
+    /// Why [`Features::intersector`] traces the scene, for the plan.
+    pub fn intersector_reason(&self) -> &str {
+        match self.intersector() {
+            Intersector::Inline => self.reason(Feature::InlineIntersection),
+            Intersector::Host => self.reason(Feature::HostRays),
+            Intersector::RayQueries => self.reason(Feature::RayQueries),
+            _ => self.reason(Feature::WideBvh),
+        }
+    }
+
+    /// The schedule these features lay the paths out with (never [`Schedule::Auto`]).
+    pub fn schedule(&self) -> Schedule {
+        if self.on(Feature::Wavefront) {
+            Schedule::Wavefront
+        } else {
+            Schedule::Megakernel
+        }
+    }
+
     /// The same features with `f` set to `included` (tests compare shaders that differ in
     /// one feature).
     #[must_use]
@@ -375,18 +411,18 @@ fn material_ranges(scene: &GpuScene, index: usize, m: &GpuMaterial) -> MaterialR
 /// Why a CPU adapter does not trace through its ray queries unless asked to (lavapipe
 /// has them from Mesa 25): measured in `docs/benchmarks.md` ("Ray queries on lavapipe").
 const CPU_RAY_QUERIES_REASON: &str = "a CPU adapter: lavapipe's ray queries measured 0.16-0.36x \
-     the kernel's own intersection (LUMAGRAPH_RAY_QUERY=on asks for them)";
+     the kernel's own intersection (--intersector rays asks for them)";
 
 /// Why a CPU adapter traverses the 8-wide BVH unless asked otherwise: measured in
 /// `docs/benchmarks.md` ("The 8-wide BVH on lavapipe").
 const CPU_WIDE_BVH_REASON: &str = "a CPU adapter: the 8-wide BVH measured 2.3x the binary \
      one's paths/s on Sponza and 1.4x on an 82 k-triangle mesh on lavapipe \
-     (LUMAGRAPH_BVH=binary asks for the binary one)";
+     (--intersector binary asks for the binary one)";
 
 /// Why a GPU adapter traverses the binary BVH unless asked otherwise: measured in
 /// `docs/benchmarks.md` ("The 8-wide BVH against the binary one").
 const GPU_WIDE_BVH_REASON: &str = "the binary BVH: the 8-wide one measured 0.82x on Sponza \
-     and 1.01x on a 1.3 M-triangle mesh on an NVIDIA H200 (LUMAGRAPH_BVH=wide asks for it)";
+     and 1.01x on a 1.3 M-triangle mesh on an NVIDIA H200 (--intersector wide asks for it)";
 
 /// What the decisions are made from, worked out once.
 struct Facts<'a> {
@@ -414,30 +450,13 @@ impl<'a> Facts<'a> {
         let prims = scene.tri_positions.len() + scene.shapes.len();
         let instanced = !scene.instances.is_empty();
         // Why the device's ray queries cannot trace this scene, if they cannot.
-        let no_ray_queries = if !options.specialize {
-            Some("general shader: WGSL BVH".to_owned())
-        } else if instanced {
-            Some(super::INSTANCES_REASON.to_owned())
+        let no_ray_queries = super::support::why_not(Intersector::RayQueries, scene, options);
+        // The intersector asked for where it can trace the scene (the support matrix and
+        // the adapter); else the adapter decides.
+        let asked = if super::support::why_not(options.intersector, scene, options).is_some() {
+            Intersector::Auto
         } else {
-            match options.ray_query_limit {
-                None => Some(if crate::context::ray_queries_turned_off() {
-                    "LUMAGRAPH_RAY_QUERY=off".to_owned()
-                } else {
-                    "the device has no ray queries".to_owned()
-                }),
-                Some(most) => crate::accel::unsupported(scene, most),
-            }
-        };
-        // The intersector asked for where it can trace the scene; else the adapter decides.
-        let asked = match options.intersector {
-            Intersector::RayQueries if no_ray_queries.is_some() => Intersector::Auto,
-            Intersector::Inline
-                if !options.specialize || prims > INLINE_MAX_PRIMITIVES || instanced =>
-            {
-                Intersector::Auto
-            }
-            Intersector::WideBvh if instanced => Intersector::Auto,
-            asked => asked,
+            options.intersector
         };
         let inline_for = |asked| {
             options.specialize
@@ -449,17 +468,8 @@ impl<'a> Facts<'a> {
                     _ => false,
                 }
         };
-        let mut inline = inline_for(asked);
-        let mut host = super::host_rays_decision(scene, options, inline, asked);
-        // The host asked for where it cannot trace the scene (no Embree, analytic shapes, media…):
-        // the adapter decides, as for the others.
-        let asked = if asked == Intersector::Host && !host.included {
-            inline = inline_for(Intersector::Auto);
-            host = super::host_rays_decision(scene, options, inline, Intersector::Auto);
-            Intersector::Auto
-        } else {
-            asked
-        };
+        let inline = inline_for(asked);
+        let host = super::host_rays_decision(scene, options, inline, asked);
         let ray_queries = match no_ray_queries {
             Some(why) => decision(false, why),
             None if inline => decision(false, "intersected inline"),

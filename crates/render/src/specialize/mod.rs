@@ -15,6 +15,7 @@
 
 mod codegen;
 mod features;
+pub mod support;
 
 pub use codegen::{inline_intersection, inline_materials_data, inline_scene_data, parallelograms};
 pub use features::{Decision, Feature, Features};
@@ -41,8 +42,9 @@ pub struct AdapterTraits {
 /// The path tracer's intersectors. Each implements the contract of
 /// `shaders/pathtrace/contract.wgsl` (the closest hit, occlusion up to a distance, the
 /// alpha any-hit test); the Rust mirror (`lumagraph_scene::traverse`) follows it on the CPU.
-/// Which one traces a scene is decided once per shader ([`Feature`]); this is what a test,
-/// a benchmark or an environment variable may ask for instead of that decision.
+/// Which one traces a scene is decided once per shader ([`Feature`]); this is what the
+/// `PathTrace` node's `intersector` param, `lumagraph render --intersector`, a test or a
+/// benchmark may ask for instead of that decision ([`support`] says what each can trace).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Intersector {
     /// The scene and the adapter decide: on CPU adapters, small scenes inline, larger ones
@@ -76,6 +78,41 @@ impl Intersector {
             Self::RayQueries => "ray queries",
         }
     }
+
+    /// Every choice, [`Intersector::Auto`] first.
+    pub const ALL: [Self; 6] = [
+        Self::Auto,
+        Self::Inline,
+        Self::Host,
+        Self::BinaryBvh,
+        Self::WideBvh,
+        Self::RayQueries,
+    ];
+
+    /// Its word in the `intersector` param and the `--intersector` option.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Inline => "inline",
+            Self::Host => "host",
+            Self::BinaryBvh => "binary",
+            Self::WideBvh => "wide",
+            Self::RayQueries => "rays",
+        }
+    }
+
+    /// The intersector a word names ([`Intersector::name`]).
+    ///
+    /// # Errors
+    /// An unknown word, with the known ones.
+    pub fn from_name(name: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|i| i.name() == name)
+            .ok_or_else(|| {
+                format!("unknown intersector {name:?}: auto, inline, host, binary, wide or rays")
+            })
+    }
 }
 
 /// How the path tracer's work is laid out on the device.
@@ -104,6 +141,29 @@ impl Schedule {
             Self::Megakernel => "the megakernel",
             Self::Wavefront => "the wavefront",
         }
+    }
+
+    /// Every choice, [`Schedule::Auto`] first.
+    pub const ALL: [Self; 3] = [Self::Auto, Self::Megakernel, Self::Wavefront];
+
+    /// Its word in the `schedule` param and the `--schedule` option.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Megakernel => "megakernel",
+            Self::Wavefront => "wavefront",
+        }
+    }
+
+    /// The schedule a word names ([`Schedule::name`]).
+    ///
+    /// # Errors
+    /// An unknown word, with the known ones.
+    pub fn from_name(name: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|i| i.name() == name)
+            .ok_or_else(|| format!("unknown schedule {name:?}: auto, megakernel or wavefront"))
     }
 }
 
@@ -136,10 +196,12 @@ pub struct PathTraceOptions {
     /// acceleration structures holds. GPU adapters trace through them wherever the scene
     /// would otherwise traverse the BVH in WGSL.
     pub ray_query_limit: Option<u32>,
-    /// The intersector asked for (tests, benchmarks, `LUMAGRAPH_BVH`, `LUMAGRAPH_RAY_QUERY`),
-    /// or [`Intersector::Auto`]: the scene and the adapter decide.
+    /// The intersector asked for (the `intersector` param, `--intersector`, tests,
+    /// benchmarks), or [`Intersector::Auto`]: the scene and the adapter decide. One that
+    /// cannot trace the scene ([`support::why_not`]) is decided as `Auto`; the node refuses
+    /// to render then ([`support::refusal`]).
     pub intersector: Intersector,
-    /// The schedule asked for (tests, benchmarks, `LUMAGRAPH_WAVEFRONT`), or
+    /// The schedule asked for (the `schedule` param, `--schedule`, tests, benchmarks), or
     /// [`Schedule::Auto`].
     pub schedule: Schedule,
 }
@@ -309,31 +371,6 @@ fn textures_reason(scene: &GpuScene, all: bool) -> String {
     }
 }
 
-/// Why the steps of host intersection and of the wavefront cannot trace `scene`, if they
-/// cannot: they shade triangle hits only, without media, adaptive sampling or bounce counts
-/// beyond what a step keeps.
-fn steps_cannot_trace(scene: &GpuScene, options: PathTraceOptions) -> Option<String> {
-    let media = scene.materials.iter().any(|x| {
-        x.flags & (lumagraph_scene::MATERIAL_MEDIUM | lumagraph_scene::MATERIAL_INDEX_MATCHED) != 0
-    });
-    if scene.tri_positions.is_empty() || !scene.shapes.is_empty() {
-        Some("analytic shapes or no triangles: the steps shade triangle hits only".to_owned())
-    } else if !scene.instances.is_empty() {
-        Some(INSTANCES_REASON.to_owned())
-    } else if media {
-        Some("participating media: shadow rays cross boundaries in WGSL".to_owned())
-    } else if options.adaptive {
-        Some("adaptive sampling: traced in WGSL".to_owned())
-    } else if scene.settings.max_bounces >= HOST_RAYS_MAX_BOUNCES {
-        Some(format!(
-            "{} bounces: a step keeps at most {HOST_RAYS_MAX_BOUNCES}",
-            scene.settings.max_bounces
-        ))
-    } else {
-        None
-    }
-}
-
 /// Why only the binary WGSL BVH traces a scene with instanced meshes: the others (inline
 /// code, the 8-wide BVH, ray queries, the host and the wavefront's step records) take flat
 /// scenes only so far.
@@ -360,7 +397,7 @@ fn host_rays_decision(
             false,
             format!("no host intersector: {}", host_rays_unavailable()),
         )
-    } else if let Some(why) = steps_cannot_trace(scene, options) {
+    } else if let Some(why) = support::cannot_trace(support::Tracer::Host, scene, options) {
         (false, why)
     } else {
         (
@@ -384,12 +421,12 @@ pub const WAVEFRONT_MIN_TRIANGLES: usize = 100_000;
 /// Why a GPU adapter schedules such scenes as a wavefront unless asked otherwise.
 const GPU_WAVEFRONT_REASON: &str = "a GPU adapter, textured materials and a large BVH: the \
      wavefront measured 1.11x the megakernel's paths/s on Sponza on an NVIDIA H200 \
-     (LUMAGRAPH_WAVEFRONT=off asks for the megakernel)";
+     (--schedule megakernel asks for the megakernel)";
 
 /// Why a GPU adapter keeps the megakernel for the other scenes.
 const GPU_MEGAKERNEL_REASON: &str = "the megakernel measured 1.8x the wavefront's paths/s on \
      the Cornell box, 1.7x on a 1.3 M-triangle mesh and 6.7x on a textured 12-triangle box on \
-     an NVIDIA H200 (LUMAGRAPH_WAVEFRONT=on asks for the wavefront)";
+     an NVIDIA H200 (--schedule wavefront asks for the wavefront)";
 
 /// Whether the wavefront schedules the paths (`WAVEFRONT`), and why (not): where asked
 /// for, or on a GPU adapter for large scenes with textured materials
@@ -405,7 +442,7 @@ fn wavefront_decision(
         Schedule::Wavefront => Ok("asked for"),
         Schedule::Auto if options.cpu_adapter => Err(
             "a CPU adapter: the megakernel, or the host's steps (the wavefront measured 0.5x \
-             the megakernel on lavapipe; LUMAGRAPH_WAVEFRONT=on asks for it)"
+             the megakernel on lavapipe; --schedule wavefront asks for it)"
                 .to_owned(),
         ),
         Schedule::Auto if textured_materials(scene) == 0 => {
@@ -425,7 +462,7 @@ fn wavefront_decision(
             "rays intersected on the host, which steps the paths itself".to_owned(),
         ),
         Ok(_) if inline => (false, "intersected inline: the megakernel".to_owned()),
-        Ok(why) => match steps_cannot_trace(scene, options) {
+        Ok(why) => match support::cannot_trace(support::Tracer::Wavefront, scene, options) {
             Some(cannot) => (false, format!("{cannot}: the megakernel")),
             None => (true, why.to_owned()),
         },
@@ -434,9 +471,6 @@ fn wavefront_decision(
 }
 
 /// Why the host intersector is not used, for the plan.
-/// Host intersection's steps keep the bounce in 24 bits of a word (`save_slot` in the shader).
-const HOST_RAYS_MAX_BOUNCES: u32 = 1 << 24;
-
 fn host_rays_unavailable() -> String {
     match crate::embree::Embree::load() {
         Ok(_) => "WGSL intersection asked for".to_owned(),

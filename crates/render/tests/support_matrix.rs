@@ -1,0 +1,162 @@
+//! The path tracer's support matrix (`lumagraph_render::specialize::support`): printed, each
+//! cell checked against what the decisions do when that intersector (or the wavefront) is
+//! asked for on a small scene with that row's content, and the table in
+//! `docs/pathtracer.md` checked against it. No GPU needed.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use std::path::Path;
+
+use lumagraph_render::specialize::support::{self, Content, HOST_RAYS_MAX_BOUNCES, MATRIX, Tracer};
+use lumagraph_render::specialize::{Feature, Features, Intersector, PathTraceOptions, Schedule};
+use lumagraph_scene::{FEATURE_ALPHA, GpuScene, MATERIAL_MEDIUM, Scene};
+
+fn root() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+}
+
+fn scene(rel: &str) -> GpuScene {
+    GpuScene::build(&Scene::load(&root().join(rel)).unwrap()).unwrap()
+}
+
+/// A CPU adapter with Embree and ray queries: every intersector available.
+fn base_options() -> PathTraceOptions {
+    PathTraceOptions {
+        specialize: true,
+        cpu_adapter: true,
+        host_rays: true,
+        ray_query_limit: Some(1 << 24),
+        ..PathTraceOptions::default()
+    }
+}
+
+/// A small scene with `content` (and nothing else of the matrix's rows), and the options
+/// that render it.
+fn with(content: Content) -> (GpuScene, PathTraceOptions) {
+    let mut options = base_options();
+    let mut s = scene("assets/cornell.ron");
+    match content {
+        Content::GeneralShader => options.specialize = false,
+        Content::GpuAdapter => options.cpu_adapter = false,
+        Content::ManyPrimitives => s = scene("tests/scenes/mesh_env.ron"),
+        Content::Shapes => s = scene("assets/cornell_spheres.ron"),
+        Content::Instances => s = scene("tests/scenes/instances.ron"),
+        Content::Media => s.materials[0].flags |= MATERIAL_MEDIUM,
+        Content::Adaptive => options.adaptive = true,
+        Content::ManyBounces => s.settings.max_bounces = HOST_RAYS_MAX_BOUNCES,
+        Content::Alpha => s.header.features |= FEATURE_ALPHA,
+        Content::Aovs => options.aovs = true,
+    }
+    (s, options)
+}
+
+/// Whether `tracer` traces `scene` when asked for: the decisions give it, and a render
+/// asking for it is not refused.
+fn traced(tracer: Tracer, scene: &GpuScene, options: PathTraceOptions) -> (bool, String) {
+    let options = match tracer {
+        Tracer::Wavefront => PathTraceOptions {
+            intersector: Intersector::BinaryBvh,
+            schedule: Schedule::Wavefront,
+            ..options
+        },
+        _ => PathTraceOptions {
+            intersector: [
+                Intersector::Inline,
+                Intersector::Host,
+                Intersector::BinaryBvh,
+                Intersector::WideBvh,
+                Intersector::RayQueries,
+            ]
+            .into_iter()
+            .find(|&i| Tracer::of(i) == Some(tracer))
+            .unwrap(),
+            ..options
+        },
+    };
+    let f = Features::decide(scene, options);
+    let refusal = support::refusal(scene, options, &f);
+    let given = match tracer {
+        Tracer::Wavefront => f.on(Feature::Wavefront),
+        _ => f.intersector() == options.intersector,
+    };
+    assert_eq!(
+        given,
+        refusal.is_none(),
+        "{tracer:?}: the decision and the refusal disagree ({refusal:?}; {})",
+        f.summary()
+    );
+    (given, refusal.unwrap_or_default())
+}
+
+#[test]
+fn every_cell_of_the_support_matrix_is_what_the_decisions_do() {
+    println!("{}", support::markdown());
+    // The scene every row starts from has none of them, and everything traces it.
+    let (plain, options) = (scene("assets/cornell.ron"), base_options());
+    for c in Content::ALL {
+        assert!(!c.in_scene(&plain, options), "cornell.ron has {c:?}");
+    }
+    for (tracer, _) in MATRIX {
+        let (given, why) = traced(tracer, &plain, options);
+        assert!(given, "{tracer:?} on cornell.ron: {why}");
+    }
+    let mut checked = 0;
+    for c in Content::ALL {
+        let (s, options) = with(c);
+        assert!(c.in_scene(&s, options), "{c:?}");
+        // Anything else the scene has (the instanced scene has more than 64 primitives)
+        // is traced by every column that traces `c`, so the cell alone decides.
+        for other in Content::ALL
+            .into_iter()
+            .filter(|&o| o != c && o.in_scene(&s, options))
+        {
+            for (tracer, _) in MATRIX {
+                assert!(
+                    !tracer.traces(c) || tracer.traces(other),
+                    "the {c:?} scene has {other:?} too, which {tracer:?} does not trace"
+                );
+            }
+        }
+        for (tracer, _) in MATRIX {
+            let (given, why) = traced(tracer, &s, options);
+            assert_eq!(
+                given,
+                tracer.traces(c),
+                "{tracer:?} with {c:?}: the table says {}, the decisions {}: {why}",
+                tracer.traces(c),
+                given
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, Content::ALL.len() * MATRIX.len());
+}
+
+/// Asked for where the adapter lacks it: the host without Embree, ray queries without
+/// them; each refused with why.
+#[test]
+fn an_intersector_the_adapter_lacks_is_refused_with_why() {
+    let plain = scene("assets/cornell.ron");
+    let options = PathTraceOptions {
+        host_rays: false,
+        ray_query_limit: None,
+        ..base_options()
+    };
+    for (tracer, what) in [
+        (Tracer::Host, "no host intersector"),
+        (Tracer::RayQueries, "no ray queries"),
+    ] {
+        let (given, why) = traced(tracer, &plain, options);
+        assert!(!given && why.contains(what), "{tracer:?}: {why}");
+    }
+}
+
+/// `docs/pathtracer.md` shows the matrix as [`support::markdown`] writes it.
+#[test]
+fn the_docs_show_the_support_matrix() {
+    let doc = std::fs::read_to_string(root().join("docs/pathtracer.md")).unwrap();
+    let table = support::markdown();
+    assert!(
+        doc.contains(&table),
+        "docs/pathtracer.md does not hold the support matrix; put this table in it:\n{table}"
+    );
+}
