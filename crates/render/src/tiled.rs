@@ -138,7 +138,8 @@ fn untileable(e: &Untileable, why: &str) -> RenderError {
 ///
 /// # Errors
 /// The first sink that writes no single image file (`MultiLayerOutput` writes several
-/// images into one): a tiled render has nothing to paste its tiles into.
+/// images into one): a tiled render has nothing to paste its tiles into; any sink of a
+/// graph whose working space is not Rec. 709 (the pasted image is written as Rec. 709).
 fn image_sinks(plan: &Plan) -> std::result::Result<Vec<(usize, TextureId)>, Untileable> {
     let mut sinks = Vec::new();
     for (p, pass) in plan.passes.iter().enumerate() {
@@ -154,6 +155,19 @@ fn image_sinks(plan: &Plan) -> std::result::Result<Vec<(usize, TextureId)>, Unti
                     .to_owned(),
             });
         };
+        if plan.working_space != lumagraph_graph::WorkingSpace::Rec709 {
+            // The pasted image is written as a Rec. 709 file (chromaticities, a PNG's
+            // encoding): refused rather than tagged wrongly.
+            return Err(Untileable {
+                node: pass.node.clone(),
+                kind: pass.kind.name.to_owned(),
+                reason: format!(
+                    "a tiled render writes its image as Rec. 709, and this graph's working \
+                     space is {}",
+                    plan.working_space
+                ),
+            });
+        }
         if let Some(texture) = pass.input(port.name) {
             sinks.push((p, texture));
         }
@@ -530,5 +544,10 @@ mod tests {
             "node \"out\" (MultiLayerOutput) cannot run tile by tile: it does not write one \
              image file for the tiles to be pasted into (Output does)"
         );
+        // A graph in ACEScg: its image would be written as Rec. 709.
+        let mut aces = plan("Output");
+        aces.working_space = lumagraph_graph::WorkingSpace::AcesCg;
+        let refused = super::image_sinks(&aces).unwrap_err().to_string();
+        assert!(refused.contains("ACEScg"), "{refused}");
     }
 }
