@@ -16,7 +16,7 @@
 // through the path tracer's own functions (pathtrace/textures.wgsl) at the interpolated UV.
 // With HAS_ALPHA, fragments of alpha-masked materials whose opacity (times the base colour
 // texture's alpha) is below the cutoff are discarded, as the path tracer's any-hit test cuts
-// them out (pathtrace/alpha.wgsl); blended ones are discarded with probability 1 - opacity,
+// them out (pathtrace/intersect/alpha.wgsl); blended ones are discarded with probability 1 - opacity,
 // drawn per pixel and material (the path tracer draws per ray and primitive).
 // Outputs: albedo (base color; alpha 2 on emissive materials, 1 on others, which Denoise uses
 // to keep lights and lit surfaces apart), shading normal, distance along the ray; 0 where
@@ -68,7 +68,7 @@ struct VertexIn {
     @location(7) color: vec4f,
 }
 
-// The instance a vertex is drawn for (a `GpuInstance`, pathtrace/instances.wgsl): its
+// The instance a vertex is drawn for (a `GpuInstance`, pathtrace/intersect/instances.wgsl): its
 // object-to-world and world-to-object rows and (root, flags, pad_scale, pad_base); the identity for
 // the scene's own triangles and shapes.
 struct InstanceIn {

@@ -2,4 +2,4 @@
 // scenes the renderer replaces this file with generated code that tests every primitive
 // with its coordinates written into the shader (see
 // crates/render/src/specialize/codegen.rs).
-#import "pathtrace/bvh.wgsl"
+#import "pathtrace/intersect/bvh.wgsl"

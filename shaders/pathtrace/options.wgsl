@@ -4,7 +4,7 @@
 
 // Write first-hit albedo, normal and depth (through the pixel center) to the AOV outputs.
 const WRITE_AOVS: bool = true;
-// Adaptive sampling: skip the pixels `pathtrace/adaptive.wgsl` has stopped, and keep the
+// Adaptive sampling: skip the pixels `pathtrace/integrator/adaptive.wgsl` has stopped, and keep the
 // statistics it stops them by.
 const ADAPTIVE: bool = true;
 // Workgroups trace rows of tiles spread over the image (CPU adapters: llvmpipe gives each
@@ -53,12 +53,12 @@ const HAS_ALPHA: bool = true;
 
 // The host intersects the rays (CPU adapters with Embree, scenes of triangles without
 // media): each dispatch takes every path one step, between the host's answers (the entry
-// points `wave_start`, `wave_misses` and `wave_hits` in pathtrace/wave.wgsl), instead of
+// points `wave_start`, `wave_misses` and `wave_hits` in pathtrace/integrator/wave.wgsl), instead of
 // tracing whole paths.
 const HOST_RAYS: bool = true;
 
 // The paths of a frame are taken one bounce at a time by small kernels (`wave_trace` traces
-// the rays the steps write, on the device; `pathtrace/wave.wgsl`).
+// the rays the steps write, on the device; `pathtrace/integrator/wave.wgsl`).
 const WAVEFRONT: bool = true;
-// Paths traced in steps (`pathtrace/wave.wgsl`): HOST_RAYS or WAVEFRONT.
+// Paths traced in steps (`pathtrace/integrator/wave.wgsl`): HOST_RAYS or WAVEFRONT.
 const WAVES: bool = true;

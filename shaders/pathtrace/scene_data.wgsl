@@ -4,8 +4,8 @@
 // generated code that returns them from `switch` statements with the values written into the
 // shader, so no bounce loads them from memory (see
 // crates/render/src/specialize/codegen.rs).
-// From its includer: the bindings `materials`, `lights`, `light_alias`, `tri_positions`,
-// `tri_shading` and `shapes`.
+// requires: var materials, var lights, var light_alias (integrator/pathtrace.wgsl)
+// requires: var tri_positions, var tri_shading, var shapes (integrator/pathtrace.wgsl)
 #import "pathtrace/scene_types.wgsl"
 
 fn scene_material(id: u32) -> Material {

@@ -11,7 +11,7 @@
 // each decoded from sRGB first when asked; or the nearest texel when the glTF sampler says
 // NEAREST. UV (0, 0) is the image's top-left corner. Wrapping and filtering are done here,
 // texel by texel (`textureLoad`), so no texel of a neighbour in the atlas is ever read.
-// From its includer: the bindings `texture_descs` and `textures` (the atlas).
+// requires: var texture_descs, var textures (integrator/pathtrace.wgsl or gbuffer/gbuffer.wgsl)
 #import "pathtrace/scene_types.wgsl"
 #import "common/color.wgsl"
 

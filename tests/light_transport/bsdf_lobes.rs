@@ -1,4 +1,4 @@
-//! Statistical tests of every lobe of the path tracer's BSDF (`shaders/pathtrace/bsdf.wgsl`),
+//! Statistical tests of every lobe of the path tracer's BSDF (`shaders/pathtrace/bsdf/bsdf.wgsl`),
 //! run on the GPU through `render::bsdf_check`, as Mitsuba's and pbrt's test suites do.
 //!
 //! - **Chi-square**: the directions `sample_bsdf` draws follow the pdf `eval_bsdf` reports

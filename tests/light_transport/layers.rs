@@ -1,5 +1,5 @@
 //! The layers over the material's lobes — glTF's clear coat and sheen
-//! (`shaders/pathtrace/coat.wgsl`, `sheen.wgsl`, layered in `bsdf.wgsl`) — by the lobe tests
+//! (`shaders/pathtrace/bsdf/coat.wgsl`, `sheen.wgsl`, layered in `bsdf.wgsl`) — by the lobe tests
 //! of [`super::bsdf_lobes`], and against the glTF specification's formulas evaluated and
 //! integrated here on the CPU, in f64, independently of the shader and its tables.
 //!

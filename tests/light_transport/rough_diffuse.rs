@@ -1,5 +1,5 @@
 //! The rough diffuse base (`diffuse_roughness`, the energy-preserving Oren–Nayar model EON,
-//! `shaders/pathtrace/eon.wgsl`) against an independent evaluation: the model's equations
+//! `shaders/pathtrace/bsdf/eon.wgsl`) against an independent evaluation: the model's equations
 //! written again here in f64 from the paper (Portsmouth, Kutz and Hill 2025, JCGT 14(1)).
 //! Mitsuba 3.9.1 has no rough diffuse plugin to compare with.
 //!

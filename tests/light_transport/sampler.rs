@@ -1,4 +1,4 @@
-//! The path tracer's sampler (`shaders/pathtrace/sampler.wgsl`, `common/sobol.wgsl`).
+//! The path tracer's sampler (`shaders/pathtrace/integrator/sampler.wgsl`, `common/sobol.wgsl`).
 //!
 //! - The WGSL Owen-scrambled Sobol values are bit-identical to the `sobol_burley` crate's
 //!   (Burley 2020) for 8192 indices × 4 dimensions × 5 seeds.

@@ -1,4 +1,4 @@
-//! Instanced meshes through the GPU: the two-level walk of `pathtrace/bvh.wgsl` against the
+//! Instanced meshes through the GPU: the two-level walk of `pathtrace/intersect/bvh.wgsl` against the
 //! CPU mirror's, ray by ray; the path tracer's image of an instanced scene against the same
 //! scene with its instances copied; and a scene of 1000 instances of a 100 352-triangle
 //! mesh, whose copies (100 M triangles) no intersector could hold.

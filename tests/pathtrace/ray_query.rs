@@ -1,7 +1,7 @@
 //! Ray queries (`plan`: "ray queries"): where the device has them
 //! (`wgpu::Features::EXPERIMENTAL_RAY_QUERY`; lavapipe from Mesa 25, which the set-up
 //! installs), the device's acceleration structure finds the candidates and
-//! `pathtrace/ray_query.wgsl` tests them with the WGSL BVH's own tests. GPU adapters trace
+//! `pathtrace/intersect/ray_query.wgsl` tests them with the WGSL BVH's own tests. GPU adapters trace
 //! through them; CPU adapters when asked (`--intersector rays`, or a test's resources).
 //! The GPU tests run on a driver with ray queries: the test device's, or else Mesa 25's
 //! lavapipe in a child process (`common::ray_queries_here`); without one they fail unless

@@ -56,8 +56,8 @@ fn specialized_sources() -> Vec<(&'static str, String)> {
     let wide_source = Specialization::new(&scene, wide).source().unwrap();
     assert!(wide_source.contains("WIDE_ROBUST_FAR"));
     vec![
-        ("pathtrace/ray_query.wgsl", source),
-        ("pathtrace/wide_bvh.wgsl", wide_source),
+        ("pathtrace/intersect/ray_query.wgsl", source),
+        ("pathtrace/intersect/wide_bvh.wgsl", wide_source),
     ]
 }
 
@@ -144,9 +144,10 @@ fn identifiers(text: &str) -> Vec<(String, char)> {
     out
 }
 
-/// The module-scope names `text` declares: functions, structs, constants, variables
-/// (what is inside braces, bodies and members, left out).
-fn declared(text: &str) -> std::collections::BTreeSet<String> {
+/// The module-scope names `text` declares, each with its kind (`fn`, `struct`, `const`,
+/// `alias`, `override` or `var`): functions, structs, constants, variables (what is inside
+/// braces, bodies and members, left out).
+fn declared(text: &str) -> std::collections::BTreeMap<String, &'static str> {
     let mut depth = 0usize;
     let mut top = String::new();
     for line in text.lines() {
@@ -161,14 +162,18 @@ fn declared(text: &str) -> std::collections::BTreeSet<String> {
         top.push('\n');
     }
     let words = identifiers(&top);
-    let mut out = std::collections::BTreeSet::new();
+    let mut out = std::collections::BTreeMap::new();
     for (k, (word, _)) in words.iter().enumerate() {
-        if matches!(
-            word.as_str(),
-            "fn" | "struct" | "const" | "alias" | "override"
-        ) && let Some((name, _)) = words.get(k + 1)
-        {
-            out.insert(name.clone());
+        let kind = match word.as_str() {
+            "fn" => "fn",
+            "struct" => "struct",
+            "const" => "const",
+            "alias" => "alias",
+            "override" => "override",
+            _ => continue,
+        };
+        if let Some((name, _)) = words.get(k + 1) {
+            out.insert(name.clone(), kind);
         }
     }
     // `var<storage, read> name`, `var<private> name`, `var name`: the first word after the
@@ -188,26 +193,66 @@ fn declared(text: &str) -> std::collections::BTreeSet<String> {
                 )
             });
             if let Some(name) = name {
-                out.insert(name.clone());
+                out.insert(name.clone(), "var");
             }
         }
     }
     out
 }
 
-/// No file of the path tracer leans on its includer unannounced: what a file of
-/// `shaders/pathtrace/` or `shaders/common/` uses (a function it calls, a module-scope
-/// variable, binding or constant it reads) is defined by the file itself or by what it
-/// imports, or is named on its `From its includer` line. Checked against everything those
-/// files define at module scope, so a new file cannot silently call what only one includer
-/// defines, and each file says what it needs to be read or replaced on its own.
+/// What a file's `// requires:` lines declare it leaves to its includer, as (kind, name)
+/// pairs: each line is `// requires: KIND NAME, KIND NAME, ... (where it comes from)`,
+/// KIND one of `fn`, `var` (a binding or module-scope variable), `const`, `struct`,
+/// `alias`, `override`. Malformed items are returned as errors.
+fn requires(text: &str) -> (Vec<(String, String)>, Vec<String>) {
+    let mut out = Vec::new();
+    let mut errors = Vec::new();
+    for line in text.lines() {
+        let Some(rest) = line.trim_start().strip_prefix("// requires:") else {
+            continue;
+        };
+        let list = rest.split('(').next().unwrap_or("");
+        for item in list.split(',') {
+            let parts: Vec<&str> = item.split_whitespace().collect();
+            match parts.as_slice() {
+                [kind, name]
+                    if matches!(
+                        *kind,
+                        "fn" | "var" | "const" | "struct" | "alias" | "override"
+                    ) && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') =>
+                {
+                    out.push(((*kind).to_owned(), (*name).to_owned()));
+                }
+                _ => errors.push(format!("malformed `// requires:` item {:?}", item.trim())),
+            }
+        }
+    }
+    (out, errors)
+}
+
+/// No file of the path tracer leans on its includer unannounced, and none announces what it
+/// no longer needs. What a file of `shaders/pathtrace/` or `shaders/common/` uses (a
+/// function it calls, a struct or constant it names, a module-scope variable or binding it
+/// reads) and neither it nor what it imports defines is left to its includer; exactly those
+/// names, with their kinds, must be declared on the file's `// requires:` lines.
+///
+/// An identifier scan, not a compiler: "uses" means the name appears outside comments and
+/// import lines, not after a `.`, and is not a local or parameter of the file; only names
+/// that some file of those folders (or the generated `pathtrace/shared.wgsl` and
+/// `pathtrace/shapes.wgsl`) declares at module scope are considered, so a name only
+/// generated code (specialization's replacements) defines is not caught, and a local that
+/// shadows a module-scope name of the same spelling counts as a local.
 #[test]
-fn every_path_tracer_file_imports_or_names_what_it_uses() {
+fn every_path_tracer_file_imports_or_requires_what_it_uses() {
     let names: Vec<&str> = shader::all_names()
         .filter(|n| n.starts_with("pathtrace/") || n.starts_with("common/"))
         .collect();
-    let mut everywhere = std::collections::BTreeSet::new();
-    for name in &names {
+    let mut everywhere = std::collections::BTreeMap::new();
+    for name in names
+        .iter()
+        .copied()
+        .chain(["pathtrace/shared.wgsl", "pathtrace/shapes.wgsl"])
+    {
         everywhere.extend(declared(&shader::raw(name).unwrap()));
     }
     let mut failures = Vec::new();
@@ -229,25 +274,40 @@ fn every_path_tracer_file_imports_or_names_what_it_uses() {
             })
             .map(|(_, (w, _))| w.as_str())
             .collect();
-        // The comment lines from "From its includer" to the end of that comment.
-        let announced: Vec<String> = own
-            .lines()
-            .skip_while(|l| !l.contains("From its includer"))
-            .take_while(|l| l.trim_start().starts_with("//"))
-            .flat_map(|l| identifiers(l.trim_start().trim_start_matches('/')))
-            .map(|(w, _)| w)
-            .collect();
-        let missing: std::collections::BTreeSet<&str> = words
+        let missing: std::collections::BTreeMap<&str, &str> = words
             .iter()
             .filter(|(w, next)| *next == '(' || !locals.contains(w.as_str()))
-            .map(|(w, _)| w.as_str())
-            .filter(|w| everywhere.contains(*w) && !visible.contains(*w))
-            .filter(|w| !announced.iter().any(|a| a == w))
+            .filter_map(|(w, _)| everywhere.get_key_value(w.as_str()))
+            .filter(|(w, _)| !visible.contains_key(w.as_str()))
+            .map(|(w, kind)| (w.as_str(), *kind))
             .collect();
-        if !missing.is_empty() {
+        let (required, errors) = requires(&own);
+        failures.extend(errors.into_iter().map(|e| format!("{name}: {e}")));
+        let required: std::collections::BTreeMap<&str, &str> = required
+            .iter()
+            .map(|(kind, w)| (w.as_str(), kind.as_str()))
+            .collect();
+        let undeclared: Vec<String> = missing
+            .iter()
+            .filter(|(w, kind)| required.get(*w) != Some(*kind))
+            .map(|(w, kind)| format!("{kind} {w}"))
+            .collect();
+        if !undeclared.is_empty() {
             failures.push(format!(
-                "{name}: uses {} without importing or naming it",
-                missing.into_iter().collect::<Vec<_>>().join(", ")
+                "{name}: uses {} without importing it or declaring it on a `// requires:` line",
+                undeclared.join(", ")
+            ));
+        }
+        let stale: Vec<String> = required
+            .iter()
+            .filter(|(w, kind)| missing.get(*w) != Some(*kind))
+            .map(|(w, kind)| format!("{kind} {w}"))
+            .collect();
+        if !stale.is_empty() {
+            failures.push(format!(
+                "{name}: `// requires:` names {}, which it does not use, imports, or declares \
+                 with another kind",
+                stale.join(", ")
             ));
         }
     }

@@ -1,5 +1,5 @@
 //! The wavefront (`Schedule::Wavefront`, `--schedule wavefront`): the paths of a frame
-//! taken one bounce at a time by the steps of `pathtrace/wave.wgsl`, each step's rays traced
+//! taken one bounce at a time by the steps of `pathtrace/integrator/wave.wgsl`, each step's rays traced
 //! on the device by `wave_trace` through the intersector the megakernel uses, with the same
 //! rules for rays leaving a surface. Same random numbers, same arithmetic, same hits: the
 //! images are the megakernel's, bit for bit.

@@ -1,5 +1,5 @@
 //! The 8-wide compressed BVH (`plan`: "8-wide BVH"; `crates/render/src/wide_bvh.rs`,
-//! `shaders/pathtrace/wide_bvh.wgsl`): CPU adapters traverse it where they traverse a BVH
+//! `shaders/pathtrace/intersect/wide_bvh.wgsl`): CPU adapters traverse it where they traverse a BVH
 //! in WGSL, GPU adapters the binary BVH, each as measured faster there
 //! (`docs/benchmarks.md`); `--intersector wide` or `binary` (or a test's resources) asks for
 //! one. Its hits are the binary BVH's: the same exact tests on the same primitives.

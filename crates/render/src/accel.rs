@@ -1,5 +1,5 @@
 //! The scene's acceleration structure on devices with ray queries
-//! (`wgpu::Features::EXPERIMENTAL_RAY_QUERY`): what `pathtrace/ray_query.wgsl` traces
+//! (`wgpu::Features::EXPERIMENTAL_RAY_QUERY`): what `pathtrace/intersect/ray_query.wgsl` traces
 //! instead of the WGSL BVH. One bottom-level structure holds the triangles' boxes (in the
 //! order of `GpuScene::tri_positions`, so a candidate's primitive index is the triangle's),
 //! another the analytic shapes'; the top level has one instance of each, untransformed. Every

@@ -1,7 +1,7 @@
-//! The path tracer's BSDF (`shaders/pathtrace/bsdf.wgsl`) on its own, sampled and evaluated
+//! The path tracer's BSDF (`shaders/pathtrace/bsdf/bsdf.wgsl`) on its own, sampled and evaluated
 //! on the GPU for one material and outgoing direction, so tests can check each lobe's
 //! sampling against its pdf (chi-square), its weights against `f · cos / pdf` and its
-//! reciprocity. The kernel is `shaders/pathtrace/bsdf_check.wgsl`.
+//! reciprocity. The kernel is `shaders/pathtrace/bsdf/bsdf_check.wgsl`.
 
 use glam::Vec3;
 use lumagraph_scene::GpuMaterial;
@@ -61,7 +61,7 @@ impl BsdfCheck {
     /// # Errors
     /// When the shader does not compile.
     pub fn new(ctx: &GpuContext) -> Result<Self> {
-        let kernel = Kernel::new(ctx, "pathtrace/bsdf_check.wgsl")?;
+        let kernel = Kernel::new(ctx, "pathtrace/bsdf/bsdf_check.wgsl")?;
         let ggx_table = crate::bsdf_tables::upload(ctx, true);
         Ok(Self {
             kernel,

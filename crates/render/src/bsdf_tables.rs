@@ -1,5 +1,5 @@
 //! GGX albedo tables, computed here (not copied from anywhere) and uploaded for the path
-//! tracer's material model (`shaders/pathtrace/bsdf.wgsl`).
+//! tracer's material model (`shaders/pathtrace/bsdf/bsdf.wgsl`).
 //!
 //! With Schlick's Fresnel `F = F0 + (1 − F0)(1 − c)^5`, the directional albedo of a GGX
 //! reflection lobe is linear in `F0`: `E(μ) = F0·A(μ, r) + B(μ, r)`, where
@@ -9,7 +9,7 @@
 //! Kulla–Conty multiple-scattering term (which needs `E` at F0 = 1 and its average).
 //!
 //! After them, the directional albedo `E_s(μ, r)` of glTF's sheen lobe at colour 1
-//! ([`sheen_albedo`], `shaders/pathtrace/sheen.wgsl`), which the layers below a sheen lose.
+//! ([`sheen_albedo`], `shaders/pathtrace/bsdf/sheen.wgsl`), which the layers below a sheen lose.
 //!
 //! Entries are estimated with stratified visible-normal sampling, in f64, exactly the
 //! estimator the shader's sampling uses, so the furnace balance holds to the table's
@@ -202,7 +202,7 @@ pub fn sheen_table() -> &'static [[f32; 2]] {
     &TABLE
 }
 
-/// The tables in a storage buffer, as `shaders/pathtrace/bsdf.wgsl` reads them
+/// The tables in a storage buffer, as `shaders/pathtrace/bsdf/bsdf.wgsl` reads them
 /// (`ggx_table`): the GGX tables, then the sheen table where `sheen` says some material has
 /// one (zeros, never read, where none has: it takes a moment to compute).
 pub fn upload(ctx: &crate::GpuContext, sheen: bool) -> wgpu::Buffer {

@@ -277,7 +277,7 @@ impl GpuContext {
         let experimental_features = if features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
             // SAFETY: wgpu marks ray queries experimental (its API may change, and bugs in
             // it may be undefined behaviour). lumagraph uses them only through
-            // `crate::accel` and `pathtrace/ray_query.wgsl`, whose images the tests compare
+            // `crate::accel` and `pathtrace/intersect/ray_query.wgsl`, whose images the tests compare
             // with the WGSL BVH's; LUMAGRAPH_RAY_QUERY=off leaves them out.
             unsafe { wgpu::ExperimentalFeatures::enabled() }
         } else {

@@ -1,5 +1,5 @@
 //! The environment map on the GPU: texels with their sampling weights, and the alias table
-//! that draws cells by them (`shaders/pathtrace/env.wgsl`).
+//! that draws cells by them (`shaders/pathtrace/lights/env.wgsl`).
 //!
 //! Radiance is Mitsuba's `envmap` lookup: bilinear between texel values placed at
 //! u = (x + ½) / W (wrapping around) and v = y / (H − 1). Sampling follows the same

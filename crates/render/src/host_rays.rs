@@ -5,7 +5,7 @@
 //! intersects the rays of each step in between: the kernel writes each path's next ray and
 //! its shadow ray into the `wave` buffer, the host reads them back, traces them with Embree
 //! on its threads and writes the hits back, and the kernel shades them in the next dispatch
-//! (`wave_start`, `wave_misses` and `wave_hits` in `shaders/pathtrace/wave.wgsl`). The
+//! (`wave_start`, `wave_misses` and `wave_hits` in `shaders/pathtrace/integrator/wave.wgsl`). The
 //! random numbers and the shading are the kernel's own; only the hits come from Embree.
 
 use crate::context::GpuContext;

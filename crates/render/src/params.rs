@@ -205,13 +205,13 @@ pub const ENUM_CONSTANTS: &[(&str, &str, &str, &str)] = &[
     (
         "PathTrace",
         "sampler",
-        "pathtrace/pathtrace.wgsl",
+        "pathtrace/integrator/pathtrace.wgsl",
         "SAMPLER_",
     ),
     (
         "PathTrace",
         "strategy",
-        "pathtrace/pathtrace.wgsl",
+        "pathtrace/integrator/pathtrace.wgsl",
         "STRATEGY_",
     ),
 ];

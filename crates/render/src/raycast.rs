@@ -1,5 +1,5 @@
 //! Ray queries on the GPU: the closest hit of each ray, through the path tracer's BVH
-//! traversal (`shaders/pathtrace/raycast.wgsl`, over the binary BVH or the 8-wide one).
+//! traversal (`shaders/pathtrace/intersect/raycast.wgsl`, over the binary BVH or the 8-wide one).
 //! Used to check the GPU traversal against the CPU one, for picking, and to time traversal
 //! alone (`lumagraph bench --traversal`).
 
@@ -48,7 +48,7 @@ impl Raycaster {
     /// # Errors
     /// When the shader does not compile.
     pub fn new(ctx: &GpuContext) -> Result<Self> {
-        let kernel = Kernel::new(ctx, "pathtrace/raycast.wgsl")?;
+        let kernel = Kernel::new(ctx, "pathtrace/intersect/raycast.wgsl")?;
         Ok(Self { kernel })
     }
 
@@ -59,13 +59,17 @@ impl Raycaster {
     /// When the shader does not compile.
     pub fn wide(ctx: &GpuContext) -> Result<Self> {
         let source = crate::shader::resolve_with(
-            "pathtrace/raycast.wgsl",
+            "pathtrace/intersect/raycast.wgsl",
             &[(
-                "pathtrace/bvh.wgsl",
-                "#import \"pathtrace/wide_bvh.wgsl\"\n".to_owned(),
+                "pathtrace/intersect/bvh.wgsl",
+                "#import \"pathtrace/intersect/wide_bvh.wgsl\"\n".to_owned(),
             )],
         )?;
-        let kernel = Kernel::from_source(ctx, "pathtrace/raycast.wgsl (8-wide BVH)", &source)?;
+        let kernel = Kernel::from_source(
+            ctx,
+            "pathtrace/intersect/raycast.wgsl (8-wide BVH)",
+            &source,
+        )?;
         Ok(Self { kernel })
     }
 

@@ -1,4 +1,4 @@
-//! The path tracer's sampler on the GPU (`shaders/pathtrace/sampler.wgsl`), evaluated for a
+//! The path tracer's sampler on the GPU (`shaders/pathtrace/integrator/sampler.wgsl`), evaluated for a
 //! list of queries so tests can hold it against the `sobol_burley` crate and check the
 //! stratification of the points a pixel gets.
 
@@ -46,7 +46,7 @@ impl SamplerCheck {
     /// # Errors
     /// When the shader does not compile.
     pub fn new(ctx: &GpuContext) -> Result<Self> {
-        let kernel = Kernel::new(ctx, "pathtrace/sampler_points.wgsl")?;
+        let kernel = Kernel::new(ctx, "pathtrace/integrator/sampler_points.wgsl")?;
         Ok(Self { kernel })
     }
 

@@ -47,7 +47,7 @@ pub const WAVE_NO_RAY: f32 = -1.0;
 pub const CHUNK_FIRST: u32 = 1;
 /// `Frame::chunk_flags`: the frame's last dispatch (writes the mean).
 pub const CHUNK_LAST: u32 = 2;
-/// `Frame::wave` (`pathtrace/wave.wgsl`): a step of a frame's paths (its entry points
+/// `Frame::wave` (`pathtrace/integrator/wave.wgsl`): a step of a frame's paths (its entry points
 /// `wave_start`, `wave_misses`, `wave_hits`).
 pub const WAVE_STEP: u32 = 1;
 /// `Frame::wave`: the pass writing the pixels' means from `chunk_sums` (and the AOVs).
@@ -59,7 +59,7 @@ pub const WAVE_FINISH: u32 = 2;
 pub const LIGHT_UNIFORM_SHARE: f32 = lumagraph_scene::LIGHT_UNIFORM_SHARE;
 
 /// The custom data of the ray queries' instance of the triangles' boxes
-/// ([`crate::accel`], `pathtrace/ray_query.wgsl`).
+/// ([`crate::accel`], `pathtrace/intersect/ray_query.wgsl`).
 pub const ACCEL_TRIANGLES: u32 = 0;
 /// The custom data of the ray queries' instance of the analytic shapes' boxes.
 pub const ACCEL_SHAPES: u32 = 1;
@@ -68,7 +68,7 @@ crate::param_block! {
     /// The rays a step of host intersection writes for one slot: the next ray and the
     /// shadow ray leave from the same point (`t_near` < 0: no such ray;
     /// [`WAVE_FINISH_ME`]: none, but the slot is to be stepped).
-    pub struct WaveRays in "pathtrace/pathtrace.wgsl" as "WaveRays" {
+    pub struct WaveRays in "pathtrace/integrator/pathtrace.wgsl" as "WaveRays" {
         origin: [f32; 3],
         next_near: f32,
         next_dir: [f32; 3],

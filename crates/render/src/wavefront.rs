@@ -1,7 +1,7 @@
 //! The wavefront: the path tracer's paths taken one bounce at a time by small kernels, all on
 //! the device. Each step shades every listed slot's hit and writes its next ray and shadow
 //! ray — the steps of host intersection (`wave_start`, `wave_misses`, `wave_hits` in
-//! `shaders/pathtrace/wave.wgsl`) — and `wave_trace` then traces those rays through the
+//! `shaders/pathtrace/integrator/wave.wgsl`) — and `wave_trace` then traces those rays through the
 //! intersector the megakernel would use and lists each slot for the next step, those whose
 //! ray missed from the start of the next list and those whose ray hit from its end. Nothing
 //! is read back but the two counts of the last list, once per [`STEPS_PER_SUBMIT`] steps, to

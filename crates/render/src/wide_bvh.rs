@@ -1,5 +1,5 @@
 //! The 8-wide compressed BVH (CWBVH, Ylitie, Karras and Laine, "Efficient Incoherent Ray
-//! Traversal on GPUs Through Compressed Wide BVHs", HPG 2017) that `pathtrace/wide_bvh.wgsl`
+//! Traversal on GPUs Through Compressed Wide BVHs", HPG 2017) that `pathtrace/intersect/wide_bvh.wgsl`
 //! traverses where the plan says "8-wide BVH" ([`crate::specialize::Feature::WideBvh`]).
 //! [`obvhs`] builds it (PLOC, reinsertion, then the conversion to eight children per node,
 //! up to three primitives per leaf) over the same padded boxes the device's acceleration
@@ -37,7 +37,7 @@ use crate::error::{RenderError, Result};
 /// Most nodes on a path from the root: the traversal's stack holds one entry a level.
 pub const WIDE_BVH_STACK: usize = 32;
 
-/// `pathtrace/wide_bvh.wgsl`'s shape bit in the primitive list (the shader's `PRIM_SHAPE`).
+/// `pathtrace/intersect/wide_bvh.wgsl`'s shape bit in the primitive list (the shader's `PRIM_SHAPE`).
 const PRIM_SHAPE: u32 = lumagraph_scene::PRIM_SHAPE;
 
 /// A box from `lo` to `hi`, grown by a few ulps of `scale` (the largest magnitude the

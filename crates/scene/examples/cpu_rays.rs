@@ -1,6 +1,6 @@
 //! Closest-hit rays per second on the CPU, for a scene file: the path tracer's own BVH
 //! traversal (`lumagraph_scene::traverse`, the line-for-line mirror of
-//! `shaders/pathtrace/bvh.wgsl`) beside obvhs's compressed wide BVH (CWBVH), on the same
+//! `shaders/pathtrace/intersect/bvh.wgsl`) beside obvhs's compressed wide BVH (CWBVH), on the same
 //! rays. It measures how much of the BVH shader's cost on a CPU adapter is the traversal
 //! itself and how much is the way the driver compiles it (see docs/benchmarks.md).
 //!

@@ -134,7 +134,7 @@ pub fn preset(name: &str) -> Option<Conductor> {
 
 /// Unpolarized Fresnel reflectance of a conductor of index `eta + i k` at incidence
 /// cosine `cos_i` (exact; pbrt's `FrComplex` in real arithmetic). Mirrored by
-/// `fresnel_conductor` in `shaders/pathtrace/bsdf.wgsl`.
+/// `fresnel_conductor` in `shaders/pathtrace/bsdf/bsdf.wgsl`.
 pub fn fresnel(cos_i: f32, eta: f32, k: f32) -> f32 {
     let c2 = (cos_i * cos_i).clamp(0.0, 1.0);
     let s2 = 1.0 - c2;

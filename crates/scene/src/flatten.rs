@@ -241,7 +241,7 @@ pub const LIGHT_UNIFORM_SHARE: f32 = 0.5;
 /// is near what it lights (a small lamp beside a large panel) gets too few samples; evenly
 /// alone, a large mesh light of many small triangles starves a bright one. Half each is at
 /// most twice as noisy as the better of the two for any scene. Mirrored by
-/// `light_select_pdf` in `shaders/pathtrace/lights.wgsl`.
+/// `light_select_pdf` in `shaders/pathtrace/lights/lights.wgsl`.
 pub fn light_selection(powers: &[f32]) -> Vec<f32> {
     let total: f32 = powers.iter().sum();
     let n = powers.len() as f32;

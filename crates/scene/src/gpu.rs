@@ -122,7 +122,7 @@ pub struct GpuInstance {
     /// How much a ray's origin coordinates weigh in the rounding error of the moved ray
     /// (the largest row sum of |`to_object`|'s 3×3 part; offset 104): the boxes of its
     /// mesh grow by `INSTANCE_PAD` × (this × the origin's largest coordinate + `pad_base` +
-    /// the moved origin's largest coordinate) (`instance_ray` in `pathtrace/instances.wgsl`).
+    /// the moved origin's largest coordinate) (`instance_ray` in `pathtrace/intersect/instances.wgsl`).
     pub pad_scale: f32,
     /// The rest of that bound: `to_object`'s largest translation and the mesh's largest
     /// coordinate (offset 108).

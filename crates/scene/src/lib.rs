@@ -15,7 +15,7 @@
 //! - [`texture`]: decoded glTF textures, their packing for the GPU and a CPU sampler
 //!   that mirrors the shader's.
 //! - [`traverse`]: CPU ray queries over exactly that layout, mirrored by
-//!   `shaders/pathtrace/bvh.wgsl`.
+//!   `shaders/pathtrace/intersect/bvh.wgsl`.
 //!
 //! Broken input never panics: syntax and semantic errors name the file, line:column and
 //! the shape or material; broken triangles are dropped and counted in a [`LoadReport`].

@@ -1,5 +1,5 @@
 //! Ray queries on the CPU over exactly the flat layout of [`GpuScene`], written to be
-//! mirrored line for line by `shaders/pathtrace/bvh.wgsl` (same names, same order of
+//! mirrored line for line by `shaders/pathtrace/intersect/bvh.wgsl` (same names, same order of
 //! operations). Used by tests against brute force, and as the reference for the shader.
 //!
 //! Rays start at `origin` and hits count for `0 < t < t_max`: callers offset origins off
@@ -157,7 +157,7 @@ fn pcg_hash(v: u32) -> u32 {
 
 /// A number in [0, 1) that is a function of the ray and the triangle only: stochastic
 /// transparency's choice, the same for the ray wherever it is traced (`alpha_hash` in
-/// `pathtrace/alpha.wgsl`, line for line).
+/// `pathtrace/intersect/alpha.wgsl`, line for line).
 pub fn alpha_hash(prim: u32, ray: &Ray) -> f32 {
     let bits = |x: f32| x.to_bits();
     let mut h = pcg_hash(bits(ray.dir.z));
@@ -179,7 +179,7 @@ pub fn alpha_hash(prim: u32, ray: &Ray) -> f32 {
 /// where its opacity (× the vertex colour's alpha and the base colour texture's alpha at the
 /// hit) reaches the cutoff,
 /// `Blend` where [`alpha_hash`] falls below it, always otherwise (`triangle_hit_counts` in
-/// `pathtrace/alpha.wgsl`, line for line).
+/// `pathtrace/intersect/alpha.wgsl`, line for line).
 pub fn triangle_hit_counts(scene: &GpuScene, prim: u32, u: f32, v: f32, ray: &Ray) -> bool {
     let m = &scene.materials[scene.tri_shading[prim as usize].material as usize];
     if m.flags & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND) == 0 {
@@ -229,7 +229,7 @@ pub fn occluded(scene: &GpuScene, ray: &Ray, t_max: f32) -> bool {
 }
 
 /// Boxes of a mesh's BVH are tested with the ray moved into the mesh's space: they grow by
-/// this much of the coordinates involved (`INSTANCE_PAD` in `pathtrace/instances.wgsl`).
+/// this much of the coordinates involved (`INSTANCE_PAD` in `pathtrace/intersect/instances.wgsl`).
 const INSTANCE_PAD: f32 = 9.536_743e-7;
 
 /// The rows `first..first + 3` of `inst` (0: object to world, 3: world to object) applied

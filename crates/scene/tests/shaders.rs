@@ -64,9 +64,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 
 #[test]
 fn bvh_wgsl_validates_with_a_stub() {
-    let imported = lumagraph_wgsl::imports("pathtrace/bvh.wgsl", &source).unwrap();
+    let imported = lumagraph_wgsl::imports("pathtrace/intersect/bvh.wgsl", &source).unwrap();
     assert!(imported.iter().any(|f| f == "pathtrace/scene_types.wgsl"));
-    let mut src = resolve("pathtrace/bvh.wgsl");
+    let mut src = resolve("pathtrace/intersect/bvh.wgsl");
     src.push_str(STUB);
     validate(&src, "bvh.wgsl + stub");
 }
@@ -229,7 +229,7 @@ fn wgsl_layouts_match_rust() {
     }
 }
 
-/// `pathtrace/instances.wgsl` reads an instance as vec4s of `bvh_nodes`: rows 0-2
+/// `pathtrace/intersect/instances.wgsl` reads an instance as vec4s of `bvh_nodes`: rows 0-2
 /// `to_world`, 3-5 `to_object`, 6 (`root`, `flags`, `pad_scale`, `pad_base`), 7 (`index`); two node
 /// records in all.
 #[test]
@@ -243,14 +243,16 @@ fn instance_records_are_where_instances_wgsl_reads_them() {
     assert_eq!(offset_of!(GpuInstance, pad_scale), 6 * 16 + 8);
     assert_eq!(offset_of!(GpuInstance, pad_base), 6 * 16 + 12);
     assert_eq!(offset_of!(GpuInstance, index), 7 * 16);
-    let src = std::fs::read_to_string(common::shaders().join("pathtrace/instances.wgsl")).unwrap();
+    let src = std::fs::read_to_string(common::shaders().join("pathtrace/intersect/instances.wgsl"))
+        .unwrap();
     assert!(src.contains("return bvh_nodes[slot * 4u + 6u];"));
     assert!(src.contains("const INSTANCE_PAD: f32 = 9.536743e-7;"));
 }
 
 #[test]
 fn wgsl_constants_match_rust() {
-    let src = std::fs::read_to_string(common::shaders().join("pathtrace/bvh.wgsl")).unwrap();
+    let src =
+        std::fs::read_to_string(common::shaders().join("pathtrace/intersect/bvh.wgsl")).unwrap();
     let end = format!("const BVH_END: u32 = {:#x}u;", lumagraph_scene::BVH_END);
     assert!(src.contains(&end), "bvh.wgsl must declare `{end}`");
     let types =

@@ -1,7 +1,7 @@
 // The disk (crates/scene/src/shapes/disk.rs): `center`, `radius` and its front normal
 // `axis`; flat and one-sided as a triangle is, lit by sampling its area uniformly.
 #import "pathtrace/scene_types.wgsl"
-#import "pathtrace/primitives.wgsl"
+#import "pathtrace/intersect/primitives.wgsl"
 #import "common/sampling.wgsl"
 
 // The hit in (0, t_max), or -1, of disk `prim` (its index | PRIM_SHAPE); a ray leaving it

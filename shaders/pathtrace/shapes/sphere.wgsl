@@ -1,7 +1,7 @@
 // The sphere (crates/scene/src/shapes/sphere.rs): `center` and `radius`, seen from outside,
 // lit by sampling the cone it subtends.
 #import "pathtrace/scene_types.wgsl"
-#import "pathtrace/primitives.wgsl"
+#import "pathtrace/intersect/primitives.wgsl"
 #import "common/sampling.wgsl"
 
 // Both roots (near, far) of ray/sphere in the robust form of Ray Tracing Gems, ch. 7; (-1, -1)

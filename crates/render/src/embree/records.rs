@@ -50,7 +50,7 @@ pub struct HostHit {
 impl crate::params::ParamBlock for HostHit {
     const LAYOUT: crate::params::BlockLayout = crate::params::BlockLayout {
         name: "HostHit",
-        shader: "pathtrace/pathtrace.wgsl",
+        shader: "pathtrace/integrator/pathtrace.wgsl",
         wgsl: "WaveHit",
         size: std::mem::size_of::<Self>(),
         fields: &[

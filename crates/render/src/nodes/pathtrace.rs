@@ -119,7 +119,7 @@ fn specialized(
 
 crate::param_block! {
     /// The path tracer's per-frame uniform block.
-    pub(crate) struct Frame in "pathtrace/pathtrace.wgsl" as "Frame" {
+    pub(crate) struct Frame in "pathtrace/integrator/pathtrace.wgsl" as "Frame" {
         settings: lumagraph_scene::GpuSettings,
         camera: lumagraph_scene::GpuCamera,
         header: lumagraph_scene::GpuHeader,
@@ -144,7 +144,7 @@ crate::param_block! {
         /// [`CPU_SAMPLES_PER_DISPATCH`]).
         chunk_first: u32,
         chunk_count: u32,
-        /// `CHUNK_FIRST` | `CHUNK_LAST` (`pathtrace/pathtrace.wgsl`).
+        /// `CHUNK_FIRST` | `CHUNK_LAST` (`pathtrace/integrator/pathtrace.wgsl`).
         chunk_flags: u32,
         /// With host intersection or the wavefront: `WAVE_STEP` or `WAVE_FINISH`; the batch
         /// of slots traced: its first, and the slots the `wave` buffer holds; how many of a
@@ -168,8 +168,8 @@ crate::param_block! {
 pub(crate) const CPU_SAMPLES_PER_DISPATCH: [u32; 2] = [8, 256];
 
 crate::param_block! {
-    /// The adaptive sampling pass's params (`pathtrace/adaptive.wgsl`).
-    pub(crate) struct AdaptiveParams in "pathtrace/adaptive.wgsl" as "Params" {
+    /// The adaptive sampling pass's params (`pathtrace/integrator/adaptive.wgsl`).
+    pub(crate) struct AdaptiveParams in "pathtrace/integrator/adaptive.wgsl" as "Params" {
         size: [u32; 2],
         min_frames: u32,
         error2: f32,
@@ -202,7 +202,7 @@ struct Adaptive {
 impl Adaptive {
     fn new(ctx: &GpuContext) -> Result<Self> {
         Ok(Self {
-            kernel: Kernel::new(ctx, "pathtrace/adaptive.wgsl")?,
+            kernel: Kernel::new(ctx, "pathtrace/integrator/adaptive.wgsl")?,
             params: uniform_buffer(
                 ctx,
                 "adaptive params",
@@ -321,10 +321,10 @@ pub(crate) struct PathTrace {
     env: crate::env_map::EnvMap,
     /// Largest channel value a sample may contribute; 0 is off.
     firefly_clamp: f32,
-    /// The `sampler` param's option index (`SAMPLER_*` in `pathtrace/sampler.wgsl`).
+    /// The `sampler` param's option index (`SAMPLER_*` in `pathtrace/integrator/sampler.wgsl`).
     sampler: u32,
     /// `STRATEGY_MIS` (0), `STRATEGY_LIGHT` (1) or `STRATEGY_BSDF` (2) in
-    /// `pathtrace/pathtrace.wgsl`.
+    /// `pathtrace/integrator/pathtrace.wgsl`.
     strategy: u32,
     /// Sobol replicates (1 or 2), alternating by frame.
     replicates: u32,
@@ -369,7 +369,13 @@ impl PathTrace {
             .on(Feature::Wavefront)
             .then(|| crate::wavefront::Wavefront::new(ctx));
         let (main, entries) = entry_points(&features);
-        let kernel = Kernel::with_entries(ctx, "pathtrace/pathtrace.wgsl", &source, main, entries)?;
+        let kernel = Kernel::with_entries(
+            ctx,
+            "pathtrace/integrator/pathtrace.wgsl",
+            &source,
+            main,
+            entries,
+        )?;
         let env = match &scene.environment_map {
             Some(path) => crate::env_map::EnvMap::load(
                 ctx,

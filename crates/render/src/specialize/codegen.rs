@@ -67,7 +67,7 @@ pub fn inline_intersection(scene: &GpuScene, alpha: bool) -> Option<String> {
         return None;
     }
     // Primitives of alpha-masked or blended materials take the any-hit test
-    // (`triangle_hit_counts`, `shape_hit_counts` in pathtrace/alpha.wgsl), each triangle
+    // (`triangle_hit_counts`, `shape_hit_counts` in pathtrace/intersect/alpha.wgsl), each triangle
     // on its own.
     let alpha_material = |m: u32| {
         alpha
@@ -145,7 +145,7 @@ pub fn inline_intersection(scene: &GpuScene, alpha: bool) -> Option<String> {
     Some(format!(
         "// Generated for this scene: {} triangles and {} analytic shapes, tested one by one with
 // their coordinates inline (no BVH, no geometry buffers read).
-#import \"pathtrace/primitives.wgsl\"
+#import \"pathtrace/intersect/primitives.wgsl\"
 #import \"pathtrace/shapes.wgsl\"
 
 fn intersect_scene_within(ray: Ray, t_max: f32) -> Hit {{

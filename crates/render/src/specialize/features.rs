@@ -24,12 +24,12 @@ pub enum Feature {
     /// Intersection through the BVH (WGSL traversal, or the host's).
     BvhTraversal,
     /// The WGSL traversal walks the 8-wide compressed BVH ([`crate::wide_bvh`],
-    /// `pathtrace/wide_bvh.wgsl`) instead of the binary stackless one: on CPU adapters,
+    /// `pathtrace/intersect/wide_bvh.wgsl`) instead of the binary stackless one: on CPU adapters,
     /// where it measured faster, and where asked (`--intersector wide`); GPU adapters keep
     /// the binary one, which measured faster there.
     WideBvh,
     /// Intersection through the device's ray queries: its acceleration structure finds the
-    /// candidates, the WGSL tests them ([`crate::accel`], `pathtrace/ray_query.wgsl`).
+    /// candidates, the WGSL tests them ([`crate::accel`], `pathtrace/intersect/ray_query.wgsl`).
     RayQueries,
     /// Every primitive tested with its coordinates written into the code.
     InlineIntersection,
@@ -54,15 +54,15 @@ pub enum Feature {
     GlassLobe,
     /// The energy-preserving Oren–Nayar diffuse base.
     RoughDiffuse,
-    /// The clear coat over the lobes (`pathtrace/coat.wgsl`).
+    /// The clear coat over the lobes (`pathtrace/bsdf/coat.wgsl`).
     Coat,
-    /// The sheen under the clear coat (`pathtrace/sheen.wgsl`).
+    /// The sheen under the clear coat (`pathtrace/bsdf/sheen.wgsl`).
     Sheen,
     /// Media inside shapes and index-matched boundaries.
     Media,
     /// The any-hit test of alpha-masked and blended materials, in every intersector.
     Alpha,
-    /// Instanced meshes: the WGSL BVH walk has two levels (`pathtrace/instances.wgsl`).
+    /// Instanced meshes: the WGSL BVH walk has two levels (`pathtrace/intersect/instances.wgsl`).
     Instances,
     /// First-hit albedo, normal and depth.
     FirstHitAovs,
@@ -287,7 +287,7 @@ impl Features {
                 let _ = writeln!(out, "const {name}: bool = {};", d.included);
             }
         }
-        // Paths traced in steps (`pathtrace/wave.wgsl`), by either.
+        // Paths traced in steps (`pathtrace/integrator/wave.wgsl`), by either.
         let waves = self.on(Feature::HostRays) || self.on(Feature::Wavefront);
         let _ = writeln!(out, "const WAVES: bool = {waves};");
         out

@@ -40,7 +40,7 @@ pub struct AdapterTraits {
 }
 
 /// The path tracer's intersectors. Each implements the contract of
-/// `shaders/pathtrace/contract.wgsl` (the closest hit, occlusion up to a distance, the
+/// `shaders/pathtrace/intersect/contract.wgsl` (the closest hit, occlusion up to a distance, the
 /// alpha any-hit test); the Rust mirror (`lumagraph_scene::traverse`) follows it on the CPU.
 /// Which one traces a scene is decided once per shader ([`Feature`]); this is what the
 /// `PathTrace` node's `intersector` param, `lumagraph render --intersector`, a test or a
@@ -57,11 +57,11 @@ pub enum Intersector {
     Inline,
     /// The host (Embree), on CPU adapters, for the scenes it can trace.
     Host,
-    /// The binary stackless BVH traversed in WGSL (`pathtrace/bvh.wgsl`).
+    /// The binary stackless BVH traversed in WGSL (`pathtrace/intersect/bvh.wgsl`).
     BinaryBvh,
-    /// The 8-wide compressed BVH traversed in WGSL (`pathtrace/wide_bvh.wgsl`).
+    /// The 8-wide compressed BVH traversed in WGSL (`pathtrace/intersect/wide_bvh.wgsl`).
     WideBvh,
-    /// The device's ray queries (`pathtrace/ray_query.wgsl`), where it has them and they
+    /// The device's ray queries (`pathtrace/intersect/ray_query.wgsl`), where it has them and they
     /// can trace the scene.
     RayQueries,
 }
@@ -124,10 +124,10 @@ pub enum Schedule {
     /// `docs/benchmarks.md`.
     #[default]
     Auto,
-    /// One invocation traces a pixel's whole paths (`main` in `pathtrace/pathtrace.wgsl`).
+    /// One invocation traces a pixel's whole paths (`main` in `pathtrace/integrator/pathtrace.wgsl`).
     Megakernel,
     /// The paths of a frame are taken one bounce at a time by small kernels: the steps of
-    /// host intersection shade (`pathtrace/wave.wgsl`) and `wave_trace` traces the rays they
+    /// host intersection shade (`pathtrace/integrator/wave.wgsl`) and `wave_trace` traces the rays they
     /// wrote, on the device, between them ([`crate::wavefront`]). For the scenes host
     /// intersection takes (triangles, no media, no adaptive sampling).
     Wavefront,
@@ -213,8 +213,8 @@ pub struct Specialization {
     /// What is compiled in and left out, and why.
     pub features: Features,
     /// Replaces `pathtrace/intersect.wgsl` ([`Feature::InlineIntersection`], or
-    /// [`Feature::RayQueries`]: `pathtrace/ray_query.wgsl`, or [`Feature::WideBvh`]:
-    /// `pathtrace/wide_bvh.wgsl`).
+    /// [`Feature::RayQueries`]: `pathtrace/intersect/ray_query.wgsl`, or [`Feature::WideBvh`]:
+    /// `pathtrace/intersect/wide_bvh.wgsl`).
     intersection: Option<String>,
     /// Replaces `pathtrace/scene_data.wgsl` ([`Feature::InlineData`]).
     scene_data: Option<String>,
@@ -234,9 +234,9 @@ impl Specialization {
         let intersection = if inline {
             inline_intersection(scene, features.on(Feature::Alpha))
         } else if features.on(Feature::RayQueries) {
-            Some("#import \"pathtrace/ray_query.wgsl\"\n".to_owned())
+            Some("#import \"pathtrace/intersect/ray_query.wgsl\"\n".to_owned())
         } else if features.on(Feature::WideBvh) {
-            Some("#import \"pathtrace/wide_bvh.wgsl\"\n".to_owned())
+            Some("#import \"pathtrace/intersect/wide_bvh.wgsl\"\n".to_owned())
         } else {
             None
         };
@@ -255,7 +255,7 @@ impl Specialization {
         }
     }
 
-    /// The path tracer's source: `pathtrace/pathtrace.wgsl` with the options file written
+    /// The path tracer's source: `pathtrace/integrator/pathtrace.wgsl` with the options file written
     /// from the features and the generated files in place of the ones they replace.
     ///
     /// # Errors
@@ -271,7 +271,8 @@ impl Specialization {
         if let Some(code) = &self.shapes {
             overrides.push((lumagraph_scene::shapes::FILE, code.clone()));
         }
-        let source = crate::shader::resolve_with("pathtrace/pathtrace.wgsl", &overrides)?;
+        let source =
+            crate::shader::resolve_with("pathtrace/integrator/pathtrace.wgsl", &overrides)?;
         Ok(if self.features.on(Feature::RayQueries) {
             // An `enable` directive comes before any declaration.
             format!("enable wgpu_ray_query;\n{source}")

@@ -1,7 +1,7 @@
 // The camera: pinhole rays, and rays through a thin lens (depth of field).
-// From its includer (pathtrace/pathtrace.wgsl): `frame`.
+// requires: var frame (integrator/pathtrace.wgsl)
 #import "pathtrace/scene_types.wgsl"
-#import "pathtrace/sampler.wgsl"
+#import "pathtrace/integrator/sampler.wgsl"
 #import "common/sampling.wgsl"
 
 // The pinhole ray through image position `u` within `pixel`.

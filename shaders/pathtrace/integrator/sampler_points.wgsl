@@ -2,7 +2,7 @@
 // mode 0: x = sobol_owen(index = a, dimension = b, seed = c);
 // mode 1: the 2D point of pair d for pixel a, sample b, seed c (sample_2d, Sobol sampler,
 // one replicate).
-#import "pathtrace/sampler.wgsl"
+#import "pathtrace/integrator/sampler.wgsl"
 
 struct Params {
     count: u32,

@@ -18,11 +18,11 @@
 // wave.wgsl holds the steps of host intersection and of the wavefront. This file: the frame's uniform block, the
 // bindings, the entry point and the loop over a pixel's samples.
 #import "pathtrace/scene_types.wgsl"
-#import "pathtrace/sampler.wgsl"
+#import "pathtrace/integrator/sampler.wgsl"
 #import "common/sampling.wgsl"
 #import "pathtrace/options.wgsl"
-#import "pathtrace/bsdf.wgsl"
-#import "pathtrace/env.wgsl"
+#import "pathtrace/bsdf/bsdf.wgsl"
+#import "pathtrace/lights/env.wgsl"
 #import "pathtrace/textures.wgsl"
 // Constants shared with the Rust side, generated from crates/render/src/shared.rs.
 #import "pathtrace/shared.wgsl"
@@ -93,7 +93,7 @@ struct Frame {
 @group(0) @binding(16) var<storage, read> tri_texcoords: array<TriTexcoords>;
 @group(0) @binding(17) var<storage, read> texture_descs: array<TexDesc>;
 // Adaptive sampling (ADAPTIVE), per pixel of the window: the sums (rgb) and frame counts (a)
-// of the even and of the odd frames, in that order, and whether `pathtrace/adaptive.wgsl`
+// of the even and of the odd frames, in that order, and whether `pathtrace/integrator/adaptive.wgsl`
 // stopped the pixel (16-byte stand-ins otherwise).
 @group(0) @binding(18) var<storage, read_write> adaptive_halves: array<vec4f>;
 @group(0) @binding(19) var<storage, read> adaptive_stopped: array<u32>;
@@ -103,21 +103,21 @@ struct Frame {
 @group(0) @binding(21) var<storage, read_write> chunk_sums: array<vec4f>;
 // With WAVES, the paths in flight and the rays the host or `wave_trace` intersects (a
 // 16-byte stand-in otherwise): see `wave_start`, `wave_misses` and `wave_hits` in
-// pathtrace/wave.wgsl.
+// pathtrace/integrator/wave.wgsl.
 @group(0) @binding(22) var<storage, read_write> wave: array<vec4<u32>>;
 // The texture atlas: every texture of the scene in the RGBA8 pages of one array texture.
 @group(0) @binding(23) var textures: texture_2d_array<f32>;
 
 #import "pathtrace/intersect.wgsl"
 #import "pathtrace/scene_data.wgsl"
-#import "pathtrace/alpha.wgsl"
-#import "pathtrace/medium.wgsl"
-#import "pathtrace/mis.wgsl"
-#import "pathtrace/surface.wgsl"
-#import "pathtrace/lights.wgsl"
-#import "pathtrace/camera.wgsl"
-#import "pathtrace/integrator.wgsl"
-#import "pathtrace/wave.wgsl"
+#import "pathtrace/intersect/alpha.wgsl"
+#import "pathtrace/integrator/medium.wgsl"
+#import "pathtrace/integrator/mis.wgsl"
+#import "pathtrace/integrator/surface.wgsl"
+#import "pathtrace/lights/lights.wgsl"
+#import "pathtrace/integrator/camera.wgsl"
+#import "pathtrace/integrator/integrator.wgsl"
+#import "pathtrace/integrator/wave.wgsl"
 
 // Rays traced by this invocation (camera, extension and shadow rays), for the report.
 var<private> ray_count: u32;

@@ -1,6 +1,6 @@
-#import "pathtrace/primitives.wgsl"
-#import "pathtrace/candidates.wgsl"
-#import "pathtrace/contract.wgsl"
+#import "pathtrace/intersect/primitives.wgsl"
+#import "pathtrace/intersect/candidates.wgsl"
+#import "pathtrace/intersect/contract.wgsl"
 #import "pathtrace/shared.wgsl"
 
 // Scene intersection through the device's ray queries (`enable wgpu_ray_query`, which the
@@ -20,9 +20,7 @@
 // edges, and a ray the device sends to one triangle and the exact test to none would go
 // through.)
 //
-// From its includer: the bindings `tri_positions` and `shapes` (as for bvh.wgsl), the
-// constants `HAS_TRIANGLES`, `HAS_SHAPES` and `HAS_ALPHA`, and the any-hit tests
-// `triangle_hit_counts` and `shape_hit_counts`.
+// requires: const HAS_TRIANGLES, const HAS_SHAPES (options.wgsl)
 
 @group(0) @binding(24) var scene_accel: acceleration_structure;
 

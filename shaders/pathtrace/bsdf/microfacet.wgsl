@@ -3,7 +3,8 @@
 // visible-normal sampling, and the albedo tables that make layers over them conserve energy
 // (`ggx_table`, computed by crates/render/src/bsdf_tables.rs).
 // Vectors are in the shading frame (normal = +z); wo points to the viewer.
-// From its includer: the binding `ggx_table`.
+// requires: var ggx_table (the GGX albedo tables of crates/render/src/bsdf_tables.rs:
+//   integrator/pathtrace.wgsl, bsdf/bsdf_check.wgsl)
 #import "common/sampling.wgsl"
 
 // Below this alpha (= roughness^2) a lobe is a perfect mirror or interface.

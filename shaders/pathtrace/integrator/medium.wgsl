@@ -7,14 +7,13 @@
 // the scene loader refuses media that overlap (so none is nested in another), and paths
 // start outside every medium (the camera must not be in one).
 // Also next-event estimation from a point in a medium (`medium_next_event`).
-// From its includer (pathtrace/pathtrace.wgsl): `frame`, the binding `lights` and
-// `ray_count`.
+// requires: var frame, var ray_count (integrator/pathtrace.wgsl)
 #import "pathtrace/scene_types.wgsl"
 #import "pathtrace/intersect.wgsl"
 #import "pathtrace/scene_data.wgsl"
-#import "pathtrace/surface.wgsl"
-#import "pathtrace/lights.wgsl"
-#import "pathtrace/mis.wgsl"
+#import "pathtrace/integrator/surface.wgsl"
+#import "pathtrace/lights/lights.wgsl"
+#import "pathtrace/integrator/mis.wgsl"
 
 // `medium_id` when the path is in no medium.
 const NO_MEDIUM: u32 = 0xffffffffu;

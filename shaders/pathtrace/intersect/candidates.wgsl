@@ -1,14 +1,15 @@
-#import "pathtrace/primitives.wgsl"
-#import "pathtrace/instances.wgsl"
+#import "pathtrace/intersect/primitives.wgsl"
+#import "pathtrace/intersect/instances.wgsl"
 #import "pathtrace/shapes.wgsl"
 
 // A candidate primitive tested as every intersector tests the primitives it finds (the BVH's
 // leaves, the wide BVH's, the device's ray-query candidates): the exact ray/primitive test,
 // the rules for rays leaving a surface (`skip_prim`, the origin's error, primitives.wgsl) and
 // the any-hit test of alpha-masked and blended materials (alpha.wgsl).
-// From its includer: the bindings `tri_positions`, `shapes` and (instances.wgsl)
-// `bvh_nodes`, the constant `HAS_ALPHA`,
-// and the any-hit tests `triangle_hit_counts` and `shape_hit_counts`.
+// requires: const HAS_ALPHA (options.wgsl, or intersect/raycast.wgsl)
+// requires: var tri_positions, var shapes (integrator/pathtrace.wgsl or intersect/raycast.wgsl)
+// requires: fn triangle_hit_counts, fn shape_hit_counts (the any-hit tests:
+//   intersect/alpha.wgsl, or intersect/raycast.wgsl)
 
 // Triangle `i`: vec4(1, t, u, v) where it counts as a hit with 0 < t < t_max, else x = 0.
 fn candidate_triangle(i: u32, ray: Ray, t_max: f32) -> vec4<f32> {

@@ -7,7 +7,7 @@
 // normal-mapped, or follows its own normal map. Its lobe and albedo are taken in its frame,
 // with its cosines; it reflects nothing towards or from below its own horizon.
 #import "pathtrace/scene_types.wgsl"
-#import "pathtrace/microfacet.wgsl"
+#import "pathtrace/bsdf/microfacet.wgsl"
 #import "common/sampling.wgsl"
 
 // The coat's normal at the point shaded, in the shading frame of the base (+z where it

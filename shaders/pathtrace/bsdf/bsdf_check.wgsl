@@ -26,7 +26,7 @@ struct Params {
 @group(0) @binding(3) var<storage, read> dirs: array<vec4f>;
 @group(0) @binding(4) var<storage, read_write> out: array<vec4f>;
 
-#import "pathtrace/bsdf.wgsl"
+#import "pathtrace/bsdf/bsdf.wgsl"
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3u) {

@@ -7,9 +7,10 @@
 // scaled by 1 - max(sheen_color) E_s(mu_o) (E_s the lobe's directional albedo at colour 1,
 // from the table crates/render/src/bsdf_tables.rs appends to the GGX tables), as glTF's
 // albedo scaling does. Sampled by the cosine.
-// From its includer: the binding `ggx_table` (the sheen table follows the GGX tables).
+// Uses nothing its includer must define; bsdf/microfacet.wgsl declares the `ggx_table` it
+// reads (the sheen table follows the GGX tables).
 #import "common/sampling.wgsl"
-#import "pathtrace/microfacet.wgsl"
+#import "pathtrace/bsdf/microfacet.wgsl"
 
 // Perceptual roughness below this is taken as this: the distribution of a smaller one is a
 // spike at grazing angles that no table resolves (Filament clamps to 0.07 too).

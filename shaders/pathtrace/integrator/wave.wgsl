@@ -1,9 +1,9 @@
 // Paths traced in steps (WAVES): the `wave_*` entry points of host intersection (HOST_RAYS)
 // and of the wavefront (WAVEFRONT).
-// From its includer (pathtrace/pathtrace.wgsl): `frame`, the bindings `wave`, `chunk_sums`
-// and `stats`, and `add_sample`.
+// requires: var frame, var wave, var chunk_sums, var stats (integrator/pathtrace.wgsl)
+// requires: fn add_sample (integrator/pathtrace.wgsl)
 #import "pathtrace/shared.wgsl"
-#import "pathtrace/integrator.wgsl"
+#import "pathtrace/integrator/integrator.wgsl"
 #import "pathtrace/intersect.wgsl"
 
 // Host intersection (HOST_RAYS). The paths of a frame are traced in steps: each dispatch

@@ -19,7 +19,6 @@
 // frames of the same total then splits the samples the same way: 2 frames of 8 samples or
 // 16 of 1 take the same points and numbers. With one (the default), every frame goes on
 // with the one sequence: a little less noise, and no independent halves.
-// From its includer: `frame` (the sampler, the replicates and the frame's first sample).
 #import "common/rng.wgsl"
 #import "common/sobol.wgsl"
 

@@ -1,10 +1,9 @@
-// From its includer: the bindings `bvh_nodes`, `tri_positions` and `shapes`, the constants
-// `HAS_TRIANGLES`, `HAS_SHAPES`, `HAS_ALPHA` and `HAS_INSTANCES`, and the any-hit tests `triangle_hit_counts`
-// and `shape_hit_counts` (in the path tracer options.wgsl and alpha.wgsl; raycast.wgsl
-// declares its own).
-#import "pathtrace/primitives.wgsl"
-#import "pathtrace/candidates.wgsl"
-#import "pathtrace/contract.wgsl"
+// requires: const HAS_TRIANGLES, const HAS_SHAPES, const HAS_INSTANCES (options.wgsl;
+//   intersect/raycast.wgsl declares its own)
+// requires: var bvh_nodes (integrator/pathtrace.wgsl or intersect/raycast.wgsl)
+#import "pathtrace/intersect/primitives.wgsl"
+#import "pathtrace/intersect/candidates.wgsl"
+#import "pathtrace/intersect/contract.wgsl"
 
 // BVH traversal, a line-for-line mirror of crates/scene/src/traverse.rs. The including
 // shader declares the storage buffers:

@@ -2,17 +2,16 @@
 // a point on it or a direction to it (triangles, analytic shapes as their kind samples them
 // (pathtrace/shapes/), point, spot and directional lights, the environment map), and the
 // pdfs MIS needs.
-// From its includer (pathtrace/pathtrace.wgsl): `frame` and the bindings `tri_texcoords`
-// and `textures`.
+// requires: var frame, var tri_texcoords (integrator/pathtrace.wgsl)
 #import "pathtrace/scene_types.wgsl"
 #import "pathtrace/options.wgsl"
 #import "pathtrace/shared.wgsl"
-#import "pathtrace/sampler.wgsl"
+#import "pathtrace/integrator/sampler.wgsl"
 #import "common/sampling.wgsl"
-#import "pathtrace/env.wgsl"
+#import "pathtrace/lights/env.wgsl"
 #import "pathtrace/scene_data.wgsl"
 #import "pathtrace/textures.wgsl"
-#import "pathtrace/surface.wgsl"
+#import "pathtrace/integrator/surface.wgsl"
 #import "pathtrace/shapes.wgsl"
 
 struct LightSample {

@@ -4,9 +4,9 @@
 // BVH root node, its flags (INSTANCE_MIRROR) and the two terms of its boxes' padding
 // (`instance_ray`), 7 its index. An instance is named by its
 // first slot. Mirrored line for line by crates/scene/src/traverse.rs.
-// From its includer: the binding `bvh_nodes`.
+// requires: var bvh_nodes (integrator/pathtrace.wgsl or intersect/raycast.wgsl)
 #import "pathtrace/scene_types.wgsl"
-#import "pathtrace/primitives.wgsl"
+#import "pathtrace/intersect/primitives.wgsl"
 
 // Boxes of a mesh's BVH are tested with the ray moved into the mesh's space, which rounding
 // moves off the true one: they grow by this much of the coordinates involved (8 float steps),

@@ -20,7 +20,7 @@ struct Params {
 @group(0) @binding(4) var<storage, read> tri_positions: array<TriPositions>;
 @group(0) @binding(5) var<storage, read> shapes: array<Shape>;
 
-#import "pathtrace/bvh.wgsl"
+#import "pathtrace/intersect/bvh.wgsl"
 
 // Ray queries are not specialized to the scene: both primitive kinds' tests are compiled;
 // they see every surface solid (no material is bound: alpha's any-hit test is not run).

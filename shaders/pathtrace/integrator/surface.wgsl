@@ -1,14 +1,13 @@
 // What a hit is: the surface point (position and its rounding error, normals, material,
 // light, texture coordinates) reconstructed from the intersector's hit, and the robust
 // origin of a ray leaving it.
-// From its includer (pathtrace/pathtrace.wgsl): the bindings `tri_texcoords` and
-// `textures`.
+// requires: var tri_texcoords (integrator/pathtrace.wgsl)
 #import "pathtrace/scene_types.wgsl"
 #import "pathtrace/options.wgsl"
 #import "pathtrace/intersect.wgsl"
 #import "pathtrace/scene_data.wgsl"
 #import "pathtrace/textures.wgsl"
-#import "pathtrace/instances.wgsl"
+#import "pathtrace/intersect/instances.wgsl"
 #import "pathtrace/shapes.wgsl"
 
 struct Surface {

@@ -7,7 +7,7 @@
 // pdf in (u, v). The includer declares `env_texels: array<vec4f>`, `env_alias:
 // array<AliasEntry>` (one entry per cell) and `frame` (map size, rotation, scale in
 // `frame.settings`).
-// From its includer: `frame` and the bindings `env_texels` and `env_alias`.
+// requires: var frame, var env_texels, var env_alias (integrator/pathtrace.wgsl)
 #import "pathtrace/scene_types.wgsl"
 #import "common/sampling.wgsl"
 

@@ -1,6 +1,6 @@
 // Multiple importance sampling of direct light: the weights of a BSDF-sampled hit on an
 // emitter and of a light sample (power heuristic, or one strategy alone: `frame.strategy`).
-// From its includer (pathtrace/pathtrace.wgsl): `frame`.
+// requires: var frame (integrator/pathtrace.wgsl)
 #import "common/sampling.wgsl"
 
 const STRATEGY_MIS: u32 = 0u;

@@ -1,7 +1,7 @@
-// From its includer: `trace_scene(ray, t_max, any_hit)`, the intersector's walk (bvh.wgsl,
-// wide_bvh.wgsl and ray_query.wgsl each define it and import this file).
+// requires: fn trace_scene (the intersector's walk: intersect/bvh.wgsl, intersect/wide_bvh.wgsl
+//   or intersect/ray_query.wgsl, each of which imports this file)
 #import "pathtrace/scene_types.wgsl"
-#import "pathtrace/primitives.wgsl"
+#import "pathtrace/intersect/primitives.wgsl"
 
 // The intersector contract, for intersectors that trace a ray with one function: the
 // including file defines

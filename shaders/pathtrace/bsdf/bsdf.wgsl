@@ -19,15 +19,16 @@
 // The GGX albedo tables (`ggx_table`, computed by crates/render/src/bsdf_tables.rs and
 // declared by the includer) make the white furnace white at every roughness.
 // Vectors are in the shading frame (normal = +z); wo points to the viewer.
-// From its includer: the binding `ggx_table` (the GGX albedo tables, crates/render/src/bsdf_tables.rs).
+// Uses nothing its includer must define; what its imports need they declare (`ggx_table`,
+// bsdf/microfacet.wgsl).
 #import "pathtrace/scene_types.wgsl"
 #import "pathtrace/options.wgsl"
 #import "common/color.wgsl"
 #import "common/sampling.wgsl"
-#import "pathtrace/eon.wgsl"
-#import "pathtrace/microfacet.wgsl"
-#import "pathtrace/coat.wgsl"
-#import "pathtrace/sheen.wgsl"
+#import "pathtrace/bsdf/eon.wgsl"
+#import "pathtrace/bsdf/microfacet.wgsl"
+#import "pathtrace/bsdf/coat.wgsl"
+#import "pathtrace/bsdf/sheen.wgsl"
 
 // The largest f32 below 1.
 const ONE_MINUS_EPSILON: f32 = 0.99999994;

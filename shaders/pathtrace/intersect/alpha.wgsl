@@ -8,7 +8,7 @@
 // the ray and the primitive alone, so it is the same wherever the ray is traced). Camera
 // rays, bounces and shadow rays all take it. Compiled in with HAS_ALPHA only.
 //
-// From its includer: the bindings `tri_texcoords` and `textures`.
+// requires: var tri_texcoords (integrator/pathtrace.wgsl)
 #import "pathtrace/scene_types.wgsl"
 #import "pathtrace/options.wgsl"
 #import "pathtrace/scene_data.wgsl"

@@ -1,19 +1,18 @@
 // The integrator: a path's state, and one bounce of it (`path_step_from`, the one shading
 // core of the megakernel and of host intersection's steps): emission found with its MIS
 // weight, media, next-event estimation, BSDF sampling, Russian roulette.
-// From its includer (pathtrace/pathtrace.wgsl): `frame`, the binding `lights` and
-// `ray_count`.
+// requires: var frame, var ray_count (integrator/pathtrace.wgsl)
 #import "pathtrace/scene_types.wgsl"
 #import "pathtrace/options.wgsl"
-#import "pathtrace/sampler.wgsl"
-#import "pathtrace/bsdf.wgsl"
+#import "pathtrace/integrator/sampler.wgsl"
+#import "pathtrace/bsdf/bsdf.wgsl"
 #import "pathtrace/intersect.wgsl"
-#import "pathtrace/alpha.wgsl"
-#import "pathtrace/medium.wgsl"
-#import "pathtrace/mis.wgsl"
-#import "pathtrace/surface.wgsl"
-#import "pathtrace/lights.wgsl"
-#import "pathtrace/camera.wgsl"
+#import "pathtrace/intersect/alpha.wgsl"
+#import "pathtrace/integrator/medium.wgsl"
+#import "pathtrace/integrator/mis.wgsl"
+#import "pathtrace/integrator/surface.wgsl"
+#import "pathtrace/lights/lights.wgsl"
+#import "pathtrace/integrator/camera.wgsl"
 
 const RR_START: u32 = 5u;
 
