@@ -151,3 +151,50 @@ fn an_acescg_graph_writes_tagged_exr_and_rec709_png() {
         .unwrap();
     assert!(codes <= 1, "PNG: {codes} codes");
 }
+
+/// The path tracer in an ACEScg graph: its Rec. 709 colour (what `tests/mitsuba_suite.rs`
+/// holds to Mitsuba 3's references) is converted into ACEScg after it and accumulated
+/// there; the same Cornell box render (64², 8 frames of 1 spp, the same seed) through
+/// `Tonemap` comes out as the Rec. 709 graph's, within one 8-bit code, and the accumulation
+/// is OpenColorIO's conversion of the Rec. 709 one (1e-5 of the pixel's largest component).
+#[test]
+fn the_path_tracer_in_an_acescg_graph_shows_the_rec709_render() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let scene = common::gpu_scene("assets/cornell.ron", Some(64));
+    let run = |space: WorkingSpace| {
+        let mut graph = common::progressive_graph(&[]);
+        graph
+            .nodes
+            .push(Node::new("tm", "Tonemap").with("operator", ParamValue::Str("agx".into())));
+        graph.edges.push(Edge::new("acc.color", "tm.color"));
+        graph.working_space = space;
+        let mut exec = common::executor(&graph, &["acc.color", "tm.color"], &scene).unwrap();
+        exec.run_frames(8, true).unwrap();
+        (
+            exec.read_port("acc.color").unwrap(),
+            exec.read_port("tm.color").unwrap(),
+        )
+    };
+    let (rec709, rec709_tm) = run(WorkingSpace::Rec709);
+    let (aces, aces_tm) = run(WorkingSpace::AcesCg);
+    let config = ColorConfig::load(
+        "ocio://cg-config-v4.0.0_aces-v2.0_ocio-v2.5",
+        &common::root(),
+    )
+    .unwrap();
+    let to_aces = config.processor("Linear Rec.709 (sRGB)", "ACEScg").unwrap();
+    let mut worst = 0.0_f32;
+    for (r, a) in rec709.pixels.iter().zip(&aces.pixels) {
+        let want = to_aces.apply_rgb([r[0], r[1], r[2]]);
+        let scale = want.iter().fold(1e-3_f32, |m, v| m.max(v.abs()));
+        for c in 0..3 {
+            worst = worst.max((a[c] - want[c]).abs() / scale);
+        }
+    }
+    let codes = worst_code(&rec709_tm, &aces_tm);
+    eprintln!("path tracer in ACEScg: accumulation {worst:.1e}, Tonemap {codes} code(s)");
+    assert!(worst < 1e-5, "{worst}");
+    assert!(codes <= 1, "{codes}");
+}

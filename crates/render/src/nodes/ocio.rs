@@ -40,17 +40,24 @@ pub fn working_to_rec709(
     image: &mut crate::cpu::Image,
 ) -> Result<()> {
     use lumagraph_graph::WorkingSpace;
-    if space == WorkingSpace::Rec709 {
-        return Ok(());
-    }
-    let config = ColorConfig::load(
-        lumagraph_graph::working_space::CONVERSION_CONFIG,
-        std::path::Path::new("."),
-    )
-    .map_err(color_error)?;
-    let processor = config
-        .processor(space.ocio_names()[0], WorkingSpace::Rec709.ocio_names()[0])
-        .map_err(color_error)?;
+    // The editor's viewer calls this for every preview frame: the processor (a built-in
+    // config parsed, a CPU program made) is made once per process.
+    static ACESCG: std::sync::OnceLock<std::result::Result<Processor, String>> =
+        std::sync::OnceLock::new();
+    let processor = match space {
+        WorkingSpace::Rec709 => return Ok(()),
+        WorkingSpace::AcesCg => ACESCG.get_or_init(|| {
+            ColorConfig::load(
+                lumagraph_graph::working_space::CONVERSION_CONFIG,
+                std::path::Path::new("."),
+            )
+            .and_then(|c| c.processor(space.ocio_names()[0], WorkingSpace::Rec709.ocio_names()[0]))
+            .map_err(|e| e.0)
+        }),
+    };
+    let processor = processor
+        .as_ref()
+        .map_err(|e| RenderError::Gpu(e.clone()))?;
     processor.apply(bytemuck::cast_slice_mut(&mut image.pixels));
     Ok(())
 }
