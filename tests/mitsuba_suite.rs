@@ -183,6 +183,7 @@ suite!(
     media_absorbing_glass,
     media_scattering,
     mesh_env,
+    projector,
     punctual_lights,
     sponza_diffuse,
     thin_lens,

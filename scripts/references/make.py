@@ -275,19 +275,11 @@ def mitsuba_scene(export_dir, spp, seed):
             shape["interior"] = inside
         d[f"{sh['kind']}_{k}"] = shape
     for k, l in enumerate(s["lights"]):
-        if l["type"] == "point":
-            d[f"light_{k}"] = {"type": "point", "position": l["position"],
-                               "intensity": rgb(l["intensity"])}
-        elif l["type"] == "spot":
-            up = [0, 1, 0] if abs(l["target"][1] - l["position"][1]) < 0.99 * math.dist(
-                l["target"], l["position"]) else [1, 0, 0]
-            d[f"light_{k}"] = {"type": "spot", "intensity": rgb(l["intensity"]),
-                               "cutoff_angle": l["cutoff_angle"], "beam_width": l["beam_width"],
-                               "to_world": T().look_at(origin=l["position"], target=l["target"],
-                                                       up=up)}
-        elif l["type"] == "directional":
-            d[f"light_{k}"] = {"type": "directional", "direction": l["direction"],
-                               "irradiance": rgb(l["irradiance"])}
+        # A light without area: its kind's Mitsuba emitter (crates/scene/src/lights/), as is.
+        light = dict(l["mitsuba"])
+        if "to_world" in light:
+            light["to_world"] = T(light["to_world"])
+        d[f"light_{k}"] = light
     env = s["environment"]
     if env["type"] == "constant":
         d["environment"] = {"type": "constant", "radiance": rgb(env["radiance"])}

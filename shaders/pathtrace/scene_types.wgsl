@@ -25,11 +25,6 @@ const MATERIAL_ALPHA_BLEND: u32 = 64u;
 const TRI_ALPHA: u32 = 1u;
 const LIGHT_SHAPE: u32 = 1u;
 const LIGHT_TWO_SIDED: u32 = 2u;
-const LIGHT_POINT: u32 = 4u;
-const LIGHT_SPOT: u32 = 8u;
-const LIGHT_DIRECTIONAL: u32 = 16u;
-// Point, spot and directional lights: no area, never hit, sampled with a delta pdf.
-const LIGHT_DELTA: u32 = 28u;
 const ENV_NONE: u32 = 0u;
 const ENV_CONSTANT: u32 = 1u;
 const ENV_MAP: u32 = 2u;
@@ -185,10 +180,10 @@ struct TexDesc {
     pad: u32,
 }
 
-// Emissive triangle (p0, e1, e2) or analytic shape (LIGHT_SHAPE: `prim`), 64 bytes, or a light
-// without area: point (position p0, intensity in `emission`), spot (also unit axis e1,
-// e2 = (cutoff, beam width) half-angles in radians), directional (unit travel direction e1,
-// irradiance in `emission`).
+// Emissive triangle (p0, e1, e2) or analytic shape (LIGHT_SHAPE: `prim`), kind 0, 80 bytes;
+// or a light without area, of kind LIGHT_<NAME> (pathtrace/light_kinds.wgsl, generated from
+// crates/scene/src/lights/): position p0, unit axis e1, frame x e2, intensity or irradiance
+// in `emission`, its own numbers in `params`, as pathtrace/lights/<name>.wgsl reads them.
 // Selection probability: half power / SceneHeader.total_light_power, half 1 / num_lights.
 struct Light {
     p0: vec3<f32>,
@@ -199,6 +194,8 @@ struct Light {
     area: f32,
     emission: vec3<f32>,
     power: f32,
+    params: vec3<f32>,
+    kind: u32,
 }
 
 // Alias table entry over the lights (Vose), 8 bytes.

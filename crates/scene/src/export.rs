@@ -152,25 +152,12 @@ struct ShapeOut {
     material: u32,
 }
 
+/// A light without area: its kind (`point`, `spot`, …) and its Mitsuba 3 emitter.
 #[derive(Serialize)]
-#[serde(tag = "type", rename_all = "lowercase")]
-enum LightOut {
-    Point {
-        position: [f32; 3],
-        intensity: [f32; 3],
-    },
-    Spot {
-        position: [f32; 3],
-        /// A point on the axis, one unit from the light.
-        target: [f32; 3],
-        intensity: [f32; 3],
-        cutoff_angle: f32,
-        beam_width: f32,
-    },
-    Directional {
-        direction: [f32; 3],
-        irradiance: [f32; 3],
-    },
+struct LightOut {
+    #[serde(rename = "type")]
+    kind: String,
+    mitsuba: serde_json::Value,
 }
 
 #[derive(Serialize)]
@@ -447,34 +434,10 @@ fn material_out(m: &crate::scene::Material) -> MaterialOut {
 }
 
 fn light_out(l: &PunctualLight) -> LightOut {
-    match *l {
-        PunctualLight::Point {
-            position,
-            intensity,
-        } => LightOut::Point {
-            position: position.to_array(),
-            intensity: intensity.to_array(),
-        },
-        PunctualLight::Spot {
-            position,
-            axis,
-            intensity,
-            cutoff,
-            beam,
-        } => LightOut::Spot {
-            position: position.to_array(),
-            target: (position + axis).to_array(),
-            intensity: intensity.to_array(),
-            cutoff_angle: cutoff.to_degrees(),
-            beam_width: beam.to_degrees(),
-        },
-        PunctualLight::Directional {
-            direction,
-            irradiance,
-        } => LightOut::Directional {
-            direction: direction.to_array(),
-            irradiance: irradiance.to_array(),
-        },
+    let kind = crate::lights::kind_of(l).expect("a light without area has a kind");
+    LightOut {
+        kind: kind.name().to_lowercase(),
+        mitsuba: kind.mitsuba(l),
     }
 }
 

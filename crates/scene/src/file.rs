@@ -505,76 +505,118 @@ impl ShapeDesc {
     }
 }
 
-/// A light that is not a surface: a point, a spot or a direction. None of them is seen by
-/// rays (they have no area); they light the scene through light sampling only.
-#[derive(Clone, Debug, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-#[non_exhaustive]
-pub enum LightDesc {
-    /// Light from one point, the same in every direction (Mitsuba `point`).
-    Point {
-        /// Name for messages.
-        #[serde(default)]
-        name: Option<String>,
-        /// Where it is, world space.
-        position: V3,
-        /// Radiant intensity, W/sr (linear RGB).
-        intensity: V3,
-    },
-    /// A point light emitting into a cone (Mitsuba `spot`): full `intensity` within
-    /// `beam_width` of its axis, falling linearly in angle to 0 at `cutoff_angle`.
-    Spot {
-        /// Name for messages.
-        #[serde(default)]
-        name: Option<String>,
-        /// Where it is, world space.
-        position: V3,
-        /// A point on its axis.
-        target: V3,
-        /// Radiant intensity on the axis, W/sr (linear RGB).
-        intensity: V3,
-        /// Half-angle of the cone outside which it is black, degrees, in (0, 90]. Default 20.
-        #[serde(default = "default_cutoff")]
-        cutoff_angle: f32,
-        /// Half-angle of the cone of full intensity, degrees, in [0, `cutoff_angle`].
-        /// Default ¾ of `cutoff_angle`.
-        #[serde(default)]
-        beam_width: Option<f32>,
-    },
-    /// Parallel light from infinitely far away, as the sun (Mitsuba `directional`).
-    Directional {
-        /// Name for messages.
-        #[serde(default)]
-        name: Option<String>,
-        /// The direction the light travels in (from the light towards the scene).
-        direction: V3,
-        /// Irradiance on a surface facing the light, W/m² (linear RGB).
-        irradiance: V3,
-    },
+/// A light that is not a surface (point, spot, directional, projector: one of
+/// [`crate::lights::KINDS`]), written as its kind's name and its fields,
+/// `Spot(position: (0, 2, 0), target: (0, 0, 0), intensity: (5, 5, 5))`. None of them is
+/// seen by rays (they have no area); they light the scene through light sampling only. The
+/// fields are checked by the kind when the scene loads ([`crate::lights::LightKind::load`]);
+/// an unknown kind or field is refused as the file is read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightDesc {
+    /// Its kind: an index into [`crate::lights::KINDS`].
+    pub kind: u32,
+    /// Name for messages.
+    pub name: Option<String>,
+    /// Its other fields, as written.
+    pub fields: crate::lights::Fields,
 }
 
 impl LightDesc {
     /// The light's name, if it has one.
     pub fn name(&self) -> Option<&str> {
-        match self {
-            Self::Point { name, .. } | Self::Spot { name, .. } | Self::Directional { name, .. } => {
-                name.as_deref()
-            }
-        }
+        self.name.as_deref()
     }
 
     /// The kind, as written in the file.
     pub fn kind(&self) -> &'static str {
-        match self {
-            Self::Point { .. } => "Point",
-            Self::Spot { .. } => "Spot",
-            Self::Directional { .. } => "Directional",
-        }
+        crate::lights::KINDS[self.kind as usize].name()
     }
 }
 
-fn default_cutoff() -> f32 {
-    20.0
+impl<'de> Deserialize<'de> for LightDesc {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_enum("LightDesc", &[], LightVisitor)
+    }
+}
+
+struct LightVisitor;
+
+impl<'de> serde::de::Visitor<'de> for LightVisitor {
+    type Value = LightDesc;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a light, its kind's name and its fields: Point(position: …, …)")
+    }
+
+    fn visit_enum<A: serde::de::EnumAccess<'de>>(self, data: A) -> Result<LightDesc, A::Error> {
+        use serde::de::{Error, VariantAccess};
+        let (Key(name), variant): (Key, _) = data.variant()?;
+        let kind = crate::lights::kind_named(&name).ok_or_else(|| {
+            let names: Vec<String> = crate::lights::KINDS
+                .iter()
+                .map(|k| format!("`{}`", k.name()))
+                .collect();
+            A::Error::custom(format!(
+                "unknown light `{name}`, expected one of {}",
+                names.join(", ")
+            ))
+        })?;
+        variant.struct_variant(&[], FieldsVisitor(kind))
+    }
+}
+
+struct FieldsVisitor(u32);
+
+/// A field's name: an identifier, as RON writes struct fields.
+struct Key(String);
+
+impl<'de> Deserialize<'de> for Key {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = Key;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a field name")
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Key, E> {
+                Ok(Key(v.to_owned()))
+            }
+        }
+        d.deserialize_identifier(V)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for FieldsVisitor {
+    type Value = LightDesc;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("the light's fields, (name: value, …)")
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<LightDesc, A::Error> {
+        use serde::de::Error;
+        let kind = crate::lights::KINDS[self.0 as usize];
+        let mut out = LightDesc {
+            kind: self.0,
+            name: None,
+            fields: crate::lights::Fields::default(),
+        };
+        while let Some(Key(key)) = map.next_key::<Key>()? {
+            if key == "name" {
+                out.name = map.next_value::<Option<String>>()?;
+                continue;
+            }
+            if !kind.fields().contains(&key.as_str()) {
+                return Err(A::Error::unknown_field(&key, kind.fields()));
+            }
+            if out.fields.0.contains_key(&key) {
+                return Err(A::Error::custom(format!("duplicate field `{key}`")));
+            }
+            let value = map.next_value::<ron::Value>()?;
+            out.fields.0.insert(key, value);
+        }
+        Ok(out)
+    }
 }
 
 /// What rays that leave the scene see.

@@ -13,10 +13,9 @@ use crate::gpu::{
     ENV_CONSTANT, ENV_MAP, ENV_NONE, ENV_SHOW_BACKGROUND, FEATURE_ENVIRONMENT, FEATURE_LIGHTS,
     FEATURE_MEDIA, FEATURE_METAL, FEATURE_SHAPES, FEATURE_TEXTURES, FEATURE_TRANSMISSION,
     GpuAliasEntry, GpuBvhNode, GpuBvhRecord, GpuCamera, GpuHeader, GpuLight, GpuMaterial,
-    GpuSettings, GpuShape, GpuTriShading, GpuTriTexcoords, GpuTriangle, LIGHT_DIRECTIONAL,
-    LIGHT_POINT, LIGHT_SHAPE, LIGHT_SPOT, LIGHT_TWO_SIDED, MATERIAL_CONDUCTOR,
-    MATERIAL_INDEX_MATCHED, MATERIAL_MEDIUM, MATERIAL_SINGLE_SCATTER, MATERIAL_TWO_SIDED, NO_LIGHT,
-    TRI_VERTEX_NORMALS,
+    GpuSettings, GpuShape, GpuTriShading, GpuTriTexcoords, GpuTriangle, LIGHT_SHAPE,
+    LIGHT_TWO_SIDED, MATERIAL_CONDUCTOR, MATERIAL_INDEX_MATCHED, MATERIAL_MEDIUM,
+    MATERIAL_SINGLE_SCATTER, MATERIAL_TWO_SIDED, NO_LIGHT, TRI_VERTEX_NORMALS,
 };
 use crate::scene::{Material, NO_TEXTURE, PunctualLight, Scene};
 
@@ -177,60 +176,12 @@ impl From<&Material> for GpuMaterial {
     }
 }
 
-/// The light-table entry of a point, spot or directional light and its emitted power (for
-/// selection): 4π I for a point, ∫ falloff over the sphere × I for a spot (2π (1 − cos)
-/// over the full cone, plus the linear ramp's share), and for a directional light its
-/// irradiance over the disk of the scene's bounding sphere (`radius`).
+/// The light-table entry of a light without area and its emitted power (for selection),
+/// as its kind gives it ([`crate::lights::LightKind::power`]; `radius` bounds the scene).
 fn punctual_light(l: &PunctualLight, radius: f32) -> (GpuLight, f32) {
-    use std::f32::consts::PI;
-    let mut g = GpuLight::default();
-    let power = match *l {
-        PunctualLight::Point {
-            position,
-            intensity,
-        } => {
-            g.flags = LIGHT_POINT;
-            g.p0 = position.to_array();
-            g.emission = intensity.to_array();
-            4.0 * PI * luminance(intensity)
-        }
-        PunctualLight::Spot {
-            position,
-            axis,
-            intensity,
-            cutoff,
-            beam,
-        } => {
-            g.flags = LIGHT_SPOT;
-            g.p0 = position.to_array();
-            g.e1 = axis.to_array();
-            g.e2 = [cutoff, beam, 0.0];
-            g.emission = intensity.to_array();
-            // The falloff's solid angle, by midpoint rule in θ over [beam, cutoff].
-            let full = 2.0 * PI * (1.0 - beam.cos());
-            let steps = 64;
-            let dt = (cutoff - beam) / steps as f32;
-            let ramp: f32 = (0..steps)
-                .map(|i| {
-                    let t = beam + (i as f32 + 0.5) * dt;
-                    2.0 * PI * t.sin() * (cutoff - t) / (cutoff - beam).max(1e-12) * dt
-                })
-                .sum();
-            (full + ramp) * luminance(intensity)
-        }
-        PunctualLight::Directional {
-            direction,
-            irradiance,
-        } => {
-            g.flags = LIGHT_DIRECTIONAL;
-            g.e1 = direction.to_array();
-            g.emission = irradiance.to_array();
-            PI * radius * radius * luminance(irradiance)
-        }
-    };
-    g.prim = NO_LIGHT;
-    g.power = power;
-    (g, power)
+    let kind = crate::lights::kind_of(l).expect("a light without area has a kind");
+    let power = kind.power(l, radius);
+    (GpuLight { power, ..*l }, power)
 }
 
 /// Share of light samples spread uniformly over the lights; the rest go by power.
@@ -713,6 +664,7 @@ impl GpuScene {
                     area,
                     emission: m.emission.to_array(),
                     power,
+                    ..GpuLight::default()
                 });
             }
             self.tri_shading.push(GpuTriShading {

@@ -49,17 +49,6 @@ pub const MATERIAL_ALPHA_BLEND: u32 = 64;
 pub const LIGHT_SHAPE: u32 = 1;
 /// [`GpuLight::flags`]: emission leaves both sides of the triangle.
 pub const LIGHT_TWO_SIDED: u32 = 2;
-/// [`GpuLight::flags`]: a point light at `p0` of radiant intensity `emission`.
-pub const LIGHT_POINT: u32 = 4;
-/// [`GpuLight::flags`]: a spot light at `p0`, unit axis `e1`, `e2` = (cutoff, beam width)
-/// half-angles in radians, radiant intensity `emission` on the axis.
-pub const LIGHT_SPOT: u32 = 8;
-/// [`GpuLight::flags`]: a directional light travelling along unit `e1`, irradiance
-/// `emission`.
-pub const LIGHT_DIRECTIONAL: u32 = 16;
-/// [`GpuLight::flags`]: the lights with no area, never hit, sampled with a delta pdf
-/// (point, spot, directional).
-pub const LIGHT_DELTA: u32 = LIGHT_POINT | LIGHT_SPOT | LIGHT_DIRECTIONAL;
 
 /// [`GpuSettings::env_kind`]: black environment.
 pub const ENV_NONE: u32 = 0;
@@ -384,30 +373,37 @@ impl GpuTriTexcoords {
     }
 }
 
-/// An emitter, 64 bytes: an emissive triangle or shape, or a point, spot or directional
-/// light ([`LIGHT_POINT`], [`LIGHT_SPOT`], [`LIGHT_DIRECTIONAL`]).
+/// An emitter, 80 bytes: an emissive triangle or shape, or a light without area of a kind
+/// in [`crate::lights::KINDS`] (`kind`), which reads the fields as its file says.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuLight {
-    /// Triangle corner 0; zero for a shape, whose sampling reads the shape (offset 0).
+    /// Triangle corner 0; zero for a shape, whose sampling reads the shape; a light
+    /// without area's position (offset 0).
     pub p0: [f32; 3],
     /// [`LIGHT_SHAPE`], [`LIGHT_TWO_SIDED`] (offset 12).
     pub flags: u32,
-    /// Triangle edge 1, or zero (offset 16).
+    /// Triangle edge 1; a light without area's unit axis, its frame's z (offset 16).
     pub e1: [f32; 3],
     /// The primitive: triangle index, or shape index (offset 28).
     pub prim: u32,
-    /// Triangle edge 2, or zero (offset 32).
+    /// Triangle edge 2; a light without area's frame's unit x (offset 32).
     pub e2: [f32; 3],
     /// Emitting area (offset 44).
     pub area: f32,
-    /// Emitted radiance, linear RGB (offset 48).
+    /// Emitted radiance, linear RGB; a light without area's intensity or irradiance (offset
+    /// 48).
     pub emission: [f32; 3],
     /// Emitted power for selection: luminance(emission) × area × π (× 2 if two-sided), × the
     /// emissive texture's mean over the triangle when it has one (offset 60). Selection
     /// probability: [`crate::light_selection`], half power / `GpuHeader::total_light_power`,
     /// half 1 / `num_lights`.
     pub power: f32,
+    /// A light without area's own numbers (offset 64).
+    pub params: [f32; 3],
+    /// 0: an emissive triangle or shape; else a light without area, of kind
+    /// `crate::lights::KINDS[kind - 1]` (offset 76).
+    pub kind: u32,
 }
 
 /// One entry of the light alias table (Vose), 8 bytes: pick `i` uniformly, keep it with

@@ -29,6 +29,7 @@ pub mod file;
 mod flatten;
 pub mod gpu;
 pub mod import;
+pub mod lights;
 mod load;
 pub mod orbit;
 pub mod save;

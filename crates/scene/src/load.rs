@@ -103,7 +103,7 @@ impl<'a> Locator<'a> {
     /// found by their kind's name followed by `(`), or where that light starts.
     fn in_light(&self, index: usize, needle: &str) -> Option<Pos> {
         let list = self.text.find("lights:")?;
-        let kinds = ["Point", "Spot", "Directional"];
+        let kinds: Vec<&str> = crate::lights::KINDS.iter().map(|k| k.name()).collect();
         let mut starts = Vec::new();
         let mut i = list;
         while i < self.text.len() {
@@ -399,71 +399,8 @@ fn material_from_desc(name: &str, d: &MaterialDesc) -> Result<Material, SceneErr
     })
 }
 
-fn angle(field: &'static str, degrees: f32, max: f32) -> Result<f32, SceneError> {
-    if degrees.is_finite() && (0.0..=max).contains(&degrees) {
-        Ok(degrees.to_radians())
-    } else {
-        Err(bad(
-            field,
-            format!("{degrees} must be in [0, {max}] degrees"),
-        ))
-    }
-}
-
 fn light_from_desc(d: &LightDesc) -> Result<PunctualLight, SceneError> {
-    Ok(match d {
-        LightDesc::Point {
-            position,
-            intensity,
-            ..
-        } => PunctualLight::Point {
-            position: finite3("position", *position)?,
-            intensity: non_negative3("intensity", *intensity)?,
-        },
-        LightDesc::Spot {
-            position,
-            target,
-            intensity,
-            cutoff_angle,
-            beam_width,
-            ..
-        } => {
-            let position = finite3("position", *position)?;
-            let axis = finite3("target", *target)? - position;
-            if axis.length_squared() == 0.0 {
-                return Err(bad("target", "the target must differ from the position"));
-            }
-            let cutoff = angle("cutoff_angle", *cutoff_angle, 90.0)?;
-            if cutoff == 0.0 {
-                return Err(bad("cutoff_angle", "0 degrees lights nothing"));
-            }
-            let beam = match beam_width {
-                Some(b) => angle("beam_width", *b, *cutoff_angle)?,
-                None => 0.75 * cutoff,
-            };
-            PunctualLight::Spot {
-                position,
-                axis: axis.normalize(),
-                intensity: non_negative3("intensity", *intensity)?,
-                cutoff,
-                beam,
-            }
-        }
-        LightDesc::Directional {
-            direction,
-            irradiance,
-            ..
-        } => {
-            let direction = finite3("direction", *direction)?;
-            if direction.length_squared() == 0.0 {
-                return Err(bad("direction", "the direction must not be zero"));
-            }
-            PunctualLight::Directional {
-                direction: direction.normalize(),
-                irradiance: non_negative3("irradiance", *irradiance)?,
-            }
-        }
-    })
+    crate::lights::KINDS[d.kind as usize].load(&d.fields)
 }
 
 /// A version 1 environment map in version 2's (Mitsuba's) orientation, lighting the scene

@@ -415,37 +415,9 @@ impl Shape {
 }
 
 /// A light without area: it lights the scene through light sampling only and is never hit.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum PunctualLight {
-    /// Light from one point, the same in every direction.
-    Point {
-        /// Position.
-        position: Vec3,
-        /// Radiant intensity, W/sr.
-        intensity: Vec3,
-    },
-    /// Light from one point into a cone about `axis`: full `intensity` within `beam` of
-    /// the axis, falling linearly in angle to 0 at `cutoff` (Mitsuba's `spot`).
-    Spot {
-        /// Position.
-        position: Vec3,
-        /// Unit axis, the direction light leaves along.
-        axis: Vec3,
-        /// Radiant intensity on the axis, W/sr.
-        intensity: Vec3,
-        /// Half-angle outside which it is black, radians.
-        cutoff: f32,
-        /// Half-angle of full intensity, radians, at most `cutoff`.
-        beam: f32,
-    },
-    /// Parallel light from infinitely far away.
-    Directional {
-        /// Unit direction the light travels in.
-        direction: Vec3,
-        /// Irradiance on a surface facing the light, W/m².
-        irradiance: Vec3,
-    },
-}
+/// Its record is its GPU record, of a kind in [`crate::lights::KINDS`] (`kind` is the index
+/// + 1), which reads its fields its own way; [`crate::GpuScene::build`] sets its `power`.
+pub type PunctualLight = crate::gpu::GpuLight;
 
 /// What loading left out or changed, never fatal.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]

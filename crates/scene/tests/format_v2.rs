@@ -8,8 +8,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use lumagraph_scene::{
-    Environment, GpuScene, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPOT, MATERIAL_CONDUCTOR,
-    MATERIAL_SINGLE_SCATTER, PunctualLight, Scene, SceneError,
+    Environment, GpuScene, MATERIAL_CONDUCTOR, MATERIAL_SINGLE_SCATTER, Scene, SceneError,
 };
 
 fn parse(text: &str) -> Result<Scene, SceneError> {
@@ -142,20 +141,18 @@ fn point_spot_and_directional_lights() {
     ],"#;
     let s = parse(&scene("", lights, "None")).unwrap();
     assert_eq!(s.lights.len(), 3);
-    match s.lights[1] {
-        PunctualLight::Spot {
-            axis, cutoff, beam, ..
-        } => {
-            assert!((axis - Vec3::NEG_Y).length() < 1e-6);
-            assert!((cutoff - 30f32.to_radians()).abs() < 1e-6);
-            // Mitsuba's default beam width: 3/4 of the cutoff.
-            assert!((beam - 22.5f32.to_radians()).abs() < 1e-6);
-        }
-        l => panic!("{l:?}"),
-    }
+    let spot = &s.lights[1];
+    assert!((Vec3::from(spot.e1) - Vec3::NEG_Y).length() < 1e-6);
+    assert!((spot.params[0] - 30f32.to_radians()).abs() < 1e-6);
+    // Mitsuba's default beam width: 3/4 of the cutoff.
+    assert!((spot.params[1] - 22.5f32.to_radians()).abs() < 1e-6);
     let g = GpuScene::build(&s).unwrap();
-    let flags: Vec<u32> = g.lights.iter().map(|l| l.flags).collect();
-    assert_eq!(flags, [LIGHT_POINT, LIGHT_SPOT, LIGHT_DIRECTIONAL]);
+    let kinds: Vec<&str> = g
+        .lights
+        .iter()
+        .map(|l| lumagraph_scene::lights::kind_of(l).unwrap().name())
+        .collect();
+    assert_eq!(kinds, ["Point", "Spot", "Directional"]);
     assert_eq!(g.lights[2].e1, [0.0, -1.0, 0.0]);
     // Power for selection: 4 pi I for the point light.
     let point_power =
@@ -186,6 +183,44 @@ fn bad_lights_are_located_errors() {
             "Directional(direction: (0, 0, 0), irradiance: (1, 1, 1))",
             "direction",
         ),
+        (
+            "Projector(position: (0, 1, 0), target: (1, 0, 0), irradiance: (1, 1, 1), fov: 180)",
+            "fov: 180 must be in (0, 180) degrees",
+        ),
+        (
+            "Projector(position: (0, 1, 0), target: (0, 0, 0), up: (0, 2, 0), irradiance: (1, 1, 1), fov: 30)",
+            "up: must not be parallel to the axis",
+        ),
+        (
+            "Projector(position: (0, 1, 0), target: (1, 0, 0), irradiance: (1, 1, 1))",
+            "fov: is missing",
+        ),
+        (
+            "Point(position: (0, 1), intensity: (1, 1, 1))",
+            "position: must be three numbers",
+        ),
+    ] {
+        let text = scene("", &format!("lights: [\n        {light},\n    ],"), "None");
+        let e = parse(&text).unwrap_err();
+        let msg = e.to_string();
+        assert!(msg.contains(says), "{msg}");
+        assert_eq!(e.pos.unwrap().line, 12, "{msg}");
+    }
+}
+
+/// An unknown kind of light, or a field its kind does not read, is refused as the file is
+/// read, with the kinds or fields there are.
+#[test]
+fn unknown_light_kinds_and_fields_are_syntax_errors() {
+    for (light, says) in [
+        (
+            "Area(position: (0, 1, 0))",
+            "unknown light `Area`, expected one of `Point`, `Spot`, `Directional`, `Projector`",
+        ),
+        (
+            "Point(position: (0, 1, 0), intensity: (1, 1, 1), radius: 2)",
+            "`radius`",
+        ),
     ] {
         let text = scene("", &format!("lights: [\n        {light},\n    ],"), "None");
         let e = parse(&text).unwrap_err();
@@ -203,53 +238,15 @@ fn gltf_lights_import_as_the_scene_file_lights() {
     let from_ron = Scene::load(&tests_dir().join("punctual_lights.ron")).unwrap();
     assert_eq!(from_gltf.lights.len(), 3);
     for (a, b) in from_gltf.lights.iter().zip(&from_ron.lights) {
-        let close = |x: Vec3, y: Vec3| (x - y).abs().max_element() < 1e-5;
-        match (a, b) {
-            (
-                PunctualLight::Point {
-                    position: p,
-                    intensity: i,
-                },
-                PunctualLight::Point {
-                    position: q,
-                    intensity: j,
-                },
-            ) => assert!(close(*p, *q) && close(*i, *j), "{a:?} vs {b:?}"),
-            (
-                PunctualLight::Spot {
-                    position: p,
-                    axis: x,
-                    intensity: i,
-                    cutoff: c,
-                    beam: w,
-                },
-                PunctualLight::Spot {
-                    position: q,
-                    axis: y,
-                    intensity: j,
-                    cutoff: d,
-                    beam: v,
-                },
-            ) => assert!(
-                close(*p, *q)
-                    && close(*x, *y)
-                    && close(*i, *j)
-                    && (c - d).abs() < 1e-6
-                    && (w - v).abs() < 1e-6,
-                "{a:?} vs {b:?}"
-            ),
-            (
-                PunctualLight::Directional {
-                    direction: x,
-                    irradiance: i,
-                },
-                PunctualLight::Directional {
-                    direction: y,
-                    irradiance: j,
-                },
-            ) => assert!(close(*x, *y) && close(*i, *j), "{a:?} vs {b:?}"),
-            _ => panic!("{a:?} vs {b:?}"),
-        }
+        let close =
+            |x: [f32; 3], y: [f32; 3]| (Vec3::from(x) - Vec3::from(y)).abs().max_element() < 1e-5;
+        assert_eq!(a.kind, b.kind, "{a:?} vs {b:?}");
+        assert!(
+            close(a.p0, b.p0) && close(a.e1, b.e1) && close(a.e2, b.e2),
+            "{a:?} vs {b:?}"
+        );
+        assert!(close(a.emission, b.emission), "{a:?} vs {b:?}");
+        assert!(close(a.params, b.params), "{a:?} vs {b:?}");
     }
 }
 

@@ -360,10 +360,19 @@ fn shapes_lights_and_version_are_not_edited() {
     edited.shapes.pop();
     assert_eq!(not_editable(&edited), "shapes");
     let mut edited = parse(&text);
-    edited.lights.push(LightDesc::Directional {
+    edited.lights.push(LightDesc {
+        kind: lumagraph_scene::lights::kind_named("Directional").unwrap(),
         name: None,
-        direction: [0.0, -1.0, 0.0],
-        irradiance: [1.0; 3],
+        fields: lumagraph_scene::lights::Fields::of([
+            (
+                "direction",
+                ron::Value::Seq(vec![ron::Value::from(0.0f32); 3]),
+            ),
+            (
+                "irradiance",
+                ron::Value::Seq(vec![ron::Value::from(1.0f32); 3]),
+            ),
+        ]),
     });
     assert_eq!(not_editable(&edited), "lights");
     let mut edited = parse(&text);

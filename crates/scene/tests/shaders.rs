@@ -10,11 +10,14 @@ use lumagraph_scene::{
     GpuTexDesc, GpuTriShading, GpuTriTexcoords, GpuTriangle,
 };
 
-/// The shader folder, and the one generated file the scene crate writes (the dispatch over
-/// the kinds of shapes).
+/// The shader folder, and the generated files the scene crate writes (the dispatches over
+/// the kinds of shapes and of lights without area).
 fn source(name: &str) -> Option<String> {
     if name == lumagraph_scene::shapes::FILE {
         return Some(lumagraph_scene::shapes::wgsl());
+    }
+    if name == lumagraph_scene::lights::FILE {
+        return Some(lumagraph_scene::lights::wgsl());
     }
     lumagraph_wgsl::from_dir(common::shaders())(name)
 }
@@ -155,7 +158,7 @@ fn wgsl_layouts_match_rust() {
         layout!(
             GpuLight,
             "Light",
-            [p0, flags, e1, prim, e2, area, emission, power]
+            [p0, flags, e1, prim, e2, area, emission, power, params, kind]
         ),
         layout!(GpuAliasEntry, "AliasEntry", [prob, other]),
         layout!(
@@ -269,10 +272,6 @@ fn wgsl_constants_match_rust() {
         ("NODE_COUNT_SHIFT", lumagraph_scene::bvh::NODE_COUNT_SHIFT),
         ("LIGHT_SHAPE", lumagraph_scene::LIGHT_SHAPE),
         ("LIGHT_TWO_SIDED", lumagraph_scene::LIGHT_TWO_SIDED),
-        ("LIGHT_POINT", lumagraph_scene::LIGHT_POINT),
-        ("LIGHT_SPOT", lumagraph_scene::LIGHT_SPOT),
-        ("LIGHT_DIRECTIONAL", lumagraph_scene::LIGHT_DIRECTIONAL),
-        ("LIGHT_DELTA", lumagraph_scene::LIGHT_DELTA),
         ("MATERIAL_TWO_SIDED", lumagraph_scene::MATERIAL_TWO_SIDED),
         ("TRI_VERTEX_NORMALS", lumagraph_scene::TRI_VERTEX_NORMALS),
         ("ENV_NONE", lumagraph_scene::ENV_NONE),

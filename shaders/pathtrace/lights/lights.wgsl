@@ -1,7 +1,8 @@
 // Light sampling: picking a light (alias table by power, with a uniform share), sampling
 // a point on it or a direction to it (triangles, analytic shapes as their kind samples them
-// (pathtrace/shapes/), point, spot and directional lights, the environment map), and the
-// pdfs MIS needs.
+// (pathtrace/shapes/), lights without area as their kind does (pathtrace/lights/<kind>.wgsl,
+// through the generated pathtrace/light_kinds.wgsl), the environment map), and the pdfs MIS
+// needs.
 // requires: var frame, var tri_texcoords (integrator/pathtrace.wgsl)
 #import "pathtrace/scene_types.wgsl"
 #import "pathtrace/options.wgsl"
@@ -13,22 +14,8 @@
 #import "pathtrace/textures.wgsl"
 #import "pathtrace/integrator/surface.wgsl"
 #import "pathtrace/shapes.wgsl"
-
-struct LightSample {
-    // Unit direction from the shading point to the light.
-    wi: vec3f,
-    dist: f32,
-    radiance: vec3f,
-    // Solid-angle pdf, light selection included; 0 when the sample is invalid.
-    pdf: f32,
-    // How far the shadow ray stops short of `dist`, so that it does not reach the light (or
-    // what is coplanar with it): the sampled point's error off the light's plane over the
-    // cosine there, and a relative term for the error of t.
-    margin: f32,
-    // A point, spot or directional light: `pdf` is only its selection probability, and no
-    // BSDF-sampled ray can reach it (no MIS).
-    delta: bool,
-}
+#import "pathtrace/lights/sample.wgsl"
+#import "pathtrace/light_kinds.wgsl"
 
 fn env_map_on() -> bool {
     return HAS_ENV_MAP && frame.settings.env_kind == ENV_MAP;
@@ -79,29 +66,9 @@ fn sample_light(x: vec3f, bounce: u32) -> LightSample {
     out.delta = false;
     let l = scene_light(pick_light(rand()));
     let u = sample_2d_at(PAIR_LIGHT, bounce);
-    if (l.flags & LIGHT_DELTA) != 0u {
-        out.delta = true;
-        out.pdf = light_select_pdf(l);
-        if (l.flags & LIGHT_DIRECTIONAL) != 0u {
-            out.wi = -l.e1;
-            out.dist = F32_MAX;
-            out.radiance = l.emission;
-            out.margin = 0.0;
-            return out;
-        }
-        let d = l.p0 - x;
-        let dist2 = dot(d, d);
-        let dist = sqrt(dist2);
-        out.wi = d / dist;
-        out.dist = dist;
-        out.margin = EDGE_ERR * dist;
-        var falloff = 1.0;
-        if (l.flags & LIGHT_SPOT) != 0u {
-            // Full within the beam width e2.y, linear in angle to 0 at the cutoff e2.x.
-            let theta = acos(clamp(dot(-out.wi, l.e1), -1.0, 1.0));
-            falloff = clamp((l.e2.x - theta) / max(l.e2.x - l.e2.y, 1e-12), 0.0, 1.0);
-        }
-        out.radiance = l.emission * (falloff / dist2);
+    if l.kind != 0u {
+        out = punctual_sample(l, x);
+        out.pdf *= light_select_pdf(l);
         return out;
     }
     if (l.flags & LIGHT_SHAPE) != 0u {

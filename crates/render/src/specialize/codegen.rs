@@ -242,6 +242,12 @@ const MATERIAL_TYPES: [&str; 34] = [
     "u32", "vec3f", "f32", "f32", "f32", "u32", "u32", "vec3f", "f32",
 ];
 
+/// The WGSL types of [`lights_rows`]'s fields, in order (`Light` in
+/// `pathtrace/scene_types.wgsl`).
+const LIGHT_TYPES: [&str; 10] = [
+    "vec3f", "u32", "vec3f", "u32", "vec3f", "f32", "vec3f", "f32", "vec3f", "u32",
+];
+
 /// Every material as WGSL literals, field by field.
 fn materials_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
     scene
@@ -303,6 +309,8 @@ fn lights_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
                 l.f(x.area),
                 l.v3(x.emission),
                 l.f(x.power),
+                l.v3(x.params),
+                u(x.kind),
             ]
         })
         .collect()
@@ -407,12 +415,7 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
         positions.len(),
         shapes.len(),
         table_fns("scene_material", "Material", &MATERIAL_TYPES, &materials),
-        table_fns(
-            "scene_light",
-            "Light",
-            &[f3, u1, f3, u1, f3, f1, f3, f1],
-            &lights
-        ),
+        table_fns("scene_light", "Light", &LIGHT_TYPES, &lights),
         table_fns("scene_light_alias", "AliasEntry", &[f1, u1], &alias),
         table_fns(
             "scene_tri_positions",
@@ -448,7 +451,7 @@ pub fn inline_materials_data(scene: &GpuScene) -> Option<String> {
         return None;
     }
     let l = Literals::default();
-    let (f3, f1, u1) = ("vec3f", "f32", "u32");
+    let (f1, u1) = ("f32", "u32");
     let materials = materials_rows(scene, &l);
     let few_lights = scene.lights.len() <= INLINE_MAX_MATERIALS;
     let (lights, alias) = if few_lights {
@@ -462,12 +465,7 @@ pub fn inline_materials_data(scene: &GpuScene) -> Option<String> {
     let light_fns = if few_lights {
         format!(
             "{}{}",
-            table_fns(
-                "scene_light",
-                "Light",
-                &[f3, u1, f3, u1, f3, f1, f3, f1],
-                &lights
-            ),
+            table_fns("scene_light", "Light", &LIGHT_TYPES, &lights),
             table_fns("scene_light_alias", "AliasEntry", &[f1, u1], &alias)
         )
     } else {

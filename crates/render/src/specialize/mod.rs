@@ -221,6 +221,9 @@ pub struct Specialization {
     /// Replaces `pathtrace/shapes.wgsl` with the dispatch over the kinds of shapes the
     /// scene has (specialized shaders only).
     shapes: Option<String>,
+    /// Replaces `pathtrace/light_kinds.wgsl` with the dispatch over the kinds of lights
+    /// without area the scene has (specialized shaders only).
+    light_kinds: Option<String>,
 }
 
 impl Specialization {
@@ -228,6 +231,9 @@ impl Specialization {
     pub fn new(scene: &GpuScene, options: PathTraceOptions) -> Self {
         let shapes = options.specialize.then(|| {
             lumagraph_scene::shapes::wgsl_for(|k| scene.shapes.iter().any(|s| s.kind == k))
+        });
+        let light_kinds = options.specialize.then(|| {
+            lumagraph_scene::lights::wgsl_for(|k| scene.lights.iter().any(|l| l.kind == k + 1))
         });
         let features = Features::decide(scene, options);
         let inline = features.on(Feature::InlineIntersection);
@@ -252,6 +258,7 @@ impl Specialization {
             intersection,
             scene_data,
             shapes,
+            light_kinds,
         }
     }
 
@@ -270,6 +277,9 @@ impl Specialization {
         }
         if let Some(code) = &self.shapes {
             overrides.push((lumagraph_scene::shapes::FILE, code.clone()));
+        }
+        if let Some(code) = &self.light_kinds {
+            overrides.push((lumagraph_scene::lights::FILE, code.clone()));
         }
         let source =
             crate::shader::resolve_with("pathtrace/integrator/pathtrace.wgsl", &overrides)?;

@@ -536,26 +536,15 @@ fn punctual_light(
         return Err("its node's transform is singular".to_owned());
     }
     Ok(match light.kind() {
-        Kind::Point => PunctualLight::Point {
-            position,
-            intensity: power,
-        },
-        Kind::Directional => PunctualLight::Directional {
-            direction: axis,
-            irradiance: power,
-        },
+        Kind::Point => crate::lights::point(position, power),
+        Kind::Directional => crate::lights::directional(axis, power),
         Kind::Spot {
             inner_cone_angle,
             outer_cone_angle,
         } => {
             let cutoff = outer_cone_angle.clamp(1e-4, std::f32::consts::FRAC_PI_2);
-            PunctualLight::Spot {
-                position,
-                axis,
-                intensity: power,
-                cutoff,
-                beam: inner_cone_angle.clamp(0.0, cutoff),
-            }
+            let beam = inner_cone_angle.clamp(0.0, cutoff);
+            crate::lights::spot(position, axis, power, cutoff, beam)
         }
     })
 }
