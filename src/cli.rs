@@ -911,6 +911,7 @@ fn test_chart(out: &Path) -> Result<()> {
 /// environment variable for the Vulkan loader (see [`GpuContext::quiet_device_select`]).
 pub fn main_with(library: NodeLibrary) -> ExitCode {
     GpuContext::quiet_device_select();
+    crate::overrides::apply();
     let cli = Cli::parse();
     match run(cli, &Arc::new(library)) {
         Ok(()) => ExitCode::SUCCESS,

@@ -21,6 +21,7 @@
 
 pub mod cli;
 pub mod converge;
+pub mod overrides;
 
 pub use lumagraph_color as color;
 pub use lumagraph_editor as editor;

@@ -849,6 +849,7 @@ fn nodes(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
 /// Render graphs from Python.
 #[pymodule(name = "lumagraph")]
 fn lumagraph_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    lumagraph::overrides::apply();
     // At import, before any session opens a Vulkan instance: no bogus libwayland error
     // where the machine has no XDG_RUNTIME_DIR.
     lumagraph::render::GpuContext::quiet_device_select();

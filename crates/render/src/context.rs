@@ -278,7 +278,7 @@ impl GpuContext {
             // SAFETY: wgpu marks ray queries experimental (its API may change, and bugs in
             // it may be undefined behaviour). lumagraph uses them only through
             // `crate::accel` and `pathtrace/intersect/ray_query.wgsl`, whose images the tests compare
-            // with the WGSL BVH's; LUMAGRAPH_RAY_QUERY=off leaves them out.
+            // with the WGSL BVH's; `turn_off_ray_queries` leaves them out.
             unsafe { wgpu::ExperimentalFeatures::enabled() }
         } else {
             wgpu::ExperimentalFeatures::disabled()
@@ -518,7 +518,16 @@ pub fn human_bytes(bytes: u64) -> String {
     }
 }
 
-/// Whether `LUMAGRAPH_RAY_QUERY=off` asks lumagraph not to use the device's ray queries.
+static RAY_QUERIES_OFF: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Keeps devices opened from now on from enabling ray queries, where the application asks so
+/// (the command line, the editor and the Python module do for `LUMAGRAPH_RAY_QUERY=off`:
+/// `lumagraph::overrides`); the path tracer then traces through its WGSL BVHs.
+pub fn turn_off_ray_queries() {
+    RAY_QUERIES_OFF.store(true, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// Whether [`turn_off_ray_queries`] was called.
 pub fn ray_queries_turned_off() -> bool {
-    std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "off" || v == "0")
+    RAY_QUERIES_OFF.load(std::sync::atomic::Ordering::Relaxed)
 }

@@ -52,7 +52,9 @@ mod wavefront;
 pub mod wide_bvh;
 
 pub use checkpoint::Checkpoint;
-pub use context::{GPU_TIMEOUT, GpuContext, for_tests, human_bytes};
+pub use context::{
+    GPU_TIMEOUT, GpuContext, for_tests, human_bytes, ray_queries_turned_off, turn_off_ray_queries,
+};
 pub use error::{RenderError, Result};
 pub use executor::{Executor, FrameReport, PassClock};
 pub use kernel::{Binding, Kernel, PassBuilder, uniform_buffer};

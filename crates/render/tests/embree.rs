@@ -17,6 +17,10 @@ use rayon::prelude::*;
 
 /// Embree, or `None` (after saying why) when it may be missing.
 fn embree() -> Option<Arc<Embree>> {
+    // As the command line does (`lumagraph::overrides`): the library reads no variable.
+    if let Ok(path) = std::env::var("LUMAGRAPH_EMBREE") {
+        let _ = lumagraph_render::embree::configure(lumagraph_render::embree::Library::Path(path));
+    }
     match Embree::load() {
         Ok(e) => Some(e),
         Err(why) if std::env::var("LUMAGRAPH_ALLOW_NO_EMBREE").is_ok_and(|v| v == "1") => {

@@ -10,9 +10,12 @@
 //!   given (the path tracer's BVH order, [`lumagraph_scene::GpuScene::tri_corners`]).
 //! - [`HostRay`] and [`HostHit`]: 32 and 16 bytes, the layouts the WGSL writes and reads.
 //!
-//! Library names tried, in order: the path in `LUMAGRAPH_EMBREE` when set, then
-//! `libembree3.so.3`, `libembree3.so`, `libembree3.dylib`, `embree3.dll`.
-//! `LUMAGRAPH_EMBREE=off` disables Embree. The environment is read once per process.
+//! Library names tried, in order: the path the application gave ([`configure`]) when it gave
+//! one, then `libembree3.so.3`, `libembree3.so`, `libembree3.dylib`, `embree3.dll` (the
+//! system's search path: `LD_LIBRARY_PATH` and the like). The application may also turn
+//! Embree off; the command line, the editor and the Python module do so for
+//! `LUMAGRAPH_EMBREE=off` and take `LUMAGRAPH_EMBREE=PATH` as the path (`lumagraph::overrides`).
+//! The library itself reads no environment variable.
 //!
 //! Triangles are two-sided and hit where `tnear < t < tfar` (Embree makes no promise for
 //! `t` at either end exactly). Barycentrics follow Embree's convention, which is also the
@@ -83,7 +86,29 @@ impl Drop for Embree {
     }
 }
 
-/// The library names tried, in order, after `LUMAGRAPH_EMBREE`.
+/// Where the application tells the loader to look for Embree ([`configure`]).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum Library {
+    /// The system's names ([`LIBRARY_NAMES`]).
+    #[default]
+    System,
+    /// This file first, then the system's names.
+    Path(String),
+    /// Never load Embree.
+    Off,
+}
+
+static LIBRARY: OnceLock<Library> = OnceLock::new();
+
+/// Tells the loader where to look for Embree, before anything loads it (once per process).
+///
+/// # Errors
+/// When it was configured already, with what it was configured to.
+pub fn configure(library: Library) -> Result<(), Library> {
+    LIBRARY.set(library)
+}
+
+/// The library names tried, in order, after the path [`configure`] gave.
 const LIBRARY_NAMES: [&str; 4] = [
     "libembree3.so.3",
     "libembree3.so",
@@ -94,16 +119,18 @@ const LIBRARY_NAMES: [&str; 4] = [
 impl Embree {
     /// The process's Embree, loaded on first call (see the module documentation for the
     /// names tried). The error says which names were tried and why each failed, or that
-    /// `LUMAGRAPH_EMBREE=off` disabled it; it is the same on every call.
+    /// the application turned it off; it is the same on every call.
     pub fn load() -> Result<Arc<Embree>, String> {
         static EMBREE: OnceLock<Result<Arc<Embree>, String>> = OnceLock::new();
         EMBREE
             .get_or_init(|| {
-                let chosen = std::env::var("LUMAGRAPH_EMBREE").ok();
-                let chosen = chosen.as_deref().map(str::trim).filter(|s| !s.is_empty());
-                if chosen.is_some_and(|s| s.eq_ignore_ascii_case("off")) {
-                    return Err("Embree disabled by LUMAGRAPH_EMBREE=off".to_owned());
-                }
+                let chosen = match LIBRARY.get_or_init(Library::default) {
+                    Library::Off => {
+                        return Err("Embree turned off (LUMAGRAPH_EMBREE=off)".to_owned());
+                    }
+                    Library::Path(p) => Some(p.as_str()),
+                    Library::System => None,
+                };
                 let mut failures = Vec::new();
                 for name in chosen.into_iter().chain(LIBRARY_NAMES) {
                     match Self::open(name) {
@@ -122,7 +149,7 @@ impl Embree {
     /// Opens one library and makes its device.
     fn open(name: &str) -> Result<Embree, String> {
         // SAFETY: loading a shared library runs its initializers; Embree's only set up its
-        // own state. The name comes from our list or the user's `LUMAGRAPH_EMBREE`.
+        // own state. The name comes from our list or the path the application gave.
         let lib = unsafe { libloading::Library::new(name) }.map_err(|e| e.to_string())?;
         // SAFETY: a library named as Embree 3 that exports these symbols is taken to be
         // Embree 3; its major version is checked below before any scene is made.

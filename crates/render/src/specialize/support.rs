@@ -216,7 +216,7 @@ pub fn why_not(
         )),
         Tracer::RayQueries => match options.ray_query_limit {
             None => Some(
-                "the device has no ray queries (or LUMAGRAPH_RAY_QUERY=off turned them off)"
+                "the device has no ray queries (or they were turned off: LUMAGRAPH_RAY_QUERY=off)"
                     .to_owned(),
             ),
             Some(most) => crate::accel::unsupported(scene, most),

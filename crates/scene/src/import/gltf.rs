@@ -516,6 +516,15 @@ fn check_range(
     Ok(())
 }
 
+static DECODE_THREADS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// How many threads decode a glTF file's images from now on (0: the machine's, at most 16),
+/// as the application asks (the command line, the editor and the Python module do for
+/// `LUMAGRAPH_DECODE_THREADS=N`: `lumagraph::overrides`).
+pub fn set_decode_threads(n: usize) {
+    DECODE_THREADS.store(n, std::sync::atomic::Ordering::Relaxed);
+}
+
 /// Luminous efficacy of 555 nm light, lm/W: photometric glTF units to radiometric ones.
 pub const LUMENS_PER_WATT: f32 = 683.0;
 
@@ -910,18 +919,16 @@ impl<'a> Decoder<'a> {
         Ok(index)
     }
 
-    /// Threads [`Decoder::decode_all`] uses: `LUMAGRAPH_DECODE_THREADS` where set, else
-    /// the machine's, at most 16; at most one per image.
+    /// Threads [`Decoder::decode_all`] uses: what [`set_decode_threads`] gave, else the
+    /// machine's, at most 16; at most one per image.
     fn threads(&self) -> usize {
-        std::env::var("LUMAGRAPH_DECODE_THREADS")
-            .ok()
-            .and_then(|v| v.parse::<usize>().ok())
-            .unwrap_or_else(|| {
-                std::thread::available_parallelism()
-                    .map_or(1, std::num::NonZero::get)
-                    .min(16)
-            })
-            .clamp(1, self.users.len().max(1))
+        match DECODE_THREADS.load(std::sync::atomic::Ordering::Relaxed) {
+            0 => std::thread::available_parallelism()
+                .map_or(1, std::num::NonZero::get)
+                .min(16),
+            n => n,
+        }
+        .clamp(1, self.users.len().max(1))
     }
 
     /// Decodes every image the materials use, on [`Decoder::threads`] threads, and returns
