@@ -199,20 +199,8 @@ fn bad_lights_are_located_errors() {
             "Point(position: (0, 1), intensity: (1, 1, 1))",
             "position: must be three numbers",
         ),
-    ] {
-        let text = scene("", &format!("lights: [\n        {light},\n    ],"), "None");
-        let e = parse(&text).unwrap_err();
-        let msg = e.to_string();
-        assert!(msg.contains(says), "{msg}");
-        assert_eq!(e.pos.unwrap().line, 12, "{msg}");
-    }
-}
-
-/// An unknown kind of light, or a field its kind does not read, is refused as the file is
-/// read, with the kinds or fields there are.
-#[test]
-fn unknown_light_kinds_and_fields_are_syntax_errors() {
-    for (light, says) in [
+        // An unknown kind, or a field its kind does not read, is refused as the file is
+        // read, with the kinds or fields there are.
         (
             "Area(position: (0, 1, 0))",
             "unknown light `Area`, expected one of `Point`, `Spot`, `Directional`, `Projector`",

@@ -131,15 +131,7 @@ pub fn wgsl() -> String {
 /// left out (every kind if it has none): leaving a kind out never changes an image, as the
 /// scene has no light of it.
 pub fn wgsl_for(present: impl Fn(u32) -> bool) -> String {
-    let mut kinds: Vec<(u32, &dyn LightKind)> = (0..KINDS.len() as u32)
-        .filter(|&i| present(i))
-        .map(|i| (i, KINDS[i as usize]))
-        .collect();
-    if kinds.is_empty() {
-        kinds = (0..KINDS.len() as u32)
-            .map(|i| (i, KINDS[i as usize]))
-            .collect();
-    }
+    let kinds = crate::shapes::kinds_present(&KINDS, present);
     let mut out = String::from(
         "// Generated from crates/scene/src/lights/mod.rs (`KINDS`): calls each light \
          without area\n// by its kind. Not a file on disk.\n",

@@ -63,6 +63,21 @@ pub fn kind_named(name: &str) -> Option<u32> {
         .map(|i| i as u32)
 }
 
+/// The kinds of `all` that `present` keeps, with their indices, or all of them where it
+/// keeps none (a generated dispatch always has a kind to fall back on).
+pub(crate) fn kinds_present<T: ?Sized>(
+    all: &[&'static T],
+    present: impl Fn(u32) -> bool,
+) -> Vec<(u32, &'static T)> {
+    let indexed = || (0..all.len() as u32).map(|i| (i, all[i as usize]));
+    let kinds: Vec<_> = indexed().filter(|&(i, _)| present(i)).collect();
+    if kinds.is_empty() {
+        indexed().collect()
+    } else {
+        kinds
+    }
+}
+
 /// The name shaders import the dispatch by.
 pub const FILE: &str = "pathtrace/shapes.wgsl";
 
@@ -78,15 +93,7 @@ pub fn wgsl() -> String {
 /// specialization writes it for its scene; leaving a kind out never changes an image, as the
 /// scene has no shape of it.
 pub fn wgsl_for(present: impl Fn(u32) -> bool) -> String {
-    let mut kinds: Vec<(u32, &dyn ShapeKind)> = (0..KINDS.len() as u32)
-        .filter(|&i| present(i))
-        .map(|i| (i, KINDS[i as usize]))
-        .collect();
-    if kinds.is_empty() {
-        kinds = (0..KINDS.len() as u32)
-            .map(|i| (i, KINDS[i as usize]))
-            .collect();
-    }
+    let kinds = kinds_present(&KINDS, present);
     let mut out = String::from(
         "// Generated from crates/scene/src/shapes/mod.rs (`KINDS`): calls each analytic \
          shape's\n// functions by its kind. Not a file on disk.\n",
