@@ -58,17 +58,22 @@ pub fn plan_tiling(
 ) -> Result<Option<Tiling>> {
     let limits = ctx.device.limits();
     let max_side = limits.max_texture_dimension_2d;
-    // Node-owned history buffers hold 16 bytes a pixel.
-    let max_buffer = limits
-        .max_storage_buffer_binding_size
-        .min(limits.max_buffer_size);
-    let buffer_pixels = max_buffer / 16;
+    let max_buffer = history_limit(&limits);
     let fits = |w: u32, h: u32, bytes: u64| {
-        w <= max_side
-            && h <= max_side
-            && u64::from(w) * u64::from(h) <= buffer_pixels
-            && bytes <= MEMORY_BUDGET
+        beyond_limits(&limits, Extent::new(w, h)).is_none() && bytes <= MEMORY_BUDGET
     };
+    if forced == Some(0)
+        && let Some(limit) = beyond_limits(&limits, image)
+    {
+        return Err(RenderError::TooLarge {
+            what: format!(
+                "{}×{} render without tiles (--tile 0)",
+                image.width, image.height
+            ),
+            adapter: ctx.info.name.clone(),
+            message: format!("{limit}; leave out --tile, or give a tile side"),
+        });
+    }
     let why = match forced {
         Some(0) => return Ok(None),
         Some(side) => format!("--tile {side}"),
@@ -94,7 +99,14 @@ pub fn plan_tiling(
         )
     };
     let tile = match forced {
-        Some(side) => side,
+        Some(side) => {
+            check_forced(&limits, side, window).map_err(|message| RenderError::TooLarge {
+                what: format!("{}×{} render in tiles of {side}", image.width, image.height),
+                adapter: ctx.info.name.clone(),
+                message,
+            })?;
+            side
+        }
         None => {
             let mut tile = LARGEST_TILE;
             loop {
@@ -124,6 +136,63 @@ pub fn plan_tiling(
         tiles,
         why,
     }))
+}
+
+/// Bytes a pixel of a node's own history takes (`Accumulate`'s sums: 16 B a pixel each).
+const HISTORY_BYTES: u64 = 16;
+
+/// The largest buffer of node history the device binds.
+fn history_limit(limits: &wgpu::Limits) -> u64 {
+    limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size)
+}
+
+/// Which of the device's hard limits an image (or a tile's window) of `extent` passes, in
+/// words naming the limit; `None` where it fits.
+fn beyond_limits(limits: &wgpu::Limits, extent: Extent) -> Option<String> {
+    let (w, h) = (extent.width, extent.height);
+    let max_side = limits.max_texture_dimension_2d;
+    let max_buffer = history_limit(limits);
+    if w > max_side || h > max_side {
+        return Some(format!(
+            "a {w}×{h} image passes the adapter's largest 2D texture side, {max_side} \
+             (max_texture_dimension_2d)"
+        ));
+    }
+    let history = u64::from(w) * u64::from(h) * HISTORY_BYTES;
+    (history > max_buffer).then(|| {
+        format!(
+            "{w}×{h} pixels of {HISTORY_BYTES}-byte history take {}, more than the largest \
+             buffer the adapter binds, {} (max_storage_buffer_binding_size)",
+            human_bytes(history),
+            human_bytes(max_buffer)
+        )
+    })
+}
+
+/// Whether tiles of `side` (`window` gives a tile's window, apron included) fit the device's
+/// hard limits; else why, with the largest power-of-two side that fits.
+fn check_forced(
+    limits: &wgpu::Limits,
+    side: u32,
+    window: impl Fn(u32) -> Extent,
+) -> std::result::Result<(), String> {
+    let Some(limit) = beyond_limits(limits, window(side)) else {
+        return Ok(());
+    };
+    let w = window(side);
+    let largest = std::iter::successors(Some(side.next_power_of_two() / 2), |t| {
+        (*t > 1).then_some(t / 2)
+    })
+    .find(|&t| beyond_limits(limits, window(t)).is_none());
+    Err(match largest {
+        Some(t) => format!(
+            "a tile's {}×{} window: {limit}; --tile {t} fits (or leave out --tile)",
+            w.width, w.height
+        ),
+        None => format!("a tile's {}×{} window: {limit}", w.width, w.height),
+    })
 }
 
 fn untileable(e: &Untileable, why: &str) -> RenderError {
@@ -528,6 +597,36 @@ mod tests {
             keep: &[],
         };
         lumagraph_graph::compile(&g, &Registry::with_builtins(), &options).unwrap()
+    }
+
+    /// A tile side given with `--tile` renders where its window fits the device's hard limits
+    /// and is otherwise refused naming the limit and a side that fits: on lavapipe's limits
+    /// (128 MiB bound buffers, 16384² textures) a 16384² render takes 2048 but not 4096.
+    #[test]
+    fn forced_tiles_beyond_the_limits_are_refused_naming_them() {
+        let limits = wgpu::Limits {
+            max_storage_buffer_binding_size: 128 << 20,
+            max_texture_dimension_2d: 16384,
+            ..wgpu::Limits::default()
+        };
+        let window = |t: u32| {
+            Extent::new(
+                lumagraph_graph::tile::window(16384, t, 1),
+                lumagraph_graph::tile::window(16384, t, 1),
+            )
+        };
+        assert_eq!(super::check_forced(&limits, 2048, window), Ok(()));
+        for side in [4096, 8192, 16384] {
+            let why = super::check_forced(&limits, side, window).unwrap_err();
+            assert!(why.contains("max_storage_buffer_binding_size"), "{why}");
+            assert!(
+                why.ends_with("--tile 2048 fits (or leave out --tile)"),
+                "{why}"
+            );
+        }
+        let why = super::beyond_limits(&limits, Extent::new(20000, 8)).unwrap();
+        assert!(why.contains("(max_texture_dimension_2d)"), "{why}");
+        assert_eq!(super::beyond_limits(&limits, Extent::new(2050, 2050)), None);
     }
 
     /// `Output` writes its `color` as one file, which a tiled render pastes its tiles
