@@ -62,7 +62,10 @@ pub fn plan_tiling(
     let fits = |w: u32, h: u32, bytes: u64| {
         beyond_limits(&limits, Extent::new(w, h)).is_none() && bytes <= MEMORY_BUDGET
     };
+    // Without tiles, an image wider than the device's textures is refused by the executor,
+    // naming the node; a history buffer larger than it binds, here.
     if forced == Some(0)
+        && image.width.max(image.height) <= max_side
         && let Some(limit) = beyond_limits(&limits, image)
     {
         return Err(RenderError::TooLarge {
