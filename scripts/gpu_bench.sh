@@ -19,9 +19,14 @@
 #   LUMAGRAPH=target/release/lumagraph SPONZA=path/to/Sponza bash scripts/gpu_bench.sh [OUT]
 #
 # SPONZA: a folder holding Sponza.gltf (the Crytek Sponza in glTF; see docs/benchmarks.md for
-# the copy used); without it the Sponza rows are skipped. BUDGET: seconds for the whole script
-# (default 450). SIZE: the image's side (1000). SCENES: which of "cornell mesh sponza" to run. MESH_OBJ: an existing
-# 1.3 M-triangle blob (else it is made with scripts/bench/mesh_env.py, about 30-50 s).
+# the copy used); without it the Sponza row is skipped and the closed Sponza uses
+# assets/sponza-small. BUDGET: seconds for the whole script (default 450). SIZE: the image's
+# side (1000). SCENES: which of "cornell cornell_seed mesh mesh_white sponza sponza_closed" to
+# run (default all: ours, and beside each the seed-like one of assets/bench/, built from seed
+# 000's description: the dark box, the white mesh, the closed Sponza lit by small lights).
+# MESH_OBJ: an existing 1.3 M-triangle blob (else it is made with scripts/bench/mesh_env.py,
+# about 30-50 s). Each bench line prints rays per path, so the seed's time can be set beside
+# ours with the work per path known.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 repo=$(pwd)
@@ -30,7 +35,7 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)
 lg=${LUMAGRAPH:-target/release/lumagraph}
 budget=${BUDGET:-450}
-scenes=${SCENES:-cornell mesh sponza}
+scenes=${SCENES:-cornell cornell_seed mesh mesh_white sponza sponza_closed}
 full_spp=15000
 size=${SIZE:-1000}
 bench_spp=${BENCH_SPP:-64}
@@ -63,15 +68,27 @@ hdr="$repo/assets/hdri/venice_sunset_1k.hdr"
 # The Cornell box of the reference suite at 1000x1000.
 sed -e "s/width: 256, height: 256/width: $size, height: $size/" assets/cornell.ron >"$work/cornell.ron"
 
-# The mesh scene (assets/bench/mesh_env.ron) with its blob subdivided to 1 310 720 triangles.
+# The seed-like box (assets/bench/cornell_seed.ron: dark gold, single-channel side walls).
+sed -e "s/width: 1000, height: 1000/width: $size, height: $size/" assets/bench/cornell_seed.ron >"$work/cornell_seed.ron"
+
+# The mesh scene (assets/bench/mesh_env.ron) with its blob subdivided to 1 310 720 triangles,
+# and the seed-like white mesh (assets/bench/mesh_white.ron) of the same blob.
 mesh_obj=${MESH_OBJ:-$work/blob8.obj}
 [[ "$mesh_obj" = /* ]] || mesh_obj="$repo/$mesh_obj"
-if [[ " $scenes " == *" mesh "* ]] && [ ! -f "$mesh_obj" ]; then
+if [[ " $scenes " == *" mesh"* ]] && [ ! -f "$mesh_obj" ]; then
     python3 scripts/bench/mesh_env.py make "$mesh_obj" --level 8 >>"$log" 2>&1 &
     mesh_pid=$!
 fi
 sed -e "s|path: \"blob.obj\"|path: \"$mesh_obj\"|" -e "s|\"../hdri/venice_sunset_1k.hdr\"|\"$hdr\"|" \
     -e "s/width: 256, height: 256/width: $size, height: $size/" assets/bench/mesh_env.ron >"$work/mesh.ron"
+sed -e "s|path: \"blob8.obj\"|path: \"$mesh_obj\"|" -e "s|\"../hdri/venice_sunset_1k.hdr\"|\"$hdr\"|" \
+    -e "s/width: 1000, height: 1000/width: $size, height: $size/" assets/bench/mesh_white.ron >"$work/mesh_white.ron"
+
+# The seed-like closed Sponza (assets/bench/sponza_closed.ron), with SPONZA's glTF where given.
+sponza_gltf="$repo/assets/sponza-small/Sponza.gltf"
+[ -n "${SPONZA:-}" ] && [ -f "$SPONZA/Sponza.gltf" ] && sponza_gltf="$(cd "$SPONZA" && pwd)/Sponza.gltf"
+sed -e "s|\"../sponza-small/Sponza.gltf\"|\"$sponza_gltf\"|" \
+    -e "s/width: 1000, height: 1000/width: $size, height: $size/" assets/bench/sponza_closed.ron >"$work/sponza_closed.ron"
 
 # Sponza: its glTF materials and first camera, the Venice map and a low sun.
 if [ -n "${SPONZA:-}" ] && [ -f "$SPONZA/Sponza.gltf" ]; then
@@ -99,11 +116,13 @@ run_scene() {
     # general shader's.
     local mps general
     mps=$(grep -m1 -oE '[0-9.]+ M paths/s' "$work/bench.txt" | grep -oE '^[0-9.]+')
+    local rpp
+    rpp=$(grep -m1 -oE '[0-9.]+ rays/path' "$work/bench.txt" | grep -oE '^[0-9.]+')
     general=$(grep -m1 -E '^  general ' "$work/bench.txt" | grep -oE '[0-9.]+ M paths/s' | grep -oE '^[0-9.]+')
     # The megakernel against the wavefront, where the scene allows the wavefront.
     local front
     front=$(grep -m1 -oE 'megakernel / wavefront: [0-9.]+x' "$work/bench.txt" | grep -oE '[0-9.]+x')
-    [ -n "$mps" ] || { say "== $name: bench printed no paths/s"; rows+=("| $name | failed | | | | | | | | |"); return; }
+    [ -n "$mps" ] || { say "== $name: bench printed no paths/s"; rows+=("| $name | failed | | | | | | | | | |"); return; }
     # The 8-wide BVH (--intersector wide), which bench measures with the binary BVH after it:
     # two pairs for the wide-against-binary ratio (the binary figure above, and this one).
     say "== $name: bench with the 8-wide BVH (--intersector wide), then the binary one"
@@ -126,12 +145,12 @@ run_scene() {
     fi
     # Mitsuba 3 on the same scene, where MITSUBA_PYTHON names a Python with it.
     local mitsuba=""
-    if [ -n "${MITSUBA_PYTHON:-}" ] && [ "$name" != sponza ]; then
+    if [ -n "${MITSUBA_PYTHON:-}" ] && [[ "$name" == cornell* || "$name" == mesh ]]; then
         local variant=${MITSUBA_VARIANT:-cuda_ad_rgb} json=""
         say "== $name: Mitsuba 3 ($variant, $bench_spp spp, best of 3)"
-        if [ "$name" = cornell ]; then
-            "$lg" export "$scene" --out "$work/cornell_export" >/dev/null 2>&1
-            json=$(timeout 300 "$MITSUBA_PYTHON" scripts/bench/mitsuba_time.py "$work/cornell_export" \
+        if [[ "$name" == cornell* ]]; then
+            "$lg" export "$scene" --out "$work/${name}_export" >/dev/null 2>&1
+            json=$(timeout 300 "$MITSUBA_PYTHON" scripts/bench/mitsuba_time.py "$work/${name}_export" \
                 --spp "$bench_spp" --runs 3 --variant "$variant" 2>>"$log" | tail -n 1)
         else
             json=$(timeout 300 "$MITSUBA_PYTHON" scripts/bench/mesh_env.py mitsuba "$mesh_obj" --spp "$bench_spp" \
@@ -144,8 +163,8 @@ run_scene() {
     # Predicted wall time at 15 000 spp, with 15 % for the graph's other passes.
     local predicted spp note
     predicted=$(awk -v m="$mps" -v s=$full_spp 'BEGIN { printf "%d", 1.15 * 1e6 * s / (m * 1e6) + 1 }')
-    local share=$(( $(left) - 20 ))
-    [ "$name" != sponza ] && [[ " $scenes " == *" sponza "* ]] && [ -f "$work/sponza.ron" ] && share=$(( share / 2 ))
+    # The time left, shared with the scenes still to run.
+    local share=$(( ($(left) - 20) / remaining ))
     if [ "$predicted" -le "$share" ]; then
         spp=$full_spp
         note="measured"
@@ -162,23 +181,26 @@ run_scene() {
     secs=$(echo "$line" | grep -oE 'in [0-9.]+ s' | grep -oE '[0-9.]+')
     paths=$(echo "$line" | grep -oE '[0-9.]+ M paths/s' | grep -oE '^[0-9.]+')
     if [ -z "$secs" ]; then
-        rows+=("| $name | $mps | $front | $wide | $ratio | $general | $mitsuba | render failed | | |")
+        rows+=("| $name | $mps | $rpp | $front | $wide | $ratio | $general | $mitsuba | render failed | | |")
         return
     fi
     local at_full
     at_full=$(awk -v t="$secs" -v s="$spp" -v f=$full_spp 'BEGIN { printf "%.1f", t * f / s }')
-    rows+=("| $name | $mps | $front | $wide | $ratio | $general | $mitsuba | $paths | $at_full s | $note |")
+    rows+=("| $name | $mps | $rpp | $front | $wide | $ratio | $general | $mitsuba | $paths | $at_full s | $note |")
 }
 
+remaining=$(wc -w <<<"$scenes")
 for s in $scenes; do
-    if [ "$s" = mesh ] && [ -n "${mesh_pid:-}" ]; then
+    if [[ "$s" == mesh* ]] && [ -n "${mesh_pid:-}" ]; then
         wait "$mesh_pid" || say "== mesh: making the blob failed"
+        mesh_pid=""
     fi
     run_scene "$s"
+    remaining=$((remaining - 1))
 done
 
 say ""
 say "== $(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null || "$lg" adapters 2>/dev/null | head -1), ${size}x$size, 20 bounces, $full_spp spp, total $(( $(date +%s) - start )) s"
-say "| scene | bench, specialized, M paths/s | megakernel / wavefront | 8-wide BVH | wide / binary (two pairs) | general | Mitsuba 3, M paths/s (lumagraph / Mitsuba) | render, M paths/s | wall time to $full_spp spp | |"
-say "|---|---|---|---|---|---|---|---|---|---|"
+say "| scene | bench, specialized, M paths/s | rays/path | megakernel / wavefront | 8-wide BVH | wide / binary (two pairs) | general | Mitsuba 3, M paths/s (lumagraph / Mitsuba) | render, M paths/s | wall time to $full_spp spp | |"
+say "|---|---|---|---|---|---|---|---|---|---|---|"
 for r in "${rows[@]}"; do say "$r"; done

@@ -38,6 +38,9 @@ struct Figures {
     host: Option<HostFigures>,
     /// The shader's features (what the variants to compare with are chosen by).
     features: Option<crate::render::specialize::Features>,
+    /// Rays traced per path (camera, bounce and shadow rays; the node's `rays` counter over
+    /// the timed runs), where counted.
+    rays_per_path: Option<f64>,
 }
 
 /// Where host intersection's time went, summed over the timed runs.
@@ -90,6 +93,7 @@ fn measure(
     let mut best = 0.0_f64;
     let mut best_cpu: Option<f64> = None;
     let mut host: Option<HostFigures> = None;
+    let mut rays = 0u64;
     for _ in 0..runs.max(1) {
         let before = exec.counters()?;
         let cpu_start = cpu_time();
@@ -98,6 +102,7 @@ fn measure(
         let secs = start.elapsed().as_secs_f64();
         let after = exec.counters()?;
         let diff = |name: &str| counter(&after, name).saturating_sub(counter(&before, name));
+        rays += diff("rays");
         if after.iter().any(|(_, c)| c.name == "host_steps") {
             let h = host.get_or_insert_with(HostFigures::default);
             h.frames += u64::from(frames);
@@ -118,6 +123,8 @@ fn measure(
         how,
         host,
         features,
+        #[expect(clippy::cast_precision_loss, reason = "a ratio")]
+        rays_per_path: (rays > 0).then(|| rays as f64 / (paths * f64::from(runs.max(1)))),
     })
 }
 
@@ -134,8 +141,12 @@ fn print(label: &str, f: &Figures) {
         .cpu
         .map(|c| format!(", {:.3} M per CPU second", c / 1e6))
         .unwrap_or_default();
+    let rays = f
+        .rays_per_path
+        .map(|r| format!(", {r:.2} rays/path ({:.1} M rays/s)", f.wall * r / 1e6))
+        .unwrap_or_default();
     println!(
-        "  {label:<12} {:>8.3} M paths/s{cpu}   ({})",
+        "  {label:<12} {:>8.3} M paths/s{cpu}{rays}   ({})",
         f.wall / 1e6,
         f.how
     );
