@@ -40,11 +40,14 @@ pub struct SceneBuffers {
 }
 
 fn storage(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
-    // Bindings may not be empty: a scene without shapes still binds a (zeroed) buffer.
+    // Bindings may not be empty: a scene without shapes still binds a (zeroed) buffer, as
+    // large as one of any record (the shader's minimum binding size: a `Light` is 80 bytes,
+    // a `Material` 208).
+    const SMALLEST: usize = 512;
     let mut padded;
-    let contents = if bytes.len() < 64 {
+    let contents = if bytes.len() < SMALLEST {
         padded = bytes.to_vec();
-        padded.resize(64, 0);
+        padded.resize(SMALLEST, 0);
         &padded[..]
     } else {
         bytes
