@@ -191,10 +191,9 @@ pub fn run(
     // Where the specialized shader walks the 8-wide BVH, the binary one beside it (the
     // specialized shader as `--intersector binary` runs it).
     let binary = if special.on(Feature::WideBvh) {
-        let binary = Resources {
-            intersector: Intersector::BinaryBvh,
-            ..asked.clone()
-        };
+        let binary = asked
+            .clone()
+            .tracing(|t| t.intersector = Intersector::BinaryBvh);
         let binary = measure(&ctx, scene, binary, spp, runs)?;
         print("binary BVH", &binary);
         println!(
@@ -211,14 +210,13 @@ pub fn run(
     if !special.on(Feature::HostRays) {
         use crate::render::specialize::Schedule;
         let front = special.on(Feature::Wavefront);
-        let other = Resources {
-            schedule: if front {
+        let other = asked.clone().tracing(|t| {
+            t.schedule = if front {
                 Schedule::Megakernel
             } else {
                 Schedule::Wavefront
-            },
-            ..asked.clone()
-        };
+            };
+        });
         // The wavefront cannot take every scene: then there is nothing to compare.
         let other = match measure(&ctx, scene, other, spp, runs) {
             Ok(other) => Some(other),
@@ -242,10 +240,7 @@ pub fn run(
         return Ok(());
     }
     let wgsl = if special.on(Feature::HostRays) {
-        let wgsl = Resources {
-            intersector: Intersector::WideBvh,
-            ..Resources::default()
-        };
+        let wgsl = Resources::default().tracing(|t| t.intersector = Intersector::WideBvh);
         let wgsl = measure(&ctx, scene, wgsl, spp, runs)?;
         print("WGSL BVH", &wgsl);
         Some(wgsl)
@@ -253,20 +248,14 @@ pub fn run(
         None
     };
     let buffers = if special.on(Feature::InlineData) {
-        let buffers = Resources {
-            scene_data_in_buffers: true,
-            ..Resources::default()
-        };
+        let buffers = Resources::default().tracing(|t| t.scene_data_in_buffers = true);
         let buffers = measure(&ctx, scene, buffers, spp, runs)?;
         print("buffers", &buffers);
         Some(buffers)
     } else {
         None
     };
-    let general = Resources {
-        general_shaders: true,
-        ..Resources::default()
-    };
+    let general = Resources::default().tracing(|t| t.general_shaders = true);
     let general = measure(&ctx, scene, general, spp, runs)?;
     print("general", &general);
     if binary.is_some() {

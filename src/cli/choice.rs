@@ -6,7 +6,7 @@
 //! when not `auto`, wins over both.
 
 use crate::render::Resources;
-use crate::render::specialize::{Intersector, Schedule};
+use crate::render::specialize::{Intersector, Schedule, Tracing};
 
 /// The path tracer's choices on the command line.
 #[derive(clap::Args, Clone, Copy, Debug, Default)]
@@ -38,8 +38,11 @@ impl Choice {
     /// `resources` with the intersector and schedule asked for.
     pub(crate) fn apply(self, resources: Resources) -> Resources {
         Resources {
-            intersector: self.intersector(),
-            schedule: self.schedule(),
+            tracer: Tracing {
+                intersector: self.intersector(),
+                schedule: self.schedule(),
+                ..resources.tracer
+            },
             ..resources
         }
     }

@@ -6,6 +6,7 @@
 
 #![allow(dead_code, reason = "each test binary uses a different subset")]
 
+use lumagraph::render::specialize::Tracing;
 use std::path::{Path, PathBuf};
 use std::sync::LazyLock;
 
@@ -111,7 +112,10 @@ pub fn executor(
     };
     let resources = Resources {
         scene: Some(std::sync::Arc::clone(scene)),
-        intersector,
+        tracer: Tracing {
+            intersector,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     Some(Executor::new(ctx, plan, &resources).unwrap())

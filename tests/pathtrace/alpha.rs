@@ -4,6 +4,7 @@
 //! camera rays, bounces and shadow rays alike.
 
 use crate::common;
+use lumagraph::render::specialize::Tracing;
 
 use std::sync::Arc;
 
@@ -131,16 +132,25 @@ pub(super) fn albedos(
 #[test]
 fn masked_checkerboard_shows_the_wall_through_its_holes() {
     let inline_or_bvh = Resources {
-        as_gpu_adapter: true,
+        tracer: Tracing {
+            as_gpu_adapter: true,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     let wgsl = Resources {
-        intersector: Intersector::BinaryBvh,
+        tracer: Tracing {
+            intersector: Intersector::BinaryBvh,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     let wide = Resources {
-        as_gpu_adapter: true,
-        intersector: Intersector::WideBvh,
+        tracer: Tracing {
+            as_gpu_adapter: true,
+            intersector: Intersector::WideBvh,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     check_checkerboard(
@@ -170,7 +180,10 @@ fn masked_checkerboard_shows_the_wall_through_ray_queries() {
         return;
     }
     let ray_queries = Resources {
-        intersector: Intersector::RayQueries,
+        tracer: Tracing {
+            intersector: Intersector::RayQueries,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     check_checkerboard(1, &[("ray queries", ray_queries.clone())]);
@@ -279,7 +292,10 @@ fn blended_quad_passes_one_minus_its_opacity() {
         .unwrap();
         let resources = Resources {
             scene: Some(Arc::clone(&gpu)),
-            as_gpu_adapter: bvh,
+            tracer: Tracing {
+                as_gpu_adapter: bvh,
+                ..Tracing::default()
+            },
             ..Resources::default()
         };
         let mut exec = Executor::new(ctx, plan, &resources).unwrap();

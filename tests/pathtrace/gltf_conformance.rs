@@ -6,6 +6,7 @@
 //! from one that ignores the feature.
 
 use crate::common;
+use lumagraph::render::specialize::Tracing;
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -162,7 +163,10 @@ impl Render {
         .unwrap();
         let resources = Resources {
             scene: Some(Arc::clone(&gpu)),
-            as_gpu_adapter: true,
+            tracer: Tracing {
+                as_gpu_adapter: true,
+                ..Tracing::default()
+            },
             ..Resources::default()
         };
         let mut exec = Executor::new(ctx, plan, &resources).unwrap();

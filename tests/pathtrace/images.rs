@@ -11,6 +11,7 @@
 //!   under an environment; Cornell with 28 spheres of 28 materials), 64×64 at 8 spp.
 
 use crate::common;
+use lumagraph::render::specialize::Tracing;
 
 use std::sync::Arc;
 
@@ -184,10 +185,13 @@ fn a_frame_of_many_samples_traces_every_path() {
         let plan = compile(&graph, &["acc.color".to_owned()], Some(&grid)).unwrap();
         let resources = Resources {
             scene: Some(Arc::clone(&grid)),
-            intersector: if wgsl {
-                Intersector::WideBvh
-            } else {
-                Intersector::Auto
+            tracer: Tracing {
+                intersector: if wgsl {
+                    Intersector::WideBvh
+                } else {
+                    Intersector::Auto
+                },
+                ..Tracing::default()
             },
             ..Resources::default()
         };
@@ -298,8 +302,11 @@ fn render_small(
         (64, 64),
         spp,
         Resources {
-            scene_data_in_buffers: in_buffers,
-            as_gpu_adapter: bvh,
+            tracer: Tracing {
+                scene_data_in_buffers: in_buffers,
+                as_gpu_adapter: bvh,
+                ..Tracing::default()
+            },
             ..Resources::default()
         },
     )
@@ -369,7 +376,10 @@ fn spreading_workgroups_over_the_image_renders_bit_identical_images() {
                 size,
                 8,
                 Resources {
-                    workgroups_in_image_order: in_order,
+                    tracer: Tracing {
+                        workgroups_in_image_order: in_order,
+                        ..Tracing::default()
+                    },
                     ..Resources::default()
                 },
             )
@@ -410,9 +420,12 @@ fn leaving_out_a_missing_primitive_kind_renders_bit_identical_images() {
                 (48, 40),
                 8,
                 Resources {
-                    general_shaders: general,
-                    as_gpu_adapter: true,
-                    scene_data_in_buffers: true,
+                    tracer: Tracing {
+                        general_shaders: general,
+                        as_gpu_adapter: true,
+                        scene_data_in_buffers: true,
+                        ..Tracing::default()
+                    },
                     ..Resources::default()
                 },
             )
@@ -503,7 +516,10 @@ fn host_against_wgsl(name: &str, size: (u32, u32), spp: u32) -> Option<HostAgain
         return None;
     }
     let wgsl_only = Resources {
-        intersector: Intersector::WideBvh,
+        tracer: Tracing {
+            intersector: Intersector::WideBvh,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     let (wgsl, how_wgsl) = common::render_with(name, size, spp, wgsl_only).unwrap();
@@ -643,7 +659,10 @@ fn inlined_materials_of_a_large_scene_render_what_the_buffers_render() {
         return;
     };
     let buffers = Resources {
-        scene_data_in_buffers: true,
+        tracer: Tracing {
+            scene_data_in_buffers: true,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     let (buffers, how_buffers) =

@@ -4,6 +4,7 @@
 //! mesh, whose copies (100 M triangles) no intersector could hold.
 
 use crate::common;
+use lumagraph::render::specialize::Tracing;
 
 use std::sync::Arc;
 
@@ -142,8 +143,11 @@ fn render(
     let plan = compile(&graph, &outputs, Some(&scene)).unwrap();
     let resources = Resources {
         scene: Some(scene),
-        as_gpu_adapter: true,
-        intersector: Intersector::BinaryBvh,
+        tracer: Tracing {
+            as_gpu_adapter: true,
+            intersector: Intersector::BinaryBvh,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     let mut exec = Executor::new(ctx, plan, &resources).unwrap();

@@ -8,6 +8,7 @@
 //! `LUMAGRAPH_ALLOW_NO_RAY_QUERY=1`.
 
 use crate::common;
+use lumagraph::render::specialize::Tracing;
 
 use lumagraph::render::Resources;
 use lumagraph::render::specialize::{
@@ -154,13 +155,19 @@ fn ray_queries_are_chosen_where_the_device_has_them() {
 fn against_wgsl_bvh(name: &str) -> Option<(usize, f64)> {
     // Both as a GPU adapter runs (the same dispatches, materials read from buffers).
     let rq = Resources {
-        intersector: Intersector::RayQueries,
-        as_gpu_adapter: true,
+        tracer: Tracing {
+            intersector: Intersector::RayQueries,
+            as_gpu_adapter: true,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     let bvh = Resources {
-        as_gpu_adapter: true,
-        intersector: Intersector::BinaryBvh,
+        tracer: Tracing {
+            as_gpu_adapter: true,
+            intersector: Intersector::BinaryBvh,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     common::same_hits(name, rq, bvh, |a, b| {

@@ -14,6 +14,7 @@
 //! what the specialized one leaves out.
 
 use crate::common;
+use lumagraph::render::specialize::Tracing;
 
 use std::sync::Arc;
 
@@ -212,9 +213,12 @@ fn frames(scene: &GpuScene, general: bool, seed: u32) -> Option<(Vec<Image>, Fea
     let plan = compile(&graph, &["pt.color".to_owned()], Some(&scene)).unwrap();
     let resources = Resources {
         scene: Some(Arc::clone(&scene)),
-        general_shaders: general,
-        as_gpu_adapter: true,
-        scene_data_in_buffers: true,
+        tracer: Tracing {
+            general_shaders: general,
+            as_gpu_adapter: true,
+            scene_data_in_buffers: true,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     let mut exec = Executor::new(ctx, plan, &resources).unwrap();

@@ -7,6 +7,7 @@
 //! flattened scene; the tolerances and what was measured are stated at each test.
 
 use crate::common;
+use lumagraph::render::specialize::Tracing;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -323,7 +324,10 @@ fn render(scene: &Arc<GpuScene>, spp: i64) -> Option<[Image; 5]> {
     // scene, x = y = 0.667 on a quad from (0, 0) to (1, 1), is such a crack).
     let resources = Resources {
         scene: Some(Arc::clone(scene)),
-        as_gpu_adapter: true,
+        tracer: Tracing {
+            as_gpu_adapter: true,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     let mut exec = Executor::new(ctx, plan, &resources).unwrap();

@@ -9,14 +9,17 @@ use crate::common;
 use std::sync::Arc;
 
 use lumagraph::render::Resources;
-use lumagraph::render::specialize::{Feature, Intersector, Schedule};
+use lumagraph::render::specialize::{Feature, Intersector, Schedule, Tracing};
 use lumagraph::scene::GpuScene;
 
 fn as_gpu(intersector: Intersector, schedule: Schedule) -> Resources {
     Resources {
-        as_gpu_adapter: true,
-        intersector,
-        schedule,
+        tracer: Tracing {
+            as_gpu_adapter: true,
+            intersector,
+            schedule,
+            ..Tracing::default()
+        },
         ..Resources::default()
     }
 }

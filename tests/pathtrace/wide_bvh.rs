@@ -5,6 +5,7 @@
 //! one. Its hits are the binary BVH's: the same exact tests on the same primitives.
 
 use crate::common;
+use lumagraph::render::specialize::Tracing;
 
 use lumagraph::render::Resources;
 use lumagraph::render::specialize::{
@@ -315,13 +316,19 @@ fn records_nodes(bvh: &WideBvh) -> usize {
 #[test]
 fn the_wide_bvh_renders_what_the_binary_bvh_renders() {
     let wide = Resources {
-        as_gpu_adapter: true,
-        intersector: Intersector::WideBvh,
+        tracer: Tracing {
+            as_gpu_adapter: true,
+            intersector: Intersector::WideBvh,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     let binary = Resources {
-        as_gpu_adapter: true,
-        intersector: Intersector::BinaryBvh,
+        tracer: Tracing {
+            as_gpu_adapter: true,
+            intersector: Intersector::BinaryBvh,
+            ..Tracing::default()
+        },
         ..Resources::default()
     };
     for name in [

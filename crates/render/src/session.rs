@@ -15,6 +15,7 @@
 //! # anyhow::Ok(())
 //! ```
 
+use crate::specialize::Tracing;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -183,8 +184,11 @@ impl Session {
             out_dir: options.out,
             outputs_anywhere: options.outputs_anywhere,
             scene: scene.clone(),
-            intersector: options.intersector,
-            schedule: options.schedule,
+            tracer: Tracing {
+                intersector: options.intersector,
+                schedule: options.schedule,
+                ..Tracing::default()
+            },
             ..Resources::default()
         };
         let mut exec = Executor::with_library(&ctx, plan, &resources, &library)?;

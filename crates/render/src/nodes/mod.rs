@@ -45,28 +45,10 @@ pub struct Resources {
     pub working_space: lumagraph_graph::WorkingSpace,
     /// The scene, flattened, for nodes that render one.
     pub scene: Option<Arc<lumagraph_scene::GpuScene>>,
-    /// Use the general shaders even where a scene-specialized one exists (benchmarks).
-    pub general_shaders: bool,
-    /// In the specialized shader, keep materials, lights and shading data in their storage
-    /// buffers even where they could be written into the code (tests and benchmarks).
-    pub scene_data_in_buffers: bool,
-    /// Decide the path tracer's shader as a GPU adapter would (no inline intersection, no
-    /// host, no spreading of workgroups, ray queries only where `intersector` asks for them)
-    /// even on a CPU adapter: tests run what GPUs run on lavapipe.
-    pub as_gpu_adapter: bool,
-    /// The path tracer's intersector, where the command line (`--intersector`), a test or a
-    /// benchmark asks for one ([`crate::specialize::Intersector`]; `Auto`, the default: the
-    /// scene and the adapter decide). A `PathTrace` node's `intersector` param, when not
-    /// `auto`, wins over it. One that cannot trace the scene is an error when the node is
-    /// built, never a silent fallback.
-    pub intersector: crate::specialize::Intersector,
-    /// The path tracer's schedule, where the command line (`--schedule`), a test or a
-    /// benchmark asks for one ([`crate::specialize::Schedule`]; `Auto`, the default: the
-    /// scene and the adapter decide). The node's `schedule` param, when not `auto`, wins.
-    pub schedule: crate::specialize::Schedule,
-    /// Trace workgroups in image order even on a CPU adapter, where they are otherwise
-    /// spread over the image to balance the driver's threads (a test compares the two).
-    pub workgroups_in_image_order: bool,
+    /// What the path tracer is asked for beyond its node's params (the command line's
+    /// `--intersector` and `--schedule`, and the knobs tests and benchmarks turn); only
+    /// `PathTrace` reads it.
+    pub tracer: crate::specialize::Tracing,
     /// What the graph's image-file sources read, per output port, for the sinks that
     /// write it back (filled as they load; see [`crate::image_io::Sources`]).
     pub sources: crate::image_io::Sources,
@@ -174,6 +156,13 @@ impl Resources {
             p,
             self.outputs_anywhere,
         )?)
+    }
+
+    /// These resources with what the path tracer is asked for changed by `change`.
+    #[must_use]
+    pub fn tracing(mut self, change: impl FnOnce(&mut crate::specialize::Tracing)) -> Self {
+        change(&mut self.tracer);
+        self
     }
 }
 

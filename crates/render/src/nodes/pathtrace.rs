@@ -59,16 +59,16 @@ fn adaptive_on(pass: &Pass) -> bool {
 
 /// How a pass's shader is specialized: to the scene unless the resources ask for the
 /// general shader, to the kind of adapter, with first-hit AOVs when something reads them.
-/// `resources.as_gpu_adapter` has it decided as on a GPU adapter. The pass's `intersector`
+/// `resources.tracer.as_gpu_adapter` has it decided as on a GPU adapter. The pass's `intersector`
 /// and `schedule` params, where not `auto`, ask for an intersector and a schedule; else
-/// `resources.intersector` and `resources.schedule` (`--intersector`, `--schedule`) do.
+/// `resources.tracer.intersector` and `resources.tracer.schedule` (`--intersector`, `--schedule`) do.
 fn options(
     pass: &Pass,
     resources: &Resources,
     traits: crate::specialize::AdapterTraits,
 ) -> crate::specialize::PathTraceOptions {
     use crate::specialize::{Intersector, Schedule};
-    let cpu_adapter = traits.cpu && !resources.as_gpu_adapter;
+    let cpu_adapter = traits.cpu && !resources.tracer.as_gpu_adapter;
     let param = |name: &str| {
         if pass.params.has(name) {
             pass.params.str(name).to_owned()
@@ -78,22 +78,22 @@ fn options(
     };
     // The registry's options are exactly the names, so an unknown one cannot reach here.
     let intersector = match Intersector::from_name(&param("intersector")) {
-        Ok(Intersector::Auto) | Err(_) => resources.intersector,
+        Ok(Intersector::Auto) | Err(_) => resources.tracer.intersector,
         Ok(asked) => asked,
     };
     let schedule = match Schedule::from_name(&param("schedule")) {
-        Ok(Schedule::Auto) | Err(_) => resources.schedule,
+        Ok(Schedule::Auto) | Err(_) => resources.tracer.schedule,
         Ok(asked) => asked,
     };
     crate::specialize::PathTraceOptions {
         ray_query_limit: traits
             .ray_query_limit
-            .filter(|_| !resources.as_gpu_adapter || intersector == Intersector::RayQueries),
+            .filter(|_| !resources.tracer.as_gpu_adapter || intersector == Intersector::RayQueries),
         intersector,
-        specialize: !resources.general_shaders,
+        specialize: !resources.tracer.general_shaders,
         cpu_adapter,
-        data_in_buffers: resources.scene_data_in_buffers,
-        in_image_order: resources.workgroups_in_image_order,
+        data_in_buffers: resources.tracer.scene_data_in_buffers,
+        in_image_order: resources.tracer.workgroups_in_image_order,
         aovs: ["albedo", "normal", "depth"]
             .iter()
             .any(|p| pass.output(p).is_some()),

@@ -167,6 +167,34 @@ impl Schedule {
     }
 }
 
+/// What a path tracer is asked for beyond its node's params: the intersector and the
+/// schedule (the command line's `--intersector` and `--schedule`, a session's options), and
+/// the knobs tests and benchmarks turn. It travels in [`crate::Resources::tracer`]; only
+/// `PathTrace` reads it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Tracing {
+    /// The intersector ([`Intersector::Auto`], the default: the scene and the adapter
+    /// decide). A `PathTrace` node's `intersector` param, when not `auto`, wins over it. One
+    /// that cannot trace the scene is an error when the node is built, never a silent
+    /// fallback.
+    pub intersector: Intersector,
+    /// The schedule ([`Schedule::Auto`], the default: the scene and the adapter decide).
+    /// The node's `schedule` param, when not `auto`, wins.
+    pub schedule: Schedule,
+    /// Use the general shaders even where a scene-specialized one exists (benchmarks).
+    pub general_shaders: bool,
+    /// In the specialized shader, keep materials, lights and shading data in their storage
+    /// buffers even where they could be written into the code (tests and benchmarks).
+    pub scene_data_in_buffers: bool,
+    /// Decide the shader as a GPU adapter would (no inline intersection, no host, no
+    /// spreading of workgroups, ray queries only where `intersector` asks for them) even on
+    /// a CPU adapter: tests run what GPUs run on lavapipe.
+    pub as_gpu_adapter: bool,
+    /// Trace workgroups in image order even on a CPU adapter, where they are otherwise
+    /// spread over the image to balance the driver's threads (a test compares the two).
+    pub workgroups_in_image_order: bool,
+}
+
 /// What the graph needs of the path tracer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PathTraceOptions {
