@@ -28,7 +28,7 @@ enum Mode {
     /// Only the passes marked in `Executor::only`, timed; their sinks write. No frame is
     /// added.
     Only,
-    /// Everything once, timed, nodes with history presenting it ([`NodeExec::set_present`]);
+    /// Everything once, timed, nodes with history presenting it ([`crate::nodes::History::set_present`]);
     /// sinks write. No frame is added.
     Present,
 }
@@ -439,10 +439,10 @@ impl Executor {
     pub fn checkpoint(&mut self, key: u64) -> Result<crate::Checkpoint> {
         let mut nodes = Vec::new();
         for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
-            if let Some(state) = node
-                .save_state(&self.ctx)
-                .map_err(|e| e.in_node(&pass.node))?
-            {
+            if let Some(history) = node.history() {
+                let state = history
+                    .save_state(&self.ctx)
+                    .map_err(|e| e.in_node(&pass.node))?;
                 nodes.push((pass.node.clone(), state));
             }
         }
@@ -466,26 +466,26 @@ impl Executor {
         let mut used = 0;
         for (pass, node) in self.plan.passes.iter().zip(&mut self.nodes) {
             let saved = checkpoint.nodes.iter().find(|(id, _)| *id == pass.node);
-            let keeps = node.save_state(&self.ctx)?.is_some();
-            match (saved, keeps) {
-                (Some((_, state)), true) => {
-                    node.load_state(&self.ctx, pass, state)
+            match (saved, node.history()) {
+                (Some((_, state)), Some(history)) => {
+                    history
+                        .load_state(&self.ctx, pass, state)
                         .map_err(|e| e.in_node(&pass.node))?;
                     used += 1;
                 }
-                (None, true) => {
+                (None, Some(_)) => {
                     return Err(RenderError::Gpu(
                         "the checkpoint has no state for this node".into(),
                     )
                     .in_node(&pass.node));
                 }
-                (Some(_), false) => {
+                (Some(_), None) => {
                     return Err(RenderError::Gpu(
                         "the checkpoint has a state for this node, which keeps none".into(),
                     )
                     .in_node(&pass.node));
                 }
-                (None, false) => {}
+                (None, None) => {}
             }
         }
         if used != checkpoint.nodes.len() {
@@ -504,15 +504,15 @@ impl Executor {
     /// as in a render that took them. See [`crate::partial`].
     pub fn start_at_sample(&mut self, first: u32, frames: u64) {
         self.reset_history();
-        for node in &mut self.nodes {
-            node.start_at_sample(first, frames);
+        for history in self.nodes.iter_mut().filter_map(|n| n.history()) {
+            history.start_at_sample(first, frames);
         }
         self.frames = frames;
     }
 
     /// The history of one render of every sample range the checkpoints `parts` (of
     /// partial renders of this plan, in sample order) hold: each node's states merged
-    /// ([`NodeExec::merge_states`]). Its frames are the last part's; restore it
+    /// ([`crate::nodes::History::merge_states`]). Its frames are the last part's; restore it
     /// ([`Executor::restore`]) and [`Executor::present`] it.
     ///
     /// # Errors
@@ -541,7 +541,13 @@ impl Executor {
                 .in_node(&pass.node));
             }
             let merged = node
-                .merge_states(&states)
+                .history()
+                .ok_or_else(|| {
+                    RenderError::Gpu(
+                        "this node keeps no history to merge from partial renders".into(),
+                    )
+                })
+                .and_then(|h| h.merge_states(&states))
                 .map_err(|e| e.in_node(&pass.node))?;
             nodes.push((pass.node.clone(), merged));
         }
@@ -556,7 +562,7 @@ impl Executor {
 
     /// Runs the whole graph once over the history as it stands (after a
     /// [`Executor::restore`]), adding nothing to it: nodes with history write what the frame
-    /// that added their last sample wrote ([`NodeExec::set_present`]), the rest of the
+    /// that added their last sample wrote ([`crate::nodes::History::set_present`]), the rest of the
     /// graph runs on that, and sinks write their files. A merge of partial renders ends
     /// with it.
     ///
@@ -564,12 +570,12 @@ impl Executor {
     /// When a node fails (one with no history to present among them); the error names the
     /// node.
     pub fn present(&mut self) -> Result<FrameReport> {
-        for node in &mut self.nodes {
-            node.set_present(&self.ctx, true);
+        for history in self.nodes.iter_mut().filter_map(|n| n.history()) {
+            history.set_present(&self.ctx, true);
         }
         let report = self.run(1, Mode::Present);
-        for node in &mut self.nodes {
-            node.set_present(&self.ctx, false);
+        for history in self.nodes.iter_mut().filter_map(|n| n.history()) {
+            history.set_present(&self.ctx, false);
         }
         report
     }

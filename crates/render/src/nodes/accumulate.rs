@@ -14,7 +14,7 @@ use lumagraph_graph::{Extent, Pass, TexFormat};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::kernel::{Kernel, uniform_buffer};
-use crate::nodes::{NodeExec, NodeImpl, Recording, boxed};
+use crate::nodes::{History, NodeExec, NodeImpl, Recording, boxed};
 use crate::pool::{PooledTexture, create};
 
 /// The `Accumulate` kind: it owns its history buffers.
@@ -168,52 +168,8 @@ impl Accumulate {
 }
 
 impl NodeExec for Accumulate {
-    fn save_state(&mut self, ctx: &GpuContext) -> Result<Option<Vec<u8>>> {
-        // Header: width, height, and the size of each buffer; then the buffers. No history
-        // yet (or one to be cleared) is an empty state.
-        let Some((extent, sum, comp, m2)) = self.history.as_ref().filter(|_| !self.clear) else {
-            return Ok(Some(Vec::new()));
-        };
-        let mut out = Vec::new();
-        out.extend_from_slice(&extent.width.to_le_bytes());
-        out.extend_from_slice(&extent.height.to_le_bytes());
-        for b in [sum, comp, m2] {
-            out.extend_from_slice(&b.size().to_le_bytes());
-        }
-        for b in [sum, comp, m2] {
-            crate::readback::append_buffer(ctx, b, &mut out)?;
-        }
-        Ok(Some(out))
-    }
-
-    fn load_state(&mut self, ctx: &GpuContext, pass: &Pass, state: &[u8]) -> Result<()> {
-        if state.is_empty() {
-            self.clear = true;
-            return Ok(());
-        }
-        let bad =
-            |why: String| crate::error::RenderError::Gpu(format!("accumulation state: {why}"));
-        let (w, h, sections) = sections(state).map_err(bad)?;
-        if Extent::new(w, h) != pass.extent {
-            return Err(bad(format!("{w}×{h}, but the image is {}", pass.extent)));
-        }
-        self.make_history(ctx, pass.extent);
-        let Some((_, sum, comp, m2)) = &self.history else {
-            return Err(bad("no buffers".into()));
-        };
-        for (b, bytes) in [sum, comp, m2].into_iter().zip(sections) {
-            if bytes.len() as u64 != b.size() {
-                return Err(bad(format!(
-                    "a buffer of {} bytes where {} are expected (variance on or off?)",
-                    bytes.len(),
-                    b.size()
-                )));
-            }
-            ctx.queue.write_buffer(b, 0, bytes);
-        }
-        self.write_params(ctx, pass.extent);
-        self.clear = false;
-        Ok(())
+    fn history(&mut self) -> Option<&mut dyn History> {
+        Some(self)
     }
 
     fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
@@ -231,22 +187,6 @@ impl NodeExec for Accumulate {
 
     fn reset(&mut self) {
         self.clear = true;
-    }
-
-    fn start_at_sample(&mut self, _first: u32, frames: u64) {
-        self.parity = u32::from(frames % 2 == 1);
-    }
-
-    fn set_present(&mut self, ctx: &GpuContext, present: bool) {
-        self.present = present;
-        if let Some((extent, ..)) = &self.history {
-            self.write_params(ctx, *extent);
-        }
-    }
-
-    fn merge_states(&mut self, states: &[&[u8]]) -> Result<Vec<u8>> {
-        merge_accumulations(states, self.variance == VARIANCE_HALVES)
-            .map_err(|e| crate::error::RenderError::Gpu(format!("accumulation state: {e}")))
     }
 
     fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
@@ -293,6 +233,68 @@ impl NodeExec for Accumulate {
             .buffer(m2)
             .write(view(var, 1))
             .dispatch_2d(ctx, encoder, pass.extent, timer)
+    }
+}
+
+impl History for Accumulate {
+    fn save_state(&mut self, ctx: &GpuContext) -> Result<Vec<u8>> {
+        // Header: width, height, and the size of each buffer; then the buffers. No history
+        // yet (or one to be cleared) is an empty state.
+        let Some((extent, sum, comp, m2)) = self.history.as_ref().filter(|_| !self.clear) else {
+            return Ok(Vec::new());
+        };
+        let mut out = Vec::new();
+        out.extend_from_slice(&extent.width.to_le_bytes());
+        out.extend_from_slice(&extent.height.to_le_bytes());
+        for b in [sum, comp, m2] {
+            out.extend_from_slice(&b.size().to_le_bytes());
+        }
+        for b in [sum, comp, m2] {
+            crate::readback::append_buffer(ctx, b, &mut out)?;
+        }
+        Ok(out)
+    }
+    fn load_state(&mut self, ctx: &GpuContext, pass: &Pass, state: &[u8]) -> Result<()> {
+        if state.is_empty() {
+            self.clear = true;
+            return Ok(());
+        }
+        let bad =
+            |why: String| crate::error::RenderError::Gpu(format!("accumulation state: {why}"));
+        let (w, h, sections) = sections(state).map_err(bad)?;
+        if Extent::new(w, h) != pass.extent {
+            return Err(bad(format!("{w}×{h}, but the image is {}", pass.extent)));
+        }
+        self.make_history(ctx, pass.extent);
+        let Some((_, sum, comp, m2)) = &self.history else {
+            return Err(bad("no buffers".into()));
+        };
+        for (b, bytes) in [sum, comp, m2].into_iter().zip(sections) {
+            if bytes.len() as u64 != b.size() {
+                return Err(bad(format!(
+                    "a buffer of {} bytes where {} are expected (variance on or off?)",
+                    bytes.len(),
+                    b.size()
+                )));
+            }
+            ctx.queue.write_buffer(b, 0, bytes);
+        }
+        self.write_params(ctx, pass.extent);
+        self.clear = false;
+        Ok(())
+    }
+    fn start_at_sample(&mut self, _first: u32, frames: u64) {
+        self.parity = u32::from(frames % 2 == 1);
+    }
+    fn set_present(&mut self, ctx: &GpuContext, present: bool) {
+        self.present = present;
+        if let Some((extent, ..)) = &self.history {
+            self.write_params(ctx, *extent);
+        }
+    }
+    fn merge_states(&mut self, states: &[&[u8]]) -> Result<Vec<u8>> {
+        merge_accumulations(states, self.variance == VARIANCE_HALVES)
+            .map_err(|e| crate::error::RenderError::Gpu(format!("accumulation state: {e}")))
     }
 }
 

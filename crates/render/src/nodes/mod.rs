@@ -306,46 +306,11 @@ pub trait NodeExec {
         Ok(Vec::new())
     }
 
-    /// The history this node keeps across frames, as bytes for a checkpoint
-    /// ([`crate::Checkpoint`]); `None` when it keeps none. Reads back from the GPU.
-    ///
-    /// # Errors
-    /// When the readback fails.
-    fn save_state(&mut self, _ctx: &GpuContext) -> Result<Option<Vec<u8>>> {
-        Ok(None)
-    }
-
-    /// Puts back what [`NodeExec::save_state`] returned, so the next frame continues
-    /// exactly where the saved one stopped.
-    ///
-    /// # Errors
-    /// When the bytes do not fit this node (another size, a truncated file).
-    fn load_state(&mut self, _ctx: &GpuContext, _pass: &Pass, _state: &[u8]) -> Result<()> {
-        Err(RenderError::Gpu(
-            "this node keeps no state to restore".into(),
-        ))
-    }
-
-    /// Starts the history at sample `first` of each pixel's sequence instead of 0, as if
-    /// the samples before it had been taken elsewhere: a partial render of a sample range
-    /// (`lumagraph render --samples`); `frames` took those samples. Nodes whose history is
-    /// not indexed by sample or frame ignore it.
-    fn start_at_sample(&mut self, _first: u32, _frames: u64) {}
-
-    /// While `present` is set, [`NodeExec::record`] writes the node's outputs from its
-    /// history as it stands, adding nothing to it: the outputs of the frame that added the
-    /// last sample. A merge of partial renders restores the merged history and presents it.
-    fn set_present(&mut self, _ctx: &GpuContext, _present: bool) {}
-
-    /// Combines the states ([`NodeExec::save_state`]) of several partial renders of
-    /// disjoint sample ranges, in sample order, into the state of one render of them all.
-    ///
-    /// # Errors
-    /// When the states do not fit together, or the node cannot merge its history.
-    fn merge_states(&mut self, _states: &[&[u8]]) -> Result<Vec<u8>> {
-        Err(RenderError::Gpu(
-            "this node's history cannot be merged from partial renders".into(),
-        ))
+    /// The history this node keeps across frames (sums of samples, a sample counter), for
+    /// checkpoints, partial renders and their merge ([`History`]); `None` (the default)
+    /// when it keeps none.
+    fn history(&mut self) -> Option<&mut dyn History> {
+        None
     }
 
     /// Runs after the frame's GPU work finished; returns files written.
@@ -355,6 +320,42 @@ pub trait NodeExec {
     fn finish(&mut self, _ctx: &GpuContext, _pass: &Pass) -> Result<Vec<PathBuf>> {
         Ok(Vec::new())
     }
+}
+
+/// The history a progressive node keeps across frames (`Accumulate`'s sums, `PathTrace`'s
+/// sample counter): what a checkpoint saves and restores ([`crate::Checkpoint`]), a partial
+/// render of a sample range starts from, and a merge of partial renders combines and
+/// presents. A node has it through [`NodeExec::history`].
+pub trait History {
+    /// The history as bytes for a checkpoint. Reads back from the GPU.
+    ///
+    /// # Errors
+    /// When the readback fails.
+    fn save_state(&mut self, ctx: &GpuContext) -> Result<Vec<u8>>;
+
+    /// Puts back what [`History::save_state`] returned, so the next frame continues exactly
+    /// where the saved one stopped.
+    ///
+    /// # Errors
+    /// When the bytes do not fit this node (another size, a truncated file).
+    fn load_state(&mut self, ctx: &GpuContext, pass: &Pass, state: &[u8]) -> Result<()>;
+
+    /// Starts the history at sample `first` of each pixel's sequence instead of 0, as if
+    /// the samples before it had been taken elsewhere: a partial render of a sample range
+    /// (`lumagraph render --samples`); `frames` took those samples.
+    fn start_at_sample(&mut self, first: u32, frames: u64);
+
+    /// While `present` is set, [`NodeExec::record`] writes the node's outputs from its
+    /// history as it stands, adding nothing to it: the outputs of the frame that added the
+    /// last sample. A merge of partial renders restores the merged history and presents it.
+    fn set_present(&mut self, ctx: &GpuContext, present: bool);
+
+    /// Combines the states ([`History::save_state`]) of several partial renders of disjoint
+    /// sample ranges, in sample order, into the state of one render of them all.
+    ///
+    /// # Errors
+    /// When the states do not fit together.
+    fn merge_states(&mut self, states: &[&[u8]]) -> Result<Vec<u8>>;
 }
 
 /// What a pass of a kind specialized to the scene compiles in and leaves out, with these

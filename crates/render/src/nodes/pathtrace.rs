@@ -16,7 +16,7 @@ use lumagraph_graph::TexFormat;
 
 use crate::host_rays::{HostCounts, WaveStep};
 use crate::kernel::PassBuilder;
-use crate::nodes::{Counter, FrameIo, NodeExec, NodeImpl, Recording, Resources, boxed};
+use crate::nodes::{Counter, FrameIo, History, NodeExec, NodeImpl, Recording, Resources, boxed};
 use crate::pool::{PooledTexture, create};
 use crate::readback::map_read;
 use crate::scene_gpu::SceneBuffers;
@@ -814,6 +814,10 @@ impl PathTrace {
 }
 
 impl NodeExec for PathTrace {
+    fn history(&mut self) -> Option<&mut dyn History> {
+        Some(self)
+    }
+
     fn update(&mut self, _ctx: &GpuContext, pass: &Pass) -> Result<()> {
         self.samples_per_frame = u32::try_from(pass.params.int("samples_per_frame")).unwrap_or(1);
         #[expect(clippy::cast_possible_truncation, reason = "GPU math is f32")]
@@ -934,61 +938,6 @@ impl NodeExec for PathTrace {
         notes
     }
 
-    fn save_state(&mut self, ctx: &GpuContext) -> Result<Option<Vec<u8>>> {
-        // Folds the GPU's counters into the totals first.
-        self.counters(ctx)?;
-        let mut bytes = Vec::with_capacity(24);
-        for v in [u64::from(self.samples), self.dropped, self.rays] {
-            bytes.extend_from_slice(&v.to_le_bytes());
-        }
-        // Adaptive sampling's state follows: the window size, the halves, the stopped flags.
-        let a = &self.adaptive;
-        if a.on() && !a.clear && a.extent.pixels() > 0 {
-            bytes.extend_from_slice(&a.extent.width.to_le_bytes());
-            bytes.extend_from_slice(&a.extent.height.to_le_bytes());
-            crate::readback::append_buffer(ctx, &a.halves, &mut bytes)?;
-            crate::readback::append_buffer(ctx, &a.stopped, &mut bytes)?;
-        }
-        Ok(Some(bytes))
-    }
-
-    fn load_state(&mut self, ctx: &GpuContext, pass: &Pass, state: &[u8]) -> Result<()> {
-        let word = |i: usize| {
-            state
-                .get(8 * i..8 * i + 8)
-                .and_then(|b| b.try_into().ok())
-                .map(u64::from_le_bytes)
-        };
-        let (Some(samples), Some(dropped), Some(rays)) = (word(0), word(1), word(2)) else {
-            return Err(RenderError::Gpu(format!(
-                "a path tracer's state is at least 24 bytes, this one {}",
-                state.len()
-            )));
-        };
-        self.load_adaptive(ctx, pass, &state[24..])?;
-        self.samples = u32::try_from(samples)
-            .map_err(|_| RenderError::Gpu(format!("{samples} samples per pixel is too many")))?;
-        self.dropped = dropped;
-        self.rays = rays;
-        Ok(())
-    }
-
-    fn start_at_sample(&mut self, first: u32, _frames: u64) {
-        self.samples = first;
-    }
-
-    fn set_present(&mut self, _ctx: &GpuContext, present: bool) {
-        // Presenting re-runs the frame that took the last samples (for outputs read
-        // downstream, such as the first-hit AOVs); recording it counts them again.
-        if present {
-            self.samples = self.samples.saturating_sub(self.samples_per_frame);
-        }
-    }
-
-    fn merge_states(&mut self, states: &[&[u8]]) -> Result<Vec<u8>> {
-        merge_path_tracers(states).map_err(RenderError::Gpu)
-    }
-
     fn counters(&mut self, ctx: &GpuContext) -> Result<Vec<Counter>> {
         let mut encoder = ctx
             .device
@@ -1029,6 +978,59 @@ impl NodeExec for PathTrace {
             counters.push(Counter::new("adaptive_samples", self.adaptive_samples));
         }
         Ok(counters)
+    }
+}
+
+impl History for PathTrace {
+    fn save_state(&mut self, ctx: &GpuContext) -> Result<Vec<u8>> {
+        // Folds the GPU's counters into the totals first.
+        self.counters(ctx)?;
+        let mut bytes = Vec::with_capacity(24);
+        for v in [u64::from(self.samples), self.dropped, self.rays] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        // Adaptive sampling's state follows: the window size, the halves, the stopped flags.
+        let a = &self.adaptive;
+        if a.on() && !a.clear && a.extent.pixels() > 0 {
+            bytes.extend_from_slice(&a.extent.width.to_le_bytes());
+            bytes.extend_from_slice(&a.extent.height.to_le_bytes());
+            crate::readback::append_buffer(ctx, &a.halves, &mut bytes)?;
+            crate::readback::append_buffer(ctx, &a.stopped, &mut bytes)?;
+        }
+        Ok(bytes)
+    }
+    fn load_state(&mut self, ctx: &GpuContext, pass: &Pass, state: &[u8]) -> Result<()> {
+        let word = |i: usize| {
+            state
+                .get(8 * i..8 * i + 8)
+                .and_then(|b| b.try_into().ok())
+                .map(u64::from_le_bytes)
+        };
+        let (Some(samples), Some(dropped), Some(rays)) = (word(0), word(1), word(2)) else {
+            return Err(RenderError::Gpu(format!(
+                "a path tracer's state is at least 24 bytes, this one {}",
+                state.len()
+            )));
+        };
+        self.load_adaptive(ctx, pass, &state[24..])?;
+        self.samples = u32::try_from(samples)
+            .map_err(|_| RenderError::Gpu(format!("{samples} samples per pixel is too many")))?;
+        self.dropped = dropped;
+        self.rays = rays;
+        Ok(())
+    }
+    fn start_at_sample(&mut self, first: u32, _frames: u64) {
+        self.samples = first;
+    }
+    fn set_present(&mut self, _ctx: &GpuContext, present: bool) {
+        // Presenting re-runs the frame that took the last samples (for outputs read
+        // downstream, such as the first-hit AOVs); recording it counts them again.
+        if present {
+            self.samples = self.samples.saturating_sub(self.samples_per_frame);
+        }
+    }
+    fn merge_states(&mut self, states: &[&[u8]]) -> Result<Vec<u8>> {
+        merge_path_tracers(states).map_err(RenderError::Gpu)
     }
 }
 
