@@ -11,10 +11,10 @@ use wgpu::util::DeviceExt as _;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::kernel::{Kernel, uniform_buffer};
-use crate::shared::{CHUNK_FIRST, CHUNK_LAST, WAVE_FINISH, WAVE_STEP};
+use crate::shared::{CHUNK_FIRST, CHUNK_LAST, WAVE_FINISH};
 use lumagraph_graph::TexFormat;
 
-use crate::host_rays::{HostCounts, WaveStep};
+use crate::host_rays::HostCounts;
 use crate::kernel::PassBuilder;
 use crate::nodes::{Counter, FrameIo, History, NodeExec, NodeImpl, Recording, Resources, boxed};
 use crate::pool::{PooledTexture, create};
@@ -27,9 +27,14 @@ use crate::specialize::{Feature, Features};
 /// ([`crate::shared::WAVE_COUNTS_AT`]).
 const STATS: u64 = 8;
 
+mod adaptive;
 mod backend;
+mod history;
+mod steps;
 
+use adaptive::Adaptive;
 use backend::Backend;
+use steps::submit_pending;
 
 /// The `PathTrace` kind.
 pub(crate) const IMPL: NodeImpl = NodeImpl::new("PathTrace", |ctx, pass, resources| {
@@ -177,110 +182,6 @@ crate::param_block! {
         samples_per_frame: u32,
         pad0: u32,
         pad1: u32,
-    }
-}
-
-/// Adaptive sampling's pass and per-pixel state (16-byte stand-ins while it is off).
-struct Adaptive {
-    kernel: Kernel,
-    params: wgpu::Buffer,
-    /// Per pixel of the window: the sums (rgb) and frame counts of the even and odd frames.
-    halves: wgpu::Buffer,
-    /// Per pixel: 1 once it stopped.
-    stopped: wgpu::Buffer,
-    /// This frame's pixels still sampling: their count, then each one's position.
-    active: wgpu::Buffer,
-    /// The window size the buffers are for (0×0: stand-ins).
-    extent: lumagraph_graph::Extent,
-    /// Clear the buffers before the next frame.
-    clear: bool,
-    /// `adaptive_error` (0: off) and the frames every pixel takes first.
-    error: f32,
-    min_spp: u32,
-}
-
-impl Adaptive {
-    fn new(ctx: &GpuContext) -> Result<Self> {
-        Ok(Self {
-            kernel: Kernel::new(ctx, "pathtrace/integrator/adaptive.wgsl")?,
-            params: uniform_buffer(
-                ctx,
-                "adaptive params",
-                bytemuck::bytes_of(&AdaptiveParams::default()),
-            ),
-            halves: storage(ctx, "adaptive halves", 16),
-            stopped: storage(ctx, "adaptive stopped", 16),
-            active: storage(ctx, "adaptive active", 16),
-            extent: lumagraph_graph::Extent::new(0, 0),
-            clear: true,
-            error: 0.0,
-            min_spp: 16,
-        })
-    }
-
-    fn on(&self) -> bool {
-        self.error > 0.0
-    }
-
-    /// Records the pass that stops pixels before a frame and writes `samples`; `frames` is
-    /// the frames run before this one and the samples each takes.
-    fn record(
-        &mut self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        pass: &Pass,
-        [frames, samples_per_frame]: [u32; 2],
-        samples: &wgpu::TextureView,
-        timer: Option<&mut crate::timing::GpuTimer>,
-    ) -> Result<()> {
-        self.fit(ctx, pass.extent);
-        if self.clear && self.on() {
-            encoder.clear_buffer(&self.halves, 0, None);
-            encoder.clear_buffer(&self.stopped, 0, None);
-            self.clear = false;
-        }
-        if self.on() {
-            encoder.clear_buffer(&self.active, 0, Some(4));
-        }
-        let block = AdaptiveParams {
-            size: [pass.extent.width, pass.extent.height],
-            min_frames: self.min_spp.div_ceil(samples_per_frame).max(2),
-            error2: if self.on() {
-                self.error * self.error
-            } else {
-                -1.0
-            },
-            frames,
-            samples_per_frame,
-            ..AdaptiveParams::default()
-        };
-        let staging = ctx
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("adaptive params staging"),
-                contents: bytemuck::bytes_of(&block),
-                usage: wgpu::BufferUsages::COPY_SRC,
-            });
-        encoder.copy_buffer_to_buffer(&staging, 0, &self.params, 0, self.params.size());
-        self.kernel
-            .pass(&format!("{} (adaptive)", pass.node))
-            .uniform(&self.params)
-            .buffer(&self.halves)
-            .buffer(&self.stopped)
-            .write(samples)
-            .buffer(&self.active)
-            .dispatch_2d(ctx, encoder, pass.extent, timer)
-    }
-
-    /// Buffers for a window of `extent` (new ones, to be cleared, when it changed).
-    fn fit(&mut self, ctx: &GpuContext, extent: lumagraph_graph::Extent) {
-        if self.on() && self.extent != extent {
-            self.halves = storage(ctx, "adaptive halves", 32 * extent.pixels());
-            self.stopped = storage(ctx, "adaptive stopped", 4 * extent.pixels());
-            self.active = storage(ctx, "adaptive active", 4 + 4 * extent.pixels());
-            self.extent = extent;
-            self.clear = true;
-        }
     }
 }
 
@@ -573,159 +474,6 @@ impl PathTrace {
         self.bind(&pass.node, views, sums, wave)
             .dispatch_2d(ctx, encoder, pass.extent, timer)
     }
-
-    /// Traces a frame with host intersection: the steps of its paths are dispatched and
-    /// submitted in order, the host intersecting the rays of each step, leaving the
-    /// pixels' sums in `chunk_sums` for the pass [`Self::record_steps_finish`] records.
-    fn trace_host(
-        &mut self,
-        ctx: &GpuContext,
-        io: &FrameIo<'_>,
-        pass: &Pass,
-        frame: Frame,
-    ) -> Result<()> {
-        let backend = std::mem::replace(&mut self.backend, Backend::Wgsl);
-        let Backend::Host(mut host) = backend else {
-            self.backend = backend;
-            return Ok(());
-        };
-        host.fit(ctx, pass.extent);
-        let sums = self.steps_sums(ctx, pass);
-        let views = self.views(pass, io);
-        let max_steps = self.max_steps(&frame);
-        let result = host.trace_frame(ctx, max_steps, |step, enc, wave| {
-            let f = Frame {
-                wave: WAVE_STEP,
-                wave_base: step.base,
-                wave_capacity: step.capacity,
-                wave_split: step.misses,
-                ..frame
-            };
-            ctx.queue
-                .write_buffer(&self.frame, 0, bytemuck::bytes_of(&f));
-            let passes = if step.first {
-                [("wave_start", step.misses), ("wave_hits", 0)]
-            } else {
-                [("wave_misses", step.misses), ("wave_hits", step.hits)]
-            };
-            for (entry, slots) in passes {
-                if slots > 0 {
-                    self.bind(&pass.node, views, &sums, wave)
-                        .entry(entry)
-                        .dispatch(ctx, enc, [WaveStep::groups(slots), 1, 1], None)?;
-                }
-            }
-            Ok(())
-        });
-        self.backend = Backend::Host(host);
-        result
-    }
-
-    /// Records the pass that writes the means (and AOVs) of a frame traced in steps, with
-    /// the graph.
-    fn record_steps_finish(
-        &mut self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        io: &FrameIo<'_>,
-        pass: &Pass,
-        frame: Frame,
-        timer: Option<&mut crate::timing::GpuTimer>,
-    ) -> Result<()> {
-        let sums = self.steps_sums(ctx, pass);
-        let views = self.views(pass, io);
-        let wave = match (self.backend.host(), &self.wavefront) {
-            (Some(host), _) => host.wave().clone(),
-            (None, Some(front)) => front.wave().clone(),
-            (None, None) => return Ok(()),
-        };
-        self.record_finish(ctx, encoder, pass, frame, (views, &sums, &wave), timer)
-    }
-}
-
-impl PathTrace {
-    /// The per-pixel sums of a frame traced in steps: `chunk_sums`, grown to the window
-    /// once, not a buffer per frame.
-    fn steps_sums(&mut self, ctx: &GpuContext, pass: &Pass) -> wgpu::Buffer {
-        let size = 16 * pass.extent.pixels();
-        if self.chunk_sums.size() < size {
-            self.chunk_sums = storage(ctx, "pathtrace chunk sums", size);
-        }
-        self.chunk_sums.clone()
-    }
-
-    /// Traces a frame by the wavefront: its steps are recorded and submitted in order, all
-    /// on the device, leaving the pixels' sums in `chunk_sums` for the pass
-    /// [`Self::record_steps_finish`] records.
-    fn trace_wavefront(
-        &mut self,
-        ctx: &GpuContext,
-        io: &FrameIo<'_>,
-        pass: &Pass,
-        frame: Frame,
-    ) -> Result<()> {
-        let Some(mut front) = self.wavefront.take() else {
-            return Ok(());
-        };
-        front.fit(ctx, pass.extent);
-        let sums = self.steps_sums(ctx, pass);
-        let views = self.views(pass, io);
-        let max_steps = self.max_steps(&frame);
-        let list_at = std::mem::offset_of!(Frame, wave_list) as u64;
-        let words = front.list_words().clone();
-        let wave = front.wave().clone();
-        let result = self
-            .bind(&pass.node, views, &sums, &wave)
-            .bound(ctx)
-            .and_then(|bound| {
-                front.trace_frame(ctx, &self.stats, max_steps, |step, enc| {
-                    if step.first {
-                        let f = Frame {
-                            wave: WAVE_STEP,
-                            wave_base: step.base,
-                            wave_capacity: step.capacity,
-                            wave_split: 0,
-                            wave_list: step.list,
-                            ..frame
-                        };
-                        stage_frame(ctx, enc, &f, &self.frame);
-                    } else {
-                        enc.copy_buffer_to_buffer(
-                            &words,
-                            4 * u64::from(step.list),
-                            &self.frame,
-                            list_at,
-                            4,
-                        );
-                    }
-                    let groups = [step.groups, 1, 1];
-                    if step.first {
-                        bound.dispatch(enc, Some("wave_start"), groups, None)?;
-                    } else {
-                        bound.dispatch(enc, Some("wave_misses"), groups, None)?;
-                        bound.dispatch(enc, Some("wave_hits"), groups, None)?;
-                    }
-                    bound.dispatch(enc, Some("wave_trace"), groups, None)
-                })
-            });
-        self.wavefront = Some(front);
-        result
-    }
-
-    /// Traces a frame in steps, host intersection's or the wavefront's.
-    fn trace_steps(
-        &mut self,
-        ctx: &GpuContext,
-        io: &FrameIo<'_>,
-        pass: &Pass,
-        frame: Frame,
-    ) -> Result<()> {
-        if self.backend.host().is_some() {
-            self.trace_host(ctx, io, pass, frame)
-        } else {
-            self.trace_wavefront(ctx, io, pass, frame)
-        }
-    }
 }
 
 /// The path tracer's entry points for host intersection's steps (see [`WaveStep`]).
@@ -747,21 +495,6 @@ fn entry_points(features: &Features) -> (&'static str, &'static [&'static str]) 
     }
 }
 
-/// Submits what the graph recorded before this pass, so that the steps of a frame traced
-/// in steps run after it, and after the previous frame's finish pass, which reads the sums
-/// those steps overwrite (`chunk_sums`, kept from frame to frame). The executor does the
-/// same before [`NodeExec::submit_own`].
-fn submit_pending(ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
-    let pending = std::mem::replace(
-        encoder,
-        ctx.device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("graph"),
-            }),
-    );
-    ctx.queue.submit([pending.finish()]);
-}
-
 /// Records a copy of `frame` into the uniform buffer `dst` through a staging buffer, in
 /// order with the passes recorded around it.
 fn stage_frame(
@@ -778,39 +511,6 @@ fn stage_frame(
             usage: wgpu::BufferUsages::COPY_SRC,
         });
     encoder.copy_buffer_to_buffer(&staging, 0, dst, 0, dst.size());
-}
-
-impl PathTrace {
-    /// Restores adaptive sampling's buffers from what follows the counters in a saved state
-    /// (nothing: adaptive sampling was off, or no frame had run).
-    fn load_adaptive(&mut self, ctx: &GpuContext, pass: &Pass, rest: &[u8]) -> Result<()> {
-        let a = &mut self.adaptive;
-        if rest.is_empty() {
-            a.clear = true;
-            return Ok(());
-        }
-        let px = usize::try_from(pass.extent.pixels()).unwrap_or(usize::MAX);
-        let expected = 8 + 36 * px;
-        let size = rest.get(..8).map(|b| {
-            [&b[..4], &b[4..]].map(|w| u32::from_le_bytes(w.try_into().unwrap_or_default()))
-        });
-        if !a.on()
-            || rest.len() != expected
-            || size != Some([pass.extent.width, pass.extent.height])
-        {
-            return Err(RenderError::Gpu(format!(
-                "a path tracer's adaptive sampling state does not fit: {} bytes for {} \
-                 ({expected} expected; is adaptive_error on in both?)",
-                rest.len(),
-                pass.extent
-            )));
-        }
-        a.fit(ctx, pass.extent);
-        ctx.queue.write_buffer(&a.halves, 0, &rest[8..8 + 32 * px]);
-        ctx.queue.write_buffer(&a.stopped, 0, &rest[8 + 32 * px..]);
-        a.clear = false;
-        Ok(())
-    }
 }
 
 impl NodeExec for PathTrace {
@@ -979,86 +679,4 @@ impl NodeExec for PathTrace {
         }
         Ok(counters)
     }
-}
-
-impl History for PathTrace {
-    fn save_state(&mut self, ctx: &GpuContext) -> Result<Vec<u8>> {
-        // Folds the GPU's counters into the totals first.
-        self.counters(ctx)?;
-        let mut bytes = Vec::with_capacity(24);
-        for v in [u64::from(self.samples), self.dropped, self.rays] {
-            bytes.extend_from_slice(&v.to_le_bytes());
-        }
-        // Adaptive sampling's state follows: the window size, the halves, the stopped flags.
-        let a = &self.adaptive;
-        if a.on() && !a.clear && a.extent.pixels() > 0 {
-            bytes.extend_from_slice(&a.extent.width.to_le_bytes());
-            bytes.extend_from_slice(&a.extent.height.to_le_bytes());
-            crate::readback::append_buffer(ctx, &a.halves, &mut bytes)?;
-            crate::readback::append_buffer(ctx, &a.stopped, &mut bytes)?;
-        }
-        Ok(bytes)
-    }
-    fn load_state(&mut self, ctx: &GpuContext, pass: &Pass, state: &[u8]) -> Result<()> {
-        let word = |i: usize| {
-            state
-                .get(8 * i..8 * i + 8)
-                .and_then(|b| b.try_into().ok())
-                .map(u64::from_le_bytes)
-        };
-        let (Some(samples), Some(dropped), Some(rays)) = (word(0), word(1), word(2)) else {
-            return Err(RenderError::Gpu(format!(
-                "a path tracer's state is at least 24 bytes, this one {}",
-                state.len()
-            )));
-        };
-        self.load_adaptive(ctx, pass, &state[24..])?;
-        self.samples = u32::try_from(samples)
-            .map_err(|_| RenderError::Gpu(format!("{samples} samples per pixel is too many")))?;
-        self.dropped = dropped;
-        self.rays = rays;
-        Ok(())
-    }
-    fn start_at_sample(&mut self, first: u32, _frames: u64) {
-        self.samples = first;
-    }
-    fn set_present(&mut self, _ctx: &GpuContext, present: bool) {
-        // Presenting re-runs the frame that took the last samples (for outputs read
-        // downstream, such as the first-hit AOVs); recording it counts them again.
-        if present {
-            self.samples = self.samples.saturating_sub(self.samples_per_frame);
-        }
-    }
-    fn merge_states(&mut self, states: &[&[u8]]) -> Result<Vec<u8>> {
-        merge_path_tracers(states).map_err(RenderError::Gpu)
-    }
-}
-
-/// Merges path tracer states (samples, dropped samples, rays, `u64` each): the samples of
-/// the last range's end, the counts summed.
-///
-/// # Errors
-/// When a state is not a path tracer's.
-fn merge_path_tracers(states: &[&[u8]]) -> std::result::Result<Vec<u8>, String> {
-    let mut merged = [0u64; 3];
-    for state in states {
-        if state.len() != 24 {
-            return Err(if state.len() > 24 {
-                "adaptive sampling cannot be split into sample ranges: each part would stop \
-                 pixels by its own samples (render it whole, or tile it)"
-                    .to_owned()
-            } else {
-                format!(
-                    "a path tracer's state is 24 bytes, this one {}",
-                    state.len()
-                )
-            });
-        }
-        let word =
-            |i: usize| u64::from_le_bytes(state[8 * i..8 * i + 8].try_into().unwrap_or_default());
-        merged[0] = merged[0].max(word(0));
-        merged[1] += word(1);
-        merged[2] += word(2);
-    }
-    Ok(merged.iter().flat_map(|v| v.to_le_bytes()).collect())
 }
