@@ -31,7 +31,8 @@ fn disk_dir() -> Option<PathBuf> {
 }
 
 /// The raw text of one shader file (or of a generated one: [`crate::shared::FILE`], and
-/// [`lumagraph_scene::shapes::FILE`], which calls each kind of shape).
+/// [`lumagraph_scene::shapes::FILE`], which calls each kind of shape, and
+/// [`lumagraph_scene::lobes::FILE`], the `Material` struct).
 ///
 /// # Errors
 /// When there is no such file.
@@ -41,6 +42,9 @@ pub fn raw(name: &str) -> Result<String> {
     }
     if name == lumagraph_scene::shapes::FILE {
         return Ok(lumagraph_scene::shapes::wgsl());
+    }
+    if name == lumagraph_scene::lobes::FILE {
+        return Ok(lumagraph_scene::lobes::wgsl());
     }
     // Only names inside the folder: an `#import` of a kind declared in a graph file names
     // a shader, never another file on disk.

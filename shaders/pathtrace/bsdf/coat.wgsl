@@ -41,10 +41,19 @@ struct CoatParams {
     // `clearcoat` in [0, 1].
     weight: f32,
     lobe: LobeParams,
+    // What the layers below are multiplied by besides the share the coat reflects
+    // (1 - coat_albedo): white for a clear coat. bsdf.wgsl's layering applies it to their
+    // evaluation and to their delta samples' weights.
+    through: vec3f,
 }
 
 fn coat_params(m: Material) -> CoatParams {
-    return CoatParams(clamp(m.clearcoat, 0.0, 1.0), ggx_lobe(m.clearcoat_roughness));
+    return CoatParams(clamp(m.clearcoat, 0.0, 1.0), ggx_lobe(m.clearcoat_roughness), vec3f(1.0));
+}
+
+// No coat: nothing reflected, everything through.
+fn no_coat() -> CoatParams {
+    return CoatParams(0.0, ggx_lobe(0.0), vec3f(1.0));
 }
 
 // The coat's directional albedo (its weight included) at view cosine mu: what it reflects
