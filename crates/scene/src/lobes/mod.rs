@@ -1,7 +1,7 @@
 //! The material's parameters, declared once. A material is one record on the GPU
 //! ([`GpuMaterial`], WGSL `Material`), read by the lobes of `shaders/pathtrace/bsdf/`; the
 //! record and the parameters the lobes take from the scene format are two tables in
-//! [`table`](self) (`lobes/table.rs`), and everything else is derived from them:
+//! `lobes/table.rs`, and everything else is derived from them:
 //!
 //! - **The record's layout**, `material_record!`: the Rust struct [`GpuMaterial`] (`repr(C)`,
 //!   `Pod`), its WGSL twin `struct Material`, written from the same rows ([`wgsl`], served by

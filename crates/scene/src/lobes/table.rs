@@ -124,6 +124,10 @@ material_record! {
     specular_color: vec3f,
     /// glTF `clearcoatNormalTexture.scale`.
     clearcoat_normal_scale: f32,
+    /// Clear coat tint, linear RGB; white: none (coat.wgsl).
+    clearcoat_tint: vec3f,
+    /// Padding.
+    pad8: u32,
 }
 
 /// Calls `$then!` with the arguments given and then every lobe parameter, one row each:
@@ -167,6 +171,15 @@ macro_rules! lobe_params {
             /// Perceptual roughness of the clear coat in [0, 1]. Default 0 (a mirror).
             coat.clearcoat_roughness: f32 = 0.0, unit_range,
                 "coat roughness", "0: a mirror", 1.0;
+            /// Colour of the clear coat, linear RGB (Autodesk Standard Surface's `coat_color`): it
+            /// tints what lies below the coat, seen through it on the light's way in and out.
+            /// The rule is Standard Surface's as its `MaterialX` graph applies it
+            /// (`coat_attenuation`): the layers below a coat of weight `clearcoat` are multiplied
+            /// by 1 + `clearcoat` · (`clearcoat_tint` − 1), once, for the round trip, at every angle
+            /// (`OpenPBR`'s `coat_color` instead lengthens the path with the angle). The coat's own
+            /// reflection stays white. Each channel in [0, 1]. Default white (none).
+            coat.clearcoat_tint: rgb = [1.0, 1.0, 1.0], non_negative3,
+                "coat tint", "colour of what is seen through the coat; white: none", 1.0;
             /// Colour of a sheen under the clear coat (glTF `KHR_materials_sheen`: the velvet of
             /// cloth at grazing angles), linear RGB. Default black (none).
             sheen.sheen_color: rgb = [0.0, 0.0, 0.0], non_negative3,
