@@ -102,57 +102,8 @@ struct ShapeSample {
     margin: f32,
 }
 
-// Material, 208 bytes. Texture indices: 16 bits each, 0xffff = none; each texture
-// multiplies its factor (see textures.wgsl).
-struct Material {
-    base_color: vec3<f32>,
-    roughness: f32,
-    emission: vec3<f32>,
-    metallic: f32,
-    specular: f32,
-    specular_tint: f32,
-    transmission: f32,
-    ior: f32,
-    tex_base_mr: u32,
-    tex_emissive_normal: u32,
-    flags: u32,
-    normal_scale: f32,
-    tex_transmission_specular: u32,
-    tex_specular_color: u32,
-    // Roughness of the diffuse base: 0 Lambertian, else energy-preserving Oren-Nayar (EON).
-    diffuse_roughness: f32,
-    // Opacity, times the base colour texture's alpha (MATERIAL_ALPHA_MASK, _BLEND).
-    opacity: f32,
-    // Complex index of refraction of a conductor (MATERIAL_CONDUCTOR), and its metal
-    // lobe's cosine-weighted average Fresnel reflectance.
-    eta: vec3<f32>,
-    // MATERIAL_ALPHA_MASK's cutoff.
-    alpha_cutoff: f32,
-    k: vec3<f32>,
-    // Clear coat texture (low 16 bits, R) and clear coat roughness texture (high, G).
-    tex_coat: u32,
-    f_avg: vec3<f32>,
-    // Sheen colour texture (low 16 bits, RGB sRGB) and sheen roughness texture (high, A).
-    tex_sheen: u32,
-    // Homogeneous medium inside (MATERIAL_MEDIUM): absorption and scattering coefficients
-    // per unit length, and the Henyey-Greenstein asymmetry of its phase function.
-    sigma_a: vec3<f32>,
-    phase_g: f32,
-    sigma_s: vec3<f32>,
-    pad5: u32,
-    // Sheen (sheen.wgsl): colour (black: none) and perceptual roughness; clear coat
-    // (coat.wgsl): weight (0: none) and perceptual roughness.
-    sheen_color: vec3<f32>,
-    sheen_roughness: f32,
-    clearcoat: f32,
-    clearcoat_roughness: f32,
-    pad6: u32,
-    pad7: u32,
-    // Colour of the dielectric specular at normal incidence: it multiplies F0 (clamped to
-    // 1), not the grazing reflectance (bsdf.wgsl's `dielectric_fresnel`).
-    specular_color: vec3<f32>,
-    clearcoat_normal_scale: f32,
-}
+// Material: generated from crates/scene/src/lobes/table.rs, the same rows as GpuMaterial.
+#import "pathtrace/material.wgsl"
 
 // A triangle's tangents (xyz, w = handedness), UVs (two sets) and vertex colours (RGBA8, R in
 // the low byte, RGB sRGB-encoded; white without) at its corners, 112 bytes, same index as

@@ -238,8 +238,8 @@ fn requires(text: &str) -> (Vec<(String, String)>, Vec<String>) {
 ///
 /// An identifier scan, not a compiler: "uses" means the name appears outside comments and
 /// import lines, not after a `.`, and is not a local or parameter of the file; only names
-/// that some file of those folders (or the generated `pathtrace/shared.wgsl` and
-/// `pathtrace/shapes.wgsl`) declares at module scope are considered, so a name only
+/// that some file of those folders (or the generated `pathtrace/shared.wgsl`,
+/// `pathtrace/shapes.wgsl` and `pathtrace/material.wgsl`) declares at module scope are considered, so a name only
 /// generated code (specialization's replacements) defines is not caught, and a local that
 /// shadows a module-scope name of the same spelling counts as a local.
 #[test]
@@ -248,11 +248,11 @@ fn every_path_tracer_file_imports_or_requires_what_it_uses() {
         .filter(|n| n.starts_with("pathtrace/") || n.starts_with("common/"))
         .collect();
     let mut everywhere = std::collections::BTreeMap::new();
-    for name in names
-        .iter()
-        .copied()
-        .chain(["pathtrace/shared.wgsl", "pathtrace/shapes.wgsl"])
-    {
+    for name in names.iter().copied().chain([
+        "pathtrace/shared.wgsl",
+        "pathtrace/shapes.wgsl",
+        "pathtrace/material.wgsl",
+    ]) {
         everywhere.extend(declared(&shader::raw(name).unwrap()));
     }
     let mut failures = Vec::new();

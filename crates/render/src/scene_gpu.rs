@@ -42,7 +42,7 @@ pub struct SceneBuffers {
 fn storage(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
     // Bindings may not be empty: a scene without shapes still binds a (zeroed) buffer, as
     // large as one of any record (the shader's minimum binding size: a `Light` is 80 bytes,
-    // a `Material` 208).
+    // a `Material` 224).
     const SMALLEST: usize = 512;
     let mut padded;
     let contents = if bytes.len() < SMALLEST {

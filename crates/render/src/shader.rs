@@ -30,9 +30,10 @@ fn disk_dir() -> Option<PathBuf> {
     }
 }
 
-/// The raw text of one shader file (or of a generated one: [`crate::shared::FILE`], and
-/// [`lumagraph_scene::shapes::FILE`], which calls each kind of shape, and
-/// [`lumagraph_scene::lights::FILE`], each kind of light without area).
+/// The raw text of one shader file (or of a generated one: [`crate::shared::FILE`];
+/// [`lumagraph_scene::shapes::FILE`], which calls each kind of shape;
+/// [`lumagraph_scene::lights::FILE`], each kind of light without area; and
+/// [`lumagraph_scene::lobes::FILE`], the `Material` struct).
 ///
 /// # Errors
 /// When there is no such file.
@@ -45,6 +46,9 @@ pub fn raw(name: &str) -> Result<String> {
     }
     if name == lumagraph_scene::lights::FILE {
         return Ok(lumagraph_scene::lights::wgsl());
+    }
+    if name == lumagraph_scene::lobes::FILE {
+        return Ok(lumagraph_scene::lobes::wgsl());
     }
     // Only names inside the folder: an `#import` of a kind declared in a graph file names
     // a shader, never another file on disk.

@@ -63,20 +63,10 @@ struct MaterialOut {
     name: String,
     base_color: [f32; 3],
     emission: [f32; 3],
-    roughness: f32,
-    diffuse_roughness: f32,
     metallic: f32,
-    specular: f32,
-    specular_tint: f32,
-    /// Colour of the dielectric specular at normal incidence (white: none).
-    specular_color: [f32; 3],
-    transmission: f32,
-    /// Clear coat weight and roughness (0: none).
-    clearcoat: f32,
-    clearcoat_roughness: f32,
-    /// Sheen colour (black: none) and roughness.
-    sheen_color: [f32; 3],
-    sheen_roughness: f32,
+    /// Every lobe parameter ([`crate::lobes::PARAMS`]) by its name.
+    #[serde(flatten)]
+    lobes: serde_json::Map<String, serde_json::Value>,
     ior: f32,
     two_sided: bool,
     eta: Option<[f32; 3]>,
@@ -387,17 +377,11 @@ fn material_out(m: &crate::scene::Material) -> MaterialOut {
         name: m.name.clone(),
         base_color: m.base_color.to_array(),
         emission: m.emission.to_array(),
-        roughness: m.roughness,
-        diffuse_roughness: m.diffuse_roughness,
         metallic: m.metallic,
-        specular: m.specular,
-        specular_tint: m.specular_tint,
-        specular_color: m.specular_color.to_array(),
-        transmission: m.transmission,
-        clearcoat: m.clearcoat,
-        clearcoat_roughness: m.clearcoat_roughness,
-        sheen_color: m.sheen_color.to_array(),
-        sheen_roughness: m.sheen_roughness,
+        lobes: crate::lobes::PARAMS
+            .iter()
+            .map(|p| (p.name.to_owned(), (p.export)(m)))
+            .collect(),
         ior: m.ior,
         two_sided: m.two_sided,
         eta: m.conductor.map(|c| c.eta.to_array()),

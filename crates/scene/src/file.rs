@@ -117,19 +117,38 @@ fn default_up() -> V3 {
     [0.0, 1.0, 0.0]
 }
 
-/// A material; every field has a default, so a diffuse material is just `base_color`.
-#[derive(Clone, Debug, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct MaterialDesc {
+/// The scene format's material, its lobe parameters' fields from `lobe_params!`
+/// ([`crate::lobes`]).
+macro_rules! material_desc {
+    ({ $($field:tt)* } { $($default:tt)* } $(
+        $(#[doc = $doc:literal])*
+        $lobe:ident . $name:ident : $kind:ident = $value:expr, $check:ident,
+        $label:literal, $tip:literal, $max:literal;
+    )*) => {
+        /// A material; every field has a default, so a diffuse material is just `base_color`.
+        #[derive(Clone, Debug, PartialEq, Deserialize)]
+        #[serde(deny_unknown_fields, default)]
+        pub struct MaterialDesc {
+            $($field)*
+            $( $(#[doc = $doc])* pub $name: crate::lobes::desc_ty!($kind), )*
+        }
+
+        impl Default for MaterialDesc {
+            fn default() -> Self {
+                Self {
+                    $($default)*
+                    $( $name: $value, )*
+                }
+            }
+        }
+    };
+}
+
+crate::lobes::lobe_params!(material_desc! {
     /// Diffuse albedo, or metal reflectance (linear RGB). Default 0.8 grey.
     pub base_color: V3,
     /// Emitted radiance (linear RGB). Default black.
     pub emission: V3,
-    /// Perceptual roughness in [0, 1] (α = roughness²). Default 0.5.
-    pub roughness: f32,
-    /// Roughness of the diffuse base in [0, 1] (`OpenPBR`'s `base_diffuse_roughness`): 0 is
-    /// Lambertian, above 0 the energy-preserving Oren–Nayar model (EON). Default 0.
-    pub diffuse_roughness: f32,
     /// 0 dielectric, 1 metal. Default 0, or 1 with `conductor`, `eta` or `k`.
     pub metallic: Option<f32>,
     /// A measured conductor by name (`"Au"`, `"Ag"`, `"Al"`, `"Cu"`, …; see
@@ -146,28 +165,6 @@ pub struct MaterialDesc {
     /// true; false matches renderers without it (Mitsuba's `roughconductor`,
     /// `roughdielectric`).
     pub multiscatter: bool,
-    /// Dielectric specular strength; 0.5 means F0 = 0.04. Default 0.5. Use 0 for a pure
-    /// Lambertian surface.
-    pub specular: f32,
-    /// Tints the dielectric specular towards the base color, in [0, 1]. Default 0.
-    pub specular_tint: f32,
-    /// Colour of the dielectric specular at normal incidence (glTF's
-    /// `specularColorFactor`), linear RGB, ≥ 0: it multiplies F0 (clamped to 1) and leaves
-    /// the grazing reflection white. Default white.
-    pub specular_color: V3,
-    /// Fraction of the dielectric lobe that is transmitted (glass), in [0, 1]. Default 0.
-    pub transmission: f32,
-    /// Weight in [0, 1] of a clear coat on top (glTF `KHR_materials_clearcoat`): a
-    /// dielectric layer of ior 1.5 that reflects like a varnish and lets the rest through.
-    /// Default 0 (none).
-    pub clearcoat: f32,
-    /// Perceptual roughness of the clear coat in [0, 1]. Default 0 (a mirror).
-    pub clearcoat_roughness: f32,
-    /// Colour of a sheen under the clear coat (glTF `KHR_materials_sheen`: the velvet of
-    /// cloth at grazing angles), linear RGB. Default black (none).
-    pub sheen_color: V3,
-    /// Perceptual roughness of the sheen in [0, 1] (below 0.07 taken as 0.07). Default 0.
-    pub sheen_roughness: f32,
     /// Index of refraction. Default 1.5.
     pub ior: f32,
     /// Emission leaves both sides. Default false (front only).
@@ -195,7 +192,24 @@ pub struct MaterialDesc {
     /// The surface's opacity in [0, 1] (glTF's base colour factor alpha, OBJ's `d`).
     /// Default 1.
     pub opacity: f32,
-}
+} {
+    base_color: [0.8, 0.8, 0.8],
+    emission: [0.0; 3],
+    metallic: None,
+    conductor: None,
+    eta: None,
+    k: None,
+    multiscatter: true,
+    ior: 1.5,
+    two_sided: false,
+    attenuation_color: None,
+    attenuation_distance: None,
+    medium: None,
+    index_matched: false,
+    alpha_mode: AlphaModeDesc::Opaque,
+    alpha_cutoff: 0.5,
+    opacity: 1.0,
+});
 
 /// How a material's opacity is used (glTF `alphaMode`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
@@ -229,39 +243,6 @@ impl Default for MediumDesc {
             sigma_a: [0.0; 3],
             sigma_s: [0.0; 3],
             g: 0.0,
-        }
-    }
-}
-
-impl Default for MaterialDesc {
-    fn default() -> Self {
-        Self {
-            base_color: [0.8, 0.8, 0.8],
-            emission: [0.0; 3],
-            roughness: 0.5,
-            diffuse_roughness: 0.0,
-            metallic: None,
-            conductor: None,
-            eta: None,
-            k: None,
-            multiscatter: true,
-            specular: 0.5,
-            specular_tint: 0.0,
-            specular_color: [1.0; 3],
-            transmission: 0.0,
-            clearcoat: 0.0,
-            clearcoat_roughness: 0.0,
-            sheen_color: [0.0; 3],
-            sheen_roughness: 0.0,
-            ior: 1.5,
-            two_sided: false,
-            attenuation_color: None,
-            attenuation_distance: None,
-            medium: None,
-            index_matched: false,
-            alpha_mode: AlphaModeDesc::Opaque,
-            alpha_cutoff: 0.5,
-            opacity: 1.0,
         }
     }
 }

@@ -136,16 +136,11 @@ impl From<&Material> for GpuMaterial {
                 c.average_reflectance().to_array(),
             )
         });
-        GpuMaterial {
+        let mut g = GpuMaterial {
             base_color: m.base_color.to_array(),
-            roughness: m.roughness,
             emission: m.emission.to_array(),
             metallic: m.metallic,
-            specular: m.specular,
-            specular_tint: m.specular_tint,
-            transmission: m.transmission,
             ior: m.ior,
-            diffuse_roughness: m.diffuse_roughness,
             opacity: m.opacity,
             alpha_cutoff,
             tex_base_mr: tex16(m.textures.base_color)
@@ -159,12 +154,7 @@ impl From<&Material> for GpuMaterial {
                 | (tex16(m.textures.clearcoat_normal) << 16),
             tex_coat: tex16(m.textures.clearcoat) | (tex16(m.textures.clearcoat_roughness) << 16),
             tex_sheen: tex16(m.textures.sheen_color) | (tex16(m.textures.sheen_roughness) << 16),
-            sheen_color: m.sheen_color.to_array(),
-            specular_color: m.specular_color.to_array(),
             clearcoat_normal_scale: m.clearcoat_normal_scale,
-            sheen_roughness: m.sheen_roughness,
-            clearcoat: m.clearcoat,
-            clearcoat_roughness: m.clearcoat_roughness,
             eta,
             k,
             f_avg,
@@ -172,7 +162,11 @@ impl From<&Material> for GpuMaterial {
             phase_g: medium.g,
             sigma_s: medium.sigma_s.to_array(),
             ..GpuMaterial::default()
+        };
+        for p in crate::lobes::PARAMS {
+            (p.flatten)(m, &mut g);
         }
+        g
     }
 }
 

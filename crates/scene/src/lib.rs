@@ -12,6 +12,8 @@
 //! - [`GpuScene`]: the scene flattened into `#[repr(C)]` arrays laid out as WGSL lays out
 //!   storage buffers ([`gpu`]), with a BVH built by obvhs ([`bvh`]), lights and an alias
 //!   table for picking them (half by power, half uniformly).
+//! - [`lobes`]: the material's parameters, declared once: the GPU record and its WGSL twin,
+//!   and the lobe parameters of the scene format, the loader, save, export and the editor.
 //! - [`texture`]: decoded glTF textures, their packing for the GPU and a CPU sampler
 //!   that mirrors the shader's.
 //! - [`traverse`]: CPU ray queries over exactly that layout, mirrored by
@@ -31,6 +33,7 @@ pub mod gpu;
 pub mod import;
 pub mod lights;
 mod load;
+pub mod lobes;
 pub mod orbit;
 pub mod save;
 mod scene;

@@ -143,7 +143,7 @@ fn finite3(field: &'static str, v: V3) -> Result<Vec3, SceneError> {
     }
 }
 
-fn non_negative3(field: &'static str, v: V3) -> Result<Vec3, SceneError> {
+pub(crate) fn non_negative3(field: &'static str, v: V3) -> Result<Vec3, SceneError> {
     let v = finite3(field, v)?;
     if v.min_element() >= 0.0 {
         Ok(v)
@@ -152,7 +152,7 @@ fn non_negative3(field: &'static str, v: V3) -> Result<Vec3, SceneError> {
     }
 }
 
-fn unit_range(field: &'static str, x: f32) -> Result<f32, SceneError> {
+pub(crate) fn unit_range(field: &'static str, x: f32) -> Result<f32, SceneError> {
     if (0.0..=1.0).contains(&x) {
         Ok(x)
     } else {
@@ -366,21 +366,11 @@ fn material_from_desc(name: &str, d: &MaterialDesc) -> Result<Material, SceneErr
             "an index-matched boundary has no surface to emit",
         ));
     }
-    Ok(Material {
+    let mut m = Material {
         name: name.to_owned(),
         base_color,
         emission: non_negative3("emission", d.emission)?,
-        roughness: unit_range("roughness", d.roughness)?,
-        diffuse_roughness: unit_range("diffuse_roughness", d.diffuse_roughness)?,
         metallic: unit_range("metallic", metallic)?,
-        specular: unit_range("specular", d.specular)?,
-        specular_tint: unit_range("specular_tint", d.specular_tint)?,
-        specular_color: non_negative3("specular_color", d.specular_color)?,
-        transmission: unit_range("transmission", d.transmission)?,
-        clearcoat: unit_range("clearcoat", d.clearcoat)?,
-        clearcoat_roughness: unit_range("clearcoat_roughness", d.clearcoat_roughness)?,
-        sheen_color: non_negative3("sheen_color", d.sheen_color)?,
-        sheen_roughness: unit_range("sheen_roughness", d.sheen_roughness)?,
         ior,
         two_sided: d.two_sided,
         conductor,
@@ -396,7 +386,11 @@ fn material_from_desc(name: &str, d: &MaterialDesc) -> Result<Material, SceneErr
             crate::file::AlphaModeDesc::Blend => crate::scene::AlphaMode::Blend,
         },
         ..Material::named(name)
-    })
+    };
+    for p in crate::lobes::PARAMS {
+        (p.load)(d, &mut m)?;
+    }
+    Ok(m)
 }
 
 fn light_from_desc(d: &LightDesc) -> Result<PunctualLight, SceneError> {

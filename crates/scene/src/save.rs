@@ -149,11 +149,11 @@ fn optional<T>(name: &'static str, value: Option<T>, leaf: impl FnOnce(T) -> Str
 }
 
 /// A float that reads back exactly, always with a decimal point or exponent.
-fn num(x: f32) -> String {
+pub(crate) fn num(x: f32) -> String {
     format!("{x:?}")
 }
 
-fn vec3(v: V3) -> String {
+pub(crate) fn vec3(v: V3) -> String {
     format!("({:?}, {:?}, {:?})", v[0], v[1], v[2])
 }
 
@@ -242,75 +242,66 @@ pub(crate) fn camera_value(c: &CameraDesc) -> Val {
 
 pub(crate) fn material_value(m: &MaterialDesc) -> Val {
     let d = MaterialDesc::default();
+    // The lobe parameters ([`crate::lobes::PARAMS`]), in the format's order: the
+    // roughnesses before `metallic`, the others after `multiscatter`.
+    let params = crate::lobes::PARAMS;
+    let mut lobes = params
+        .iter()
+        .map(|p| given(p.name, (p.save)(m), &(p.save)(&d)));
+    let before_metallic = params
+        .iter()
+        .position(|p| p.name == "specular")
+        .unwrap_or(0);
+    let mut fields = vec![
+        given("base_color", vec3(m.base_color), &vec3(d.base_color)),
+        given("emission", vec3(m.emission), &vec3(d.emission)),
+    ];
+    fields.extend(lobes.by_ref().take(before_metallic));
+    fields.extend([
+        optional("metallic", m.metallic, num),
+        optional("conductor", m.conductor.as_deref(), string),
+        optional("eta", m.eta, vec3),
+        optional("k", m.k, vec3),
+        given(
+            "multiscatter",
+            m.multiscatter.to_string(),
+            &d.multiscatter.to_string(),
+        ),
+    ]);
+    fields.extend(lobes);
+    fields.extend([
+        given("ior", num(m.ior), &num(d.ior)),
+        given(
+            "two_sided",
+            m.two_sided.to_string(),
+            &d.two_sided.to_string(),
+        ),
+        optional("attenuation_color", m.attenuation_color, vec3),
+        optional("attenuation_distance", m.attenuation_distance, num),
+        optional("medium", m.medium, |x| {
+            format!(
+                "(sigma_a: {}, sigma_s: {}, g: {})",
+                vec3(x.sigma_a),
+                vec3(x.sigma_s),
+                num(x.g)
+            )
+        }),
+        given(
+            "index_matched",
+            m.index_matched.to_string(),
+            &d.index_matched.to_string(),
+        ),
+        given(
+            "alpha_mode",
+            format!("{:?}", m.alpha_mode),
+            &format!("{:?}", d.alpha_mode),
+        ),
+        given("alpha_cutoff", num(m.alpha_cutoff), &num(d.alpha_cutoff)),
+        given("opacity", num(m.opacity), &num(d.opacity)),
+    ]);
     Val::Struct {
         variant: "",
-        fields: vec![
-            given("base_color", vec3(m.base_color), &vec3(d.base_color)),
-            given("emission", vec3(m.emission), &vec3(d.emission)),
-            given("roughness", num(m.roughness), &num(d.roughness)),
-            given(
-                "diffuse_roughness",
-                num(m.diffuse_roughness),
-                &num(d.diffuse_roughness),
-            ),
-            optional("metallic", m.metallic, num),
-            optional("conductor", m.conductor.as_deref(), string),
-            optional("eta", m.eta, vec3),
-            optional("k", m.k, vec3),
-            given(
-                "multiscatter",
-                m.multiscatter.to_string(),
-                &d.multiscatter.to_string(),
-            ),
-            given("specular", num(m.specular), &num(d.specular)),
-            given("specular_tint", num(m.specular_tint), &num(d.specular_tint)),
-            given(
-                "specular_color",
-                vec3(m.specular_color),
-                &vec3(d.specular_color),
-            ),
-            given("transmission", num(m.transmission), &num(d.transmission)),
-            given("clearcoat", num(m.clearcoat), &num(d.clearcoat)),
-            given(
-                "clearcoat_roughness",
-                num(m.clearcoat_roughness),
-                &num(d.clearcoat_roughness),
-            ),
-            given("sheen_color", vec3(m.sheen_color), &vec3(d.sheen_color)),
-            given(
-                "sheen_roughness",
-                num(m.sheen_roughness),
-                &num(d.sheen_roughness),
-            ),
-            given("ior", num(m.ior), &num(d.ior)),
-            given(
-                "two_sided",
-                m.two_sided.to_string(),
-                &d.two_sided.to_string(),
-            ),
-            optional("attenuation_color", m.attenuation_color, vec3),
-            optional("attenuation_distance", m.attenuation_distance, num),
-            optional("medium", m.medium, |x| {
-                format!(
-                    "(sigma_a: {}, sigma_s: {}, g: {})",
-                    vec3(x.sigma_a),
-                    vec3(x.sigma_s),
-                    num(x.g)
-                )
-            }),
-            given(
-                "index_matched",
-                m.index_matched.to_string(),
-                &d.index_matched.to_string(),
-            ),
-            given(
-                "alpha_mode",
-                format!("{:?}", m.alpha_mode),
-                &format!("{:?}", d.alpha_mode),
-            ),
-            given("alpha_cutoff", num(m.alpha_cutoff), &num(d.alpha_cutoff)),
-            given("opacity", num(m.opacity), &num(d.opacity)),
-        ],
+        fields,
     }
 }
 

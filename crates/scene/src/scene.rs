@@ -119,42 +119,43 @@ impl MaterialTextures {
     }
 }
 
-/// A material, with the parameters of the path tracer's BSDF.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Material {
+/// The scene's material, its lobe parameters' fields from `lobe_params!`
+/// ([`crate::lobes`]), and [`Material::named`], which gives every field the file format's
+/// default.
+macro_rules! material {
+    ({ $($field:tt)* } { $($named:tt)* } { $($default:tt)* } $(
+        $(#[doc = $doc:literal])*
+        $lobe:ident . $name:ident : $kind:ident = $value:expr, $check:ident,
+        $label:literal, $tip:literal, $max:literal;
+    )*) => {
+        /// A material, with the parameters of the path tracer's BSDF.
+        #[derive(Clone, Debug, PartialEq)]
+        pub struct Material {
+            $($field)*
+            $( $(#[doc = $doc])* pub $name: crate::lobes::scene_ty!($kind), )*
+        }
+
+        impl Material {
+            /// A material with the file format's defaults and the given name.
+            $($named)* {
+                Self {
+                    $($default)*
+                    $( $name: crate::lobes::scene_value!($kind, $value), )*
+                }
+            }
+        }
+    };
+}
+
+crate::lobes::lobe_params!(material! {
     /// Name, for messages (`"white"`, or `"<shape>/<material>"` for imported ones).
     pub name: String,
     /// Diffuse albedo or metal reflectance, linear RGB.
     pub base_color: Vec3,
     /// Emitted radiance, linear RGB.
     pub emission: Vec3,
-    /// Perceptual roughness in [0, 1].
-    pub roughness: f32,
-    /// Roughness of the diffuse base in [0, 1]: 0 Lambertian, else energy-preserving
-    /// Oren–Nayar (EON).
-    pub diffuse_roughness: f32,
     /// 0 dielectric, 1 metal.
     pub metallic: f32,
-    /// Dielectric specular strength (0.5 means F0 = 0.04).
-    pub specular: f32,
-    /// Tint of the dielectric specular towards the base color.
-    pub specular_tint: f32,
-    /// Colour of the dielectric specular at normal incidence (glTF
-    /// `KHR_materials_specular`'s `specularColorFactor`), linear RGB: it multiplies F0 (the
-    /// product clamped to 1) and leaves the grazing reflectance as it is. White: none.
-    pub specular_color: Vec3,
-    /// Transmitted fraction of the dielectric lobe.
-    pub transmission: f32,
-    /// Weight in [0, 1] of a clear coat on top of the material (glTF
-    /// `KHR_materials_clearcoat`): a dielectric layer of ior 1.5; 0 none.
-    pub clearcoat: f32,
-    /// Perceptual roughness of the clear coat in [0, 1].
-    pub clearcoat_roughness: f32,
-    /// Colour of the sheen under the clear coat (glTF `KHR_materials_sheen`), linear RGB;
-    /// black none.
-    pub sheen_color: Vec3,
-    /// Perceptual roughness of the sheen in [0, 1].
-    pub sheen_roughness: f32,
     /// Index of refraction.
     pub ior: f32,
     /// Emission leaves both sides (default: front only).
@@ -182,7 +183,25 @@ pub struct Material {
     pub opacity: f32,
     /// How the opacity is used.
     pub alpha_mode: AlphaMode,
-}
+} {
+    pub fn named(name: impl Into<String>) -> Self
+} {
+    name: name.into(),
+    base_color: Vec3::splat(0.8),
+    emission: Vec3::ZERO,
+    metallic: 0.0,
+    ior: 1.5,
+    two_sided: false,
+    textures: MaterialTextures::default(),
+    normal_scale: 1.0,
+    clearcoat_normal_scale: 1.0,
+    conductor: None,
+    multiscatter: true,
+    medium: None,
+    index_matched: false,
+    opacity: 1.0,
+    alpha_mode: AlphaMode::Opaque,
+});
 
 /// How a material's opacity is used (glTF `alphaMode`): every intersector (and the G-buffer
 /// raster) applies it to the rays that reach the surface, camera and shadow rays alike.
@@ -235,37 +254,6 @@ impl Medium {
 }
 
 impl Material {
-    /// A material with the file format's defaults and the given name.
-    pub fn named(name: impl Into<String>) -> Self {
-        Self {
-            name: name.into(),
-            base_color: Vec3::splat(0.8),
-            emission: Vec3::ZERO,
-            roughness: 0.5,
-            diffuse_roughness: 0.0,
-            metallic: 0.0,
-            specular: 0.5,
-            specular_tint: 0.0,
-            specular_color: Vec3::ONE,
-            transmission: 0.0,
-            clearcoat: 0.0,
-            clearcoat_roughness: 0.0,
-            sheen_color: Vec3::ZERO,
-            sheen_roughness: 0.0,
-            ior: 1.5,
-            two_sided: false,
-            textures: MaterialTextures::default(),
-            normal_scale: 1.0,
-            clearcoat_normal_scale: 1.0,
-            conductor: None,
-            multiscatter: true,
-            medium: None,
-            index_matched: false,
-            opacity: 1.0,
-            alpha_mode: AlphaMode::Opaque,
-        }
-    }
-
     /// The material reduced to a Lambertian diffuse of its base colour: the base colour
     /// factor and texture, opacity, alpha mode, emission (factor and texture) and two-sidedness
     /// kept, every other lobe, texture and medium left out (a `Mesh`'s `diffuse: true`).

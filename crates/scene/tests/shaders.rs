@@ -11,13 +11,16 @@ use lumagraph_scene::{
 };
 
 /// The shader folder, and the generated files the scene crate writes (the dispatches over
-/// the kinds of shapes and of lights without area).
+/// the kinds of shapes and of lights without area, the `Material` struct).
 fn source(name: &str) -> Option<String> {
     if name == lumagraph_scene::shapes::FILE {
         return Some(lumagraph_scene::shapes::wgsl());
     }
     if name == lumagraph_scene::lights::FILE {
         return Some(lumagraph_scene::lights::wgsl());
+    }
+    if name == lumagraph_scene::lobes::FILE {
+        return Some(lumagraph_scene::lobes::wgsl());
     }
     lumagraph_wgsl::from_dir(common::shaders())(name)
 }
@@ -89,48 +92,62 @@ macro_rules! layout {
     };
 }
 
-/// `Material`'s expected layout (long enough for a function of its own).
+/// `Material`'s layout: its fields as the table declares them (`lumagraph_scene::lobes`),
+/// each at its Rust offset.
 fn material_layout() -> (&'static str, usize, Vec<(&'static str, usize)>) {
-    layout!(
-        GpuMaterial,
-        "Material",
-        [
-            base_color,
-            roughness,
-            emission,
-            metallic,
-            specular,
-            specular_tint,
-            transmission,
-            ior,
-            tex_base_mr,
-            tex_emissive_normal,
-            flags,
-            normal_scale,
-            tex_transmission_specular,
-            tex_specular_color,
-            diffuse_roughness,
-            opacity,
-            eta,
-            alpha_cutoff,
-            k,
-            tex_coat,
-            f_avg,
-            tex_sheen,
-            sigma_a,
-            phase_g,
-            sigma_s,
-            pad5,
-            sheen_color,
-            sheen_roughness,
-            clearcoat,
-            clearcoat_roughness,
-            pad6,
-            pad7,
-            specular_color,
-            clearcoat_normal_scale
-        ]
-    )
+    let fields = GpuMaterial::FIELDS.iter().map(|f| (f.name, f.offset));
+    ("Material", size_of::<GpuMaterial>(), fields.collect())
+}
+
+/// The fields of the 208-byte record that the images were rendered with keep their
+/// offsets: a field added to the table goes into padding (`pad*`) or after them.
+#[test]
+fn material_fields_keep_their_offsets() {
+    let pinned: [(&str, usize); 34] = [
+        ("base_color", 0),
+        ("roughness", 12),
+        ("emission", 16),
+        ("metallic", 28),
+        ("specular", 32),
+        ("specular_tint", 36),
+        ("transmission", 40),
+        ("ior", 44),
+        ("tex_base_mr", 48),
+        ("tex_emissive_normal", 52),
+        ("flags", 56),
+        ("normal_scale", 60),
+        ("tex_transmission_specular", 64),
+        ("tex_specular_color", 68),
+        ("diffuse_roughness", 72),
+        ("opacity", 76),
+        ("eta", 80),
+        ("alpha_cutoff", 92),
+        ("k", 96),
+        ("tex_coat", 108),
+        ("f_avg", 112),
+        ("tex_sheen", 124),
+        ("sigma_a", 128),
+        ("phase_g", 140),
+        ("sigma_s", 144),
+        ("pad5", 156),
+        ("sheen_color", 160),
+        ("sheen_roughness", 172),
+        ("clearcoat", 176),
+        ("clearcoat_roughness", 180),
+        ("pad6", 184),
+        ("pad7", 188),
+        ("specular_color", 192),
+        ("clearcoat_normal_scale", 204),
+    ];
+    for (name, offset) in &pinned {
+        let now = GpuMaterial::FIELDS.iter().find(|f| f.name == *name);
+        let pad = name.starts_with("pad");
+        assert!(
+            now.map(|f| f.offset) == Some(*offset) || pad,
+            "{name}: was at {offset}, now {now:?}"
+        );
+    }
+    assert!(size_of::<GpuMaterial>() >= 208);
 }
 
 #[test]

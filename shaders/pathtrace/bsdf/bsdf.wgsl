@@ -381,7 +381,7 @@ struct Layers {
 // reflects nothing from below its horizon.
 fn layers(m: Material, wo: vec3f) -> Layers {
     let mu_o = wo.z;
-    var l = Layers(CoatParams(0.0, ggx_lobe(0.0)), 0.0, 1.0, 0.0);
+    var l = Layers(no_coat(), 0.0, 1.0, 0.0);
     let mu_c = dot(wo, coat_normal);
     if HAS_COAT && m.clearcoat > 0.0 && mu_c > 0.0 {
         l.coat = coat_params(m);
@@ -411,7 +411,7 @@ fn eval_bsdf(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
     }
     if l.p_coat > 0.0 {
         let c = coat_eval(l.coat, to_coat(wo), to_coat(wi));
-        out.f_cos = c.f_cos + (1.0 - l.p_coat) * out.f_cos;
+        out.f_cos = c.f_cos + (1.0 - l.p_coat) * l.coat.through * out.f_cos;
         out.pdf = l.p_coat * c.pdf + (1.0 - l.p_coat) * out.pdf;
     }
     return out;
@@ -420,7 +420,7 @@ fn eval_bsdf(m: Material, wo: vec3f, wi: vec3f) -> BsdfEval {
 // A sample of the whole BSDF: the coat, the sheen or the three lobes, chosen by u_lobe with
 // the layers' probabilities (`layers`), the rest of u_lobe choosing among the lobes.
 fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
-    var l = Layers(CoatParams(0.0, ggx_lobe(0.0)), 0.0, 1.0, 0.0);
+    var l = Layers(no_coat(), 0.0, 1.0, 0.0);
     if (HAS_COAT || HAS_SHEEN) && !(wo.z <= 0.0) {
         l = layers(m, wo);
     }
@@ -456,11 +456,13 @@ fn sample_bsdf(m: Material, wo: vec3f, u_lobe: f32, u: vec3f) -> BsdfSample {
     if base {
         let b = sample_base(m, wo, u_base, u);
         // A delta sample (mirror, glass) or none: the layers take from it exactly the
-        // probability of passing them. With the microfacet code compiled in, every other
+        // probability of passing them, and it is weighted by what passes the coat. With the microfacet code compiled in, every other
         // sample of the lobes is weighted by the whole BSDF (`eval`); without, the diffuse
         // base's sample is weighted again here only under layers.
         if !b.eval && (!layered || !b.s.valid || b.s.pdf == 0.0 || HAS_SPECULAR || HAS_METAL) {
-            return b.s;
+            var s = b.s;
+            s.weight *= l.coat.through;
+            return s;
         }
         wi = b.s.wi;
     }

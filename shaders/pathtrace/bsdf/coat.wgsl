@@ -5,7 +5,8 @@
 // albedo from the GGX tables: albedo scaling, as glTF's layering does with the view angle).
 // The coat has a normal of its own (`coat_normal`): glTF's coat is smooth where the base is
 // normal-mapped, or follows its own normal map. Its lobe and albedo are taken in its frame,
-// with its cosines; it reflects nothing towards or from below its own horizon.
+// with its cosines; it reflects nothing towards or from below its own horizon. A tinted coat
+// (`clearcoat_tint`) multiplies what lies below it by `CoatParams::through`.
 #import "pathtrace/scene_types.wgsl"
 #import "pathtrace/bsdf/microfacet.wgsl"
 #import "common/sampling.wgsl"
@@ -41,10 +42,22 @@ struct CoatParams {
     // `clearcoat` in [0, 1].
     weight: f32,
     lobe: LobeParams,
+    // What the layers below are multiplied by besides the share the coat reflects
+    // (1 - coat_albedo): white for a clear coat. bsdf.wgsl's layering applies it to their
+    // evaluation and to their delta samples' weights.
+    through: vec3f,
 }
 
+// What passes a coat of weight w and tint T (`clearcoat_tint`, Standard Surface's
+// `coat_color`): 1 + w (T - 1), exactly 1 for a white tint.
 fn coat_params(m: Material) -> CoatParams {
-    return CoatParams(clamp(m.clearcoat, 0.0, 1.0), ggx_lobe(m.clearcoat_roughness));
+    let w = clamp(m.clearcoat, 0.0, 1.0);
+    return CoatParams(w, ggx_lobe(m.clearcoat_roughness), 1.0 + w * (m.clearcoat_tint - 1.0));
+}
+
+// No coat: nothing reflected, everything through.
+fn no_coat() -> CoatParams {
+    return CoatParams(0.0, ggx_lobe(0.0), vec3f(1.0));
 }
 
 // The coat's directional albedo (its weight included) at view cosine mu: what it reflects

@@ -545,6 +545,14 @@ fn environment(ui: &mut Ui, env: &mut Environment) -> bool {
 }
 
 fn material(ui: &mut Ui, name: &str, m: &mut MaterialDesc) {
+    // The lobe parameters: the roughnesses before `metallic`, the rest after `conductor`.
+    let params = lumagraph_scene::lobes::PARAMS;
+    let (first, rest) = params.split_at(
+        params
+            .iter()
+            .position(|p| p.name == "specular")
+            .unwrap_or(0),
+    );
     egui::Grid::new(("material grid", name))
         .num_columns(2)
         .spacing([8.0, 4.0])
@@ -560,19 +568,7 @@ fn material(ui: &mut Ui, name: &str, m: &mut MaterialDesc) {
             row(ui, "emission", "emitted radiance, linear RGB", |ui, _| {
                 colour(ui, &mut m.emission, 1e6);
             });
-            row(ui, "roughness", "perceptual; α = roughness²", |ui, l| {
-                ui.add(egui::Slider::new(&mut m.roughness, 0.0..=1.0))
-                    .labelled_by(l);
-            });
-            row(
-                ui,
-                "diffuse roughness",
-                "0 Lambertian; above 0 energy-preserving Oren–Nayar (EON)",
-                |ui, l| {
-                    ui.add(egui::Slider::new(&mut m.diffuse_roughness, 0.0..=1.0))
-                        .labelled_by(l);
-                },
-            );
+            lobe_rows(ui, m, first);
             row(ui, "metallic", "0 dielectric, 1 metal", |ui, l| {
                 let auto = m.conductor.is_some() || m.eta.is_some() || m.k.is_some();
                 let mut v = m.metallic.unwrap_or(if auto { 1.0 } else { 0.0 });
@@ -610,42 +606,11 @@ fn material(ui: &mut Ui, name: &str, m: &mut MaterialDesc) {
                         });
                 },
             );
-            row(
-                ui,
-                "specular",
-                "dielectric specular strength; 0.5: F0 = 0.04",
-                |ui, l| {
-                    ui.add(egui::Slider::new(&mut m.specular, 0.0..=1.0))
-                        .labelled_by(l);
-                },
-            );
-            row(ui, "specular tint", "towards the base colour", |ui, l| {
-                ui.add(egui::Slider::new(&mut m.specular_tint, 0.0..=1.0))
-                    .labelled_by(l);
-            });
-            row(
-                ui,
-                "specular colour",
-                "multiplies F0 (to at most 1), not the grazing reflection; white: none",
-                |ui, _| {
-                    // Up to 25: F0 = 0.04 × 25 = 1 at the default strength.
-                    colour(ui, &mut m.specular_color, 25.0);
-                },
-            );
-            row(
-                ui,
-                "transmission",
-                "transmitted fraction of the dielectric lobe",
-                |ui, l| {
-                    ui.add(egui::Slider::new(&mut m.transmission, 0.0..=1.0))
-                        .labelled_by(l);
-                },
-            );
+            lobe_rows(ui, m, rest);
             row(ui, "ior", "index of refraction", |ui, l| {
                 ui.add(egui::Slider::new(&mut m.ior, 1.0..=3.0))
                     .labelled_by(l);
             });
-            layer_rows(ui, m);
             row(ui, "two-sided", "emission leaves both sides", |ui, _| {
                 ui.checkbox(&mut m.two_sided, "");
             });
@@ -660,36 +625,18 @@ fn material(ui: &mut Ui, name: &str, m: &mut MaterialDesc) {
         });
 }
 
-/// The clear coat and sheen rows of [`material`]'s grid.
-fn layer_rows(ui: &mut Ui, m: &mut MaterialDesc) {
-    row(
-        ui,
-        "clear coat",
-        "weight of a varnish on top (ior 1.5)",
-        |ui, l| {
-            ui.add(egui::Slider::new(&mut m.clearcoat, 0.0..=1.0))
-                .labelled_by(l);
-        },
-    );
-    row(ui, "coat roughness", "0: a mirror", |ui, l| {
-        ui.add(egui::Slider::new(&mut m.clearcoat_roughness, 0.0..=1.0))
-            .labelled_by(l);
-    });
-    row(
-        ui,
-        "sheen",
-        "colour of a cloth sheen under the coat; black: none",
-        |ui, _| {
-            colour(ui, &mut m.sheen_color, 1.0);
-        },
-    );
-    row(
-        ui,
-        "sheen roughness",
-        "below 0.07 taken as 0.07",
-        |ui, l| {
-            ui.add(egui::Slider::new(&mut m.sheen_roughness, 0.0..=1.0))
-                .labelled_by(l);
-        },
-    );
+/// The rows of the lobe parameters `params` ([`lumagraph_scene::lobes::PARAMS`]) in
+/// [`material`]'s grid: a slider from 0 to the parameter's maximum, or a colour.
+fn lobe_rows(ui: &mut Ui, m: &mut MaterialDesc, params: &[lumagraph_scene::lobes::Param]) {
+    use lumagraph_scene::lobes::ParamMut;
+    for p in params {
+        row(ui, p.label, p.tip, |ui, l| match (p.edit)(m) {
+            ParamMut::Scalar(x) => {
+                ui.add(egui::Slider::new(x, 0.0..=p.max)).labelled_by(l);
+            }
+            ParamMut::Rgb(c) => {
+                colour(ui, c, p.max);
+            }
+        });
+    }
 }

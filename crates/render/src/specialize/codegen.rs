@@ -6,7 +6,8 @@
 
 use std::fmt::Write as _;
 
-use lumagraph_scene::GpuScene;
+use lumagraph_scene::lobes::Value;
+use lumagraph_scene::{GpuMaterial, GpuScene};
 
 use super::{INLINE_MAX_MATERIALS, INLINE_MAX_PRIMITIVES};
 
@@ -234,13 +235,11 @@ fn table_fns(name: &str, ty: &str, types: &[&str], rows: &[Vec<String>]) -> Stri
     out
 }
 
-/// The WGSL types of [`materials_rows`]'s fields, in order (`Material` in
-/// `pathtrace/scene_types.wgsl`).
-const MATERIAL_TYPES: [&str; 34] = [
-    "vec3f", "f32", "vec3f", "f32", "f32", "f32", "f32", "f32", "u32", "u32", "u32", "f32", "u32",
-    "u32", "f32", "f32", "vec3f", "f32", "vec3f", "u32", "vec3f", "u32", "vec3f", "f32", "vec3f",
-    "u32", "vec3f", "f32", "f32", "f32", "u32", "u32", "vec3f", "f32",
-];
+/// The WGSL types of [`materials_rows`]'s fields, in order (`Material`, written from the
+/// same table: [`lumagraph_scene::lobes`]).
+fn material_types() -> Vec<&'static str> {
+    GpuMaterial::FIELDS.iter().map(|f| f.wgsl).collect()
+}
 
 /// The WGSL types of [`lights_rows`]'s fields, in order (`Light` in
 /// `pathtrace/scene_types.wgsl`).
@@ -254,42 +253,14 @@ fn materials_rows(scene: &GpuScene, l: &Literals) -> Vec<Vec<String>> {
         .materials
         .iter()
         .map(|m| {
-            vec![
-                l.v3(m.base_color),
-                l.f(m.roughness),
-                l.v3(m.emission),
-                l.f(m.metallic),
-                l.f(m.specular),
-                l.f(m.specular_tint),
-                l.f(m.transmission),
-                l.f(m.ior),
-                u(m.tex_base_mr),
-                u(m.tex_emissive_normal),
-                u(m.flags),
-                l.f(m.normal_scale),
-                u(m.tex_transmission_specular),
-                u(m.tex_specular_color),
-                l.f(m.diffuse_roughness),
-                l.f(m.opacity),
-                l.v3(m.eta),
-                l.f(m.alpha_cutoff),
-                l.v3(m.k),
-                u(m.tex_coat),
-                l.v3(m.f_avg),
-                u(m.tex_sheen),
-                l.v3(m.sigma_a),
-                l.f(m.phase_g),
-                l.v3(m.sigma_s),
-                u(0),
-                l.v3(m.sheen_color),
-                l.f(m.sheen_roughness),
-                l.f(m.clearcoat),
-                l.f(m.clearcoat_roughness),
-                u(0),
-                u(0),
-                l.v3(m.specular_color),
-                l.f(m.clearcoat_normal_scale),
-            ]
+            m.values()
+                .into_iter()
+                .map(|v| match v {
+                    Value::F32(x) => l.f(x),
+                    Value::U32(x) => u(x),
+                    Value::Vec3f(x) => l.v3(x),
+                })
+                .collect()
         })
         .collect()
 }
@@ -414,7 +385,7 @@ pub fn inline_scene_data(scene: &GpuScene) -> Option<String> {
         lights.len(),
         positions.len(),
         shapes.len(),
-        table_fns("scene_material", "Material", &MATERIAL_TYPES, &materials),
+        table_fns("scene_material", "Material", &material_types(), &materials),
         table_fns("scene_light", "Light", &LIGHT_TYPES, &lights),
         table_fns("scene_light_alias", "AliasEntry", &[f1, u1], &alias),
         table_fns(
@@ -498,7 +469,7 @@ fn scene_shape(i: u32) -> Shape {{
         },
         scene.tri_positions.len(),
         scene.shapes.len(),
-        table_fns("scene_material", "Material", &MATERIAL_TYPES, &materials),
+        table_fns("scene_material", "Material", &material_types(), &materials),
     ))
 }
 
