@@ -44,17 +44,26 @@ fn repo(path: &str) -> PathBuf {
 /// `assets/bench/mesh_env.ron` flattened, its mesh made first when missing.
 fn mesh_env() -> GpuScene {
     let blob = repo("assets/bench/blob.obj");
-    if !blob.exists() {
-        // Written beside and renamed, so tests making it at once never read half a file.
-        let tmp = blob.with_extension(format!("obj.{}", std::process::id()));
-        let ok = std::process::Command::new("python3")
-            .arg(repo("scripts/bench/mesh_env.py"))
-            .arg("make")
-            .arg(&tmp)
-            .status()
-            .is_ok_and(|s| s.success());
-        assert!(ok, "python3 scripts/bench/mesh_env.py make failed");
-        std::fs::rename(&tmp, &blob).unwrap();
+    // One thread of this process makes it, the others wait: they would write the same
+    // file beside it at once.
+    static MAKING: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    {
+        let _one = MAKING
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if !blob.exists() {
+            // Written beside and renamed, so other processes making it at once never read half
+            // a file.
+            let tmp = blob.with_extension(format!("obj.{}", std::process::id()));
+            let ok = std::process::Command::new("python3")
+                .arg(repo("scripts/bench/mesh_env.py"))
+                .arg("make")
+                .arg(&tmp)
+                .status()
+                .is_ok_and(|s| s.success());
+            assert!(ok, "python3 scripts/bench/mesh_env.py make failed");
+            std::fs::rename(&tmp, &blob).unwrap();
+        }
     }
     let scene = Scene::load(&repo("assets/bench/mesh_env.ron")).expect("scene");
     GpuScene::build(&scene).expect("flatten")
