@@ -8,6 +8,9 @@
 
 use lumagraph::render::specialize::Tracing;
 use std::path::{Path, PathBuf};
+
+#[path = "bench_mesh.rs"]
+mod bench_mesh;
 use std::sync::LazyLock;
 
 use lumagraph::render::GpuContext;
@@ -390,28 +393,7 @@ pub fn filter_graph(
 /// The environment-lit mesh scene (`assets/bench/mesh_env.ron`) at `size`, after making its
 /// mesh (`assets/bench/blob.obj`, not in git) with `scripts/bench/mesh_env.py` when missing.
 pub fn mesh_env_scene(size: Option<u32>) -> std::sync::Arc<lumagraph::scene::GpuScene> {
-    let blob = repo("assets/bench/blob.obj");
-    // One thread of this process makes it, the others wait: they would write the same
-    // file beside it at once.
-    static MAKING: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    {
-        let _one = MAKING
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        if !blob.exists() {
-            // Written beside and renamed, so other processes making it at once never read half
-            // a file.
-            let tmp = blob.with_extension(format!("obj.{}", std::process::id()));
-            let ok = std::process::Command::new("python3")
-                .arg(repo("scripts/bench/mesh_env.py"))
-                .arg("make")
-                .arg(&tmp)
-                .status()
-                .is_ok_and(|s| s.success());
-            assert!(ok, "python3 scripts/bench/mesh_env.py make failed");
-            std::fs::rename(&tmp, &blob).unwrap();
-        }
-    }
+    bench_mesh::bench_blob(&root());
     gpu_scene("assets/bench/mesh_env.ron", size)
 }
 

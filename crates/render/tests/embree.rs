@@ -35,6 +35,9 @@ fn embree() -> Option<Arc<Embree>> {
     }
 }
 
+#[path = "../../../tests/common/bench_mesh.rs"]
+mod bench_mesh;
+
 fn repo(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../..")
@@ -43,28 +46,7 @@ fn repo(path: &str) -> PathBuf {
 
 /// `assets/bench/mesh_env.ron` flattened, its mesh made first when missing.
 fn mesh_env() -> GpuScene {
-    let blob = repo("assets/bench/blob.obj");
-    // One thread of this process makes it, the others wait: they would write the same
-    // file beside it at once.
-    static MAKING: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    {
-        let _one = MAKING
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        if !blob.exists() {
-            // Written beside and renamed, so other processes making it at once never read half
-            // a file.
-            let tmp = blob.with_extension(format!("obj.{}", std::process::id()));
-            let ok = std::process::Command::new("python3")
-                .arg(repo("scripts/bench/mesh_env.py"))
-                .arg("make")
-                .arg(&tmp)
-                .status()
-                .is_ok_and(|s| s.success());
-            assert!(ok, "python3 scripts/bench/mesh_env.py make failed");
-            std::fs::rename(&tmp, &blob).unwrap();
-        }
-    }
+    bench_mesh::bench_blob(&repo(""));
     let scene = Scene::load(&repo("assets/bench/mesh_env.ron")).expect("scene");
     GpuScene::build(&scene).expect("flatten")
 }

@@ -71,7 +71,7 @@ pub fn kind_named(name: &str) -> Option<u32> {
         .map(|i| i as u32)
 }
 
-/// The kind's index in [`KINDS`] of a record, if it is a light without area.
+/// The kind of a record, if it is a light without area (its `kind` is an index into [`KINDS`] + 1).
 pub fn kind_of(l: &GpuLight) -> Option<&'static dyn LightKind> {
     (l.kind as usize)
         .checked_sub(1)
