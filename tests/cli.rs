@@ -583,7 +583,6 @@ fn plan_lists_shader_features_for_the_scene() {
     assert!(o.status.success(), "{stderr}");
     let left_out = stdout.split("left out:\n").last().unwrap();
     for f in [
-        "BVH traversal",
         "shape tests",
         "environment",
         "metal lobe",
@@ -610,10 +609,21 @@ fn plan_lists_shader_features_for_the_scene() {
         compiled_in.contains("8 materials with diffuse_roughness > 0"),
         "{rough}"
     );
+    // The intersector chosen, why, and why not each of the others.
     assert!(
-        stdout.contains("compiled in:\n    inline intersection"),
+        stdout.contains("  intersector: inline (36 primitives, "),
         "{stdout}"
     );
+    for other in ["host", "wide", "binary"] {
+        assert!(
+            stdout.contains(&format!(
+                "    not {other}: inline intersection traces the scene"
+            )),
+            "{stdout}"
+        );
+    }
+    // Where the adapter has no ray queries, that is the reason given instead.
+    assert!(stdout.contains("    not rays: "), "{stdout}");
     assert!(
         stdout.contains(
             "    inline materials and lights  4 materials, 2 lights, 36 primitives' shading data"

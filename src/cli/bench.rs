@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use super::progressive::counter;
 use crate::graph::{Edge, Graph, Node, ParamValue};
-use crate::render::specialize::{Feature, Intersector};
+use crate::render::specialize::{Feature, Features, Intersector};
 use crate::render::{Executor, GpuContext, Resources, compile};
 use crate::scene::GpuScene;
 use anyhow::Result;
@@ -133,6 +133,16 @@ impl Figures {
     fn on(&self, f: Feature) -> bool {
         self.features.as_ref().is_some_and(|x| x.on(f))
     }
+
+    /// Whether the host traced the rays, in steps.
+    fn host_steps(&self) -> bool {
+        self.features.as_ref().is_some_and(|f| f.kind().host_steps())
+    }
+
+    /// The intersector the shader traced with, where it has features.
+    fn intersector(&self) -> Option<&'static dyn crate::render::intersect::IntersectorKind> {
+        self.features.as_ref().map(Features::kind)
+    }
 }
 
 /// One line of the report.
@@ -188,16 +198,21 @@ pub fn run(
     );
     let special = measure(&ctx, scene, asked.clone(), spp, runs)?;
     print("specialized", &special);
-    // Where the specialized shader walks the 8-wide BVH, the binary one beside it (the
-    // specialized shader as `--intersector binary` runs it).
-    let binary = if special.on(Feature::WideBvh) {
+    // Where the specialized shader traces on the device with another intersector than the
+    // binary BVH (the 8-wide BVH, ray queries), the binary one beside it (the specialized
+    // shader as `--intersector binary` runs it).
+    let other_intersector = special
+        .intersector()
+        .filter(|k| !k.inline() && !k.host_steps() && k.intersector() != Intersector::BINARY_BVH);
+    let binary = if let Some(kind) = other_intersector {
         let binary = asked
             .clone()
-            .tracing(|t| t.intersector = Intersector::BinaryBvh);
+            .tracing(|t| t.intersector = Intersector::BINARY_BVH);
         let binary = measure(&ctx, scene, binary, spp, runs)?;
         print("binary BVH", &binary);
         println!(
-            "  specialized (8-wide BVH) / binary BVH: {:.2}x",
+            "  specialized ({}) / binary BVH: {:.2}x",
+            kind.describe(),
             special.wall / binary.wall
         );
         Some(binary)
@@ -207,7 +222,7 @@ pub fn run(
     // The wavefront beside the megakernel (or the megakernel beside the wavefront, where
     // the specialized shader is one), where the scene allows it: the specialized shader as
     // `--schedule wavefront` or `megakernel` runs it.
-    if !special.on(Feature::HostRays) {
+    if !special.host_steps() {
         use crate::render::specialize::Schedule;
         let front = special.on(Feature::Wavefront);
         let other = asked.clone().tracing(|t| {
@@ -239,8 +254,8 @@ pub fn run(
     if specialized_only {
         return Ok(());
     }
-    let wgsl = if special.on(Feature::HostRays) {
-        let wgsl = Resources::default().tracing(|t| t.intersector = Intersector::WideBvh);
+    let wgsl = if special.host_steps() {
+        let wgsl = Resources::default().tracing(|t| t.intersector = Intersector::WIDE_BVH);
         let wgsl = measure(&ctx, scene, wgsl, spp, runs)?;
         print("WGSL BVH", &wgsl);
         Some(wgsl)
@@ -359,8 +374,8 @@ fn diffuse_ray(
 /// primary hit. Each set is cast in one submission of several dispatches (enough for about
 /// a quarter of a second), best of `runs`; prints M rays/s and the rays that hit.
 pub fn traversal(scene: &Arc<GpuScene>, runs: u32) -> Result<()> {
+    use crate::render::intersect::wide_bvh::{WideBvh, upload};
     use crate::render::raycast::Raycaster;
-    use crate::render::wide_bvh::{WideBvh, upload};
     let ctx = GpuContext::headless()?;
     println!("adapter: {}", ctx.describe());
     let buffers = crate::render::SceneBuffers::upload(&ctx, scene)?;

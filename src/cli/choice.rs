@@ -52,12 +52,12 @@ impl Choice {
 /// 8-wide or the binary BVH in WGSL; else `Auto`.
 fn intersector_from_env() -> Intersector {
     if std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "on" || v == "1") {
-        return Intersector::RayQueries;
+        return Intersector::RAY_QUERIES;
     }
     match std::env::var("LUMAGRAPH_BVH").as_deref() {
-        Ok("wide") => Intersector::WideBvh,
-        Ok("binary") => Intersector::BinaryBvh,
-        _ => Intersector::Auto,
+        Ok("wide") => Intersector::WIDE_BVH,
+        Ok("binary") => Intersector::BINARY_BVH,
+        _ => Intersector::AUTO,
     }
 }
 
@@ -128,6 +128,11 @@ pub(crate) fn print_features(
             features.intersector().name(),
             features.intersector_reason()
         );
+        for (other, why) in features.intersectors() {
+            if other != features.intersector() {
+                println!("    not {}: {why}", other.name());
+            }
+        }
         println!(
             "  schedule: {} ({})",
             features.schedule().name(),

@@ -109,9 +109,9 @@ pub fn executor(
     // `LUMAGRAPH_RAY_QUERY=on` runs these renders through ray queries, as
     // `lumagraph render --intersector rays` does (docs/pathtracer.md: the reference suite).
     let intersector = if std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "on") {
-        lumagraph::render::specialize::Intersector::RayQueries
+        lumagraph::render::specialize::Intersector::RAY_QUERIES
     } else {
-        lumagraph::render::specialize::Intersector::Auto
+        lumagraph::render::specialize::Intersector::AUTO
     };
     let resources = Resources {
         scene: Some(std::sync::Arc::clone(scene)),

@@ -140,7 +140,7 @@ fn masked_checkerboard_shows_the_wall_through_its_holes() {
     };
     let wgsl = Resources {
         tracer: Tracing {
-            intersector: Intersector::BinaryBvh,
+            intersector: Intersector::BINARY_BVH,
             ..Tracing::default()
         },
         ..Resources::default()
@@ -148,7 +148,7 @@ fn masked_checkerboard_shows_the_wall_through_its_holes() {
     let wide = Resources {
         tracer: Tracing {
             as_gpu_adapter: true,
-            intersector: Intersector::WideBvh,
+            intersector: Intersector::WIDE_BVH,
             ..Tracing::default()
         },
         ..Resources::default()
@@ -181,7 +181,7 @@ fn masked_checkerboard_shows_the_wall_through_ray_queries() {
     }
     let ray_queries = Resources {
         tracer: Tracing {
-            intersector: Intersector::RayQueries,
+            intersector: Intersector::RAY_QUERIES,
             ..Tracing::default()
         },
         ..Resources::default()
@@ -232,25 +232,25 @@ fn check_checkerboard(tiles: u32, intersectors: &[(&str, Resources)]) {
             features.on(Feature::Alpha),
             "{name}: the alpha test was left out"
         );
-        let host = features.on(Feature::HostRays);
+        let host = features.intersector() == Intersector::HOST;
         if *name == "host" && !host {
             assert!(
                 !common::gpu().is_some_and(lumagraph::render::GpuContext::is_cpu)
                     || std::env::var("LUMAGRAPH_ALLOW_NO_EMBREE").is_ok_and(|v| v == "1"),
                 "no host intersection on this CPU adapter: {}",
-                features.reason(Feature::HostRays)
+                features.why(Intersector::HOST)
             );
             continue;
         }
         assert_eq!(host, *name == "host", "{name}: {}", features.summary());
         assert_eq!(
-            features.on(Feature::RayQueries),
+            features.intersector() == Intersector::RAY_QUERIES,
             *name == "ray queries",
             "{name}: {}",
             features.summary()
         );
         assert_eq!(
-            features.on(Feature::WideBvh),
+            features.intersector() == Intersector::WIDE_BVH,
             *name == "8-wide BVH",
             "{name}: {}",
             features.summary()

@@ -127,8 +127,8 @@ fn the_wide_bvh_finds_the_binary_bvhs_hits() {
     let scene = Scene::from_ron(SCENE, &common::repo("assets")).unwrap();
     let gpu_scene = GpuScene::build(&scene).unwrap();
     let buffers = SceneBuffers::upload(ctx, &gpu_scene).unwrap();
-    let wide = lumagraph::render::wide_bvh::WideBvh::build(&gpu_scene).unwrap();
-    let wide_nodes = lumagraph::render::wide_bvh::upload(ctx, &wide).unwrap();
+    let wide = lumagraph::render::intersect::wide_bvh::WideBvh::build(&gpu_scene).unwrap();
+    let wide_nodes = lumagraph::render::intersect::wide_bvh::upload(ctx, &wide).unwrap();
     let rays = random_rays(100_000);
     let binary = Raycaster::new(ctx)
         .unwrap()

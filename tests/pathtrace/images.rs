@@ -187,9 +187,9 @@ fn a_frame_of_many_samples_traces_every_path() {
             scene: Some(Arc::clone(&grid)),
             tracer: Tracing {
                 intersector: if wgsl {
-                    Intersector::WideBvh
+                    Intersector::WIDE_BVH
                 } else {
-                    Intersector::Auto
+                    Intersector::AUTO
                 },
                 ..Tracing::default()
             },
@@ -344,7 +344,7 @@ fn inlined_scene_data_renders_bit_identical_images() {
         };
         let (buffers, how_buffers) = render_small(name, 8, true, false).unwrap();
         assert!(
-            how_inline.on(Feature::InlineData) && how_inline.on(Feature::InlineIntersection),
+            how_inline.on(Feature::InlineData) && how_inline.intersector() == Intersector::INLINE,
             "{}",
             how_inline.summary()
         );
@@ -465,8 +465,8 @@ fn bvh_traversal_renders_what_inline_intersection_renders() {
             return;
         };
         let (bvh, how_bvh) = render_small(name, 8, true, true).unwrap();
-        assert!(how_inline.on(Feature::InlineIntersection));
-        assert!(!how_bvh.on(Feature::InlineIntersection));
+        assert_eq!(how_inline.intersector(), Intersector::INLINE);
+        assert_ne!(how_bvh.intersector(), Intersector::INLINE);
         for (i, (a, b)) in inline.iter().zip(&bvh).enumerate() {
             let (differ, far) = (
                 common::differing(a, b, None),
@@ -506,24 +506,24 @@ fn host_against_wgsl(name: &str, size: (u32, u32), spp: u32) -> Option<HostAgain
         return None;
     }
     let (host, how_host) = common::render_with(name, size, spp, Resources::default()).unwrap();
-    if !how_host.on(Feature::HostRays) {
+    if how_host.intersector() != Intersector::HOST {
         assert!(
             std::env::var("LUMAGRAPH_ALLOW_NO_EMBREE").is_ok_and(|v| v == "1"),
             "no host intersection on this CPU adapter ({}): install Embree 3 \
              (scripts/setup.sh), or set LUMAGRAPH_ALLOW_NO_EMBREE=1",
-            how_host.reason(Feature::HostRays)
+            how_host.why(Intersector::HOST)
         );
         return None;
     }
     let wgsl_only = Resources {
         tracer: Tracing {
-            intersector: Intersector::WideBvh,
+            intersector: Intersector::WIDE_BVH,
             ..Tracing::default()
         },
         ..Resources::default()
     };
     let (wgsl, how_wgsl) = common::render_with(name, size, spp, wgsl_only).unwrap();
-    assert!(!how_wgsl.on(Feature::HostRays));
+    assert_ne!(how_wgsl.intersector(), Intersector::HOST);
     assert_bit_identical(&format!("{name} AOVs"), &host[1..], &wgsl[1..]);
     let (a, b) = (&host[0], &wgsl[0]);
     assert!(a.pixels.iter().any(|p| p[0] > 0.0), "{name}: black");
@@ -671,7 +671,9 @@ fn inlined_materials_of_a_large_scene_render_what_the_buffers_render() {
         return;
     }
     assert!(how_inline.on(Feature::InlineData));
-    assert!(!how_buffers.on(Feature::InlineData) && !how_buffers.on(Feature::InlineIntersection));
+    assert!(
+        !how_buffers.on(Feature::InlineData) && how_buffers.intersector() != Intersector::INLINE
+    );
     assert_bit_identical("spheregrid AOVs", &inline[1..], &buffers[1..]);
     let (differ, far) = (
         common::differing(&inline[0], &buffers[0], None),

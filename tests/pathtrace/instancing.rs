@@ -145,7 +145,7 @@ fn render(
         scene: Some(scene),
         tracer: Tracing {
             as_gpu_adapter: true,
-            intersector: Intersector::BinaryBvh,
+            intersector: Intersector::BINARY_BVH,
             ..Tracing::default()
         },
         ..Resources::default()
@@ -315,7 +315,8 @@ fn a_thousand_instances_of_a_100k_triangle_mesh() {
     let mut exec = Executor::new(ctx, plan, &resources).unwrap();
     let features = exec.shader_features("pt").unwrap().clone();
     println!("{}", features.summary());
-    assert!(features.on(Feature::Instances) && features.on(Feature::BvhTraversal));
+    assert!(features.on(Feature::Instances));
+    assert_eq!(features.intersector(), Intersector::BINARY_BVH);
     let started = std::time::Instant::now();
     exec.run_frames(1, true).unwrap();
     println!(
@@ -353,7 +354,7 @@ fn a_thousand_instances_of_a_100k_triangle_mesh() {
 fn flat_only_intersectors_refuse_instances_and_the_choice_says_why() {
     use lumagraph::render::specialize::{Features, PathTraceOptions, Schedule};
     let scene = gpu_scene("On");
-    let e = lumagraph::render::wide_bvh::WideBvh::build(&scene).unwrap_err();
+    let e = lumagraph::render::intersect::wide_bvh::WideBvh::build(&scene).unwrap_err();
     assert!(
         e.contains("the 8-wide BVH takes flat scenes only, and this one has 6 instances"),
         "{e}"
@@ -361,11 +362,11 @@ fn flat_only_intersectors_refuse_instances_and_the_choice_says_why() {
     let e = lumagraph::render::accel::unsupported(&scene, u32::MAX).unwrap();
     assert!(e.contains("ray queries takes flat scenes only"), "{e}");
     for (cpu_adapter, intersector) in [
-        (true, Intersector::Auto),
-        (true, Intersector::WideBvh),
-        (true, Intersector::Host),
-        (true, Intersector::Inline),
-        (false, Intersector::RayQueries),
+        (true, Intersector::AUTO),
+        (true, Intersector::WIDE_BVH),
+        (true, Intersector::HOST),
+        (true, Intersector::INLINE),
+        (false, Intersector::RAY_QUERIES),
     ] {
         let options = PathTraceOptions {
             specialize: true,
@@ -377,22 +378,15 @@ fn flat_only_intersectors_refuse_instances_and_the_choice_says_why() {
             ..PathTraceOptions::default()
         };
         let f = Features::decide(&scene, options);
+        assert!(f.on(Feature::Instances), "{intersector:?}");
+        assert_eq!(f.intersector(), Intersector::BINARY_BVH, "{intersector:?}");
         assert!(
-            f.on(Feature::Instances) && f.on(Feature::BvhTraversal),
-            "{intersector:?}"
+            !f.on(Feature::Wavefront),
+            "{intersector:?}: the wavefront is on"
         );
-        for other in [
-            Feature::WideBvh,
-            Feature::RayQueries,
-            Feature::InlineIntersection,
-            Feature::HostRays,
-            Feature::Wavefront,
-        ] {
-            assert!(!f.on(other), "{intersector:?}: {other:?} is on");
-        }
         assert!(
-            f.reason(Feature::WideBvh).contains("instanced meshes")
-                || f.reason(Feature::RayQueries).contains("instanced meshes"),
+            f.why(Intersector::WIDE_BVH).contains("instanced meshes")
+                || f.why(Intersector::RAY_QUERIES).contains("instanced meshes"),
             "{intersector:?}: {}",
             f.summary()
         );

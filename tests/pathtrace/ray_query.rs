@@ -12,7 +12,7 @@ use lumagraph::render::specialize::Tracing;
 
 use lumagraph::render::Resources;
 use lumagraph::render::specialize::{
-    AdapterTraits, Feature, Features, Intersector, PathTraceOptions, Specialization,
+    AdapterTraits, Features, Intersector, PathTraceOptions, Specialization,
 };
 use lumagraph::scene::{GpuScene, Scene};
 
@@ -26,31 +26,22 @@ fn options(traits: AdapterTraits, forced: bool) -> PathTraceOptions {
         cpu_adapter: traits.cpu,
         ray_query_limit: traits.ray_query_limit,
         intersector: if forced {
-            Intersector::RayQueries
+            Intersector::RAY_QUERIES
         } else {
-            Intersector::Auto
+            Intersector::AUTO
         },
         ..PathTraceOptions::default()
     }
 }
 
-/// Which intersector the features choose, by feature (never by label).
+/// Which intersector the features choose (by its handle, never by label).
 fn intersector(f: &Features) -> &'static str {
-    let chosen: Vec<&str> = [
-        (Feature::InlineIntersection, "inline"),
-        (Feature::HostRays, "host"),
-        (Feature::RayQueries, "ray queries"),
-        (Feature::BvhTraversal, "WGSL BVH"),
-    ]
-    .into_iter()
-    .filter(|(x, _)| f.on(*x))
-    .map(|(_, name)| name)
-    .collect();
-    match chosen.as_slice() {
-        // Host intersection keeps the BVH feature: the host traverses its own.
-        ["host", "WGSL BVH"] => "host",
-        [one] => one,
-        other => panic!("intersectors {other:?} chosen at once: {}", f.summary()),
+    match f.intersector() {
+        Intersector::INLINE => "inline",
+        Intersector::HOST => "host",
+        Intersector::RAY_QUERIES => "ray queries",
+        Intersector::BINARY_BVH | Intersector::WIDE_BVH => "WGSL BVH",
+        other => panic!("{other:?}: {}", f.summary()),
     }
 }
 
@@ -119,7 +110,7 @@ fn ray_queries_are_chosen_where_the_device_has_them() {
         println!(
             "{what}: {} ({})",
             intersector(&f),
-            f.reason(Feature::RayQueries)
+            f.why(Intersector::RAY_QUERIES)
         );
         assert_eq!(intersector(&f), expected, "{what}: {}", f.summary());
         let source = Specialization::new(scene, options(traits, forced))
@@ -138,16 +129,19 @@ fn ray_queries_are_chosen_where_the_device_has_them() {
     }
     let f = Features::decide(&small, options(gpu(Some(8)), false));
     assert!(
-        f.reason(Feature::RayQueries)
+        f.why(Intersector::RAY_QUERIES)
             .contains("at most 8 primitives"),
         "{}",
-        f.reason(Feature::RayQueries)
+        f.why(Intersector::RAY_QUERIES)
     );
     let general = PathTraceOptions {
         specialize: false,
         ..options(gpu(rq), true)
     };
-    assert!(!Features::decide(&large, general).on(Feature::RayQueries));
+    assert_ne!(
+        Features::decide(&large, general).intersector(),
+        Intersector::RAY_QUERIES
+    );
 }
 
 /// `name` through ray queries and through the WGSL BVH (as a GPU without ray queries runs
@@ -156,7 +150,7 @@ fn against_wgsl_bvh(name: &str) -> Option<(usize, f64)> {
     // Both as a GPU adapter runs (the same dispatches, materials read from buffers).
     let rq = Resources {
         tracer: Tracing {
-            intersector: Intersector::RayQueries,
+            intersector: Intersector::RAY_QUERIES,
             as_gpu_adapter: true,
             ..Tracing::default()
         },
@@ -165,7 +159,7 @@ fn against_wgsl_bvh(name: &str) -> Option<(usize, f64)> {
     let bvh = Resources {
         tracer: Tracing {
             as_gpu_adapter: true,
-            intersector: Intersector::BinaryBvh,
+            intersector: Intersector::BINARY_BVH,
             ..Tracing::default()
         },
         ..Resources::default()

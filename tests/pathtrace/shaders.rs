@@ -43,14 +43,14 @@ fn specialized_sources() -> Vec<(&'static str, String)> {
     let ray_queries = PathTraceOptions {
         specialize: true,
         ray_query_limit: Some(1 << 24),
-        intersector: Intersector::RayQueries,
+        intersector: Intersector::RAY_QUERIES,
         ..PathTraceOptions::default()
     };
     let source = Specialization::new(&scene, ray_queries).source().unwrap();
     assert!(source.contains("rayQueryInitialize"));
     let wide = PathTraceOptions {
         specialize: true,
-        intersector: Intersector::WideBvh,
+        intersector: Intersector::WIDE_BVH,
         ..PathTraceOptions::default()
     };
     let wide_source = Specialization::new(&scene, wide).source().unwrap();

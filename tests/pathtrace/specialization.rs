@@ -357,7 +357,7 @@ fn each_feature_sets_its_own_wgsl_constant() {
         let off = all.clone().with(f, false);
         // `WAVES` is derived: paths traced in steps, by host intersection or the wavefront.
         for x in [&on, &off] {
-            let waves = x.on(Feature::HostRays) || x.on(Feature::Wavefront);
+            let waves = x.kind().host_steps() || x.on(Feature::Wavefront);
             let line = format!("const WAVES: bool = {waves};");
             assert!(x.wgsl_options().lines().any(|l| l == line), "{f:?}: {line}");
         }

@@ -1643,7 +1643,7 @@ fn textured_emitter_selection_follows_the_texture() {
 /// which and why.
 #[test]
 fn small_scenes_are_inlined_on_cpu_adapters_only() {
-    use lumagraph::render::specialize::{Feature, Features, PathTraceOptions};
+    use lumagraph::render::specialize::{Feature, Features, Intersector, PathTraceOptions};
     let scene = GpuScene::build(&Scene::load(&common::repo("assets/cornell_spheres.ron")).unwrap())
         .unwrap();
     for cpu_adapter in [true, false] {
@@ -1658,12 +1658,12 @@ fn small_scenes_are_inlined_on_cpu_adapters_only() {
             ..PathTraceOptions::default()
         };
         let f = Features::decide(&scene, opts);
-        assert_eq!(f.on(Feature::InlineIntersection), cpu_adapter);
+        assert_eq!(f.intersector() == Intersector::INLINE, cpu_adapter);
         assert_eq!(f.on(Feature::InlineData), cpu_adapter);
-        assert_eq!(f.on(Feature::BvhTraversal), !cpu_adapter);
+        assert_eq!(f.intersector() == Intersector::BINARY_BVH, !cpu_adapter);
         assert_eq!(f.on(Feature::SpreadWorkgroups), cpu_adapter);
         if !cpu_adapter {
-            let why = f.reason(Feature::BvhTraversal);
+            let why = f.why(Intersector::INLINE);
             assert!(why.contains("a GPU adapter"), "{why}");
         }
     }

@@ -34,7 +34,7 @@ fn as_gpu(intersector: Intersector, schedule: Schedule) -> Resources {
 #[test]
 fn the_wavefront_renders_what_the_megakernel_renders() {
     let name = "../tests/scenes/host/cornell_glass.ron";
-    let intersector = Intersector::BinaryBvh;
+    let intersector = Intersector::BINARY_BVH;
     let Some((front, how_front)) =
         common::render_with(name, (64, 64), 16, as_gpu(intersector, Schedule::Wavefront))
     else {
@@ -65,12 +65,15 @@ fn the_wavefront_sees_through_alpha_masks_as_the_megakernel_does() {
     use super::alpha::{albedos, checker_masked, front_and_tiled_wall};
     let scene = Arc::new(GpuScene::build(&checker_masked(front_and_tiled_wall(64, 8))).unwrap());
     let Some((_, _, front, how)) =
-        albedos(&scene, as_gpu(Intersector::BinaryBvh, Schedule::Wavefront))
+        albedos(&scene, as_gpu(Intersector::BINARY_BVH, Schedule::Wavefront))
     else {
         return;
     };
-    let (_, _, mega, _) =
-        albedos(&scene, as_gpu(Intersector::BinaryBvh, Schedule::Megakernel)).unwrap();
+    let (_, _, mega, _) = albedos(
+        &scene,
+        as_gpu(Intersector::BINARY_BVH, Schedule::Megakernel),
+    )
+    .unwrap();
     assert!(
         how.on(Feature::Wavefront) && how.on(Feature::Alpha),
         "{}",

@@ -8,10 +8,8 @@ use crate::common;
 use lumagraph::render::specialize::Tracing;
 
 use lumagraph::render::Resources;
-use lumagraph::render::specialize::{
-    Feature, Features, Intersector, PathTraceOptions, Specialization,
-};
-use lumagraph::render::wide_bvh::{WIDE_BVH_STACK, WideBvh};
+use lumagraph::render::intersect::wide_bvh::{WIDE_BVH_STACK, WideBvh};
+use lumagraph::render::specialize::{Features, Intersector, PathTraceOptions, Specialization};
 use lumagraph::scene::{GpuScene, PRIM_SHAPE, Scene};
 
 fn scene(rel: &str) -> GpuScene {
@@ -20,7 +18,7 @@ fn scene(rel: &str) -> GpuScene {
 
 /// The choice, without a device: a CPU adapter walks the wide BVH where it traverses one in
 /// WGSL (not where it intersects a small scene inline or on the host), a GPU adapter the
-/// binary one, and neither where ray queries trace the scene; `Intersector::WideBvh` /
+/// binary one, and neither where ray queries trace the scene; `Intersector::WIDE_BVH` /
 /// `BinaryBvh` (`--intersector wide` / `binary`) ask for either, over inline, host and ray
 /// queries alike; the general shader never uses it. The shader traverses the wide BVH (`wide_bvh.wgsl`)
 /// exactly where it is chosen, and the plan's reasons name the measurements.
@@ -36,48 +34,48 @@ fn the_wide_bvh_is_chosen_on_cpu_adapters_and_where_asked() {
         ..PathTraceOptions::default()
     };
     let cases = [
-        ("GPU", &large, opts(false, None, Intersector::Auto), false),
+        ("GPU", &large, opts(false, None, Intersector::AUTO), false),
         (
             "GPU, asked",
             &large,
-            opts(false, None, Intersector::WideBvh),
+            opts(false, None, Intersector::WIDE_BVH),
             true,
         ),
         (
             "GPU, small scene, asked",
             &small,
-            opts(false, None, Intersector::WideBvh),
+            opts(false, None, Intersector::WIDE_BVH),
             true,
         ),
         (
             "GPU with ray queries",
             &large,
-            opts(false, Some(1 << 24), Intersector::Auto),
+            opts(false, Some(1 << 24), Intersector::AUTO),
             false,
         ),
         (
             "GPU with ray queries, asked",
             &large,
-            opts(false, Some(1 << 24), Intersector::WideBvh),
+            opts(false, Some(1 << 24), Intersector::WIDE_BVH),
             true,
         ),
-        ("CPU", &large, opts(true, None, Intersector::Auto), true),
+        ("CPU", &large, opts(true, None, Intersector::AUTO), true),
         (
             "CPU, binary asked for",
             &large,
-            opts(true, None, Intersector::BinaryBvh),
+            opts(true, None, Intersector::BINARY_BVH),
             false,
         ),
         (
             "CPU, small scene",
             &small,
-            opts(true, None, Intersector::Auto),
+            opts(true, None, Intersector::AUTO),
             false,
         ),
         (
             "CPU, small scene, asked",
             &small,
-            opts(true, None, Intersector::WideBvh),
+            opts(true, None, Intersector::WIDE_BVH),
             true,
         ),
         (
@@ -85,7 +83,7 @@ fn the_wide_bvh_is_chosen_on_cpu_adapters_and_where_asked() {
             &large,
             PathTraceOptions {
                 host_rays: true,
-                ..opts(true, None, Intersector::Auto)
+                ..opts(true, None, Intersector::AUTO)
             },
             false,
         ),
@@ -95,7 +93,7 @@ fn the_wide_bvh_is_chosen_on_cpu_adapters_and_where_asked() {
             &small,
             PathTraceOptions {
                 host_rays: true,
-                ..opts(true, None, Intersector::Host)
+                ..opts(true, None, Intersector::HOST)
             },
             false,
         ),
@@ -104,7 +102,7 @@ fn the_wide_bvh_is_chosen_on_cpu_adapters_and_where_asked() {
             &large,
             PathTraceOptions {
                 host_rays: true,
-                ..opts(true, None, Intersector::WideBvh)
+                ..opts(true, None, Intersector::WIDE_BVH)
             },
             true,
         ),
@@ -113,28 +111,22 @@ fn the_wide_bvh_is_chosen_on_cpu_adapters_and_where_asked() {
             &large,
             PathTraceOptions {
                 specialize: false,
-                ..opts(false, None, Intersector::WideBvh)
+                ..opts(false, None, Intersector::WIDE_BVH)
             },
             false,
         ),
     ];
     for (what, scene, options, expected) in cases {
         let f = Features::decide(scene, options);
-        println!(
-            "{what}: {} ({})",
-            f.on(Feature::WideBvh),
-            f.reason(Feature::WideBvh)
-        );
-        assert_eq!(f.on(Feature::WideBvh), expected, "{what}: {}", f.summary());
-        if expected {
-            assert!(f.on(Feature::BvhTraversal), "{what}: {}", f.summary());
-        }
+        let wide = f.intersector() == Intersector::WIDE_BVH;
+        println!("{what}: {wide} ({})", f.why(Intersector::WIDE_BVH));
+        assert_eq!(wide, expected, "{what}: {}", f.summary());
         let source = Specialization::new(scene, options).source().unwrap();
         assert_eq!(source.contains("WIDE_ROBUST_FAR"), expected, "{what}");
     }
     for (cpu, measured_on) in [(false, "H200"), (true, "lavapipe")] {
-        let f = Features::decide(&large, opts(cpu, None, Intersector::Auto));
-        let why = f.reason(Feature::WideBvh);
+        let f = Features::decide(&large, opts(cpu, None, Intersector::AUTO));
+        let why = f.why(Intersector::WIDE_BVH);
         assert!(why.contains(measured_on), "{why}");
     }
 }
@@ -318,7 +310,7 @@ fn the_wide_bvh_renders_what_the_binary_bvh_renders() {
     let wide = Resources {
         tracer: Tracing {
             as_gpu_adapter: true,
-            intersector: Intersector::WideBvh,
+            intersector: Intersector::WIDE_BVH,
             ..Tracing::default()
         },
         ..Resources::default()
@@ -326,7 +318,7 @@ fn the_wide_bvh_renders_what_the_binary_bvh_renders() {
     let binary = Resources {
         tracer: Tracing {
             as_gpu_adapter: true,
-            intersector: Intersector::BinaryBvh,
+            intersector: Intersector::BINARY_BVH,
             ..Tracing::default()
         },
         ..Resources::default()
@@ -340,12 +332,8 @@ fn the_wide_bvh_renders_what_the_binary_bvh_renders() {
         "../tests/scenes/disk.ron",
     ] {
         let Some((far, mean)) = common::same_hits(name, wide.clone(), binary.clone(), |a, b| {
-            assert!(a.on(Feature::WideBvh), "{}", a.summary());
-            assert!(
-                !b.on(Feature::WideBvh) && b.on(Feature::BvhTraversal),
-                "{}",
-                b.summary()
-            );
+            assert_eq!(a.intersector(), Intersector::WIDE_BVH, "{}", a.summary());
+            assert_eq!(b.intersector(), Intersector::BINARY_BVH, "{}", b.summary());
         }) else {
             return;
         };

@@ -73,7 +73,7 @@ impl SceneAccel {
         // geometry would let the device test the triangles itself, with its own rounding:
         // watertight where Möller-Trumbore is not, so at shared edges the two disagree, and
         // a ray the device sends to one triangle and the exact test to none goes through.)
-        let (tri_boxes, shape_boxes) = crate::wide_bvh::primitive_boxes(scene);
+        let (tri_boxes, shape_boxes) = crate::intersect::primitive_boxes(scene);
         let mut tlas = device.create_tlas(&wgpu::CreateTlasDescriptor {
             label: Some("scene accel"),
             max_instances: 2,

@@ -61,7 +61,7 @@ impl WaveStep {
 type StepFn<'a> = dyn FnMut(WaveStep, &mut wgpu::CommandEncoder, &wgpu::Buffer) -> Result<()> + 'a;
 
 /// The scene in Embree and the lanes of slots traced in turn.
-pub(crate) struct HostRays {
+pub struct HostRays {
     scene: HostScene,
     /// The window's rows alternate between the lanes (with two, even rows and odd rows),
     /// each with its own buffers: while the kernel steps one lane's paths, the host

@@ -29,6 +29,7 @@ mod executor;
 pub mod frames;
 mod host_rays;
 pub mod image_io;
+pub mod intersect;
 pub mod kernel;
 mod library;
 pub mod metrics;
@@ -49,7 +50,6 @@ pub mod tile_set;
 pub mod tiled;
 mod timing;
 mod wavefront;
-pub mod wide_bvh;
 
 pub use checkpoint::Checkpoint;
 pub use context::{

@@ -63,7 +63,7 @@ impl Default for SessionOptions {
             library: None,
             frame: None,
             outputs_anywhere: false,
-            intersector: crate::specialize::Intersector::Auto,
+            intersector: crate::specialize::Intersector::AUTO,
             schedule: crate::specialize::Schedule::Auto,
         }
     }

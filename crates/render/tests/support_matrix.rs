@@ -6,7 +6,8 @@
 
 use std::path::Path;
 
-use lumagraph_render::specialize::support::{self, Content, HOST_RAYS_MAX_BOUNCES, MATRIX, Tracer};
+use lumagraph_render::intersect::KINDS;
+use lumagraph_render::specialize::support::{self, Content, HOST_RAYS_MAX_BOUNCES, Tracer};
 use lumagraph_render::specialize::{Feature, Features, Intersector, PathTraceOptions, Schedule};
 use lumagraph_scene::{FEATURE_ALPHA, GpuScene, MATERIAL_MEDIUM, Scene};
 
@@ -54,21 +55,12 @@ fn with(content: Content) -> (GpuScene, PathTraceOptions) {
 fn traced(tracer: Tracer, scene: &GpuScene, options: PathTraceOptions) -> (bool, String) {
     let options = match tracer {
         Tracer::Wavefront => PathTraceOptions {
-            intersector: Intersector::BinaryBvh,
+            intersector: Intersector::BINARY_BVH,
             schedule: Schedule::Wavefront,
             ..options
         },
-        _ => PathTraceOptions {
-            intersector: [
-                Intersector::Inline,
-                Intersector::Host,
-                Intersector::BinaryBvh,
-                Intersector::WideBvh,
-                Intersector::RayQueries,
-            ]
-            .into_iter()
-            .find(|&i| Tracer::of(i) == Some(tracer))
-            .unwrap(),
+        Tracer::Intersector(intersector) => PathTraceOptions {
+            intersector,
             ..options
         },
     };
@@ -90,12 +82,21 @@ fn traced(tracer: Tracer, scene: &GpuScene, options: PathTraceOptions) -> (bool,
 #[test]
 fn every_cell_of_the_support_matrix_is_what_the_decisions_do() {
     println!("{}", support::markdown());
+    let matrix = support::matrix();
+    // A column per intersector (and the wavefront's); each names its kind.
+    assert_eq!(matrix.len(), KINDS.len() + 1);
+    for (tracer, _) in &matrix {
+        if let Tracer::Intersector(i) = *tracer {
+            assert_eq!(Tracer::of(i), Some(*tracer));
+            assert_eq!(Intersector::from_name(i.name()), Ok(i));
+        }
+    }
     // The scene every row starts from has none of them, and everything traces it.
     let (plain, options) = (scene("assets/cornell.ron"), base_options());
     for c in Content::ALL {
         assert!(!c.in_scene(&plain, options), "cornell.ron has {c:?}");
     }
-    for (tracer, _) in MATRIX {
+    for &(tracer, _) in &matrix {
         let (given, why) = traced(tracer, &plain, options);
         assert!(given, "{tracer:?} on cornell.ron: {why}");
     }
@@ -109,14 +110,14 @@ fn every_cell_of_the_support_matrix_is_what_the_decisions_do() {
             .into_iter()
             .filter(|&o| o != c && o.in_scene(&s, options))
         {
-            for (tracer, _) in MATRIX {
+            for &(tracer, _) in &matrix {
                 assert!(
                     !tracer.traces(c) || tracer.traces(other),
                     "the {c:?} scene has {other:?} too, which {tracer:?} does not trace"
                 );
             }
         }
-        for (tracer, _) in MATRIX {
+        for &(tracer, _) in &matrix {
             let (given, why) = traced(tracer, &s, options);
             assert_eq!(
                 given,
@@ -128,7 +129,20 @@ fn every_cell_of_the_support_matrix_is_what_the_decisions_do() {
             checked += 1;
         }
     }
-    assert_eq!(checked, Content::ALL.len() * MATRIX.len());
+    assert_eq!(checked, Content::ALL.len() * matrix.len());
+}
+
+/// The last intersector the adapter's choice tries traces every row of the matrix and is
+/// always taken: whatever the scene, something traces it.
+#[test]
+fn the_last_intersector_traces_everything() {
+    let last = KINDS[KINDS.len() - 1];
+    assert!(last.traces().iter().all(|&t| t), "{}", last.describe());
+    for c in Content::ALL {
+        let (s, options) = with(c);
+        assert!(last.auto(&s, options).is_ok(), "{c:?}");
+        assert!(last.unavailable(&s, options).is_none(), "{c:?}");
+    }
 }
 
 /// Asked for where the adapter lacks it: the host without Embree, ray queries without
@@ -142,8 +156,14 @@ fn an_intersector_the_adapter_lacks_is_refused_with_why() {
         ..base_options()
     };
     for (tracer, what) in [
-        (Tracer::Host, "no host intersector"),
-        (Tracer::RayQueries, "no ray queries"),
+        (
+            Tracer::Intersector(Intersector::HOST),
+            "no host intersector",
+        ),
+        (
+            Tracer::Intersector(Intersector::RAY_QUERIES),
+            "no ray queries",
+        ),
     ] {
         let (given, why) = traced(tracer, &plain, options);
         assert!(!given && why.contains(what), "{tracer:?}: {why}");

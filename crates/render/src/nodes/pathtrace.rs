@@ -28,12 +28,10 @@ use crate::specialize::{Feature, Features};
 const STATS: u64 = 8;
 
 mod adaptive;
-mod backend;
 mod history;
 mod steps;
 
 use adaptive::Adaptive;
-use backend::Backend;
 use steps::submit_pending;
 
 /// The `PathTrace` kind.
@@ -83,7 +81,7 @@ fn options(
     };
     // The registry's options are exactly the names, so an unknown one cannot reach here.
     let intersector = match Intersector::from_name(&param("intersector")) {
-        Ok(Intersector::Auto) | Err(_) => resources.tracer.intersector,
+        Ok(Intersector::AUTO) | Err(_) => resources.tracer.intersector,
         Ok(asked) => asked,
     };
     let schedule = match Schedule::from_name(&param("schedule")) {
@@ -91,9 +89,9 @@ fn options(
         Ok(asked) => asked,
     };
     crate::specialize::PathTraceOptions {
-        ray_query_limit: traits
-            .ray_query_limit
-            .filter(|_| !resources.tracer.as_gpu_adapter || intersector == Intersector::RayQueries),
+        ray_query_limit: traits.ray_query_limit.filter(|_| {
+            !resources.tracer.as_gpu_adapter || intersector == Intersector::RAY_QUERIES
+        }),
         intersector,
         specialize: !resources.tracer.general_shaders,
         cpu_adapter,
@@ -240,7 +238,7 @@ pub(crate) struct PathTrace {
     /// several dispatches (a 16-byte stand-in until one does).
     chunk_sums: wgpu::Buffer,
     /// What traces the rays (the plan's intersector), with its state.
-    backend: Backend,
+    backend: Box<dyn crate::intersect::Traversal>,
     /// Host intersection's steps and times since the last reset (its rays go to `rays`).
     host_counts: HostCounts,
     /// The `wave` binding's stand-in without host intersection or the wavefront.
@@ -260,12 +258,12 @@ impl PathTrace {
         let (source, features) = specialized(&scene, opts)?;
         let samples_per_dispatch = if !ctx.is_cpu() {
             u32::MAX
-        } else if features.on(Feature::InlineIntersection) {
+        } else if features.kind().inline() {
             CPU_SAMPLES_PER_DISPATCH[1]
         } else {
             CPU_SAMPLES_PER_DISPATCH[0]
         };
-        let backend = Backend::new(ctx, &scene, &features)?;
+        let backend = features.kind().build(ctx, &scene)?;
         let wavefront = features
             .on(Feature::Wavefront)
             .then(|| crate::wavefront::Wavefront::new(ctx));
@@ -295,12 +293,8 @@ impl PathTrace {
             create(ctx, "unused depth", TexFormat::R32Float, one),
             create(ctx, "unused samples", TexFormat::Rgba32Float, one),
         ];
-        // The binary BVH's records only where the binary BVH is walked: not by the 8-wide
-        // BVH (its own buffer is bound), nor by host intersection unless the first-hit AOVs
-        // are written (`first_hit_aovs` traces in WGSL), nor inline or by ray queries.
-        let binary_bvh = features.on(Feature::BvhTraversal)
-            && !features.on(Feature::WideBvh)
-            && (!features.on(Feature::HostRays) || features.on(Feature::FirstHitAovs));
+        // The binary BVH's records only where the intersector reads them.
+        let binary_bvh = features.kind().reads_binary_bvh(&features);
         let buffers = SceneBuffers::upload_for(ctx, &scene, binary_bvh)?;
         let frame = uniform_buffer(
             ctx,
@@ -418,7 +412,7 @@ impl PathTrace {
             .pass(name)
             .write(color)
             .uniform(&self.frame)
-            .buffer(self.backend.bvh_nodes(&b.bvh_nodes))
+            .buffer(self.backend.bvh_nodes().unwrap_or(&b.bvh_nodes))
             .buffer(&b.tri_positions)
             .buffer(&b.tri_shading)
             .buffer(&b.shapes)
@@ -488,7 +482,7 @@ const WAVEFRONT_ENTRIES: [&str; 4] = ["wave_start", "wave_misses", "wave_hits", 
 fn entry_points(features: &Features) -> (&'static str, &'static [&'static str]) {
     if features.on(Feature::Wavefront) {
         ("wave_finish", &WAVEFRONT_ENTRIES)
-    } else if features.on(Feature::HostRays) {
+    } else if features.kind().host_steps() {
         ("wave_finish", &WAVE_ENTRIES)
     } else {
         ("main", &[])
@@ -655,7 +649,7 @@ impl NodeExec for PathTrace {
         )?;
         self.dropped += u64::from(v[0]);
         self.rays += u64::from(v[1]) | (u64::from(v[2]) << 32);
-        if let Backend::Host(host) = &mut self.backend {
+        if let Some(host) = self.backend.host_mut() {
             self.host_counts += host.take_counts();
             self.rays += std::mem::take(&mut self.host_counts.rays);
         }

@@ -14,25 +14,17 @@ use lumagraph_scene::{
     MATERIAL_ALPHA_MASK, MATERIAL_INDEX_MATCHED, MATERIAL_MEDIUM,
 };
 
-use super::{
-    INLINE_MAX_MATERIALS, INLINE_MAX_PRIMITIVES, Intersector, PathTraceOptions, Schedule, codegen,
-};
+use super::{INLINE_MAX_MATERIALS, Intersector, PathTraceOptions, Schedule, codegen};
+use crate::intersect::{IntersectorKind, KINDS};
+
+/// The last kind the adapter's choice tries: it traces every scene (a test holds it).
+fn last() -> &'static dyn IntersectorKind {
+    KINDS[KINDS.len() - 1]
+}
 
 /// One part of the path tracer that a shader compiles in or leaves out.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Feature {
-    /// Intersection through the BVH (WGSL traversal, or the host's).
-    BvhTraversal,
-    /// The WGSL traversal walks the 8-wide compressed BVH ([`crate::wide_bvh`],
-    /// `pathtrace/intersect/wide_bvh.wgsl`) instead of the binary stackless one: on CPU adapters,
-    /// where it measured faster, and where asked (`--intersector wide`); GPU adapters keep
-    /// the binary one, which measured faster there.
-    WideBvh,
-    /// Intersection through the device's ray queries: its acceleration structure finds the
-    /// candidates, the WGSL tests them ([`crate::accel`], `pathtrace/intersect/ray_query.wgsl`).
-    RayQueries,
-    /// Every primitive tested with its coordinates written into the code.
-    InlineIntersection,
     /// Materials and lights (and, with inline intersection, the primitives' shading data)
     /// written into the code.
     InlineData,
@@ -74,8 +66,6 @@ pub enum Feature {
     SpreadWorkgroups,
     /// A lane whose path ended starts its next sample at once (CPU adapters).
     PathRegeneration,
-    /// The host (Embree) intersects the rays; the WGSL shades them step by step.
-    HostRays,
     /// The wavefront: the WGSL shades the paths step by step, as for host intersection, and
     /// a kernel of its own traces each step's rays on the device ([`crate::wavefront`]).
     Wavefront,
@@ -83,11 +73,7 @@ pub enum Feature {
 
 impl Feature {
     /// Every feature, in the order `plan` lists them.
-    pub const ALL: [Self; 26] = [
-        Self::BvhTraversal,
-        Self::WideBvh,
-        Self::RayQueries,
-        Self::InlineIntersection,
+    pub const ALL: [Self; 21] = [
         Self::InlineData,
         Self::LightSampling,
         Self::Environment,
@@ -108,7 +94,6 @@ impl Feature {
         Self::Textures,
         Self::SpreadWorkgroups,
         Self::PathRegeneration,
-        Self::HostRays,
         Self::Wavefront,
     ];
 
@@ -120,10 +105,6 @@ impl Feature {
             return Box::leak(format!("feature #{}", self as usize).into_boxed_str());
         }
         match self {
-            Self::BvhTraversal => "BVH traversal",
-            Self::WideBvh => "8-wide BVH",
-            Self::RayQueries => "ray queries",
-            Self::InlineIntersection => "inline intersection",
             Self::InlineData => "inline materials and lights",
             Self::LightSampling => "light sampling (NEE + MIS)",
             Self::Environment => "environment",
@@ -144,7 +125,6 @@ impl Feature {
             Self::Textures => "material textures",
             Self::SpreadWorkgroups => "spread workgroups",
             Self::PathRegeneration => "path regeneration",
-            Self::HostRays => "host intersection",
             Self::Wavefront => "wavefront",
         }
     }
@@ -154,13 +134,7 @@ impl Feature {
     /// scene data, see [`super::Specialization::source`]).
     pub const fn wgsl_const(self) -> Option<&'static str> {
         Some(match self {
-            Self::BvhTraversal
-            | Self::WideBvh
-            | Self::RayQueries
-            | Self::InlineIntersection
-            | Self::InlineData => {
-                return None;
-            }
+            Self::InlineData => return None,
             Self::LightSampling => "HAS_LIGHTS",
             Self::Environment => "HAS_ENVIRONMENT",
             Self::EnvMapSampling => "HAS_ENV_MAP",
@@ -180,7 +154,6 @@ impl Feature {
             Self::Textures => "HAS_TEXTURES",
             Self::SpreadWorkgroups => "SPREAD_WORKGROUPS",
             Self::PathRegeneration => "REGENERATE_PATHS",
-            Self::HostRays => "HOST_RAYS",
             Self::Wavefront => "WAVEFRONT",
         })
     }
@@ -207,6 +180,10 @@ fn decision(included: bool, reason: impl Into<String>) -> Decision {
 pub struct Features {
     /// In [`Feature::ALL`]'s order.
     decisions: Vec<Decision>,
+    /// The intersector that traces the scene (never [`Intersector::AUTO`]).
+    intersector: Intersector,
+    /// Per intersector, in [`KINDS`]' order: why it traces the scene or does not.
+    intersectors: Vec<(Intersector, String)>,
 }
 
 impl Features {
@@ -215,6 +192,8 @@ impl Features {
         let facts = Facts::new(scene, options);
         Self {
             decisions: Feature::ALL.iter().map(|&f| facts.decide(f)).collect(),
+            intersector: facts.kind.intersector(),
+            intersectors: facts.intersectors,
         }
     }
 
@@ -233,29 +212,33 @@ impl Features {
         Feature::ALL.into_iter().zip(&self.decisions)
     }
 
-    /// The intersector these features trace with (never [`Intersector::Auto`]).
+    /// The intersector these features trace with (never [`Intersector::AUTO`]).
     pub fn intersector(&self) -> Intersector {
-        if self.on(Feature::InlineIntersection) {
-            Intersector::Inline
-        } else if self.on(Feature::HostRays) {
-            Intersector::Host
-        } else if self.on(Feature::RayQueries) {
-            Intersector::RayQueries
-        } else if self.on(Feature::WideBvh) {
-            Intersector::WideBvh
-        } else {
-            Intersector::BinaryBvh
-        }
+        self.intersector
+    }
+
+    /// Its kind.
+    pub fn kind(&self) -> &'static dyn IntersectorKind {
+        self.intersector.kind().unwrap_or_else(last)
     }
 
     /// Why [`Features::intersector`] traces the scene, for the plan.
     pub fn intersector_reason(&self) -> &str {
-        match self.intersector() {
-            Intersector::Inline => self.reason(Feature::InlineIntersection),
-            Intersector::Host => self.reason(Feature::HostRays),
-            Intersector::RayQueries => self.reason(Feature::RayQueries),
-            _ => self.reason(Feature::WideBvh),
-        }
+        self.why(self.intersector)
+    }
+
+    /// Why `intersector` traces the scene, or does not (where it cannot, or was passed
+    /// over, or another was asked for or chosen before it).
+    pub fn why(&self, intersector: Intersector) -> &str {
+        self.intersectors
+            .iter()
+            .find(|(i, _)| *i == intersector)
+            .map_or("the adapter's choice", |(_, why)| why.as_str())
+    }
+
+    /// Every intersector with why it traces the scene or does not, in [`KINDS`]' order.
+    pub fn intersectors(&self) -> impl Iterator<Item = (Intersector, &str)> {
+        self.intersectors.iter().map(|(i, why)| (*i, why.as_str()))
     }
 
     /// The schedule these features lay the paths out with (never [`Schedule::Auto`]).
@@ -287,8 +270,18 @@ impl Features {
                 let _ = writeln!(out, "const {name}: bool = {};", d.included);
             }
         }
+        // The intersectors' own constants: true for the one that traces.
+        for kind in KINDS {
+            if let Some(name) = kind.wgsl_const() {
+                let _ = writeln!(
+                    out,
+                    "const {name}: bool = {};",
+                    kind.intersector() == self.intersector
+                );
+            }
+        }
         // Paths traced in steps (`pathtrace/integrator/wave.wgsl`), by either.
-        let waves = self.on(Feature::HostRays) || self.on(Feature::Wavefront);
+        let waves = self.kind().host_steps() || self.on(Feature::Wavefront);
         let _ = writeln!(out, "const WAVES: bool = {waves};");
         out
     }
@@ -296,29 +289,16 @@ impl Features {
     /// One line for the render's output: how the scene is intersected and where its data
     /// lives, then what is left out.
     pub fn summary(&self) -> String {
-        let how = match (
-            self.on(Feature::InlineIntersection),
-            self.on(Feature::HostRays),
-            self.on(Feature::RayQueries),
-            self.on(Feature::InlineData),
-        ) {
-            (true, _, _, true) => "intersection inlined, materials and lights inlined",
-            (true, _, _, false) => "intersection inlined",
-            (false, true, _, true) => "rays intersected on the host, materials inlined",
-            (false, true, _, false) => "rays intersected on the host",
-            (false, false, true, true) => "ray queries, materials inlined",
-            (false, false, true, false) => "ray queries",
-            (false, false, false, true) if self.on(Feature::WideBvh) => {
-                "8-wide BVH traversal, materials inlined"
-            }
-            (false, false, false, false) if self.on(Feature::WideBvh) => "8-wide BVH traversal",
-            (false, false, false, true) => "BVH traversal, materials inlined",
-            (false, false, false, false) => "BVH traversal",
+        let kind = self.kind();
+        let how = match (self.on(Feature::InlineData), kind.inline()) {
+            (true, true) => format!("{}, materials and lights inlined", kind.how()),
+            (true, false) => format!("{}, materials inlined", kind.how()),
+            (false, _) => kind.how().to_owned(),
         };
         let how = if self.on(Feature::Wavefront) {
             format!("{how}, in wavefront steps")
         } else {
-            how.to_owned()
+            how
         };
         let left_out: Vec<&str> = self
             .iter()
@@ -408,82 +388,60 @@ fn material_ranges(scene: &GpuScene, index: usize, m: &GpuMaterial) -> MaterialR
     }
 }
 
-/// Why a CPU adapter does not trace through its ray queries unless asked to (lavapipe
-/// has them from Mesa 25): measured in `docs/benchmarks.md` ("Ray queries on lavapipe").
-const CPU_RAY_QUERIES_REASON: &str = "a CPU adapter: lavapipe's ray queries measured 0.16-0.36x \
-     the kernel's own intersection (--intersector rays asks for them)";
-
-/// Why a CPU adapter traverses the 8-wide BVH unless asked otherwise: measured in
-/// `docs/benchmarks.md` ("The 8-wide BVH on lavapipe").
-const CPU_WIDE_BVH_REASON: &str = "a CPU adapter: the 8-wide BVH measured 2.3x the binary \
-     one's paths/s on Sponza and 1.4x on an 82 k-triangle mesh on lavapipe \
-     (--intersector binary asks for the binary one)";
-
-/// Why a GPU adapter traverses the binary BVH unless asked otherwise: measured in
-/// `docs/benchmarks.md` ("The 8-wide BVH against the binary one").
-const GPU_WIDE_BVH_REASON: &str = "the binary BVH: the 8-wide one measured 0.82x on Sponza \
-     and 1.01x on a 1.3 M-triangle mesh on an NVIDIA H200 (--intersector wide asks for it)";
-
 /// What the decisions are made from, worked out once.
 struct Facts<'a> {
     scene: &'a GpuScene,
     options: PathTraceOptions,
-    /// The intersector asked for, where it can trace the scene ([`Intersector::Auto`]
-    /// where it cannot: the adapter's choice).
-    asked: Intersector,
     /// The general shader: everything compiled in.
     all: bool,
-    prims: usize,
-    inline: bool,
-    /// Whether the device's ray queries trace the scene ([`Feature::RayQueries`]), and why.
-    ray_queries: Decision,
-    /// Whether the host intersects the rays ([`Feature::HostRays`]), and why: decided once,
-    /// for that feature and for the ones it rules out.
-    host: Decision,
+    /// The intersector that traces the scene.
+    kind: &'static dyn IntersectorKind,
+    /// Per intersector, why it traces the scene or does not.
+    intersectors: Vec<(Intersector, String)>,
     inline_data: bool,
     textured: bool,
     materials: Vec<MaterialRanges>,
 }
 
+/// The intersector that traces `scene` with `options`, and why each kind does or does not:
+/// the one asked for where it can trace the scene ([`super::support::why_not`]), else the
+/// first of [`KINDS`] that can and that the adapter's choice takes
+/// ([`IntersectorKind::auto`]).
+fn choose(
+    scene: &GpuScene,
+    options: PathTraceOptions,
+) -> (&'static dyn IntersectorKind, Vec<(Intersector, String)>) {
+    let cannot = |i| super::support::why_not(i, scene, options);
+    let asked =
+        Some(options.intersector).filter(|&i| i != Intersector::AUTO && cannot(i).is_none());
+    let mut chosen: Option<&'static dyn IntersectorKind> = None;
+    let mut reasons = Vec::with_capacity(KINDS.len());
+    for &kind in KINDS {
+        let i = kind.intersector();
+        let why = match (cannot(i), chosen, asked) {
+            (Some(why), _, _) => why,
+            (None, Some(c), _) => format!("{} traces the scene", c.describe()),
+            (None, None, Some(a)) if a == i => {
+                chosen = Some(kind);
+                kind.asked(scene)
+            }
+            (None, None, Some(a)) => format!("{} asked for", a.describe()),
+            (None, None, None) => match kind.auto(scene, options) {
+                Ok(why) => {
+                    chosen = Some(kind);
+                    why
+                }
+                Err(why) => why,
+            },
+        };
+        reasons.push((i, why));
+    }
+    (chosen.unwrap_or_else(last), reasons)
+}
+
 impl<'a> Facts<'a> {
     fn new(scene: &'a GpuScene, options: PathTraceOptions) -> Self {
-        let prims = scene.tri_positions.len() + scene.shapes.len();
-        let instanced = !scene.instances.is_empty();
-        // Why the device's ray queries cannot trace this scene, if they cannot.
-        let no_ray_queries = super::support::why_not(Intersector::RayQueries, scene, options);
-        // The intersector asked for where it can trace the scene (the support matrix and
-        // the adapter); else the adapter decides.
-        let asked = if super::support::why_not(options.intersector, scene, options).is_some() {
-            Intersector::Auto
-        } else {
-            options.intersector
-        };
-        let inline_for = |asked| {
-            options.specialize
-                && prims <= INLINE_MAX_PRIMITIVES
-                && !instanced
-                && match asked {
-                    Intersector::Auto => options.cpu_adapter,
-                    Intersector::Inline => true,
-                    _ => false,
-                }
-        };
-        let inline = inline_for(asked);
-        let host = super::host_rays_decision(scene, options, inline, asked);
-        let ray_queries = match no_ray_queries {
-            Some(why) => decision(false, why),
-            None if inline => decision(false, "intersected inline"),
-            None if host.included => decision(false, "rays intersected on the host"),
-            None if asked == Intersector::RayQueries => decision(true, "asked for"),
-            None if asked != Intersector::Auto => {
-                decision(false, format!("{} asked for", asked.describe()))
-            }
-            None if options.cpu_adapter => decision(false, CPU_RAY_QUERIES_REASON),
-            None => decision(
-                true,
-                "the device's acceleration structure finds the candidates, the WGSL tests them",
-            ),
-        };
+        let (kind, intersectors) = choose(scene, options);
         let textured = scene.header.features & FEATURE_TEXTURES != 0;
         // Small scenes have all their data written into the code; larger ones on a CPU
         // adapter their materials (and few lights), the primitives' data staying in buffers.
@@ -492,16 +450,13 @@ impl<'a> Facts<'a> {
             && !options.data_in_buffers
             && !textured
             && scene.materials.len() <= INLINE_MAX_MATERIALS
-            && codegen::inlinable(scene, inline);
+            && codegen::inlinable(scene, kind.inline());
         Self {
             scene,
             options,
-            asked,
             all: !options.specialize,
-            prims,
-            inline,
-            ray_queries,
-            host,
+            kind,
+            intersectors,
             inline_data,
             textured,
             materials: scene
@@ -573,16 +528,9 @@ impl<'a> Facts<'a> {
     fn decide(&self, f: Feature) -> Decision {
         let s = self.scene;
         match f {
-            Feature::BvhTraversal => self.bvh(),
-            Feature::WideBvh => self.wide_bvh(),
-            Feature::RayQueries => self.ray_queries.clone(),
-            Feature::InlineIntersection => decision(
-                self.inline,
-                super::inline_intersection_reason(s, self.inline),
-            ),
             Feature::InlineData => decision(
                 self.inline_data,
-                super::inline_data_reason(s, self.options, self.inline_data, self.inline),
+                super::inline_data_reason(s, self.options, self.inline_data, self.kind.inline()),
             ),
             Feature::LightSampling => self.needed(s.lights.len(), "emissive primitives"),
             Feature::Environment => {
@@ -661,61 +609,17 @@ impl<'a> Facts<'a> {
                 )
             }
             Feature::PathRegeneration => decision(
-                self.options.cpu_adapter && self.inline,
+                self.options.cpu_adapter && self.kind.inline(),
                 if !self.options.cpu_adapter {
                     "a GPU adapter: one bounce loop per sample"
-                } else if self.inline {
+                } else if self.kind.inline() {
                     "a CPU adapter: a SIMD lane whose path ended starts its next sample at once"
                 } else {
                     "BVH traversal: no gain measured on a CPU adapter"
                 },
             ),
-            Feature::HostRays => self.host.clone(),
-            Feature::Wavefront => {
-                super::wavefront_decision(s, self.options, self.inline, self.host.included)
-            }
+            Feature::Wavefront => super::wavefront_decision(s, self.options, self.kind),
         }
-    }
-
-    /// Whether the WGSL traversal walks the 8-wide BVH, and why.
-    fn wide_bvh(&self) -> Decision {
-        let o = self.options;
-        if !self.bvh().included || self.host.included {
-            decision(false, "the BVH is not traversed in WGSL")
-        } else if !self.scene.instances.is_empty() {
-            decision(false, super::INSTANCES_REASON)
-        } else if !o.specialize {
-            decision(false, "general shader: the binary BVH")
-        } else {
-            match self.asked {
-                Intersector::WideBvh => decision(true, "asked for"),
-                Intersector::BinaryBvh => decision(false, "the binary BVH asked for"),
-                _ if o.cpu_adapter => decision(true, CPU_WIDE_BVH_REASON),
-                _ => decision(false, GPU_WIDE_BVH_REASON),
-            }
-        }
-    }
-
-    fn bvh(&self) -> Decision {
-        let (prims, s) = (self.prims, self.scene);
-        decision(
-            !self.inline && !self.ray_queries.included,
-            if self.inline {
-                format!("{prims} primitives <= {INLINE_MAX_PRIMITIVES}: tested inline")
-            } else if self.ray_queries.included {
-                "ray queries: the device's acceleration structure".to_owned()
-            } else if self.options.specialize
-                && !self.options.cpu_adapter
-                && prims <= INLINE_MAX_PRIMITIVES
-            {
-                format!(
-                    "{} nodes (a GPU adapter: faster than testing the {prims} primitives inline)",
-                    s.bvh_nodes.len()
-                )
-            } else {
-                format!("{} nodes", s.bvh_nodes.len())
-            },
-        )
     }
 }
 
@@ -751,12 +655,12 @@ mod tests {
             let scene = GpuScene::build(&Scene::load(&root.join(rel)).unwrap()).unwrap();
             for bits in 0..64_u32 {
                 for intersector in [
-                    Intersector::Auto,
-                    Intersector::Inline,
-                    Intersector::Host,
-                    Intersector::BinaryBvh,
-                    Intersector::WideBvh,
-                    Intersector::RayQueries,
+                    Intersector::AUTO,
+                    Intersector::INLINE,
+                    Intersector::HOST,
+                    Intersector::BINARY_BVH,
+                    Intersector::WIDE_BVH,
+                    Intersector::RAY_QUERIES,
                 ] {
                     let options = PathTraceOptions {
                         specialize: bits & 1 != 0,

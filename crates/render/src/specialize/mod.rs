@@ -17,6 +17,7 @@ mod codegen;
 mod features;
 pub mod support;
 
+pub use crate::intersect::Intersector;
 pub use codegen::{inline_intersection, inline_materials_data, inline_scene_data, parallelograms};
 pub use features::{Decision, Feature, Features};
 
@@ -37,82 +38,6 @@ pub struct AdapterTraits {
     /// Where the device has ray queries: the most primitives one of its acceleration
     /// structures holds.
     pub ray_query_limit: Option<u32>,
-}
-
-/// The path tracer's intersectors. Each implements the contract of
-/// `shaders/pathtrace/intersect/contract.wgsl` (the closest hit, occlusion up to a distance, the
-/// alpha any-hit test); the Rust mirror (`lumagraph_scene::traverse`) follows it on the CPU.
-/// Which one traces a scene is decided once per shader ([`Feature`]); this is what the
-/// `PathTrace` node's `intersector` param, `lumagraph render --intersector`, a test or a
-/// benchmark may ask for instead of that decision ([`support`] says what each can trace).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Intersector {
-    /// The scene and the adapter decide: on CPU adapters, small scenes inline, larger ones
-    /// on the host (Embree) where it can trace them, else the 8-wide BVH; on GPU adapters,
-    /// ray queries where the device has them, else the binary BVH.
-    #[default]
-    Auto,
-    /// Every primitive tested in code written for the scene (`codegen`), for scenes of at
-    /// most [`INLINE_MAX_PRIMITIVES`] primitives.
-    Inline,
-    /// The host (Embree), on CPU adapters, for the scenes it can trace.
-    Host,
-    /// The binary stackless BVH traversed in WGSL (`pathtrace/intersect/bvh.wgsl`).
-    BinaryBvh,
-    /// The 8-wide compressed BVH traversed in WGSL (`pathtrace/intersect/wide_bvh.wgsl`).
-    WideBvh,
-    /// The device's ray queries (`pathtrace/intersect/ray_query.wgsl`), where it has them and they
-    /// can trace the scene.
-    RayQueries,
-}
-
-impl Intersector {
-    /// What it is, in the plan's words.
-    pub fn describe(self) -> &'static str {
-        match self {
-            Self::Auto => "the adapter's choice",
-            Self::Inline => "inline intersection",
-            Self::Host => "host intersection",
-            Self::BinaryBvh => "the binary BVH",
-            Self::WideBvh => "the 8-wide BVH",
-            Self::RayQueries => "ray queries",
-        }
-    }
-
-    /// Every choice, [`Intersector::Auto`] first.
-    pub const ALL: [Self; 6] = [
-        Self::Auto,
-        Self::Inline,
-        Self::Host,
-        Self::BinaryBvh,
-        Self::WideBvh,
-        Self::RayQueries,
-    ];
-
-    /// Its word in the `intersector` param and the `--intersector` option.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Auto => "auto",
-            Self::Inline => "inline",
-            Self::Host => "host",
-            Self::BinaryBvh => "binary",
-            Self::WideBvh => "wide",
-            Self::RayQueries => "rays",
-        }
-    }
-
-    /// The intersector a word names ([`Intersector::name`]).
-    ///
-    /// # Errors
-    /// An unknown word, with the known ones.
-    pub fn from_name(name: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|i| i.name() == name)
-            .ok_or_else(|| {
-                format!("unknown intersector {name:?}: auto, inline, host, binary, wide or rays")
-            })
-    }
 }
 
 /// How the path tracer's work is laid out on the device.
@@ -173,7 +98,7 @@ impl Schedule {
 /// `PathTrace` reads it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Tracing {
-    /// The intersector ([`Intersector::Auto`], the default: the scene and the adapter
+    /// The intersector ([`Intersector::AUTO`], the default: the scene and the adapter
     /// decide). A `PathTrace` node's `intersector` param, when not `auto`, wins over it. One
     /// that cannot trace the scene is an error when the node is built, never a silent
     /// fallback.
@@ -225,7 +150,7 @@ pub struct PathTraceOptions {
     /// would otherwise traverse the BVH in WGSL.
     pub ray_query_limit: Option<u32>,
     /// The intersector asked for (the `intersector` param, `--intersector`, tests,
-    /// benchmarks), or [`Intersector::Auto`]: the scene and the adapter decide. One that
+    /// benchmarks), or [`Intersector::AUTO`]: the scene and the adapter decide. One that
     /// cannot trace the scene ([`support::why_not`]) is decided as `Auto`; the node refuses
     /// to render then ([`support::refusal`]).
     pub intersector: Intersector,
@@ -240,9 +165,8 @@ pub struct PathTraceOptions {
 pub struct Specialization {
     /// What is compiled in and left out, and why.
     pub features: Features,
-    /// Replaces `pathtrace/intersect.wgsl` ([`Feature::InlineIntersection`], or
-    /// [`Feature::RayQueries`]: `pathtrace/intersect/ray_query.wgsl`, or [`Feature::WideBvh`]:
-    /// `pathtrace/intersect/wide_bvh.wgsl`).
+    /// Replaces `pathtrace/intersect.wgsl`: the intersector's own code
+    /// ([`crate::intersect::IntersectorKind::wgsl`]).
     intersection: Option<String>,
     /// Replaces `pathtrace/scene_data.wgsl` ([`Feature::InlineData`]).
     scene_data: Option<String>,
@@ -264,16 +188,9 @@ impl Specialization {
             lumagraph_scene::lights::wgsl_for(|k| scene.lights.iter().any(|l| l.kind == k + 1))
         });
         let features = Features::decide(scene, options);
-        let inline = features.on(Feature::InlineIntersection);
-        let intersection = if inline {
-            inline_intersection(scene, features.on(Feature::Alpha))
-        } else if features.on(Feature::RayQueries) {
-            Some("#import \"pathtrace/intersect/ray_query.wgsl\"\n".to_owned())
-        } else if features.on(Feature::WideBvh) {
-            Some("#import \"pathtrace/intersect/wide_bvh.wgsl\"\n".to_owned())
-        } else {
-            None
-        };
+        let kind = features.kind();
+        let inline = kind.inline();
+        let intersection = kind.wgsl(scene, features.on(Feature::Alpha));
         let scene_data = if !features.on(Feature::InlineData) {
             None
         } else if inline {
@@ -311,33 +228,15 @@ impl Specialization {
         }
         let source =
             crate::shader::resolve_with("pathtrace/integrator/pathtrace.wgsl", &overrides)?;
-        Ok(if self.features.on(Feature::RayQueries) {
-            // An `enable` directive comes before any declaration.
-            format!("enable wgpu_ray_query;\n{source}")
-        } else {
-            source
+        // An `enable` directive comes before any declaration.
+        Ok(match self.features.kind().enable() {
+            Some(extension) => format!("enable {extension};\n{source}"),
+            None => source,
         })
     }
 }
 
 /// Why materials, lights and shading data are (or are not) written into the shader.
-fn inline_intersection_reason(scene: &GpuScene, inline: bool) -> String {
-    let prims = scene.tri_positions.len() + scene.shapes.len();
-    let pairs = if inline {
-        parallelograms(&scene.tri_positions)
-            .iter()
-            .filter(|(_, b)| b.is_some())
-            .count()
-    } else {
-        0
-    };
-    if pairs > 0 {
-        format!("{prims} primitives, {pairs} parallelograms of 2 triangles tested as one")
-    } else {
-        format!("{prims} primitives")
-    }
-}
-
 fn inline_data_reason(
     scene: &GpuScene,
     options: PathTraceOptions,
@@ -415,42 +314,6 @@ fn textures_reason(scene: &GpuScene, all: bool) -> String {
 /// scenes only so far.
 pub const INSTANCES_REASON: &str = "instanced meshes: the binary WGSL BVH walks the two levels (the other intersectors take flat scenes only)";
 
-/// Whether the host intersects the rays (`HOST_RAYS`), and why (not).
-fn host_rays_decision(
-    scene: &GpuScene,
-    options: PathTraceOptions,
-    inline: bool,
-    asked: Intersector,
-) -> Decision {
-    let (included, reason) = if !options.cpu_adapter || !options.specialize {
-        (
-            false,
-            "a GPU adapter or the general shader: traced in WGSL".to_owned(),
-        )
-    } else if inline {
-        (false, "intersected inline".to_owned())
-    } else if !matches!(asked, Intersector::Auto | Intersector::Host) {
-        (false, format!("{} asked for", asked.describe()))
-    } else if !options.host_rays {
-        (
-            false,
-            format!("no host intersector: {}", host_rays_unavailable()),
-        )
-    } else if let Some(why) = support::cannot_trace(support::Tracer::Host, scene, options) {
-        (false, why)
-    } else {
-        (
-            true,
-            format!(
-                "a CPU adapter: {} intersects the {} triangles on the host's threads, the WGSL shades",
-                crate::embree::Embree::load().map_or_else(|e| e, |e| e.version()),
-                scene.tri_positions.len()
-            ),
-        )
-    };
-    Decision { included, reason }
-}
-
 /// GPU adapters step scenes of at least this many triangles with textured materials as a
 /// wavefront: the one scene it measured faster on (Sponza, 262 087 triangles, 24 textured
 /// materials) has both; a 1.3 M-triangle mesh without textures and a 12-triangle textured
@@ -473,8 +336,7 @@ const GPU_MEGAKERNEL_REASON: &str = "the megakernel measured 1.8x the wavefront'
 fn wavefront_decision(
     scene: &GpuScene,
     options: PathTraceOptions,
-    inline: bool,
-    host: bool,
+    kind: &dyn crate::intersect::IntersectorKind,
 ) -> Decision {
     let wanted = match options.schedule {
         Schedule::Megakernel => Err("the megakernel asked for".to_owned()),
@@ -493,26 +355,16 @@ fn wavefront_decision(
         )),
         Schedule::Auto => Ok(GPU_WAVEFRONT_REASON),
     };
-    let (included, reason) = match wanted {
-        Err(why) => (false, why),
-        Ok(_) if !options.specialize => (false, "general shader: the megakernel".to_owned()),
-        Ok(_) if host => (
-            false,
-            "rays intersected on the host, which steps the paths itself".to_owned(),
-        ),
-        Ok(_) if inline => (false, "intersected inline: the megakernel".to_owned()),
-        Ok(why) => match support::cannot_trace(support::Tracer::Wavefront, scene, options) {
-            Some(cannot) => (false, format!("{cannot}: the megakernel")),
-            None => (true, why.to_owned()),
-        },
+    let (included, reason) = match (wanted, kind.no_wavefront()) {
+        (Err(why), _) => (false, why),
+        (Ok(_), _) if !options.specialize => (false, "general shader: the megakernel".to_owned()),
+        (Ok(_), Some(no)) => (false, no.to_owned()),
+        (Ok(why), None) => {
+            match support::cannot_trace(support::Tracer::Wavefront, scene, options) {
+                Some(cannot) => (false, format!("{cannot}: the megakernel")),
+                None => (true, why.to_owned()),
+            }
+        }
     };
     Decision { included, reason }
-}
-
-/// Why the host intersector is not used, for the plan.
-fn host_rays_unavailable() -> String {
-    match crate::embree::Embree::load() {
-        Ok(_) => "WGSL intersection asked for".to_owned(),
-        Err(e) => e,
-    }
 }

@@ -1,5 +1,6 @@
 //! The support matrix: what each intersector (and the wavefront schedule) can trace, as
-//! data. The decisions ([`super::features`]) refuse an intersector asked for where the scene
+//! data: a column per intersector, each kind's own ([`IntersectorKind::traces`]), and the
+//! wavefront's. The decisions ([`super::features`]) refuse an intersector asked for where the scene
 //! has something its column lacks, and a render that asks for it through the `PathTrace`
 //! node's `intersector` param or `lumagraph render --intersector` stops with that reason
 //! ([`refusal`]). `docs/pathtracer.md` shows the table [`markdown`] writes; a test checks
@@ -11,6 +12,7 @@ use super::{
     Feature, Features, INLINE_MAX_PRIMITIVES, INSTANCES_REASON, Intersector, PathTraceOptions,
     Schedule,
 };
+use crate::intersect::KINDS;
 
 /// Host intersection's steps keep the bounce in 24 bits of a word (`save_slot` in the shader).
 pub const HOST_RAYS_MAX_BOUNCES: u32 = 1 << 24;
@@ -94,19 +96,12 @@ impl Content {
     }
 }
 
-/// Who traces the rays: the matrix's columns.
+/// Who traces the rays: the matrix's columns, one per intersector
+/// ([`crate::intersect::KINDS`], each kind's [`IntersectorKind::traces`]) and the wavefront.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Tracer {
-    /// [`Intersector::Inline`].
-    Inline,
-    /// [`Intersector::Host`] (besides: a CPU adapter with Embree).
-    Host,
-    /// [`Intersector::BinaryBvh`].
-    BinaryBvh,
-    /// [`Intersector::WideBvh`].
-    WideBvh,
-    /// [`Intersector::RayQueries`] (besides: a device with ray queries, within its limits).
-    RayQueries,
+    /// An intersector (never [`Intersector::AUTO`]).
+    Intersector(Intersector),
     /// [`Schedule::Wavefront`] (besides: a WGSL BVH or ray queries intersect).
     Wavefront,
 }
@@ -114,78 +109,79 @@ pub enum Tracer {
 const T: bool = true;
 const F: bool = false;
 
+/// The wavefront's column: its steps shade triangle hits only, and its `wave_trace`
+/// intersects through the WGSL the intersector gives it.
+const WAVEFRONT: [bool; Content::ALL.len()] = [F, T, T, F, F, F, F, F, T, T];
+
 /// The support matrix: per column, whether it traces each [`Content::ALL`] row.
-pub const MATRIX: [(Tracer, [bool; Content::ALL.len()]); 6] = [
-    (Tracer::Inline, [F, T, F, T, F, T, T, T, T, T]),
-    (Tracer::Host, [F, F, T, F, F, F, F, F, T, T]),
-    (Tracer::BinaryBvh, [T, T, T, T, T, T, T, T, T, T]),
-    (Tracer::WideBvh, [F, T, T, T, F, T, T, T, T, T]),
-    (Tracer::RayQueries, [F, T, T, T, F, T, T, T, T, T]),
-    (Tracer::Wavefront, [F, T, T, F, F, F, F, F, T, T]),
-];
+pub fn matrix() -> Vec<(Tracer, [bool; Content::ALL.len()])> {
+    KINDS
+        .iter()
+        .map(|k| (Tracer::Intersector(k.intersector()), k.traces()))
+        .chain([(Tracer::Wavefront, WAVEFRONT)])
+        .collect()
+}
 
 impl Tracer {
-    /// The column of an intersector (none for [`Intersector::Auto`]).
+    /// The column of an intersector (none for [`Intersector::AUTO`]).
     pub fn of(intersector: Intersector) -> Option<Self> {
-        Some(match intersector {
-            Intersector::Auto => return None,
-            Intersector::Inline => Self::Inline,
-            Intersector::Host => Self::Host,
-            Intersector::BinaryBvh => Self::BinaryBvh,
-            Intersector::WideBvh => Self::WideBvh,
-            Intersector::RayQueries => Self::RayQueries,
-        })
+        intersector
+            .kind()
+            .map(|k| Self::Intersector(k.intersector()))
     }
 
     /// Whether it traces scenes with `content`.
     pub fn traces(self, content: Content) -> bool {
-        let row = MATRIX
-            .iter()
-            .find(|(t, _)| *t == self)
-            .map_or(&[F; Content::ALL.len()], |(_, row)| row);
-        row[content as usize]
+        match self {
+            Self::Intersector(i) => i.kind().is_some_and(|k| k.traces()[content as usize]),
+            Self::Wavefront => WAVEFRONT[content as usize],
+        }
     }
 
     /// The column's name in the table (the param's and the option's word).
     pub fn name(self) -> &'static str {
         match self {
-            Self::Inline => "inline",
-            Self::Host => "host",
-            Self::BinaryBvh => "binary",
-            Self::WideBvh => "wide",
-            Self::RayQueries => "rays",
+            Self::Intersector(i) => i.name(),
             Self::Wavefront => "wavefront (schedule)",
+        }
+    }
+
+    /// Why it cannot trace `content`, in the decisions' words.
+    fn lacks(self, content: Content, scene: &GpuScene) -> String {
+        match (self, content) {
+            (Self::Intersector(i), _) => match i.kind() {
+                Some(k) => k.lacks(content, scene),
+                None => reason(content, scene),
+            },
+            (Self::Wavefront, Content::GeneralShader) => {
+                "general shader: the megakernel".to_owned()
+            }
+            (Self::Wavefront, _) => reason(content, scene),
         }
     }
 }
 
-/// Why `tracer` cannot trace `content`, in the decisions' words.
-fn reason(tracer: Tracer, content: Content, scene: &GpuScene) -> String {
-    match (content, tracer) {
-        (Content::GeneralShader, Tracer::RayQueries) => "general shader: WGSL BVH".to_owned(),
-        (Content::GeneralShader, Tracer::Wavefront) => "general shader: the megakernel".to_owned(),
-        (Content::GeneralShader | Content::GpuAdapter, Tracer::Host) => {
-            "a GPU adapter or the general shader: traced in WGSL".to_owned()
-        }
-        (Content::GeneralShader, _) => "general shader: the binary BVH".to_owned(),
-        (Content::GpuAdapter, _) => "a GPU adapter".to_owned(),
-        (Content::ManyPrimitives, _) => format!(
+/// Why a column cannot trace `content`, in the decisions' words (what a kind says unless
+/// it says more, [`IntersectorKind::lacks`]).
+pub(crate) fn reason(content: Content, scene: &GpuScene) -> String {
+    match content {
+        Content::GeneralShader => "general shader: the binary BVH".to_owned(),
+        Content::GpuAdapter => "a GPU adapter".to_owned(),
+        Content::ManyPrimitives => format!(
             "{} primitives > {INLINE_MAX_PRIMITIVES}",
             scene.tri_positions.len() + scene.shapes.len()
         ),
-        (Content::Shapes, _) => {
+        Content::Shapes => {
             "analytic shapes or no triangles: the steps shade triangle hits only".to_owned()
         }
-        (Content::Instances, _) => INSTANCES_REASON.to_owned(),
-        (Content::Media, _) => {
-            "participating media: shadow rays cross boundaries in WGSL".to_owned()
-        }
-        (Content::Adaptive, _) => "adaptive sampling: traced in WGSL".to_owned(),
-        (Content::ManyBounces, _) => format!(
+        Content::Instances => INSTANCES_REASON.to_owned(),
+        Content::Media => "participating media: shadow rays cross boundaries in WGSL".to_owned(),
+        Content::Adaptive => "adaptive sampling: traced in WGSL".to_owned(),
+        Content::ManyBounces => format!(
             "{} bounces: a step keeps at most {HOST_RAYS_MAX_BOUNCES}",
             scene.settings.max_bounces
         ),
-        (Content::Alpha | Content::Aovs, _) => format!("{} not traced", content.label()),
+        Content::Alpha | Content::Aovs => format!("{} not traced", content.label()),
     }
 }
 
@@ -195,34 +191,19 @@ pub fn cannot_trace(tracer: Tracer, scene: &GpuScene, options: PathTraceOptions)
     Content::ALL
         .into_iter()
         .find(|&c| !tracer.traces(c) && c.in_scene(scene, options))
-        .map(|c| reason(tracer, c, scene))
+        .map(|c| tracer.lacks(c, scene))
 }
 
 /// Why `intersector` cannot trace `scene` with `options` (the matrix, then what the
-/// adapter has), or `None` where it can ([`Intersector::Auto`] always can).
+/// adapter has), or `None` where it can ([`Intersector::AUTO`] always can).
 pub fn why_not(
     intersector: Intersector,
     scene: &GpuScene,
     options: PathTraceOptions,
 ) -> Option<String> {
-    let tracer = Tracer::of(intersector)?;
-    if let Some(why) = cannot_trace(tracer, scene, options) {
-        return Some(why);
-    }
-    match tracer {
-        Tracer::Host if !options.host_rays => Some(format!(
-            "no host intersector: {}",
-            super::host_rays_unavailable()
-        )),
-        Tracer::RayQueries => match options.ray_query_limit {
-            None => Some(
-                "the device has no ray queries (or they were turned off: LUMAGRAPH_RAY_QUERY=off)"
-                    .to_owned(),
-            ),
-            Some(most) => crate::accel::unsupported(scene, most),
-        },
-        _ => None,
-    }
+    let kind = intersector.kind()?;
+    cannot_trace(Tracer::Intersector(intersector), scene, options)
+        .or_else(|| kind.unavailable(scene, options))
 }
 
 /// Why the intersector or schedule `options` ask for cannot be what `features` (decided
@@ -236,7 +217,7 @@ pub fn refusal(scene: &GpuScene, options: PathTraceOptions, features: &Features)
         ));
     }
     let chosen = features.intersector();
-    if options.intersector != Intersector::Auto && chosen != options.intersector {
+    if options.intersector != Intersector::AUTO && chosen != options.intersector {
         return Some(format!(
             "{} was asked for, but {} traces the scene",
             options.intersector.describe(),
@@ -244,11 +225,12 @@ pub fn refusal(scene: &GpuScene, options: PathTraceOptions, features: &Features)
         ));
     }
     if options.schedule == Schedule::Wavefront && !features.on(Feature::Wavefront) {
-        let hint = match chosen {
-            Intersector::Inline | Intersector::Host if options.intersector == Intersector::Auto => {
-                " (the wavefront traces through a WGSL BVH or ray queries: ask for one too)"
-            }
-            _ => "",
+        let hint = if options.intersector == Intersector::AUTO
+            && features.kind().no_wavefront().is_some()
+        {
+            " (the wavefront traces through a WGSL BVH or ray queries: ask for one too)"
+        } else {
+            ""
         };
         return Some(format!(
             "the wavefront was asked for, but cannot take this scene here: {}{hint}",
@@ -262,17 +244,18 @@ pub fn refusal(scene: &GpuScene, options: PathTraceOptions, features: &Features)
 pub fn markdown() -> String {
     use std::fmt::Write as _;
     let mut out = String::from("| the scene or render has |");
-    for (t, _) in MATRIX {
+    let matrix = matrix();
+    for (t, _) in &matrix {
         let _ = write!(out, " {} |", t.name());
     }
     out.push_str("\n|---|");
-    for _ in MATRIX {
+    for _ in &matrix {
         out.push_str("---|");
     }
     out.push('\n');
     for c in Content::ALL {
         let _ = write!(out, "| {} |", c.label());
-        for (t, _) in MATRIX {
+        for (t, _) in &matrix {
             out.push_str(if t.traces(c) { " yes |" } else { " no |" });
         }
         out.push('\n');

@@ -4,7 +4,7 @@
 
 use lumagraph_graph::Pass;
 
-use super::{Backend, Frame, PathTrace, stage_frame, storage};
+use super::{Frame, PathTrace, stage_frame, storage};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::host_rays::WaveStep;
@@ -22,8 +22,9 @@ impl PathTrace {
         pass: &Pass,
         frame: Frame,
     ) -> Result<()> {
-        let backend = std::mem::replace(&mut self.backend, Backend::Wgsl);
-        let Backend::Host(mut host) = backend else {
+        // Taken out of the node while the steps borrow it.
+        let mut backend = std::mem::replace(&mut self.backend, crate::intersect::nothing());
+        let Some(host) = backend.host_mut() else {
             self.backend = backend;
             return Ok(());
         };
@@ -55,7 +56,7 @@ impl PathTrace {
             }
             Ok(())
         });
-        self.backend = Backend::Host(host);
+        self.backend = backend;
         result
     }
 

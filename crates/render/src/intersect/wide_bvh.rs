@@ -1,9 +1,9 @@
 //! The 8-wide compressed BVH (CWBVH, Ylitie, Karras and Laine, "Efficient Incoherent Ray
 //! Traversal on GPUs Through Compressed Wide BVHs", HPG 2017) that `pathtrace/intersect/wide_bvh.wgsl`
-//! traverses where the plan says "8-wide BVH" ([`crate::specialize::Feature::WideBvh`]).
+//! traverses where the plan's intersector is `wide` ([`WideBvhKind`], [`Intersector::WIDE_BVH`]).
 //! [`obvhs`] builds it (PLOC, reinsertion, then the conversion to eight children per node,
 //! up to three primitives per leaf) over the same padded boxes the device's acceleration
-//! structure gets ([`primitive_boxes`]); this module packs it into one storage buffer that
+//! structure gets ([`super::primitive_boxes`]); this module packs it into one storage buffer that
 //! takes the binary BVH's binding.
 //!
 //! # Layout (`vec4<u32>` records)
@@ -22,7 +22,7 @@
 //! The leaves' primitives are copies, in leaf order, so a leaf's are read from the records
 //! next to each other, with no index to follow; their index in the scene's arrays rides
 //! along for the hit, the shading data and the any-hit test.
-//! The primitives' boxes are the ones [`primitive_boxes`] pads, and the conversion rounds
+//! The primitives' boxes are the ones [`super::primitive_boxes`] pads, and the conversion rounds
 //! child bounds outwards, so a child's box holds whatever the exact tests can hit in it.
 
 use glam::Vec3;
@@ -31,54 +31,17 @@ use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use wgpu::util::DeviceExt as _;
 
+use super::{Intersector, IntersectorKind, Traversal};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
+use crate::specialize::PathTraceOptions;
+use crate::specialize::support::Content;
 
 /// Most nodes on a path from the root: the traversal's stack holds one entry a level.
 pub const WIDE_BVH_STACK: usize = 32;
 
 /// `pathtrace/intersect/wide_bvh.wgsl`'s shape bit in the primitive list (the shader's `PRIM_SHAPE`).
 const PRIM_SHAPE: u32 = lumagraph_scene::PRIM_SHAPE;
-
-/// A box from `lo` to `hi`, grown by a few ulps of `scale` (the largest magnitude the
-/// primitive's inputs have): a point the shader's tests find on the primitive, computed from
-/// those inputs with rounding, may lie that far outside the exact box (where a sphere
-/// touches a plane through the origin, its box's face is at 0, its computed points not).
-fn padded(lo: Vec3, hi: Vec3, scale: f32) -> [f32; 6] {
-    let grow = Vec3::splat(scale * (16.0 * f32::EPSILON) + f32::MIN_POSITIVE);
-    let (lo, hi) = (lo - grow, hi + grow);
-    [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z]
-}
-
-/// Every triangle's and analytic shape's box (min xyz, max xyz), in the order of
-/// `GpuScene::tri_positions` and `GpuScene::shapes`, padded so that any point the WGSL
-/// tests find on the primitive lies inside: the inputs of both the device's acceleration
-/// structure ([`crate::accel`]) and the wide BVH.
-pub fn primitive_boxes(scene: &GpuScene) -> (Vec<[f32; 6]>, Vec<[f32; 6]>) {
-    let tris = scene
-        .tri_positions
-        .iter()
-        .map(|t| {
-            let v0 = Vec3::from(t.v0);
-            let (e1, e2) = (Vec3::from(t.e1), Vec3::from(t.e2));
-            let (v1, v2) = (v0 + e1, v0 + e2);
-            let scale = [v0, v1, v2, e1, e2]
-                .iter()
-                .map(|v| v.abs().max_element())
-                .fold(0.0f32, f32::max);
-            padded(v0.min(v1).min(v2), v0.max(v1).max(v2), scale)
-        })
-        .collect();
-    let shapes = scene
-        .shapes
-        .iter()
-        .map(|s| {
-            let [lo, hi] = lumagraph_scene::shapes::KINDS[s.kind as usize].bounds(s);
-            padded(lo, hi, lo.abs().max(hi.abs()).max_element())
-        })
-        .collect();
-    (tris, shapes)
-}
 
 /// A scene's wide BVH, packed for the GPU.
 #[derive(Clone, Debug)]
@@ -102,7 +65,7 @@ impl WideBvh {
         if !scene.instances.is_empty() {
             return Err(crate::embree::flat_only("the 8-wide BVH", scene));
         }
-        let (tri_boxes, shape_boxes) = primitive_boxes(scene);
+        let (tri_boxes, shape_boxes) = super::primitive_boxes(scene);
         let n_tris = u32::try_from(tri_boxes.len()).map_err(|_| "too many triangles")?;
         let boxes: Vec<Aabb> = tri_boxes
             .iter()
@@ -218,4 +181,94 @@ fn depth(bvh: &CwBvh) -> usize {
         }
     }
     deepest
+}
+
+impl Intersector {
+    /// The 8-wide compressed BVH traversed in WGSL (`pathtrace/intersect/wide_bvh.wgsl`).
+    pub const WIDE_BVH: Self = Self::named("wide");
+}
+
+/// Why a CPU adapter traverses the 8-wide BVH unless asked otherwise: measured in
+/// `docs/benchmarks.md` ("The 8-wide BVH on lavapipe").
+const CPU_REASON: &str = "a CPU adapter: the 8-wide BVH measured 2.3x the binary \
+     one's paths/s on Sponza and 1.4x on an 82 k-triangle mesh on lavapipe \
+     (--intersector binary asks for the binary one)";
+
+/// Why a GPU adapter traverses the binary BVH unless asked otherwise: measured in
+/// `docs/benchmarks.md` ("The 8-wide BVH against the binary one").
+const GPU_REASON: &str = "the binary BVH: the 8-wide one measured 0.82x on Sponza \
+     and 1.01x on a 1.3 M-triangle mesh on an NVIDIA H200 (--intersector wide asks for it)";
+
+/// The 8-wide BVH as an intersector: the adapter's choice on CPU adapters wherever the
+/// host does not trace; its records are bound in the binary BVH's place.
+pub struct WideBvhKind;
+
+impl IntersectorKind for WideBvhKind {
+    fn intersector(&self) -> Intersector {
+        Intersector::WIDE_BVH
+    }
+
+    fn describe(&self) -> &'static str {
+        "the 8-wide BVH"
+    }
+
+    fn how(&self) -> &'static str {
+        "8-wide BVH traversal"
+    }
+
+    fn traces(&self) -> [bool; Content::ALL.len()] {
+        use Content as C;
+        Content::ALL.map(|c| !matches!(c, C::GeneralShader | C::Instances))
+    }
+
+    fn auto(&self, _scene: &GpuScene, options: PathTraceOptions) -> Result<String, String> {
+        if options.cpu_adapter {
+            Ok(CPU_REASON.to_owned())
+        } else {
+            Err(GPU_REASON.to_owned())
+        }
+    }
+
+    fn wgsl(&self, _scene: &GpuScene, _alpha: bool) -> Option<String> {
+        Some("#import \"pathtrace/intersect/wide_bvh.wgsl\"\n".to_owned())
+    }
+
+    fn build(
+        &self,
+        ctx: &GpuContext,
+        scene: &std::sync::Arc<GpuScene>,
+    ) -> Result<Box<dyn Traversal>> {
+        let start = std::time::Instant::now();
+        let mut bvh = WideBvh::build(scene).map_err(|e| {
+            RenderError::Gpu(format!("{e} (--intersector binary traverses the binary BVH)"))
+        })?;
+        let took = start.elapsed();
+        let buffer = upload(ctx, &bvh)?;
+        bvh.records = Vec::new();
+        Ok(Box::new(Built { buffer, bvh, took }))
+    }
+}
+
+/// The 8-wide BVH's buffer (bound in the binary BVH's place), with its node count, depth,
+/// size and build time.
+struct Built {
+    buffer: wgpu::Buffer,
+    bvh: WideBvh,
+    took: std::time::Duration,
+}
+
+impl Traversal for Built {
+    fn bvh_nodes(&self) -> Option<&wgpu::Buffer> {
+        Some(&self.buffer)
+    }
+
+    fn note(&self, _scene: &GpuScene) -> Option<String> {
+        Some(format!(
+            "8-wide BVH: {} nodes, {} deep, {} built in {:.1} ms",
+            self.bvh.nodes,
+            self.bvh.depth,
+            crate::human_bytes(self.bvh.bytes),
+            self.took.as_secs_f64() * 1e3
+        ))
+    }
 }
