@@ -136,7 +136,9 @@ impl Figures {
 
     /// Whether the host traced the rays, in steps.
     fn host_steps(&self) -> bool {
-        self.features.as_ref().is_some_and(|f| f.kind().host_steps())
+        self.features
+            .as_ref()
+            .is_some_and(|f| f.kind().host_steps())
     }
 
     /// The intersector the shader traced with, where it has features.

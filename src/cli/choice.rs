@@ -25,7 +25,7 @@ pub(crate) struct Choice {
 }
 
 impl Choice {
-    /// The intersector asked for: the option, else the environment, else `Auto`.
+    /// The intersector asked for: the option, else the environment, else `AUTO`.
     pub(crate) fn intersector(self) -> Intersector {
         self.intersector.unwrap_or_else(intersector_from_env)
     }
@@ -49,7 +49,7 @@ impl Choice {
 }
 
 /// `LUMAGRAPH_RAY_QUERY=on` the device's ray queries; `LUMAGRAPH_BVH=wide` or `binary` the
-/// 8-wide or the binary BVH in WGSL; else `Auto`.
+/// 8-wide or the binary BVH in WGSL; else `AUTO`.
 fn intersector_from_env() -> Intersector {
     if std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "on" || v == "1") {
         return Intersector::RAY_QUERIES;

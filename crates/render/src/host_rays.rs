@@ -1,6 +1,7 @@
 //! Host intersection for the path tracer on CPU adapters. llvmpipe runs WGSL BVH traversal
 //! several times slower than Embree runs on the same cores (`docs/benchmarks.md`), so where
-//! Embree is found ([`crate::embree`]) and the scene allows (the plan's "host intersection"),
+//! Embree is found ([`crate::embree`]) and the scene allows (the plan's "intersector:
+//! host", [`crate::intersect::host`]),
 //! the path tracer's kernel takes every pixel's path one step at a time and the host
 //! intersects the rays of each step in between: the kernel writes each path's next ray and
 //! its shadow ray into the `wave` buffer, the host reads them back, traces them with Embree

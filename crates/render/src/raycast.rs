@@ -52,7 +52,7 @@ impl Raycaster {
         Ok(Self { kernel })
     }
 
-    /// Compiles the kernel over the 8-wide BVH ([`crate::wide_bvh`]): its buffer goes where
+    /// Compiles the kernel over the 8-wide BVH ([`crate::intersect::wide_bvh`]): its buffer goes where
     /// [`Raycaster::cast_through`] and [`Raycaster::time`] take the nodes.
     ///
     /// # Errors

@@ -47,10 +47,10 @@ pub struct SessionOptions {
     pub frame: Option<i64>,
     /// Let `Output` paths be absolute or climb out of `out` (by default they are refused).
     pub outputs_anywhere: bool,
-    /// The path tracer's intersector ([`Resources::intersector`]; `Auto`: the scene and
+    /// The path tracer's intersector ([`Resources::tracer`]'s; `AUTO`: the scene and
     /// the adapter decide).
     pub intersector: crate::specialize::Intersector,
-    /// The path tracer's schedule ([`Resources::schedule`]).
+    /// The path tracer's schedule ([`Resources::tracer`]'s).
     pub schedule: crate::specialize::Schedule,
 }
 

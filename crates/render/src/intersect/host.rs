@@ -1,6 +1,6 @@
 //! Host intersection: on CPU adapters where Embree is found ([`crate::embree`]), the host
 //! intersects the path tracer's rays on its own threads and the WGSL shades them step by
-//! step ([`crate::host_rays`], `pathtrace/integrator/wave.wgsl`).
+//! step (`host_rays.rs`, `pathtrace/integrator/wave.wgsl`).
 
 use lumagraph_scene::GpuScene;
 

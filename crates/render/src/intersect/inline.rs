@@ -1,6 +1,6 @@
 //! Inline intersection: every primitive tested in code written for the scene
 //! ([`crate::specialize::inline_intersection`]), for scenes of at most
-//! [`INLINE_MAX_PRIMITIVES`] primitives. On CPU adapters loads in loops are what llvmpipe
+//! [`crate::specialize::INLINE_MAX_PRIMITIVES`] primitives. On CPU adapters loads in loops are what llvmpipe
 //! pays most for, so small scenes are intersected this way there; GPUs traverse the BVH.
 
 use lumagraph_scene::GpuScene;

@@ -1,6 +1,6 @@
 //! The path tracer's intersectors as parts, as shapes and lights are: each is an
 //! [`IntersectorKind`] in a file of its own here (with its WGSL under
-//! `shaders/pathtrace/intersect/`), listed once in [`intersectors!`]'s one line below.
+//! `shaders/pathtrace/intersect/`), listed once in the `intersectors!` line below.
 //!
 //! A kind says what it can trace (its column of the support matrix,
 //! [`crate::specialize::support`]), what the adapter must have for it, whether the adapter's

@@ -1,7 +1,7 @@
 //! `PathTrace`: the path tracer's node. Each frame adds `samples_per_frame` samples per
 //! pixel and writes their mean, through the WGSL megakernel (`shaders/pathtrace/`)
 //! specialized to the scene ([`crate::specialize`]), whose rays one of the intersectors
-//! traces ([`crate::specialize::Intersector`]: inline, the binary or 8-wide BVH, ray
+//! traces ([`crate::intersect`]: inline, the binary or 8-wide BVH, ray
 //! queries, or the host's Embree through [`crate::host_rays`]).
 
 use lumagraph_graph::Pass;

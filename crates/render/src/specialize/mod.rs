@@ -151,7 +151,7 @@ pub struct PathTraceOptions {
     pub ray_query_limit: Option<u32>,
     /// The intersector asked for (the `intersector` param, `--intersector`, tests,
     /// benchmarks), or [`Intersector::AUTO`]: the scene and the adapter decide. One that
-    /// cannot trace the scene ([`support::why_not`]) is decided as `Auto`; the node refuses
+    /// cannot trace the scene ([`support::why_not`]) is decided as `AUTO`; the node refuses
     /// to render then ([`support::refusal`]).
     pub intersector: Intersector,
     /// The schedule asked for (the `schedule` param, `--schedule`, tests, benchmarks), or

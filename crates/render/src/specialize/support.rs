@@ -1,5 +1,5 @@
 //! The support matrix: what each intersector (and the wavefront schedule) can trace, as
-//! data: a column per intersector, each kind's own ([`IntersectorKind::traces`]), and the
+//! data: a column per intersector, each kind's own ([`crate::intersect::IntersectorKind::traces`]), and the
 //! wavefront's. The decisions ([`super::features`]) refuse an intersector asked for where the scene
 //! has something its column lacks, and a render that asks for it through the `PathTrace`
 //! node's `intersector` param or `lumagraph render --intersector` stops with that reason
@@ -97,7 +97,7 @@ impl Content {
 }
 
 /// Who traces the rays: the matrix's columns, one per intersector
-/// ([`crate::intersect::KINDS`], each kind's [`IntersectorKind::traces`]) and the wavefront.
+/// ([`crate::intersect::KINDS`], each kind's [`crate::intersect::IntersectorKind::traces`]) and the wavefront.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Tracer {
     /// An intersector (never [`Intersector::AUTO`]).
