@@ -210,8 +210,8 @@ impl Executor {
     /// Moves the window the nodes that render the scene render: its left and top pixel in
     /// the whole image (its size is the plan's). For tiled renders.
     pub fn set_origin(&mut self, origin: [u32; 2]) {
-        for node in &mut self.nodes {
-            node.set_origin(origin);
+        for view in self.nodes.iter_mut().filter_map(|n| n.view()) {
+            view.set_origin(origin);
         }
     }
 
@@ -235,9 +235,9 @@ impl Executor {
     }
 
     /// Moves the camera of the nodes that render the scene to `camera`, the scene being
-    /// otherwise the same: each node gets [`NodeExec::move_camera`], so progressive
-    /// accumulation restarts while a node that reprojects its history (`TemporalReuse`)
-    /// keeps it. Returns whether anything moved (`false` when `camera` is where the nodes
+    /// otherwise the same: each node that follows the view gets
+    /// [`crate::nodes::View::move_camera`] (a node that reprojects its history,
+    /// `TemporalReuse`, keeps it), and every other node restarts its history. Returns whether anything moved (`false` when `camera` is where the nodes
     /// already are).
     pub fn move_camera(&mut self, camera: &lumagraph_scene::GpuCamera) -> bool {
         if self.camera.as_ref() == Some(camera) {
@@ -245,7 +245,10 @@ impl Executor {
         }
         self.camera = Some(*camera);
         for node in &mut self.nodes {
-            node.move_camera(camera);
+            match node.view() {
+                Some(view) => view.move_camera(camera),
+                None => node.reset(),
+            }
         }
         true
     }
@@ -627,8 +630,8 @@ impl Executor {
                     let before = std::mem::replace(&mut encoder, new_encoder(&self.ctx));
                     submit_and_wait(&self.ctx, before)?;
                     let t = Instant::now();
-                    if node.submits_own() {
-                        node.submit_own(&self.ctx, pass, &io)
+                    if let Some(own) = node.own_work().filter(|o| o.submits_own()) {
+                        own.submit_own(&self.ctx, pass, &io)
                             .map_err(|e| e.in_node(&pass.node))?;
                     }
                     let rec = Recording {
@@ -646,11 +649,11 @@ impl Executor {
                         None => wall_ms.push((pass.node.clone(), ms)),
                     }
                 } else {
-                    if node.submits_own() {
+                    if let Some(own) = node.own_work().filter(|o| o.submits_own()) {
                         // What the graph recorded so far runs before the node's own work.
                         let before = std::mem::replace(&mut encoder, new_encoder(&self.ctx));
                         self.ctx.queue.submit([before.finish()]);
-                        node.submit_own(&self.ctx, pass, &io)
+                        own.submit_own(&self.ctx, pass, &io)
                             .map_err(|e| e.in_node(&pass.node))?;
                     }
                     let rec = Recording {
@@ -777,7 +780,10 @@ impl Executor {
     pub fn held_images(&mut self) -> Result<Vec<(usize, crate::nodes::HeldImage)>> {
         let mut out = Vec::new();
         for (p, (pass, node)) in self.plan.passes.iter().zip(&mut self.nodes).enumerate() {
-            if let Some(image) = node
+            let Some(sink) = node.sink() else {
+                continue;
+            };
+            if let Some(image) = sink
                 .held_image(&self.ctx)
                 .map_err(|e| e.in_node(&pass.node))?
             {

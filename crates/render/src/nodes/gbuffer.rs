@@ -24,7 +24,7 @@ use wgpu::util::DeviceExt as _;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::kernel::uniform_buffer;
-use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed};
+use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, View, boxed};
 use crate::pool::{PooledTexture, create, wgpu_format};
 
 /// Floats per vertex: position, normal, albedo (3 each), shape (4), uv (both sets: 4),
@@ -50,7 +50,7 @@ pub(crate) const IMPL: NodeImpl = NodeImpl::new("GBuffer", |ctx, pass, resources
 
 pub(crate) struct GBuffer {
     scene: std::sync::Arc<GpuScene>,
-    /// The camera rasterized from: the scene's, until [`NodeExec::move_camera`].
+    /// The camera rasterized from: the scene's, until [`View::move_camera`](crate::nodes::View::move_camera).
     camera_now: lumagraph_scene::GpuCamera,
     pipeline: wgpu::RenderPipeline,
     bind_group: wgpu::BindGroup,
@@ -486,6 +486,10 @@ pub(crate) fn vertices(
 }
 
 impl NodeExec for GBuffer {
+    fn view(&mut self) -> Option<&mut dyn View> {
+        Some(self)
+    }
+
     fn update(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<()> {
         let segments = u32::try_from(pass.params.int("sphere_segments")).unwrap_or(48);
         if self.vertices.is_none() || segments != self.segments {
@@ -514,14 +518,6 @@ impl NodeExec for GBuffer {
             self.segments = segments;
         }
         Ok(())
-    }
-
-    fn set_origin(&mut self, origin: [u32; 2]) {
-        self.origin = origin;
-    }
-
-    fn move_camera(&mut self, camera: &lumagraph_scene::GpuCamera) {
-        self.camera_now = *camera;
     }
 
     fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
@@ -617,5 +613,15 @@ impl NodeExec for GBuffer {
             }
         }
         Ok(())
+    }
+}
+
+impl View for GBuffer {
+    fn set_origin(&mut self, origin: [u32; 2]) {
+        self.origin = origin;
+    }
+
+    fn move_camera(&mut self, camera: &lumagraph_scene::GpuCamera) {
+        self.camera_now = *camera;
     }
 }

@@ -232,44 +232,23 @@ pub trait NodeExec {
     /// Forgets history kept across frames (progressive accumulation restarts).
     fn reset(&mut self) {}
 
-    /// The camera moved to `camera` (the scene is otherwise the same): nodes that render
-    /// the scene render from it from the next frame on. By default the node's history
-    /// restarts ([`NodeExec::reset`]); a node that can carry its history into the new
-    /// view (`TemporalReuse`) keeps it.
-    fn move_camera(&mut self, _camera: &lumagraph_scene::GpuCamera) {
-        self.reset();
+    /// What a node that follows the view keeps of it (the camera, a tiled render's
+    /// window: [`View`]); `None` (the default) for the others, whose history restarts when
+    /// the camera moves ([`NodeExec::reset`]).
+    fn view(&mut self) -> Option<&mut dyn View> {
+        None
     }
 
-    /// The image a sink writes, as recorded in the last finishing frame (rows of
-    /// `extent.width` pixels of `format`, no padding); `None` for other nodes. A tiled
-    /// render reads it instead of letting the sink write ([`crate::Executor::hold_sinks`]).
-    ///
-    /// # Errors
-    /// When the readback fails.
-    fn held_image(&mut self, _ctx: &GpuContext) -> Result<Option<HeldImage>> {
-        Ok(None)
+    /// A sink's image for a tiled render to read instead of letting the sink write
+    /// ([`Sink`]); `None` (the default) for other nodes.
+    fn sink(&mut self) -> Option<&mut dyn Sink> {
+        None
     }
 
-    /// Where the pass's images lie in the whole image, for a node that renders the scene
-    /// (a tiled render's window: left and top; the size is the pass's extent).
-    fn set_origin(&mut self, _origin: [u32; 2]) {}
-
-    /// Whether this frame's work includes submissions of the node's own, which must run
-    /// after what the graph recorded before the node (a frame traced in steps, each step
-    /// submitted and waited for). The executor then submits the graph's work so far and
-    /// calls [`NodeExec::submit_own`] before [`NodeExec::record`], so no node submits from
-    /// inside `record`.
-    fn submits_own(&self) -> bool {
-        false
-    }
-
-    /// This frame's own submissions (see [`NodeExec::submits_own`]), before its pass is
-    /// recorded.
-    ///
-    /// # Errors
-    /// When the work fails.
-    fn submit_own(&mut self, _ctx: &GpuContext, _pass: &Pass, _io: &FrameIo<'_>) -> Result<()> {
-        Ok(())
+    /// A node whose frames may include submissions of its own ([`OwnWork`]); `None` (the
+    /// default) for the others.
+    fn own_work(&mut self) -> Option<&mut dyn OwnWork> {
+        None
     }
 
     /// Records this frame's GPU work.
@@ -320,6 +299,47 @@ pub trait NodeExec {
     fn finish(&mut self, _ctx: &GpuContext, _pass: &Pass) -> Result<Vec<PathBuf>> {
         Ok(Vec::new())
     }
+}
+
+/// A node that follows the view: nodes that render the scene (`PathTrace`, `GBuffer`) and
+/// those that reproject what they keep (`TemporalReuse`). A node has it through
+/// [`NodeExec::view`].
+pub trait View {
+    /// The camera moved to `camera` (the scene is otherwise the same): nodes that render
+    /// the scene render from it from the next frame on; a node that can carry its history
+    /// into the new view (`TemporalReuse`) keeps it, the others restart it.
+    fn move_camera(&mut self, camera: &lumagraph_scene::GpuCamera);
+
+    /// Where the pass's images lie in the whole image, for a node that renders the scene
+    /// (a tiled render's window: left and top; the size is the pass's extent).
+    fn set_origin(&mut self, _origin: [u32; 2]) {}
+}
+
+/// A sink whose image a tiled render reads instead of letting it write
+/// ([`crate::Executor::hold_sinks`]). A node has it through [`NodeExec::sink`].
+pub trait Sink {
+    /// The image the sink writes, as recorded in the last finishing frame (rows of
+    /// `extent.width` pixels of `format`, no padding); `None` before one.
+    ///
+    /// # Errors
+    /// When the readback fails.
+    fn held_image(&mut self, ctx: &GpuContext) -> Result<Option<HeldImage>>;
+}
+
+/// A node whose frame's work may include submissions of its own, which must run after
+/// what the graph recorded before the node (a frame traced in steps, each step submitted
+/// and waited for; a denoiser on the host). The executor then submits the graph's work so
+/// far and calls [`OwnWork::submit_own`] before [`NodeExec::record`], so no node submits
+/// from inside `record`. A node has it through [`NodeExec::own_work`].
+pub trait OwnWork {
+    /// Whether this frame's work includes submissions of its own.
+    fn submits_own(&self) -> bool;
+
+    /// This frame's own submissions, before its pass is recorded.
+    ///
+    /// # Errors
+    /// When the work fails.
+    fn submit_own(&mut self, ctx: &GpuContext, pass: &Pass, io: &FrameIo<'_>) -> Result<()>;
 }
 
 /// The history a progressive node keeps across frames (`Accumulate`'s sums, `PathTrace`'s

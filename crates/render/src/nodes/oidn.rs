@@ -1,6 +1,6 @@
 //! `OIDN`: Intel Open Image Denoise's `RT` filter on the CPU ([`crate::oidn`]).
 //!
-//! The node works on the host: [`NodeExec::submit_own`] runs after the graph's work so far
+//! The node works on the host: [`OwnWork::submit_own`](crate::nodes::OwnWork::submit_own) runs after the graph's work so far
 //! is submitted, reads the inputs back ([`crate::readback::read_texture`]), filters them and
 //! writes the result into the output texture (`Queue::write_texture`, which lands before
 //! the passes recorded after it); [`NodeExec::record`] records nothing. The last inputs
@@ -18,7 +18,7 @@ use lumagraph_graph::{Extent, Pass, TexFormat};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::nodes::{Counter, FrameIo, NodeExec, NodeImpl, Recording, boxed};
+use crate::nodes::{Counter, FrameIo, NodeExec, NodeImpl, OwnWork, Recording, boxed};
 use crate::oidn::{Filter, Images, Oidn, Quality, Settings};
 use crate::readback::{read_texture, to_image};
 
@@ -192,6 +192,10 @@ fn clean(p: &mut [f32; 4], lo: f32, hi: f32) {
 }
 
 impl NodeExec for OidnNode {
+    fn own_work(&mut self) -> Option<&mut dyn OwnWork> {
+        Some(self)
+    }
+
     fn update(&mut self, _ctx: &GpuContext, pass: &Pass) -> Result<()> {
         self.read_params(pass)
     }
@@ -203,6 +207,25 @@ impl NodeExec for OidnNode {
         self.last = None;
     }
 
+    fn record(&mut self, _pass: &Pass, _rec: Recording<'_>) -> Result<()> {
+        // The work is done on the host, in `submit_own`.
+        Ok(())
+    }
+
+    fn notes(&self) -> Vec<String> {
+        vec![format!(
+            "Open Image Denoise {} on the CPU ({})",
+            self.oidn.version(),
+            self.oidn.library()
+        )]
+    }
+
+    fn counters(&mut self, _ctx: &GpuContext) -> Result<Vec<Counter>> {
+        Ok(vec![Counter::new("oidn_filter_runs", self.runs)])
+    }
+}
+
+impl OwnWork for OidnNode {
     fn submits_own(&self) -> bool {
         true
     }
@@ -256,22 +279,5 @@ impl NodeExec for OidnNode {
         );
         self.last = Some(output);
         Ok(())
-    }
-
-    fn record(&mut self, _pass: &Pass, _rec: Recording<'_>) -> Result<()> {
-        // The work is done on the host, in `submit_own`.
-        Ok(())
-    }
-
-    fn notes(&self) -> Vec<String> {
-        vec![format!(
-            "Open Image Denoise {} on the CPU ({})",
-            self.oidn.version(),
-            self.oidn.library()
-        )]
-    }
-
-    fn counters(&mut self, _ctx: &GpuContext) -> Result<Vec<Counter>> {
-        Ok(vec![Counter::new("oidn_filter_runs", self.runs)])
     }
 }

@@ -13,7 +13,7 @@ use lumagraph_graph::{Extent, Pass, Plan, PortType, TexFormat, TextureId, write_
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::nodes::{
-    FrameIo, HeldImage, NodeExec, NodeImpl, Recording, Resources, boxed, check_writable,
+    FrameIo, HeldImage, NodeExec, NodeImpl, Recording, Resources, Sink, boxed, check_writable,
 };
 
 /// The `Output` kind.
@@ -261,6 +261,10 @@ impl Output {
 }
 
 impl NodeExec for Output {
+    fn sink(&mut self) -> Option<&mut dyn Sink> {
+        Some(self)
+    }
+
     fn update(&mut self, _ctx: &GpuContext, pass: &Pass) -> Result<()> {
         check_writable(&self.path(pass)?)
     }
@@ -280,10 +284,6 @@ impl NodeExec for Output {
             self.staged.take(),
         ));
         Ok(())
-    }
-
-    fn held_image(&mut self, ctx: &GpuContext) -> Result<Option<HeldImage>> {
-        self.staged.as_ref().map(|s| s.read(ctx)).transpose()
     }
 
     fn finish(&mut self, ctx: &GpuContext, pass: &Pass) -> Result<Vec<PathBuf>> {
@@ -308,6 +308,12 @@ impl NodeExec for Output {
             write_image(&path, image.bytes, image.format, image.ty, image.extent)?;
         }
         Ok(vec![path])
+    }
+}
+
+impl Sink for Output {
+    fn held_image(&mut self, ctx: &GpuContext) -> Result<Option<HeldImage>> {
+        self.staged.as_ref().map(|s| s.read(ctx)).transpose()
     }
 }
 

@@ -16,7 +16,9 @@ use lumagraph_graph::TexFormat;
 
 use crate::host_rays::HostCounts;
 use crate::kernel::PassBuilder;
-use crate::nodes::{Counter, FrameIo, History, NodeExec, NodeImpl, Recording, Resources, boxed};
+use crate::nodes::{
+    Counter, FrameIo, History, NodeExec, NodeImpl, OwnWork, Recording, Resources, View, boxed,
+};
 use crate::pool::{PooledTexture, create};
 use crate::readback::map_read;
 use crate::scene_gpu::SceneBuffers;
@@ -198,7 +200,7 @@ fn storage(ctx: &GpuContext, label: &str, size: u64) -> wgpu::Buffer {
 pub(crate) struct PathTrace {
     kernel: Kernel,
     scene: std::sync::Arc<lumagraph_scene::GpuScene>,
-    /// The camera rendered from: the scene's, until [`NodeExec::move_camera`].
+    /// The camera rendered from: the scene's, until [`View::move_camera`](crate::nodes::View::move_camera).
     camera: lumagraph_scene::GpuCamera,
     buffers: SceneBuffers,
     frame: wgpu::Buffer,
@@ -508,6 +510,14 @@ fn stage_frame(
 }
 
 impl NodeExec for PathTrace {
+    fn own_work(&mut self) -> Option<&mut dyn OwnWork> {
+        Some(self)
+    }
+
+    fn view(&mut self) -> Option<&mut dyn View> {
+        Some(self)
+    }
+
     fn history(&mut self) -> Option<&mut dyn History> {
         Some(self)
     }
@@ -527,10 +537,6 @@ impl NodeExec for PathTrace {
         Ok(())
     }
 
-    fn set_origin(&mut self, origin: [u32; 2]) {
-        self.origin = origin;
-    }
-
     fn reset(&mut self) {
         self.samples = 0;
         self.dropped = 0;
@@ -538,22 +544,6 @@ impl NodeExec for PathTrace {
         self.adaptive_samples = 0;
         self.host_counts = HostCounts::default();
         self.adaptive.clear = true;
-    }
-
-    fn move_camera(&mut self, camera: &lumagraph_scene::GpuCamera) {
-        self.camera = *camera;
-        self.reset();
-    }
-
-    fn submits_own(&self) -> bool {
-        self.backend.host().is_some() || self.wavefront.is_some()
-    }
-
-    fn submit_own(&mut self, ctx: &GpuContext, pass: &Pass, io: &FrameIo<'_>) -> Result<()> {
-        let frame = self.frame(pass.extent);
-        self.trace_steps(ctx, io, pass, frame)?;
-        self.traced = Some(frame);
-        Ok(())
     }
 
     fn record(&mut self, pass: &Pass, rec: Recording<'_>) -> Result<()> {
@@ -672,5 +662,29 @@ impl NodeExec for PathTrace {
             counters.push(Counter::new("adaptive_samples", self.adaptive_samples));
         }
         Ok(counters)
+    }
+}
+
+impl OwnWork for PathTrace {
+    fn submits_own(&self) -> bool {
+        self.backend.host().is_some() || self.wavefront.is_some()
+    }
+
+    fn submit_own(&mut self, ctx: &GpuContext, pass: &Pass, io: &FrameIo<'_>) -> Result<()> {
+        let frame = self.frame(pass.extent);
+        self.trace_steps(ctx, io, pass, frame)?;
+        self.traced = Some(frame);
+        Ok(())
+    }
+}
+
+impl View for PathTrace {
+    fn set_origin(&mut self, origin: [u32; 2]) {
+        self.origin = origin;
+    }
+
+    fn move_camera(&mut self, camera: &lumagraph_scene::GpuCamera) {
+        self.camera = *camera;
+        self.reset();
     }
 }

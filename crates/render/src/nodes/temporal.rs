@@ -1,7 +1,7 @@
 //! `TemporalReuse`: reprojects a progressive render's history when the camera moves.
 //!
 //! The node learns the camera as the path tracer does: from the scene when it is made, then
-//! from [`NodeExec::move_camera`] ([`crate::Executor::move_camera`]). A move restarts
+//! from [`View::move_camera`](crate::nodes::View::move_camera) ([`crate::Executor::move_camera`]). A move restarts
 //! Accumulate (its default `move_camera` is a reset) but not this node: the next frame
 //! first reprojects what the node wrote last (rendered with the old camera) into the new
 //! view, then blends every frame's mean with it. See `shaders/post/temporal.wgsl` for the
@@ -19,7 +19,7 @@ use wgpu::util::DeviceExt as _;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::kernel::{Kernel, uniform_buffer};
-use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, boxed};
+use crate::nodes::{NodeExec, NodeImpl, Recording, Resources, View, boxed};
 use crate::pool::{PooledTexture, create};
 
 /// The `TemporalReuse` kind: it owns its history buffers.
@@ -134,6 +134,10 @@ impl TemporalReuse {
 }
 
 impl NodeExec for TemporalReuse {
+    fn view(&mut self) -> Option<&mut dyn View> {
+        Some(self)
+    }
+
     #[expect(clippy::cast_possible_truncation, reason = "GPU math is f32")]
     fn update(&mut self, _ctx: &GpuContext, pass: &Pass) -> Result<()> {
         self.history_cap = pass.params.int("history_frames") as f32;
@@ -145,12 +149,6 @@ impl NodeExec for TemporalReuse {
     fn reset(&mut self) {
         self.clear = true;
         self.history_camera = None;
-        self.frames = 0;
-    }
-
-    fn move_camera(&mut self, camera: &GpuCamera) {
-        // The history stays, rendered with `history_camera`; the next frame reprojects it.
-        self.camera = Some(*camera);
         self.frames = 0;
     }
 
@@ -230,5 +228,13 @@ impl NodeExec for TemporalReuse {
         }
         self.history_camera = self.camera;
         Ok(())
+    }
+}
+
+impl View for TemporalReuse {
+    fn move_camera(&mut self, camera: &GpuCamera) {
+        // The history stays, rendered with `history_camera`; the next frame reprojects it.
+        self.camera = Some(*camera);
+        self.frames = 0;
     }
 }

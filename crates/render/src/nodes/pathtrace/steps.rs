@@ -170,7 +170,7 @@ impl PathTrace {
 /// Submits what the graph recorded before this pass, so that the steps of a frame traced
 /// in steps run after it, and after the previous frame's finish pass, which reads the sums
 /// those steps overwrite (`chunk_sums`, kept from frame to frame). The executor does the
-/// same before [`NodeExec::submit_own`].
+/// same before [`OwnWork::submit_own`](crate::nodes::OwnWork::submit_own).
 pub(super) fn submit_pending(ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
     let pending = std::mem::replace(
         encoder,
