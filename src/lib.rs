@@ -28,5 +28,5 @@ pub use lumagraph_editor as editor;
 pub use lumagraph_footage as footage;
 pub use lumagraph_graph as graph;
 pub use lumagraph_render as render;
-pub use lumagraph_render::session;
 pub use lumagraph_scene as scene;
+pub use lumagraph_session as session;

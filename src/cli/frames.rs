@@ -1,6 +1,6 @@
 //! `lumagraph render GRAPH --frames 1-100x2`: an image sequence through a graph, in one
 //! process. Every text or path param holding a frame pattern (`####`, `%04d`, `$F4`:
-//! `lumagraph_render::frames`) takes each frame's number in turn; the graph is compiled
+//! `lumagraph_session::frames`) takes each frame's number in turn; the graph is compiled
 //! and its pipelines built once, and each frame reloads only what its number changed
 //! (`Session::set_frame`), so nodes with history (`TemporalReuse`, `AutoExposure`) see
 //! the frame before. Each frame prints its time and the files it wrote; a missing input
@@ -12,7 +12,7 @@ use std::time::Instant;
 use anyhow::{Context as _, Result, anyhow, ensure};
 
 use super::{RenderArgs, load};
-use crate::render::frames::FrameParams;
+use crate::session::frames::FrameParams;
 use crate::session::{Session, SessionOptions};
 
 /// Renders `frames` of the graph in `args`, one process, one session.

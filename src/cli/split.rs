@@ -132,7 +132,7 @@ pub(super) fn merge(args: &MergeArgs<'_>) -> Result<()> {
     let sets = args
         .partials
         .iter()
-        .filter(|p| crate::render::tile_set::TileSet::is_tile_set(p))
+        .filter(|p| crate::session::tile_set::TileSet::is_tile_set(p))
         .count();
     if sets == args.partials.len() {
         return super::tiled::merge_tiles(args.partials, args.out, args.outputs_anywhere);

@@ -1,5 +1,5 @@
 //! `render` of an image larger than the device holds: tile by tile
-//! ([`crate::render::tiled`]), with a progress bar over all tiles.
+//! ([`crate::session::tiled`]), with a progress bar over all tiles.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
@@ -10,12 +10,12 @@ use anyhow::{Result, bail};
 use super::progressive::{STOP, on_signal};
 use super::{LoadedScene, RenderArgs, progressive_source, uses_scene};
 use crate::graph::{Extent, Graph, Plan};
-use crate::render::tile_set::TileSet;
-use crate::render::tiled::{Ended, Tiling};
 use crate::render::{Executor, GpuContext, Resources};
+use crate::session::tile_set::TileSet;
+use crate::session::tiled::{Ended, Tiling};
 
 /// Renders tile by tile when `--tile` asks or the whole image does not fit the device
-/// ([`crate::render::tiled::plan_tiling`]); `Ok(None)` when the render is not tiled.
+/// ([`crate::session::tiled::plan_tiling`]); `Ok(None)` when the render is not tiled.
 pub(super) fn render_if_needed(
     args: &RenderArgs<'_>,
     graph: &Graph,
@@ -37,7 +37,7 @@ pub(super) fn render_if_needed(
             .iter()
             .filter_map(|p| args.library.owned_memory(p).map(|(b, _)| b))
             .sum::<u64>();
-    let Some(tiling) = crate::render::tiled::plan_tiling(ctx, plan, image, bytes, args.tile)?
+    let Some(tiling) = crate::session::tiled::plan_tiling(ctx, plan, image, bytes, args.tile)?
     else {
         if args.tiles.is_some() {
             bail!(
@@ -88,7 +88,7 @@ pub(super) fn render_if_needed(
         Some(range) => {
             bar.at = range.first as usize;
             let key = crate::session::render_key(graph, Some(&scene.gpu));
-            let set = crate::render::tiled::render_set(
+            let set = crate::session::tiled::render_set(
                 &mut exec,
                 &tiling,
                 image,
@@ -116,7 +116,7 @@ pub(super) fn render_if_needed(
         }
         None => {
             let key = crate::session::render_key(graph, Some(&scene.gpu));
-            let ended = crate::render::tiled::render(
+            let ended = crate::session::tiled::render(
                 &mut exec,
                 &tiling,
                 image,
@@ -260,7 +260,7 @@ pub(super) fn merge_tiles(paths: &[PathBuf], out: &Path, anywhere: bool) -> Resu
         sets.push((path.clone(), TileSet::load(path)?));
     }
     sets.sort_by_key(|(_, s)| s.first);
-    let images = crate::render::tile_set::assemble(&sets).map_err(|e| {
+    let images = crate::session::tile_set::assemble(&sets).map_err(|e| {
         anyhow::anyhow!(
             "the tile sets do not belong together:\n  {}",
             e.replace('\n', "\n  ")

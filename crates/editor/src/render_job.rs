@@ -13,9 +13,9 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use lumagraph_graph::{Edge, Graph, Node, ParamValue, Registry};
-use lumagraph_render::session::Session;
 use lumagraph_render::{Executor, GpuContext, NodeLibrary, Resources};
 use lumagraph_scene::GpuScene;
+use lumagraph_session::Session;
 
 /// What a render writes.
 #[derive(Clone, Debug, PartialEq, Eq)]

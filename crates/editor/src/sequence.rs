@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use egui::Ui;
 use lumagraph_footage::sequence::frames_on_disk;
 use lumagraph_graph::{Graph, Registry};
-use lumagraph_render::frames::FrameParams;
+use lumagraph_session::frames::FrameParams;
 
 /// The frame control's state: the current frame, playback, and the frames found on disk.
 #[derive(Clone, Debug)]

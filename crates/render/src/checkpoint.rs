@@ -73,35 +73,43 @@ pub fn render_key(graph_text: &str, scene_text: &str) -> u64 {
         .finish()
 }
 
-/// Writes `bytes` with their length before them.
-pub(crate) fn put(out: &mut Vec<u8>, bytes: &[u8]) {
+/// Writes `bytes` with their length before them (the field of every lumagraph state file:
+/// checkpoints, partial renders, tile sets).
+pub fn put(out: &mut Vec<u8>, bytes: &[u8]) {
     out.extend_from_slice(&(bytes.len() as u64).to_le_bytes());
     out.extend_from_slice(bytes);
 }
 
 /// Reads what [`put`] wrote.
-pub(crate) struct Reader<'a> {
-    pub(crate) bytes: &'a [u8],
-    pub(crate) at: usize,
+#[derive(Debug)]
+pub struct Reader<'a> {
+    /// The file's bytes.
+    pub bytes: &'a [u8],
+    /// Where the next read starts.
+    pub at: usize,
 }
 
 impl<'a> Reader<'a> {
-    pub(crate) fn take(&mut self, n: usize) -> Option<&'a [u8]> {
+    /// The next `n` bytes (`None` past the end).
+    pub fn take(&mut self, n: usize) -> Option<&'a [u8]> {
         let s = self.bytes.get(self.at..self.at.checked_add(n)?)?;
         self.at += n;
         Some(s)
     }
 
-    pub(crate) fn u64(&mut self) -> Option<u64> {
+    /// The next little-endian `u64`.
+    pub fn u64(&mut self) -> Option<u64> {
         self.take(8)?.try_into().ok().map(u64::from_le_bytes)
     }
 
-    pub(crate) fn field(&mut self) -> Option<&'a [u8]> {
+    /// The next field [`put`] wrote.
+    pub fn field(&mut self) -> Option<&'a [u8]> {
         let n = usize::try_from(self.u64()?).ok()?;
         self.take(n)
     }
 
-    pub(crate) fn text(&mut self) -> Option<String> {
+    /// The next field, as UTF-8 text.
+    pub fn text(&mut self) -> Option<String> {
         String::from_utf8(self.field()?.to_vec()).ok()
     }
 }

@@ -98,7 +98,8 @@ impl RenderError {
         }
     }
 
-    pub(crate) fn image(path: &std::path::Path, message: impl std::fmt::Display) -> Self {
+    /// An image file's error: `path`, then `message`.
+    pub fn image(path: &std::path::Path, message: impl std::fmt::Display) -> Self {
         Self::Image {
             path: path.to_owned(),
             message: message.to_string(),

@@ -321,7 +321,7 @@ impl Sink for Output {
 ///
 /// # Errors
 /// A path that leaves the output folder ([`Resources::output`]).
-pub(crate) fn output_path(pass: &Pass, resources: &Resources) -> Result<PathBuf> {
+pub fn output_path(pass: &Pass, resources: &Resources) -> Result<PathBuf> {
     resources.output(pass.params.str("path"))
 }
 

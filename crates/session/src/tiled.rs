@@ -1,7 +1,7 @@
 //! Tiled renders: an image larger than the device holds, rendered window by window through
 //! one executor and assembled on the host.
 //!
-//! The plan is compiled at the window's size ([`crate::NodeLibrary::compile_window`]); each
+//! The plan is compiled at the window's size ([`lumagraph_render::NodeLibrary::compile_window`]); each
 //! tile moves the window ([`Executor::set_origin`]), renders every frame, and its sinks' images
 //! (held, not written: [`Executor::hold_sinks`]) have their cores copied into whole-image
 //! canvases, written once at the end as the sinks would have. Only sinks that write one
@@ -15,10 +15,10 @@ use lumagraph_graph::registry::InputDef;
 use lumagraph_graph::tile::{Tile, Untileable};
 use lumagraph_graph::{Extent, Plan, TexFormat, TextureId};
 
-use crate::context::{GpuContext, human_bytes};
-use crate::error::{RenderError, Result};
-use crate::executor::Executor;
-use crate::nodes::Resources;
+use lumagraph_render::Executor;
+use lumagraph_render::Resources;
+use lumagraph_render::{GpuContext, human_bytes};
+use lumagraph_render::{RenderError, Result};
 
 /// Images, buffers and node memory above this are rendered in tiles unless asked otherwise.
 pub const MEMORY_BUDGET: u64 = 4 << 30;
@@ -145,7 +145,7 @@ pub fn plan_tiling(
 const HISTORY_BYTES: u64 = 16;
 
 /// The largest buffer of node history the device binds.
-fn history_limit(limits: &wgpu::Limits) -> u64 {
+fn history_limit(limits: &lumagraph_render::wgpu::Limits) -> u64 {
     limits
         .max_storage_buffer_binding_size
         .min(limits.max_buffer_size)
@@ -153,7 +153,7 @@ fn history_limit(limits: &wgpu::Limits) -> u64 {
 
 /// Which of the device's hard limits an image (or a tile's window) of `extent` passes, in
 /// words naming the limit; `None` where it fits.
-fn beyond_limits(limits: &wgpu::Limits, extent: Extent) -> Option<String> {
+fn beyond_limits(limits: &lumagraph_render::wgpu::Limits, extent: Extent) -> Option<String> {
     let (w, h) = (extent.width, extent.height);
     let max_side = limits.max_texture_dimension_2d;
     let max_buffer = history_limit(limits);
@@ -177,7 +177,7 @@ fn beyond_limits(limits: &wgpu::Limits, extent: Extent) -> Option<String> {
 /// Whether tiles of `side` (`window` gives a tile's window, apron included) fit the device's
 /// hard limits; else why, with the largest power-of-two side that fits.
 fn check_forced(
-    limits: &wgpu::Limits,
+    limits: &lumagraph_render::wgpu::Limits,
     side: u32,
     window: impl Fn(u32) -> Extent,
 ) -> std::result::Result<(), String> {
@@ -254,7 +254,7 @@ struct Canvas {
     param: String,
     path: PathBuf,
     bytes: Vec<u8>,
-    image: Option<crate::nodes::HeldImage>,
+    image: Option<lumagraph_render::nodes::HeldImage>,
 }
 
 /// How a tiled render ended.
@@ -294,7 +294,7 @@ pub fn render(
             Canvas {
                 node: pass.node.clone(),
                 param: pass.params.str("path").to_owned(),
-                path: crate::nodes::output::output_path(pass, resources)
+                path: lumagraph_render::nodes::output::output_path(pass, resources)
                     .map_err(|e| e.in_node(&pass.node))?,
                 bytes: Vec::new(),
                 image: None,
@@ -322,7 +322,7 @@ pub fn render(
     let mut written = Vec::new();
     for (_, canvas, _) in canvases {
         let Some(held) = canvas.image else { continue };
-        crate::nodes::output::write_image(&canvas.path, canvas.bytes, held.format, held.ty, whole)
+        lumagraph_render::write_output(&canvas.path, canvas.bytes, held.format, held.ty, whole)
             .map_err(|e| e.in_node(&canvas.node))?;
         written.push(canvas.path);
     }
@@ -392,7 +392,7 @@ pub fn render_tiles(
     range: std::ops::Range<usize>,
     frames: u32,
     mut progress: impl FnMut(usize, u32, u32) -> bool,
-    mut take: impl FnMut(usize, &Tile, Vec<(usize, crate::nodes::HeldImage)>) -> Result<()>,
+    mut take: impl FnMut(usize, &Tile, Vec<(usize, lumagraph_render::nodes::HeldImage)>) -> Result<()>,
 ) -> Result<bool> {
     exec.hold_sinks(true);
     for i in range {
@@ -412,7 +412,7 @@ pub fn render_tiles(
 
 /// Renders tiles `first..end` of `tiling` (see [`render_tiles`]) into a
 /// [`crate::tile_set::TileSet`] of every image sink's cores (`Output`'s), for `key` (the
-/// render's; [`crate::checkpoint::render_key`]) and a whole image of `whole`; `None` when
+/// render's; [`lumagraph_render::checkpoint::render_key`]) and a whole image of `whole`; `None` when
 /// `progress` stopped it.
 ///
 /// # Errors
@@ -478,7 +478,7 @@ pub fn render_set(
 }
 
 /// The core of `tile` out of its window's image.
-fn core_of(held: &crate::nodes::HeldImage, tile: &Tile) -> Vec<u8> {
+fn core_of(held: &lumagraph_render::nodes::HeldImage, tile: &Tile) -> Vec<u8> {
     let bpp = held.format.bytes_per_pixel() as usize;
     let (cx, cy) = tile.core_in_window();
     let window_row = held.extent.width as usize * bpp;
@@ -551,13 +551,13 @@ fn available_memory() -> Option<u64> {
 /// Copies the core of `tile` from its window's image `held` into the whole image.
 fn paste(
     canvas: &mut Canvas,
-    held: &crate::nodes::HeldImage,
+    held: &lumagraph_render::nodes::HeldImage,
     tile: &Tile,
     image: Extent,
 ) -> Result<()> {
     let bpp = held.format.bytes_per_pixel() as usize;
     if canvas.image.is_none() {
-        canvas.image = Some(crate::nodes::HeldImage {
+        canvas.image = Some(lumagraph_render::nodes::HeldImage {
             bytes: Vec::new(),
             format: held.format,
             ty: held.ty,
@@ -607,10 +607,10 @@ mod tests {
     /// (128 MiB bound buffers, 16384² textures) a 16384² render takes 2048 but not 4096.
     #[test]
     fn forced_tiles_beyond_the_limits_are_refused_naming_them() {
-        let limits = wgpu::Limits {
+        let limits = lumagraph_render::wgpu::Limits {
             max_storage_buffer_binding_size: 128 << 20,
             max_texture_dimension_2d: 16384,
-            ..wgpu::Limits::default()
+            ..lumagraph_render::wgpu::Limits::default()
         };
         let window = |t: u32| {
             Extent::new(

@@ -2,7 +2,7 @@
 //! `$F4`: [`lumagraph_footage::sequence`]) or, for numbers, a frame expression
 //! (`"0.25 * frame"`: [`lumagraph_graph::expr`]), and the graph at a given frame.
 //!
-//! The command line (`render --frames`), the session ([`crate::session::Session::set_frame`],
+//! The command line (`render --frames`), the session ([`crate::Session::set_frame`],
 //! the Python package's `render_frames`) and the editor's frame control all substitute
 //! frames through [`FrameParams`], so a sequence means the same everywhere.
 

@@ -20,8 +20,8 @@ use std::path::Path;
 use lumagraph_graph::tile::{Tile, tiles};
 use lumagraph_graph::{Extent, PortType, TexFormat};
 
-use crate::checkpoint::{Reader, put};
-use crate::error::{RenderError, Result};
+use lumagraph_render::checkpoint::{Reader, put};
+use lumagraph_render::{RenderError, Result};
 
 /// The file's first bytes.
 pub const MAGIC: &[u8] = b"lumagraph tiles\n";
@@ -38,7 +38,7 @@ const FORMATS: [TexFormat; 3] = [
 /// Some tiles of a tiled render: every output's cores.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct TileSet {
-    /// What was rendered (graph, scene and overrides; [`crate::checkpoint::render_key`]).
+    /// What was rendered (graph, scene and overrides; [`lumagraph_render::checkpoint::render_key`]).
     pub key: u64,
     /// The whole image.
     pub image: Extent,

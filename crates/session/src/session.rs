@@ -6,7 +6,7 @@
 //! restarts), a checkpoint to resume from.
 //!
 //! ```no_run
-//! use lumagraph_render::session::{Session, SessionOptions};
+//! use lumagraph_session::{Session, SessionOptions};
 //! let mut s = Session::open("graphs/pathtrace.ron".as_ref(), Some("assets/cornell.ron".as_ref()),
 //!     SessionOptions::default())?;
 //! s.render(64)?;
@@ -15,16 +15,16 @@
 //! # anyhow::Ok(())
 //! ```
 
-use crate::specialize::Tracing;
+use lumagraph_render::specialize::Tracing;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anyhow::{Context as _, Result};
 
-use crate::cpu::Image;
 use crate::frames::FrameParams;
-use crate::{Checkpoint, Executor, FrameReport, GpuContext, NodeLibrary, Resources};
 use lumagraph_graph::Graph;
+use lumagraph_render::cpu::Image;
+use lumagraph_render::{Checkpoint, Executor, FrameReport, GpuContext, NodeLibrary, Resources};
 use lumagraph_scene::GpuScene;
 use lumagraph_scene::edit::SceneText;
 use lumagraph_scene::file::SceneFile;
@@ -49,9 +49,9 @@ pub struct SessionOptions {
     pub outputs_anywhere: bool,
     /// The path tracer's intersector ([`Resources::tracer`]'s; `AUTO`: the scene and
     /// the adapter decide).
-    pub intersector: crate::specialize::Intersector,
+    pub intersector: lumagraph_render::specialize::Intersector,
     /// The path tracer's schedule ([`Resources::tracer`]'s).
-    pub schedule: crate::specialize::Schedule,
+    pub schedule: lumagraph_render::specialize::Schedule,
 }
 
 impl Default for SessionOptions {
@@ -63,8 +63,8 @@ impl Default for SessionOptions {
             library: None,
             frame: None,
             outputs_anywhere: false,
-            intersector: crate::specialize::Intersector::AUTO,
-            schedule: crate::specialize::Schedule::Auto,
+            intersector: lumagraph_render::specialize::Intersector::AUTO,
+            schedule: lumagraph_render::specialize::Schedule::Auto,
         }
     }
 }
@@ -342,8 +342,8 @@ impl Session {
     /// # Errors
     /// As [`Session::read`].
     pub fn png(&self, port: &str) -> Result<Vec<u8>> {
-        use crate::image_io::{encode_png, to_rgba8};
         use lumagraph_graph::{PortType, TexFormat};
+        use lumagraph_render::image_io::{encode_png, to_rgba8};
         let t = self
             .exec
             .plan()
@@ -357,7 +357,10 @@ impl Session {
             let mut image = self.exec.read(t.id)?;
             let linear = t.ty != PortType::LdrColor;
             if linear {
-                crate::nodes::ocio::working_to_rec709(self.exec.plan().working_space, &mut image)?;
+                lumagraph_render::nodes::ocio::working_to_rec709(
+                    self.exec.plan().working_space,
+                    &mut image,
+                )?;
             }
             to_rgba8(&image, linear)
         };
@@ -645,7 +648,7 @@ fn key_of(graph: &Graph, scene: &str) -> u64 {
     for e in &mut g.edges {
         e.via.clear();
     }
-    crate::checkpoint::render_key(&g.to_ron(), scene)
+    lumagraph_render::checkpoint::render_key(&g.to_ron(), scene)
 }
 
 /// Every number of the flattened scene seen from `camera`, hashed: what the GPU gets and
@@ -654,7 +657,7 @@ fn key_of(graph: &Graph, scene: &str) -> u64 {
 /// cheap (the Crytek Sponza's text was over a gigabyte and took most of a minute).
 pub(crate) fn scene_digest(s: &GpuScene, camera: &GpuCamera) -> String {
     use bytemuck::{bytes_of, cast_slice};
-    let h = crate::checkpoint::Fnv::default()
+    let h = lumagraph_render::checkpoint::Fnv::default()
         .write(bytes_of(&s.header))
         .write(bytes_of(camera))
         .write(bytes_of(&s.settings))
