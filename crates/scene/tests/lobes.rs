@@ -68,3 +68,31 @@ fn every_lobe_parameter_is_saved_loaded_flattened_and_exported_by_its_name() {
         assert_eq!(exported, &expected, "{}: exported", p.name);
     }
 }
+
+/// `docs/scene-format.md`'s materials table has a row for every lobe parameter, with the
+/// default the scene format gives it: a parameter added to the table without its doc row,
+/// or a default changed without its doc, fails here.
+#[test]
+fn the_scene_format_page_has_every_lobe_parameter_and_its_default() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let page = std::fs::read_to_string(root.join("docs/scene-format.md")).unwrap();
+    let num = |x: f32| format!("{x}");
+    for p in PARAMS {
+        let row = format!("| `{}` | ", p.name);
+        let line = page
+            .lines()
+            .find(|l| l.starts_with(&row))
+            .unwrap_or_else(|| panic!("docs/scene-format.md has no row for `{}`", p.name));
+        let mut desc = lumagraph_scene::file::MaterialDesc::default();
+        let default = match (p.edit)(&mut desc) {
+            ParamMut::Scalar(x) => format!("`{}`", num(*x)),
+            ParamMut::Rgb(c) => format!("`({}, {}, {})`", num(c[0]), num(c[1]), num(c[2])),
+        };
+        let cell = line[row.len()..].split(" | ").next().unwrap_or_default();
+        assert_eq!(
+            cell, default,
+            "docs/scene-format.md gives `{}` the default {cell}, the scene format {default}",
+            p.name
+        );
+    }
+}
