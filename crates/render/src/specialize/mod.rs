@@ -15,6 +15,7 @@
 
 mod codegen;
 mod features;
+mod ranges;
 pub mod support;
 
 pub use crate::intersect::Intersector;
