@@ -297,10 +297,13 @@ impl PathTrace {
         ];
         // The binary BVH's records only where the binary BVH is walked: not by the 8-wide
         // BVH (its own buffer is bound), nor by host intersection unless the first-hit AOVs
-        // are written (`first_hit_aovs` traces in WGSL), nor inline or by ray queries.
+        // are written (`first_hit_aovs` traces in WGSL) or the scene has instances (their
+        // records follow the nodes, and place the host's hits), nor inline or by ray queries.
         let binary_bvh = features.on(Feature::BvhTraversal)
             && !features.on(Feature::WideBvh)
-            && (!features.on(Feature::HostRays) || features.on(Feature::FirstHitAovs));
+            && (!features.on(Feature::HostRays)
+                || features.on(Feature::FirstHitAovs)
+                || features.on(Feature::Instances));
         let buffers = SceneBuffers::upload_for(ctx, &scene, binary_bvh)?;
         let frame = uniform_buffer(
             ctx,

@@ -117,7 +117,7 @@ const F: bool = false;
 /// The support matrix: per column, whether it traces each [`Content::ALL`] row.
 pub const MATRIX: [(Tracer, [bool; Content::ALL.len()]); 6] = [
     (Tracer::Inline, [F, T, F, T, F, T, T, T, T, T]),
-    (Tracer::Host, [F, F, T, F, F, F, F, F, T, T]),
+    (Tracer::Host, [F, F, T, F, T, F, F, F, T, T]),
     (Tracer::BinaryBvh, [T, T, T, T, T, T, T, T, T, T]),
     (Tracer::WideBvh, [F, T, T, T, F, T, T, T, T, T]),
     (Tracer::RayQueries, [F, T, T, T, F, T, T, T, T, T]),
