@@ -373,7 +373,9 @@ fn a_thousand_instances_of_a_100k_triangle_mesh() {
 
 /// The intersectors that take flat scenes only refuse an instanced one by name, and the path
 /// tracer's choice sends it to the binary BVH whatever is asked, saying why: it is never
-/// traced as its object-space meshes laid flat.
+/// traced as its object-space meshes laid flat. Host intersection takes instances where it
+/// takes the rest of the scene: not this one, which has a sphere; without it, a CPU
+/// adapter with Embree gives it to the host, asked or not.
 #[test]
 fn flat_only_intersectors_refuse_instances_and_the_choice_says_why() {
     use lumagraph::render::specialize::{Features, PathTraceOptions, Schedule};
@@ -420,6 +422,26 @@ fn flat_only_intersectors_refuse_instances_and_the_choice_says_why() {
                 || f.reason(Feature::RayQueries).contains("instanced meshes"),
             "{intersector:?}: {}",
             f.summary()
+        );
+    }
+    let triangles = triangles_scene("On", false);
+    for intersector in [Intersector::Auto, Intersector::Host] {
+        let options = PathTraceOptions {
+            specialize: true,
+            cpu_adapter: true,
+            host_rays: true,
+            intersector,
+            ..PathTraceOptions::default()
+        };
+        let f = Features::decide(&triangles, options);
+        assert!(
+            f.on(Feature::HostRays) && f.on(Feature::Instances) && !f.on(Feature::WideBvh),
+            "{intersector:?}: {}",
+            f.summary()
+        );
+        assert!(
+            lumagraph::render::specialize::support::refusal(&triangles, options, &f).is_none(),
+            "{intersector:?}"
         );
     }
 }

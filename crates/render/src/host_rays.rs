@@ -379,7 +379,7 @@ impl HostRays {
             "host intersection: {version}, {} triangles{} built in {:.0} ms",
             scene.len(),
             if scene.has_instances() {
-                format!(" ({} instances of {} meshes)", instances, meshes)
+                format!(" ({instances} instances of {meshes} meshes)")
             } else {
                 String::new()
             },

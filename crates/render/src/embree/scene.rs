@@ -61,6 +61,10 @@ pub struct HostScene {
     any_hit: Option<Arc<lumagraph_scene::GpuScene>>,
     /// What the filter of each triangle geometry reads (its user data), kept at a fixed
     /// address as long as the scenes.
+    #[allow(
+        clippy::vec_box,
+        reason = "Embree holds each record's address: the vector may move, the boxes not"
+    )]
     filters: Vec<Box<FilterGeometry>>,
 }
 
@@ -684,7 +688,7 @@ impl HostScene {
                         scene.0,
                         &raw mut ctx.base,
                         &raw mut packet,
-                    )
+                    );
                 };
             }
             for i in 0..chunk.len() {
@@ -724,7 +728,7 @@ impl HostScene {
                     scene.0,
                     &raw mut ctx.base,
                     &raw mut packet,
-                )
+                );
             };
             for (i, out) in out.iter_mut().enumerate() {
                 *out = u32::from(valid.0[i] != 0 && packet.tfar[i] == f32::NEG_INFINITY);
