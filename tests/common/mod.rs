@@ -512,12 +512,26 @@ pub fn render_with(
     Vec<lumagraph::render::cpu::Image>,
     lumagraph::render::specialize::Features,
 )> {
+    use lumagraph::scene::{GpuScene, Scene};
+    gpu()?;
+    let scene = GpuScene::build(&Scene::load(&repo(&format!("assets/{name}"))).unwrap()).unwrap();
+    println!("{name}:");
+    render_scene(scene, size, spp, resources)
+}
+
+/// [`render_with`] for a scene already built.
+pub fn render_scene(
+    mut scene: lumagraph::scene::GpuScene,
+    size: (u32, u32),
+    spp: u32,
+    resources: lumagraph::render::Resources,
+) -> Option<(
+    Vec<lumagraph::render::cpu::Image>,
+    lumagraph::render::specialize::Features,
+)> {
     use lumagraph::graph::ParamValue;
     use lumagraph::render::{Executor, compile};
-    use lumagraph::scene::{GpuScene, Scene};
     let ctx = gpu()?;
-    let mut scene =
-        GpuScene::build(&Scene::load(&repo(&format!("assets/{name}"))).unwrap()).unwrap();
     (scene.settings.width, scene.settings.height) = size;
     let scene = std::sync::Arc::new(scene);
     let ports = ["acc.color", "pt.albedo", "pt.normal", "pt.depth"];
@@ -530,7 +544,7 @@ pub fn render_with(
     };
     let mut exec = Executor::new(ctx, plan, &resources).unwrap();
     let features = exec.shader_features("pt").unwrap().clone();
-    println!("{name}: {}", features.summary());
+    println!("{}", features.summary());
     exec.run_frames(spp.div_ceil(4), true).unwrap();
     let images = ports.iter().map(|p| exec.read_port(p).unwrap()).collect();
     Some((images, features))

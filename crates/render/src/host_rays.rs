@@ -19,6 +19,7 @@ use crate::shared::{WAVE_FINISH_ME, WaveRays};
 const RAYS_AT: u64 = crate::shared::WAVE_RAYS_AT as u64;
 const HITS_AT: u64 = crate::shared::WAVE_HITS_AT as u64;
 const LIST_AT: u64 = crate::shared::WAVE_LIST_AT as u64;
+const INSTS_AT: u64 = crate::shared::WAVE_INSTS_AT as u64;
 /// Bytes of one slot's rays.
 const RAYS_BYTES: u64 = std::mem::size_of::<WaveRays>() as u64;
 
@@ -82,15 +83,18 @@ struct Lane {
     wave: wgpu::Buffer,
     /// `MAP_READ` copy of the step's rays.
     rays_read: wgpu::Buffer,
-    /// `MAP_WRITE` buffer of the next step's hits and list, copied into `wave` in its
-    /// encoder; and the bytes of each, for that copy.
+    /// `MAP_WRITE` buffer of the next step's hits, list and (with instances) the hits'
+    /// instances, copied into `wave` in its encoder; and the bytes of each, for that copy.
     upload: wgpu::Buffer,
-    uploaded: (u64, u64),
+    uploaded: (u64, u64, u64),
     /// The last submission that used `upload` (`None`: mapped since its creation).
     last: Option<wgpu::SubmissionIndex>,
     /// The step's next rays, then its shadow rays.
     rays: Vec<HostRay>,
     hits: Vec<HostHit>,
+    /// The instance of each hit (its node slot, or `NO_INSTANCE`): kept where the scene has
+    /// instances, else empty.
+    insts: Vec<u32>,
     /// 1 where the shadow ray is occluded.
     occluded: Vec<u32>,
     /// The slots of the step being traced, in its order, and how many of them come first
@@ -101,6 +105,7 @@ struct Lane {
     /// (with the answers for their shadow rays), in that order.
     list: Vec<u32>,
     list_hits: Vec<HostHit>,
+    list_insts: Vec<u32>,
     /// The submission of the step in flight and the bytes of rays it copies back.
     in_flight: Option<(wgpu::SubmissionIndex, u64)>,
     /// Steps submitted in this batch.
@@ -144,10 +149,19 @@ fn lap(t: &mut std::time::Instant) -> u64 {
 }
 
 impl Lane {
-    fn new(ctx: &GpuContext, slots: u64) -> Self {
+    fn new(ctx: &GpuContext, slots: u64, instanced: bool) -> Self {
         // The sections of `wave` (see the shader), the last the list of slots to step,
-        // their count first.
-        let vec4s = LIST_AT * slots + (slots + 1).div_ceil(4);
+        // their count first; or, with instances, the hits' instances after it.
+        let vec4s = if instanced {
+            INSTS_AT * slots + slots.div_ceil(4)
+        } else {
+            LIST_AT * slots + (slots + 1).div_ceil(4)
+        };
+        let insts_bytes = if instanced {
+            4 * slots.next_multiple_of(4)
+        } else {
+            0
+        };
         let n = usize::try_from(slots).unwrap_or(usize::MAX);
         Self {
             wave: buffer(ctx, "pathtrace wave", 16 * vec4s, false),
@@ -159,19 +173,21 @@ impl Lane {
             ),
             upload: ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("pathtrace wave upload"),
-                size: 16 * slots + 4 * (slots + 1).next_multiple_of(4),
+                size: 16 * slots + 4 * (slots + 1).next_multiple_of(4) + insts_bytes,
                 usage: wgpu::BufferUsages::MAP_WRITE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: true,
             }),
-            uploaded: (0, 0),
+            uploaded: (0, 0, 0),
             last: None,
             rays: vec![HostRay::default(); 2 * n],
             hits: vec![HostHit::default(); n],
+            insts: if instanced { vec![0; n] } else { Vec::new() },
             occluded: vec![0; n],
             order: Vec::new(),
             misses: 0,
             list: Vec::new(),
             list_hits: Vec::new(),
+            list_insts: Vec::new(),
             in_flight: None,
             steps: 0,
             counts: HostCounts::default(),
@@ -186,12 +202,16 @@ impl Lane {
         self.list.resize(self.list.len().next_multiple_of(4), 0);
         let hits: &[u8] = bytemuck::cast_slice(&self.list_hits);
         let list: &[u8] = bytemuck::cast_slice(&self.list);
+        let insts: &[u8] = bytemuck::cast_slice(&self.list_insts);
         map_write_after(ctx, &self.upload, self.last.take(), |view| {
             view.slice(..hits.len()).copy_from_slice(hits);
-            view.slice(hits.len()..hits.len() + list.len())
-                .copy_from_slice(list);
+            let end = hits.len() + list.len();
+            view.slice(hits.len()..end).copy_from_slice(list);
+            if !insts.is_empty() {
+                view.slice(end..end + insts.len()).copy_from_slice(insts);
+            }
         })?;
-        self.uploaded = (hits.len() as u64, list.len() as u64);
+        self.uploaded = (hits.len() as u64, list.len() as u64, insts.len() as u64);
         self.order.clear();
         self.order.extend_from_slice(&self.list[1..=count]);
         Ok(())
@@ -220,7 +240,7 @@ impl Lane {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("pathtrace step"),
             });
-        let (hits, list) = self.uploaded;
+        let (hits, list, insts) = self.uploaded;
         if hits > 0 {
             encoder.copy_buffer_to_buffer(
                 &self.upload,
@@ -237,6 +257,15 @@ impl Lane {
             16 * LIST_AT * capacity,
             list,
         );
+        if insts > 0 {
+            encoder.copy_buffer_to_buffer(
+                &self.upload,
+                hits + list,
+                &self.wave,
+                16 * INSTS_AT * capacity,
+                insts,
+            );
+        }
         step(what, &mut encoder, &self.wave)?;
         // The rays of its first `c` slots.
         let bytes = RAYS_BYTES * c as u64;
@@ -289,7 +318,11 @@ impl Lane {
         let (next, shadow) = self.rays[..2 * c].split_at(c);
         self.counts.rays += next.iter().chain(shadow).filter(|r| r.tfar >= 0.0).count() as u64;
         self.counts.other_ns += lap(&mut t);
-        scene.intersect(next, &mut self.hits[..c]);
+        if self.insts.is_empty() {
+            scene.intersect(next, &mut self.hits[..c]);
+        } else {
+            scene.intersect_instances(next, &mut self.hits[..c], &mut self.insts[..c]);
+        }
         scene.occluded(shadow, &mut self.occluded[..c]);
         self.counts.embree_ns += lap(&mut t);
         // The next step's slots: those with a ray out, those whose ray hit nothing (or
@@ -299,6 +332,7 @@ impl Lane {
         self.list.clear();
         self.list.push(0);
         self.list_hits.clear();
+        self.list_insts.clear();
         for shade in [false, true] {
             self.misses = self.list.len() - 1;
             for (j, (a, b)) in next.iter().zip(shadow).enumerate() {
@@ -311,6 +345,9 @@ impl Lane {
                     }
                     self.list.push(self.order[j]);
                     self.list_hits.push(hit);
+                    if let Some(&inst) = self.insts.get(j) {
+                        self.list_insts.push(inst);
+                    }
                 }
             }
         }
@@ -337,16 +374,23 @@ impl HostRays {
         let embree = Embree::load().map_err(fail)?;
         let version = embree.version();
         let start = std::time::Instant::now();
+        let (instances, meshes) = (scene.instances.len(), scene.mesh_triangles.len());
         let scene = HostScene::of_scene(embree, scene).map_err(fail)?;
         let note = format!(
-            "host intersection: {version}, {} triangles built in {:.0} ms",
+            "host intersection: {version}, {} triangles{} built in {:.0} ms",
             scene.len(),
+            if scene.has_instances() {
+                format!(" ({instances} instances of {meshes} meshes)")
+            } else {
+                String::new()
+            },
             start.elapsed().as_secs_f64() * 1e3
         );
         let extent = lumagraph_graph::Extent::new(1, 1);
+        let instanced = scene.has_instances();
         Ok(Self {
             scene,
-            lanes: (0..LANES).map(|_| Lane::new(ctx, 1)).collect(),
+            lanes: (0..LANES).map(|_| Lane::new(ctx, 1, instanced)).collect(),
             extent,
             capacity: 1,
             note,
@@ -371,7 +415,10 @@ impl HostRays {
     pub(crate) fn fit(&mut self, ctx: &GpuContext, extent: lumagraph_graph::Extent) {
         if extent != self.extent {
             self.capacity = extent.pixels().clamp(1, MAX_SLOTS);
-            self.lanes = (0..LANES).map(|_| Lane::new(ctx, self.capacity)).collect();
+            let instanced = self.scene.has_instances();
+            self.lanes = (0..LANES)
+                .map(|_| Lane::new(ctx, self.capacity, instanced))
+                .collect();
             self.extent = extent;
         }
     }
@@ -400,6 +447,7 @@ impl HostRays {
                 lane.list.clear();
                 lane.list.push(0);
                 lane.list_hits.clear();
+                lane.list_insts.clear();
                 lane.list.extend(
                     (base..end)
                         .filter(|s| (s / width) % u64::from(LANES) == l)

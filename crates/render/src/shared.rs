@@ -27,6 +27,10 @@ pub const WAVE_RAYS_AT: u32 = WAVE_HOT_VEC4S + WAVE_COLD_VEC4S;
 pub const WAVE_HITS_AT: u32 = WAVE_RAYS_AT + WAVE_RAYS_VEC4S;
 /// Where the list of slots starts.
 pub const WAVE_LIST_AT: u32 = WAVE_HITS_AT + 1;
+/// Host intersection, where the scene has instances: after the list (its count and a word
+/// per slot fit in a vec4 per slot), the instance of each listed position's hit (a word
+/// per slot: its node slot, or `NO_INSTANCE`). The wavefront keeps its own sections there.
+pub const WAVE_INSTS_AT: u32 = WAVE_LIST_AT + 1;
 /// The wavefront ([`crate::wavefront`]) keeps, in the host's list's place, how each step's
 /// rays leave their surface (`WAVE_LEAVE_VEC4S` vec4 per listed position, from
 /// [`WAVE_LIST_AT`]) ...
@@ -90,6 +94,7 @@ pub fn wgsl() -> String {
         ("WAVE_RAYS_AT", WAVE_RAYS_AT),
         ("WAVE_HITS_AT", WAVE_HITS_AT),
         ("WAVE_LIST_AT", WAVE_LIST_AT),
+        ("WAVE_INSTS_AT", WAVE_INSTS_AT),
         ("WAVE_LEAVE_VEC4S", WAVE_LEAVE_VEC4S),
         ("WAVE_FRONT_LISTS_AT", WAVE_FRONT_LISTS_AT),
         ("WAVE_COUNTS_AT", WAVE_COUNTS_AT),

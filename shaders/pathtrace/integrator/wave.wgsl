@@ -24,6 +24,8 @@
 //   [10S, 11S)  the host's closest hit of the ray the step reads: t, u, v (bits) and the
 //               primitive; t's sign bit set when the slot's shadow ray was occluded
 //   [11S, ...)  the step's slots: their count, then each one, a u32 each (`wave_list_at`)
+//   [12S, ...)  with instances (HAS_INSTANCES), the instance of each hit in the step's
+//               order, a u32 each: its node slot, or NO_INSTANCE (WAVE_INSTS_AT)
 // The random numbers, their order and the arithmetic are `trace_pixel`'s; only the hits are
 // the host's. The host counts the rays (`ray_count` is not kept).
 //
@@ -298,7 +300,13 @@ fn wave_step_hit(slot: u32, j: u32) {
     var s = wave_load(slot, j, WAVE_KIND_HIT);
     if !s.ended {
         let t = bitcast<f32>(s.hit.x & 0x7fffffffu);
-        s.ended = path_step_from(Hit(s.hit.w, t, bitcast<f32>(s.hit.y), bitcast<f32>(s.hit.z), NO_INSTANCE), false);
+        // The host's instance of the hit, where the scene has instances (the section after
+        // the list): its hit reads as the binary BVH's two-level walk's.
+        var inst = NO_INSTANCE;
+        if HOST_RAYS && HAS_INSTANCES {
+            inst = wave_word(WAVE_INSTS_AT * wave_slots(), j);
+        }
+        s.ended = path_step_from(Hit(s.hit.w, t, bitcast<f32>(s.hit.y), bitcast<f32>(s.hit.z), inst), false);
     }
     wave_settle(&s, WAVE_KIND_HIT);
     wave_store(s, j);

@@ -34,33 +34,69 @@ pub(super) struct RtcFilterArgs {
 /// `RTCFilterFunctionN`.
 pub(super) type RtcFilterFunction = unsafe extern "C" fn(args: *const RtcFilterArgs);
 
+/// What the any-hit filter of one triangle geometry reads (its user data): the scene whose
+/// materials decide, and the index, in the path tracer's order, of the geometry's first
+/// triangle (an instanced mesh's triangles follow the scene's own ones).
+pub(super) struct FilterGeometry {
+    pub(super) scene: *const lumagraph_scene::GpuScene,
+    pub(super) base: u32,
+}
+
+/// The context of every query: Embree's, then the rays of the query (a ray's `id` is its
+/// index there), so the filter reads a candidate's ray as given, in world space, even where
+/// Embree hands it the ray moved into an instance's space.
+#[repr(C)]
+pub(super) struct QueryContext {
+    pub(super) base: RtcIntersectContext,
+    pub(super) rays: *const HostRay,
+    pub(super) len: usize,
+}
+
 /// The any-hit test of host intersection (Embree's intersect and occluded filter of the
-/// triangle geometry): a candidate counts where
+/// triangle geometries): a candidate counts where
 /// [`lumagraph_scene::traverse::triangle_hit_counts`] says so, the CPU mirror of the WGSL
-/// intersectors' `triangle_hit_counts` (alpha masks and blending).
+/// intersectors' `triangle_hit_counts` (alpha masks and blending), with the triangle's index
+/// in the path tracer's order and the world-space ray, as the WGSL tests an instanced
+/// triangle (`candidate_instance_triangle`) and a copy of it.
 ///
 /// # Safety
 /// Called by Embree with `args` as its headers describe, the geometry's user pointer a live
-/// `GpuScene` (`HostScene` keeps it) whose triangles are the geometry's, in order.
+/// `FilterGeometry` (`HostScene` keeps it, and the `GpuScene` it names) whose triangles from
+/// `base` on are the geometry's, in order, and the context a `QueryContext` whose rays
+/// outlive the query.
 pub(super) unsafe extern "C" fn any_hit_filter(args: *const RtcFilterArgs) {
     // SAFETY: see the function's contract.
     let a = unsafe { &*args };
-    // SAFETY: the user pointer is the `GpuScene` the `HostScene` holds.
-    let scene = unsafe { &*a.geometry_user_ptr.cast::<lumagraph_scene::GpuScene>() };
+    // SAFETY: the user pointer is the `FilterGeometry` the `HostScene` holds.
+    let g = unsafe { &*a.geometry_user_ptr.cast::<FilterGeometry>() };
+    // SAFETY: as above: it names the `GpuScene` the `HostScene` holds.
+    let scene = unsafe { &*g.scene };
+    // SAFETY: every query passes a `QueryContext` (its first field is Embree's context).
+    let ctx = unsafe { &*a.context.cast::<QueryContext>() };
     let n = a.n as usize;
     for i in 0..n {
-        // SAFETY: `valid`, `ray` and `hit` hold `n` entries per field.
+        // SAFETY: `valid`, `ray` and `hit` hold `n` entries per field; `ctx.rays` holds
+        // `ctx.len` rays.
         unsafe {
             if *a.valid.add(i) == 0 {
                 continue;
             }
-            let ray = |k: usize| *a.ray.add(k * n + i);
-            let hit = |k: usize| *a.hit.add(k * n + i);
-            let r = lumagraph_scene::traverse::Ray {
-                origin: glam::Vec3::new(ray(0), ray(1), ray(2)),
-                dir: glam::Vec3::new(ray(4), ray(5), ray(6)),
+            let id = *a.ray.cast::<u32>().add(10 * n + i) as usize;
+            let r = if id < ctx.len {
+                let given = &*ctx.rays.add(id);
+                lumagraph_scene::traverse::Ray {
+                    origin: glam::Vec3::from_array(given.origin),
+                    dir: glam::Vec3::from_array(given.dir),
+                }
+            } else {
+                let ray = |k: usize| *a.ray.add(k * n + i);
+                lumagraph_scene::traverse::Ray {
+                    origin: glam::Vec3::new(ray(0), ray(1), ray(2)),
+                    dir: glam::Vec3::new(ray(4), ray(5), ray(6)),
+                }
             };
-            let prim = *a.hit.cast::<u32>().add(5 * n + i);
+            let hit = |k: usize| *a.hit.add(k * n + i);
+            let prim = g.base + *a.hit.cast::<u32>().add(5 * n + i);
             if !lumagraph_scene::traverse::triangle_hit_counts(scene, prim, hit(3), hit(4), &r) {
                 *a.valid.add(i) = 0;
             }
@@ -79,6 +115,9 @@ pub(super) const RTC_BUFFER_TYPE_INDEX: u32 = 0;
 pub(super) const RTC_BUFFER_TYPE_VERTEX: u32 = 1;
 /// `RTCGeometryType`.
 pub(super) const RTC_GEOMETRY_TYPE_TRIANGLE: u32 = 0;
+pub(super) const RTC_GEOMETRY_TYPE_INSTANCE: u32 = 121;
+/// `RTCFormat`: `RTC_FORMAT_FLOAT3X4_ROW_MAJOR` (a 3×4 matrix, row after row).
+pub(super) const RTC_FORMAT_FLOAT3X4_ROW_MAJOR: u32 = 0x9134;
 /// `RTCBuildQuality` (`RTC_BUILD_QUALITY_LOW` is 0).
 pub(super) const RTC_BUILD_QUALITY_MEDIUM: u32 = 1;
 pub(super) const RTC_BUILD_QUALITY_HIGH: u32 = 2;
@@ -228,6 +267,16 @@ pub(super) struct Api {
     pub(super) set_scene_build_quality: unsafe extern "C" fn(scene: RtcScene, quality: u32),
     pub(super) set_scene_flags: unsafe extern "C" fn(scene: RtcScene, flags: u32),
     pub(super) attach_geometry: unsafe extern "C" fn(scene: RtcScene, geometry: RtcGeometry) -> u32,
+    pub(super) attach_geometry_by_id:
+        unsafe extern "C" fn(scene: RtcScene, geometry: RtcGeometry, id: u32),
+    pub(super) set_geometry_instanced_scene:
+        unsafe extern "C" fn(geometry: RtcGeometry, scene: RtcScene),
+    pub(super) set_geometry_transform: unsafe extern "C" fn(
+        geometry: RtcGeometry,
+        time_step: u32,
+        format: u32,
+        xfm: *const c_void,
+    ),
     pub(super) commit_scene: unsafe extern "C" fn(scene: RtcScene),
     pub(super) new_geometry: unsafe extern "C" fn(device: RtcDevice, kind: u32) -> RtcGeometry,
     pub(super) release_geometry: unsafe extern "C" fn(geometry: RtcGeometry),
@@ -305,6 +354,9 @@ impl Api {
             set_scene_build_quality: sym!("rtcSetSceneBuildQuality"),
             set_scene_flags: sym!("rtcSetSceneFlags"),
             attach_geometry: sym!("rtcAttachGeometry"),
+            attach_geometry_by_id: sym!("rtcAttachGeometryByID"),
+            set_geometry_instanced_scene: sym!("rtcSetGeometryInstancedScene"),
+            set_geometry_transform: sym!("rtcSetGeometryTransform"),
             commit_scene: sym!("rtcCommitScene"),
             new_geometry: sym!("rtcNewGeometry"),
             release_geometry: sym!("rtcReleaseGeometry"),

@@ -7,7 +7,10 @@
 //!
 //! - [`Embree`]: the loaded library and its device, one per process.
 //! - [`HostScene`]: one triangle mesh, its primitive IDs the indices of the triangles as
-//!   given (the path tracer's BVH order, [`lumagraph_scene::GpuScene::tri_corners`]).
+//!   given (the path tracer's BVH order, [`lumagraph_scene::GpuScene::tri_corners`]); for a
+//!   scene with instanced meshes, an Embree scene per mesh placed by instance geometries
+//!   beside the scene's own triangles, its hits naming the triangle in the same order and
+//!   the instance ([`HostScene::intersect_instances`]).
 //! - [`HostRay`] and [`HostHit`]: 32 and 16 bytes, the layouts the WGSL writes and reads.
 //!
 //! Library names tried, in order: the path the application gave ([`configure`]) when it gave

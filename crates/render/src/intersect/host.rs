@@ -43,7 +43,7 @@ impl IntersectorKind for Host {
 
     fn traces(&self) -> [bool; Content::ALL.len()] {
         use Content as C;
-        Content::ALL.map(|c| matches!(c, C::ManyPrimitives | C::Alpha | C::Aovs))
+        Content::ALL.map(|c| matches!(c, C::ManyPrimitives | C::Instances | C::Alpha | C::Aovs))
     }
 
     fn lacks(&self, content: Content, scene: &GpuScene) -> String {
@@ -83,9 +83,10 @@ impl IntersectorKind for Host {
         Some("rays intersected on the host, which steps the paths itself")
     }
 
-    /// Only the first-hit AOVs are traced in WGSL (`first_hit_aovs`).
+    /// The first-hit AOVs are traced in WGSL (`first_hit_aovs`), and an instanced scene's
+    /// instance records follow the nodes (they place the host's hits).
     fn reads_binary_bvh(&self, features: &Features) -> bool {
-        features.on(Feature::FirstHitAovs)
+        features.on(Feature::FirstHitAovs) || features.on(Feature::Instances)
     }
 
     fn build(&self, ctx: &GpuContext, scene: &std::sync::Arc<GpuScene>) -> Result<Box<dyn Traversal>> {

@@ -310,10 +310,10 @@ fn textures_reason(scene: &GpuScene, all: bool) -> String {
     }
 }
 
-/// Why only the binary WGSL BVH traces a scene with instanced meshes: the others (inline
-/// code, the 8-wide BVH, ray queries, the host and the wavefront's step records) take flat
-/// scenes only so far.
-pub const INSTANCES_REASON: &str = "instanced meshes: the binary WGSL BVH walks the two levels (the other intersectors take flat scenes only)";
+/// Why only the binary WGSL BVH and host intersection trace a scene with instanced meshes:
+/// the others (inline code, the 8-wide BVH, ray queries and the wavefront's step records)
+/// take flat scenes only so far.
+pub const INSTANCES_REASON: &str = "instanced meshes: the binary WGSL BVH walks the two levels, host intersection places them in Embree (the other intersectors take flat scenes only)";
 
 /// GPU adapters step scenes of at least this many triangles with textured materials as a
 /// wavefront: the one scene it measured faster on (Sponza, 262 087 triangles, 24 textured
