@@ -55,6 +55,7 @@ pub use scene::{
 };
 pub use texture::{
     AtlasLimits, Downscaled, TexelRange, Texture, TextureAtlas, UvTransform, Wrap, fit_textures,
+    fit_textures_with, pack_atlas_with,
     pack_atlas,
 };
 pub use traverse::{Hit, Ray, intersect, intersect_within, occluded};
