@@ -512,25 +512,40 @@ pub fn render_with(
     Vec<lumagraph::render::cpu::Image>,
     lumagraph::render::specialize::Features,
 )> {
-    use lumagraph::graph::ParamValue;
-    use lumagraph::render::{Executor, compile};
     use lumagraph::scene::{GpuScene, Scene};
-    let ctx = gpu()?;
+    gpu()?;
     let mut scene =
         GpuScene::build(&Scene::load(&repo(&format!("assets/{name}"))).unwrap()).unwrap();
     (scene.settings.width, scene.settings.height) = size;
-    let scene = std::sync::Arc::new(scene);
+    let out = render_scene_with(&std::sync::Arc::new(scene), spp, resources);
+    if let Some((_, features)) = &out {
+        println!("{name}: {}", features.summary());
+    }
+    out
+}
+
+/// [`render_with`] for a scene at hand, at its own size.
+pub fn render_scene_with(
+    scene: &std::sync::Arc<lumagraph::scene::GpuScene>,
+    spp: u32,
+    resources: lumagraph::render::Resources,
+) -> Option<(
+    Vec<lumagraph::render::cpu::Image>,
+    lumagraph::render::specialize::Features,
+)> {
+    use lumagraph::graph::ParamValue;
+    use lumagraph::render::{Executor, compile};
+    let ctx = gpu()?;
     let ports = ["acc.color", "pt.albedo", "pt.normal", "pt.depth"];
     let outputs: Vec<String> = ports.iter().map(|p| (*p).to_owned()).collect();
     let graph = progressive_graph(&[("samples_per_frame", ParamValue::Int(4))]);
-    let plan = compile(&graph, &outputs, Some(&scene)).unwrap();
+    let plan = compile(&graph, &outputs, Some(scene)).unwrap();
     let resources = lumagraph::render::Resources {
-        scene: Some(scene),
+        scene: Some(std::sync::Arc::clone(scene)),
         ..resources
     };
     let mut exec = Executor::new(ctx, plan, &resources).unwrap();
     let features = exec.shader_features("pt").unwrap().clone();
-    println!("{name}: {}", features.summary());
     exec.run_frames(spp.div_ceil(4), true).unwrap();
     let images = ports.iter().map(|p| exec.read_port(p).unwrap()).collect();
     Some((images, features))

@@ -456,10 +456,7 @@ impl GpuScene {
         check_textures(scene)?;
         if textured {
             let packing = std::time::Instant::now();
-            out.texture_srgb = scene
-                .settings
-                .texture_mips
-                .then(|| texture_srgb(scene));
+            out.texture_srgb = scene.settings.texture_mips.then(|| texture_srgb(scene));
             out.atlas =
                 crate::texture::pack_atlas_with(&scene.textures, out.texture_srgb.as_deref());
             out.atlas_time = packing.elapsed();

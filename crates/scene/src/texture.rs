@@ -487,7 +487,11 @@ impl TextureAtlas {
         let levels = self.mip_levels(id);
         let lambda = self.lod(id, lod);
         let d = &self.descriptors[id as usize];
-        if levels == 0 || d.place[3] & TEX_NEAREST != 0 || !(lambda > 0.0) {
+        // Not above 0, or NaN: level 0.
+        if levels == 0
+            || d.place[3] & TEX_NEAREST != 0
+            || lambda.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        {
             return self.sample(id, uvs, srgb);
         }
         let uv = if d.uv_set == 0 {
@@ -767,6 +771,37 @@ fn chains(all: &[Texture], image_of: &[usize], images: usize, srgb: &[bool]) -> 
     out
 }
 
+/// The mip chain of each image where `chain_of` asks for one, built on as many threads as
+/// the machine has (each takes the next image, largest first).
+fn mip_chains(images: &[&Texture], chain_of: &[Option<bool>]) -> Vec<Vec<Texture>> {
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let mut order: Vec<usize> = (0..images.len())
+        .filter(|&i| chain_of[i].is_some())
+        .collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(images[i].texels.len()));
+    let out: Vec<Mutex<Vec<Texture>>> = images.iter().map(|_| Mutex::new(Vec::new())).collect();
+    let next = AtomicUsize::new(0);
+    let threads = std::thread::available_parallelism()
+        .map_or(1, std::num::NonZeroUsize::get)
+        .min(order.len());
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| {
+                while let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    let chain = images[i].mip_chain(chain_of[i].unwrap_or(false));
+                    if let Ok(mut slot) = out[i].lock() {
+                        *slot = chain;
+                    }
+                }
+            });
+        }
+    });
+    out.into_iter()
+        .map(|m| m.into_inner().unwrap_or_default())
+        .collect()
+}
+
 /// [`pack_atlas`], with a mip chain ([`Texture::mip_chain`]) for every image some texture
 /// filters (not nearest) when `srgb` is given: per texture, whether a material reads it as
 /// colour (its chain is then averaged in linear light). Each level is an image of its own
@@ -782,11 +817,7 @@ pub fn pack_atlas_with(all: &[Texture], srgb: Option<&[bool]>) -> TextureAtlas {
         |s| chains(all, &image_of, textures.len(), s),
     );
     // The images, then each one's levels (image i's from `first_level[i]`).
-    let levels: Vec<Vec<Texture>> = textures
-        .iter()
-        .zip(&chain_of)
-        .map(|(t, c)| c.map_or_else(Vec::new, |srgb| t.mip_chain(srgb)))
-        .collect();
+    let levels = mip_chains(&textures, &chain_of);
     let mut sizes: Vec<(u32, u32)> = textures.iter().map(|t| (t.width, t.height)).collect();
     let mut first_level = Vec::with_capacity(levels.len());
     for l in &levels {

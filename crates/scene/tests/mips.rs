@@ -3,9 +3,7 @@
 //! of the shader's trilinear lookup (`TextureAtlas::sample_lod`).
 
 use glam::{Vec2, Vec4};
-use lumagraph_scene::texture::{
-    AtlasLimits, TEX_MIPS_SHIFT, srgb_decode, srgb_encode,
-};
+use lumagraph_scene::texture::{AtlasLimits, TEX_MIPS_SHIFT, srgb_decode, srgb_encode};
 use lumagraph_scene::{
     Texture, TextureAtlas, UvTransform, Wrap, fit_textures_with, pack_atlas, pack_atlas_with,
 };
