@@ -414,8 +414,27 @@ fn load_scene(path: Option<&Path>) -> Result<Option<LoadedScene>> {
     } else {
         String::new()
     };
+    let atlas = &gpu.atlas;
+    let atlas_note = if atlas.pages > 0 {
+        let mib = |b: u64| b as f64 / f64::from(1 << 20);
+        format!(
+            ", texture atlas {:.0} ms: {} pages of {}x{} texels, {:.1} MiB{}",
+            ms(gpu.atlas_time),
+            atlas.pages,
+            atlas.page_size,
+            atlas.page_size,
+            mib(atlas.bytes()),
+            if gpu.texture_srgb.is_some() {
+                format!(" (of which mip levels {:.1} MiB)", mib(atlas.mip_bytes))
+            } else {
+                " (no mip levels: texture_mips false)".to_owned()
+            }
+        )
+    } else {
+        String::new()
+    };
     println!(
-        "  loading {:.0} ms{textures}; GPU layout {:.0} ms (of which BVH {:.0} ms){}",
+        "  loading {:.0} ms{textures}; GPU layout {:.0} ms (of which BVH {:.0} ms{atlas_note}){}",
         ms(scene.stats.total),
         ms(layout),
         ms(bvh_time),

@@ -176,6 +176,13 @@ fn opaque_here(f: VertexOut) -> bool {
 @fragment
 fn fs_main(f: VertexOut) -> FragmentOut {
     let dir = pixel_ray(f.clip.xy);
+    // The pixel's footprint per UV set (textures.wgsl `tex_sample_lod`): log2 of the larger
+    // screen-space derivative of the coordinates, taken before any branch (derivatives need
+    // uniform control flow).
+    let lod = log2(max(
+        max(vec2f(length(dpdx(f.uv.xy)), length(dpdx(f.uv.zw))), vec2f(length(dpdy(f.uv.xy)), length(dpdy(f.uv.zw)))),
+        vec2f(1e-30),
+    ));
     if HAS_ALPHA && !opaque_here(f) {
         discard;
     }
@@ -199,9 +206,9 @@ fn fs_main(f: VertexOut) -> FragmentOut {
         // A zero interpolated normal falls back to the geometric one, as in the path tracer.
         var ns = select(f.shape.xyz, normalize(n), dot(n, n) > 0.0);
         if HAS_TEXTURES {
-            let m = textured_material(materials[f.material], f.uv, f.color);
+            let m = textured_material(materials[f.material], f.uv, lod, f.color);
             out.albedo = vec4f(m.base_color, flag);
-            ns = normal_mapped(m, ns, f.shape.xyz, f.uv, f.tangent);
+            ns = normal_mapped(m, ns, f.shape.xyz, f.uv, lod, f.tangent);
         }
         out.normal = vec4f(ns, 1.0);
         out.depth = vec4f(length(f.world - cam.position), 0.0, 0.0, 0.0);

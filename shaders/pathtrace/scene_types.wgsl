@@ -128,7 +128,8 @@ struct TexDesc {
     m: vec4<f32>,
     offset: vec2<f32>,
     uv_set: u32,
-    pad: u32,
+    // Its mip level 1's descriptor (level k at mips + k - 1; TEX_MIPS_SHIFT: how many).
+    mips: u32,
 }
 
 // Emissive triangle (p0, e1, e2) or analytic shape (LIGHT_SHAPE: `prim`), kind 0, 80 bytes;

@@ -519,7 +519,7 @@ pub fn render_with(
     render_scene(scene, size, spp, resources)
 }
 
-/// [`render_with`] for a scene already built.
+/// [`render_with`] for a scene already built, at `size`.
 pub fn render_scene(
     mut scene: lumagraph::scene::GpuScene,
     size: (u32, u32),
@@ -529,22 +529,36 @@ pub fn render_scene(
     Vec<lumagraph::render::cpu::Image>,
     lumagraph::render::specialize::Features,
 )> {
+    (scene.settings.width, scene.settings.height) = size;
+    let out = render_scene_with(&std::sync::Arc::new(scene), spp, resources);
+    if let Some((_, features)) = &out {
+        println!("  {}", features.summary());
+    }
+    out
+}
+
+/// [`render_with`] for a scene at hand, at its own size.
+pub fn render_scene_with(
+    scene: &std::sync::Arc<lumagraph::scene::GpuScene>,
+    spp: u32,
+    resources: lumagraph::render::Resources,
+) -> Option<(
+    Vec<lumagraph::render::cpu::Image>,
+    lumagraph::render::specialize::Features,
+)> {
     use lumagraph::graph::ParamValue;
     use lumagraph::render::{Executor, compile};
     let ctx = gpu()?;
-    (scene.settings.width, scene.settings.height) = size;
-    let scene = std::sync::Arc::new(scene);
     let ports = ["acc.color", "pt.albedo", "pt.normal", "pt.depth"];
     let outputs: Vec<String> = ports.iter().map(|p| (*p).to_owned()).collect();
     let graph = progressive_graph(&[("samples_per_frame", ParamValue::Int(4))]);
-    let plan = compile(&graph, &outputs, Some(&scene)).unwrap();
+    let plan = compile(&graph, &outputs, Some(scene)).unwrap();
     let resources = lumagraph::render::Resources {
-        scene: Some(scene),
+        scene: Some(std::sync::Arc::clone(scene)),
         ..resources
     };
     let mut exec = Executor::new(ctx, plan, &resources).unwrap();
     let features = exec.shader_features("pt").unwrap().clone();
-    println!("{}", features.summary());
     exec.run_frames(spp.div_ceil(4), true).unwrap();
     let images = ports.iter().map(|p| exec.read_port(p).unwrap()).collect();
     Some((images, features))

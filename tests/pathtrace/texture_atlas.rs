@@ -148,7 +148,8 @@ fn a_scene_over_a_device_limit_gets_one_named_error() {
         .to_string();
     println!("{e}");
     assert!(
-        e.contains("scene part \"textures\": 3 textures in 3 pages of 1024x1024")
+        // Three pages of images and two of their mip levels.
+        e.contains("scene part \"textures\": 3 textures in 5 pages of 1024x1024")
             && e.contains("largest 2D texture side of 512")
             && e.contains("a test device"),
         "{e}"
@@ -161,7 +162,7 @@ fn a_scene_over_a_device_limit_gets_one_named_error() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("3 pages, over the adapter's 0 array layers"),
+        e.contains("5 pages, over the adapter's 0 array layers"),
         "{e}"
     );
     let small_binding = lumagraph::render::wgpu::Limits {

@@ -1668,3 +1668,111 @@ fn small_scenes_are_inlined_on_cpu_adapters_only() {
         }
     }
 }
+
+// ---------------------------------------------------------------- mip levels
+
+/// A 20 × 20 floor (the z = 0 plane) under a one-texel black and white checker of 64² texels
+/// repeated 40 times each way, seen at a grazing angle from 0.5 above it: beyond a few
+/// metres each pixel covers dozens of texels. `texture_mips` as given; 64 × 48 pixels, a
+/// constant white sky, one bounce; with `ceiling`, a second such quad 2 above the floor
+/// (double-sided), which rays bouncing off the floor meet, and 3 bounces.
+pub(crate) fn grazing_checker(dir: &Path, mips: bool, ceiling: bool) -> GpuScene {
+    let px: Vec<[u8; 4]> = (0..64 * 64)
+        .map(|i| {
+            if (i % 64 + i / 64) % 2 == 0 {
+                [255, 255, 255, 255]
+            } else {
+                [0, 0, 0, 255]
+            }
+        })
+        .collect();
+    let mut floor = Quad::at(-10.0, -10.0, 0);
+    floor.size = 20.0;
+    floor.uv1 = Vec2::splat(40.0);
+    let mut quads = vec![floor];
+    if ceiling {
+        let mut top = floor;
+        top.z = 2.0;
+        quads.push(top);
+    }
+    let g = Gltf {
+        images: vec![Img::new(64, 64, px)],
+        materials: vec![r#"{"doubleSided":true,"pbrMetallicRoughness":{"baseColorTexture":{"index":0},"metallicFactor":0.0,"roughnessFactor":1.0}}"#.into()],
+        quads,
+    };
+    let bounces = if ceiling { 3 } else { 1 };
+    let sub = dir.join(format!("grazing_{mips}_{ceiling}"));
+    std::fs::create_dir_all(&sub).unwrap();
+    g.write(&sub, "floor");
+    let text = format!(
+        "(version: 1,
+  camera: Perspective(position: (0.0, -9.0, 0.5), target: (0.0, 10.0, -0.6), up: (0.0, 0.0, 1.0), fov_y: 40.0),
+  shapes: [Mesh(name: \"m\", path: \"floor.gltf\")],
+  environment: Constant((1.0, 1.0, 1.0)),
+  render: (width: 64, height: 48, max_bounces: {bounces}, spp: 1, seed: 7, texture_mips: {mips}),
+)"
+    );
+    let scene_path = sub.join("scene.ron");
+    std::fs::write(&scene_path, text).unwrap();
+    GpuScene::build(&Scene::load(&scene_path).unwrap()).unwrap()
+}
+
+/// Mip levels take out the aliasing of a minified texture. On the grazing checker, the
+/// first-hit albedo (`PathTrace`'s AOV through each pixel center, from the ray cone, and the
+/// `GBuffer`'s, from screen-space derivatives) of every pixel whose hit is over 3 m away
+/// is the checker's mean: level 1 of a one-texel checker is already uniform, byte 188 in
+/// sRGB, 0.5029 in linear light (within 0.01: the blend with level 0 where the level of
+/// detail is under 1 — none at that distance, measured 0). Without mips the same pixels
+/// alias: some are over 0.25 from the mean (measured 0.47). And the colour converges
+/// faster: at 4 spp its relMSE against a 256-spp image of the same settings is under half
+/// of that without mips (measured 0.0032 against 0.0157); the grey region's noise is then
+/// the sky's alone.
+#[test]
+fn mip_levels_turn_a_distant_checker_grey() {
+    let dir = temp();
+    let grey = srgb_decode(188.0 / 255.0);
+    let mut relmse = [0.0_f64; 2];
+    for (k, mips) in [true, false].into_iter().enumerate() {
+        let g = grazing_checker(dir.path(), mips, false);
+        // The pixels whose center ray meets the floor over 3 m away (CPU ray cast).
+        let far: Vec<bool> = (0..48)
+            .flat_map(|y| (0..64).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                let ray = pixel_ray(&g, x, y);
+                lumagraph::scene::intersect(&g, &ray).is_some_and(|h| h.t > 3.0)
+            })
+            .collect();
+        let count = far.iter().filter(|&&f| f).count();
+        assert!(count > 300, "{count} far pixels");
+        let g = Arc::new(g);
+        let Some([color, pt_albedo, _, gb_albedo, _]) = render(&g, 4) else {
+            return;
+        };
+        let Some([reference, ..]) = render(&g, 256) else {
+            return;
+        };
+        relmse[k] = lumagraph::render::metrics::relmse(&color, &reference);
+        for (name, img) in [("PathTrace", &pt_albedo), ("GBuffer", &gb_albedo)] {
+            let worst = img
+                .pixels
+                .iter()
+                .zip(&far)
+                .filter(|(_, f)| **f)
+                .map(|(p, _)| (p[0] - grey).abs().max((p[1] - grey).abs()))
+                .fold(0.0_f32, f32::max);
+            println!(
+                "mips {mips}: {name} albedo of {count} far pixels: worst {worst:.4} from the mean {grey:.4}"
+            );
+            if mips {
+                assert!(worst < 0.01, "{name}: {worst}");
+            } else {
+                assert!(worst > 0.25, "{name}: {worst}");
+            }
+        }
+    }
+    println!(
+        "4 spp against 256 spp: relMSE {:.5} with mips, {:.5} without",
+        relmse[0], relmse[1]
+    );
+    assert!(relmse[0] < 0.5 * relmse[1], "{relmse:?}");
+}

@@ -84,6 +84,32 @@ fn the_wavefront_sees_through_alpha_masks_as_the_megakernel_does() {
     assert_eq!(differ, 0);
 }
 
+/// Texture levels of detail in the wavefront's steps: the grazing checker floor under a
+/// checkered ceiling (`textures.rs`), 3 bounces, 4 spp, where rays that bounce off the floor
+/// read the ceiling's texture at a level their cone (kept in the path's state between
+/// steps) gives. Asserted: the color bit-identical to the megakernel's, and different from
+/// the image without mips (the levels are read).
+#[test]
+fn the_wavefront_carries_the_ray_cone_as_the_megakernel_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Arc::new(super::textures::grazing_checker(dir.path(), true, true));
+    let flat = Arc::new(super::textures::grazing_checker(dir.path(), false, true));
+    let render = |scene: &Arc<GpuScene>, schedule| {
+        common::render_scene_with(scene, 4, as_gpu(Intersector::BINARY_BVH, schedule))
+    };
+    let Some((front, how)) = render(&scene, Schedule::Wavefront) else {
+        return;
+    };
+    let (mega, _) = render(&scene, Schedule::Megakernel).unwrap();
+    let (without, _) = render(&flat, Schedule::Megakernel).unwrap();
+    assert!(how.on(Feature::Wavefront), "{}", how.summary());
+    let differ = common::differing(&front[0], &mega[0], None);
+    let changed = common::differing(&without[0], &mega[0], None);
+    println!("grazing checker: {differ} pixels differ; {changed} without mips");
+    assert_eq!(differ, 0);
+    assert!(changed > 1000, "{changed}");
+}
+
 /// Where the wavefront is compiled in: asked for, or (the default) on a GPU adapter for a
 /// scene of textured materials and at least `WAVEFRONT_MIN_TRIANGLES` triangles, the kind of
 /// scene it measured faster on (Sponza on an NVIDIA H200, `docs/benchmarks.md`); never where

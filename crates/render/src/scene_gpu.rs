@@ -157,7 +157,7 @@ fn check_parts(
     if atlas.pages > 0 {
         let what = format!(
             "\"textures\": {} textures in {} pages of {}x{} texels ({})",
-            atlas.descriptors.len(),
+            atlas.textures,
             atlas.pages,
             atlas.page_size,
             atlas.page_size,

@@ -661,6 +661,12 @@ pub struct RenderSettings {
     /// Random seed. Default 0.
     #[serde(default)]
     pub seed: u32,
+    /// Mip chains for the textures, each lookup's level chosen from a ray cone and the two
+    /// levels around it blended (trilinear; see `docs/pathtracer.md`, "Texture level of
+    /// detail"). Default true; false samples every texture at full resolution (bilinear),
+    /// as renderers without mip maps (Mitsuba's `bitmap`) do.
+    #[serde(default = "yes")]
+    pub texture_mips: bool,
 }
 
 fn default_max_bounces() -> u32 {

@@ -55,6 +55,12 @@ pub struct GpuScene {
     /// Every texture a material uses, in one atlas ([`crate::texture::pack_atlas`]); empty
     /// without textures (the array texture `textures` and buffer `texture_descs`).
     pub atlas: crate::texture::TextureAtlas,
+    /// Per texture, whether a material reads it as colour (sRGB), where the atlas has mip
+    /// chains ([`crate::texture::pack_atlas_with`], the scene's `texture_mips`); `None`
+    /// without them (CPU side only: [`GpuScene::fit_textures`] packs the atlas again).
+    pub texture_srgb: Option<Vec<bool>>,
+    /// How long packing the atlas took, its mip chains included (CPU side only).
+    pub atlas_time: std::time::Duration,
     /// Each texture's channel ranges, in the order of `textures` (CPU side only: the shader
     /// specializer leaves a lobe out only where no texel can produce it).
     pub texture_ranges: Vec<crate::texture::TexelRange>,
@@ -369,8 +375,9 @@ impl GpuScene {
         if limits.hold(self.atlas.page_size, self.atlas.pages) {
             return Some(Vec::new());
         }
-        let (fitted, notes) = crate::texture::fit_textures(textures, limits)?;
-        self.atlas = crate::texture::pack_atlas(&fitted);
+        let srgb = self.texture_srgb.as_deref();
+        let (fitted, notes) = crate::texture::fit_textures_with(textures, limits, srgb)?;
+        self.atlas = crate::texture::pack_atlas_with(&fitted, srgb);
         Some(notes)
     }
 
@@ -448,7 +455,11 @@ impl GpuScene {
         let textured = surface_attributes(scene);
         check_textures(scene)?;
         if textured {
-            out.atlas = crate::texture::pack_atlas(&scene.textures);
+            let packing = std::time::Instant::now();
+            out.texture_srgb = scene.settings.texture_mips.then(|| texture_srgb(scene));
+            out.atlas =
+                crate::texture::pack_atlas_with(&scene.textures, out.texture_srgb.as_deref());
+            out.atlas_time = packing.elapsed();
             out.texture_ranges = scene
                 .textures
                 .iter()
@@ -742,6 +753,21 @@ fn surface_attributes(scene: &Scene) -> bool {
             .iter()
             .chain(scene.instanced.iter().flat_map(|m| &m.triangles))
             .any(|t| t.colors.is_some())
+}
+
+/// Per texture of `scene`, whether some material reads it as colour: its base colour,
+/// emission, specular colour or sheen colour (sRGB-encoded slots).
+fn texture_srgb(scene: &Scene) -> Vec<bool> {
+    let mut srgb = vec![false; scene.textures.len()];
+    for m in &scene.materials {
+        let t = &m.textures;
+        for id in [t.base_color, t.emissive, t.specular_color, t.sheen_color] {
+            if let Some(s) = srgb.get_mut(id as usize) {
+                *s = true;
+            }
+        }
+    }
+    srgb
 }
 
 fn check_textures(scene: &Scene) -> Result<(), SceneError> {

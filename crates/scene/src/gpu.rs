@@ -236,7 +236,9 @@ pub struct GpuTriTexcoords {
 /// Where a texture's texels are in the atlas and how a material reads them, 48 bytes: the
 /// atlas place (x | y << 16 in its page, the page, width | height << 16, flags:
 /// [`crate::Texture::flags`]), then the coordinate transform (`uv' = u · m.xy + v · m.zw +
-/// offset`) and the coordinate set.
+/// offset`) and the coordinate set, and where its mip levels' places are. A mip level's
+/// descriptor (after every texture's, [`crate::texture::TextureAtlas::descriptors`]) holds
+/// only a place.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuTexDesc {
@@ -248,8 +250,10 @@ pub struct GpuTexDesc {
     pub offset: [f32; 2],
     /// 0: `TEXCOORD_0`, 1: `TEXCOORD_1` (offset 40).
     pub uv_set: u32,
-    /// Padding (offset 44).
-    pub pad: u32,
+    /// The index of the descriptor of its mip level 1 (level k at `mips + k − 1`; how many
+    /// levels there are is in the flags, [`crate::texture::TEX_MIPS_SHIFT`]), 0 without mip
+    /// levels (offset 44).
+    pub mips: u32,
 }
 
 /// White in [`GpuTriTexcoords::colors`]: the vertex colour of meshes without one.

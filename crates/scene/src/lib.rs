@@ -55,6 +55,6 @@ pub use scene::{
 };
 pub use texture::{
     AtlasLimits, Downscaled, TexelRange, Texture, TextureAtlas, UvTransform, Wrap, fit_textures,
-    pack_atlas,
+    fit_textures_with, pack_atlas, pack_atlas_with,
 };
 pub use traverse::{Hit, Ray, intersect, intersect_within, occluded};

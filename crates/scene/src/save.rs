@@ -337,6 +337,7 @@ pub(crate) fn render_value(r: &RenderSettings) -> Val {
             given("max_bounces", r.max_bounces.to_string(), "20"),
             given("spp", r.spp.to_string(), "1"),
             given("seed", r.seed.to_string(), "0"),
+            given("texture_mips", r.texture_mips.to_string(), "true"),
         ],
     }
 }

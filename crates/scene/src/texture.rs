@@ -6,8 +6,14 @@
 //! a transform ([`UvTransform`], glTF's `KHR_texture_transform`). Sampling is bilinear between the four texels
 //! around the point (texel centers at `(i + 0.5) / width`), after decoding each texel from
 //! sRGB when asked (as a GPU filters an sRGB texture), or the nearest texel when the glTF
-//! sampler's `magFilter` is `NEAREST`. There are no mipmaps: the path tracer averages many
-//! jittered samples per pixel, which filters minified textures.
+//! sampler's `magFilter` is `NEAREST`.
+//!
+//! Mip chains ([`Texture::mip_chain`], [`pack_atlas_with`]): each image halved again and
+//! again down to 1×1, every texel the mean of the 2×2 it covers (a box filter), computed in
+//! linear light for images a material reads as colour (sRGB: decoded, averaged, encoded)
+//! and on the stored values for data (normals, roughness, alpha). The path tracer picks a
+//! level per lookup from a ray cone ([`TextureAtlas::sample_lod`]) and blends the two
+//! levels around it (trilinear); level 0 is what bilinear filtering alone reads.
 //!
 //! On the GPU all textures of a scene live in one 2D array texture of RGBA8 texels, an atlas
 //! ([`TextureAtlas`], [`pack_atlas`]): square pages of one size, each texture placed whole
@@ -177,6 +183,70 @@ impl Texture {
         }
     }
 
+    /// The mip levels below this image, level 1 first, down to 1×1 (none for a 1×1 image):
+    /// each level half the size of the one above (odd sides rounded up, the last row or
+    /// column then averaged with itself, as [`Texture::halved`]), each texel the mean of
+    /// the 2×2 texels of the level above it covers: a box filter, so level k's texel is the
+    /// mean of the 2^k × 2^k texels of level 0 under it (power-of-two sides). The means are
+    /// taken in linear light when `srgb` (RGB decoded, averaged, encoded again; alpha is
+    /// always linear) and on the stored values otherwise; each level is averaged from the
+    /// unrounded one above, and rounded to bytes only when stored.
+    #[must_use]
+    pub fn mip_chain(&self, srgb: bool) -> Vec<Self> {
+        let table = srgb_table();
+        let decode = |c: usize, b: u8| {
+            if srgb && c < 3 {
+                table[b as usize]
+            } else {
+                f32::from(b) / 255.0
+            }
+        };
+        let encode = |c: usize, v: f32| {
+            if srgb && c < 3 {
+                unorm8(srgb_encode(v))
+            } else {
+                unorm8(v)
+            }
+        };
+        let (mut w, mut h) = (self.width, self.height);
+        let mut level: Vec<[f32; 4]> = self
+            .texels
+            .iter()
+            .map(|t| std::array::from_fn(|c| decode(c, t[c])))
+            .collect();
+        let mut out = Vec::new();
+        while (w, h) != (1, 1) {
+            let (nw, nh) = (w.div_ceil(2), h.div_ceil(2));
+            let at = |x: u32, y: u32| level[(y.min(h - 1) * w + x.min(w - 1)) as usize];
+            let mut next = Vec::with_capacity(nw as usize * nh as usize);
+            for y in 0..nh {
+                for x in 0..nw {
+                    let q = [
+                        at(2 * x, 2 * y),
+                        at(2 * x + 1, 2 * y),
+                        at(2 * x, 2 * y + 1),
+                        at(2 * x + 1, 2 * y + 1),
+                    ];
+                    next.push(std::array::from_fn(|c| {
+                        0.25 * (q[0][c] + q[1][c] + q[2][c] + q[3][c])
+                    }));
+                }
+            }
+            (level, w, h) = (next, nw, nh);
+            let texels: Vec<[u8; 4]> = level
+                .iter()
+                .map(|t| std::array::from_fn(|c| encode(c, t[c])))
+                .collect();
+            out.push(Self {
+                width: w,
+                height: h,
+                texels: texels.into(),
+                ..self.clone()
+            });
+        }
+        out
+    }
+
     /// The range of each channel over every texel (bilinear filtering stays within it).
     pub fn range(&self) -> TexelRange {
         let mut r = TexelRange {
@@ -195,6 +265,21 @@ impl Texture {
 
 /// Descriptor flag: nearest-texel lookup.
 pub const TEX_NEAREST: u32 = 16;
+/// Where a descriptor's flags hold how many mip levels its texture has after level 0 (4
+/// bits: at most [`MAX_MIP_LEVELS`] − 1).
+pub const TEX_MIPS_SHIFT: u32 = 8;
+/// The most levels a mip chain has, level 0 included: a 16 384-texel side down to 1.
+pub const MAX_MIP_LEVELS: u32 = 15;
+
+/// The 256 sRGB bytes decoded to linear light.
+fn srgb_table() -> [f32; 256] {
+    std::array::from_fn(|i| srgb_decode(i as f32 / 255.0))
+}
+
+/// A byte from a value in [0, 1], rounded to nearest.
+fn unorm8(v: f32) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+}
 /// The finest subdivision [`Texture::triangle_mean`] uses: at most 64² = 4096 samples.
 pub const TRIANGLE_MEAN_MAX_SPLIT: u32 = 64;
 
@@ -303,11 +388,17 @@ pub struct TextureAtlas {
     /// Pages (array layers).
     pub pages: u32,
     /// Per texture: where its image is, how it is wrapped and filtered, and which
-    /// coordinates it reads through which transform.
+    /// coordinates it reads through which transform; then, with mip chains, one per texture
+    /// and mip level after level 0 (its place only).
     pub descriptors: Vec<GpuTexDesc>,
     /// The pages' RGBA8 texels (R in the low byte), page after page, row by row from the
     /// top; texels no texture covers are 0.
     pub texels: Vec<u32>,
+    /// Bytes of texels of the mip levels (part of the pages, [`pack_atlas_with`]); 0
+    /// without them.
+    pub mip_bytes: u64,
+    /// How many textures it holds (the first descriptors; the mip levels' follow).
+    pub textures: usize,
 }
 
 impl TextureAtlas {
@@ -316,10 +407,25 @@ impl TextureAtlas {
         4 * self.texels.len() as u64
     }
 
-    /// The texel of texture `id` at integer coordinates, wrapped: `tex_fetch` in
-    /// `pathtrace/textures.wgsl`, line for line.
-    pub fn fetch(&self, id: u32, x: i64, y: i64, srgb: bool) -> Vec4 {
-        let d = self.descriptors[id as usize].place;
+    /// How many mip levels texture `id` has after level 0.
+    pub fn mip_levels(&self, id: u32) -> u32 {
+        (self.descriptors[id as usize].place[3] >> TEX_MIPS_SHIFT) & 0xF
+    }
+
+    /// The place (`GpuTexDesc::place`) of level `level` of texture `id` (0: its own),
+    /// level clamped to its last: `tex_level` in `pathtrace/textures.wgsl`.
+    pub fn level_place(&self, id: u32, level: u32) -> [u32; 4] {
+        let d = &self.descriptors[id as usize];
+        let k = level.min(self.mip_levels(id));
+        if k == 0 {
+            d.place
+        } else {
+            self.descriptors[(d.mips + k - 1) as usize].place
+        }
+    }
+
+    /// The texel at integer coordinates of the image placed at `d`, wrapped.
+    fn fetch_at(&self, d: [u32; 4], x: i64, y: i64, srgb: bool) -> Vec4 {
         let wrap = |code: u32| match code {
             1 => Wrap::ClampToEdge,
             2 => Wrap::MirroredRepeat,
@@ -337,6 +443,82 @@ impl TextureAtlas {
         } else {
             v
         }
+    }
+
+    /// The bilinear (or nearest) value of the image placed at `d` at `uv`.
+    fn filter_at(&self, d: [u32; 4], uv: Vec2, srgb: bool) -> Vec4 {
+        let p = uv * Vec2::new((d[2] & 0xFFFF) as f32, (d[2] >> 16) as f32);
+        if d[3] & TEX_NEAREST != 0 {
+            let f = p.floor();
+            return self.fetch_at(d, f.x as i64, f.y as i64, srgb);
+        }
+        let p = p - 0.5;
+        let f = p.floor();
+        let t = p - f;
+        let (x, y) = (f.x as i64, f.y as i64);
+        let a = self
+            .fetch_at(d, x, y, srgb)
+            .lerp(self.fetch_at(d, x + 1, y, srgb), t.x);
+        let b = self
+            .fetch_at(d, x, y + 1, srgb)
+            .lerp(self.fetch_at(d, x + 1, y + 1, srgb), t.x);
+        a.lerp(b, t.y)
+    }
+
+    /// The level of detail of texture `id` for a footprint `lod` (per coordinate set: log2
+    /// of the footprint's width in that set's UV units, see `Surface::lod` in
+    /// `pathtrace/integrator/surface.wgsl`): log2 of its width in level-0 texels, through the
+    /// texture's transform (`tex_lod` in `pathtrace/textures.wgsl`). Not finite or ≤ 0
+    /// means level 0.
+    pub fn lod(&self, id: u32, lod: Vec2) -> f32 {
+        let d = &self.descriptors[id as usize];
+        let size = ((d.place[2] & 0xFFFF) as f32) * ((d.place[2] >> 16) as f32);
+        let det = (d.m[0] * d.m[3] - d.m[2] * d.m[1]).abs();
+        let set = if d.uv_set == 0 { lod.x } else { lod.y };
+        set + 0.5 * (size * det).log2()
+    }
+
+    /// [`TextureAtlas::sample`] at the level of detail `lod` (see [`TextureAtlas::lod`]):
+    /// level 0 alone (bilinear, exactly `sample`) where the texture has no mip levels,
+    /// is looked up nearest, or the level is not above 0; else the two levels around it
+    /// blended (trilinear), the last level beyond the chain. `tex_sample_lod` in
+    /// `pathtrace/textures.wgsl`.
+    pub fn sample_lod(&self, id: u32, uvs: Vec4, lod: Vec2, srgb: bool) -> Vec4 {
+        let levels = self.mip_levels(id);
+        let lambda = self.lod(id, lod);
+        let d = &self.descriptors[id as usize];
+        // Not above 0, or NaN: level 0.
+        if levels == 0
+            || d.place[3] & TEX_NEAREST != 0
+            || lambda.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        {
+            return self.sample(id, uvs, srgb);
+        }
+        let uv = if d.uv_set == 0 {
+            uvs.truncate().truncate()
+        } else {
+            Vec2::new(uvs.z, uvs.w)
+        };
+        let uv = UvTransform {
+            m: d.m,
+            offset: d.offset,
+        }
+        .apply(uv);
+        let lambda = lambda.min(levels as f32);
+        let k = lambda.floor();
+        let f = lambda - k;
+        let k = k as u32;
+        let a = self.filter_at(self.level_place(id, k), uv, srgb);
+        if f == 0.0 {
+            return a;
+        }
+        a.lerp(self.filter_at(self.level_place(id, k + 1), uv, srgb), f)
+    }
+
+    /// The texel of texture `id` at integer coordinates, wrapped: `tex_fetch` in
+    /// `pathtrace/textures.wgsl`, line for line.
+    pub fn fetch(&self, id: u32, x: i64, y: i64, srgb: bool) -> Vec4 {
+        self.fetch_at(self.descriptors[id as usize].place, x, y, srgb)
     }
 
     /// The filtered value of texture `id` for a point whose coordinates are `uvs` (set 0 in
@@ -360,23 +542,7 @@ impl TextureAtlas {
     /// The filtered value of texture `id` at `uv` in its own coordinates (after its
     /// transform): `tex_filter` in `pathtrace/textures.wgsl`.
     pub fn filter(&self, id: u32, uv: Vec2, srgb: bool) -> Vec4 {
-        let d = self.descriptors[id as usize].place;
-        let p = uv * Vec2::new((d[2] & 0xFFFF) as f32, (d[2] >> 16) as f32);
-        if d[3] & TEX_NEAREST != 0 {
-            let f = p.floor();
-            return self.fetch(id, f.x as i64, f.y as i64, srgb);
-        }
-        let p = p - 0.5;
-        let f = p.floor();
-        let t = p - f;
-        let (x, y) = (f.x as i64, f.y as i64);
-        let a = self
-            .fetch(id, x, y, srgb)
-            .lerp(self.fetch(id, x + 1, y, srgb), t.x);
-        let b = self
-            .fetch(id, x, y + 1, srgb)
-            .lerp(self.fetch(id, x + 1, y + 1, srgb), t.x);
-        a.lerp(b, t.y)
+        self.filter_at(self.descriptors[id as usize].place, uv, srgb)
     }
 }
 
@@ -482,10 +648,30 @@ pub fn fit_textures(
     all: &[Texture],
     limits: AtlasLimits,
 ) -> Option<(Vec<Texture>, Vec<Downscaled>)> {
+    fit_textures_with(all, limits, None)
+}
+
+/// [`fit_textures`] for an atlas with mip chains where `srgb` is given
+/// ([`pack_atlas_with`]): the levels count in what must fit.
+pub fn fit_textures_with(
+    all: &[Texture],
+    limits: AtlasLimits,
+    srgb: Option<&[bool]>,
+) -> Option<(Vec<Texture>, Vec<Downscaled>)> {
     let (image_of, textures) = images(all);
+    let chain_of = srgb.map_or_else(
+        || vec![None; textures.len()],
+        |s| chains(all, &image_of, textures.len(), s),
+    );
     let mut sizes: Vec<(u32, u32)> = textures.iter().map(|t| (t.width, t.height)).collect();
     loop {
-        let layout = atlas_layout(&sizes);
+        let mut every = sizes.clone();
+        for (&(w, h), c) in sizes.iter().zip(&chain_of) {
+            if c.is_some() {
+                every.extend(chain_sizes(w, h));
+            }
+        }
+        let layout = atlas_layout(&every);
         if limits.hold(layout.page, layout.pages) {
             break;
         }
@@ -552,17 +738,101 @@ pub const ATLAS_MIN_PAGE: u32 = 256;
 
 /// Places the images of `textures` in pages of one size (shelf packing, tallest first:
 /// images whose sides are powers of two fill pages without gaps) and copies their texels
-/// there; textures sharing an image ([`Texture::texels`], the same [`Arc`]) share its place.
+/// there; textures sharing an image ([`Texture::texels`], the same [`Arc`], share it).
+/// No mip levels: [`pack_atlas_with`] without them.
 pub fn pack_atlas(all: &[Texture]) -> TextureAtlas {
+    pack_atlas_with(all, None)
+}
+
+/// The sizes of an image's mip levels after level 0 ([`Texture::mip_chain`]'s).
+fn chain_sizes(w: u32, h: u32) -> Vec<(u32, u32)> {
+    let (mut w, mut h) = (w, h);
+    let mut out = Vec::new();
+    while (w, h) != (1, 1) {
+        (w, h) = (w.div_ceil(2), h.div_ceil(2));
+        out.push((w, h));
+    }
+    out
+}
+
+/// Which images get a mip chain, and whether it is averaged in linear light: per image of
+/// `images`, `None` where every texture showing it is looked up nearest (glTF `NEAREST`,
+/// no levels), else `Some(srgb)`, sRGB where some texture showing it is read as colour.
+fn chains(all: &[Texture], image_of: &[usize], images: usize, srgb: &[bool]) -> Vec<Option<bool>> {
+    let mut out = vec![None; images];
+    for (i, t) in all.iter().enumerate() {
+        if t.nearest {
+            continue;
+        }
+        let c = srgb.get(i).copied().unwrap_or(false);
+        let e = &mut out[image_of[i]];
+        *e = Some(e.unwrap_or(false) || c);
+    }
+    out
+}
+
+/// The mip chain of each image where `chain_of` asks for one, built on as many threads as
+/// the machine has (each takes the next image, largest first).
+fn mip_chains(images: &[&Texture], chain_of: &[Option<bool>]) -> Vec<Vec<Texture>> {
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let mut order: Vec<usize> = (0..images.len())
+        .filter(|&i| chain_of[i].is_some())
+        .collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(images[i].texels.len()));
+    let out: Vec<Mutex<Vec<Texture>>> = images.iter().map(|_| Mutex::new(Vec::new())).collect();
+    let next = AtomicUsize::new(0);
+    let threads = std::thread::available_parallelism()
+        .map_or(1, std::num::NonZeroUsize::get)
+        .min(order.len());
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| {
+                while let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    let chain = images[i].mip_chain(chain_of[i].unwrap_or(false));
+                    if let Ok(mut slot) = out[i].lock() {
+                        *slot = chain;
+                    }
+                }
+            });
+        }
+    });
+    out.into_iter()
+        .map(|m| m.into_inner().unwrap_or_default())
+        .collect()
+}
+
+/// [`pack_atlas`], with a mip chain ([`Texture::mip_chain`]) for every image some texture
+/// filters (not nearest) when `srgb` is given: per texture, whether a material reads it as
+/// colour (its chain is then averaged in linear light). Each level is an image of its own
+/// in the pages; its descriptor (after all the textures', one per texture and level: the
+/// texture's flags, the level's place) is found from the texture's (`GpuTexDesc::mips`).
+pub fn pack_atlas_with(all: &[Texture], srgb: Option<&[bool]>) -> TextureAtlas {
     if all.is_empty() {
         return TextureAtlas::default();
     }
     let (image_of, textures) = images(all);
-    let sizes: Vec<(u32, u32)> = textures.iter().map(|t| (t.width, t.height)).collect();
+    let chain_of = srgb.map_or_else(
+        || vec![None; textures.len()],
+        |s| chains(all, &image_of, textures.len(), s),
+    );
+    // The images, then each one's levels (image i's from `first_level[i]`).
+    let levels = mip_chains(&textures, &chain_of);
+    let mut sizes: Vec<(u32, u32)> = textures.iter().map(|t| (t.width, t.height)).collect();
+    let mut first_level = Vec::with_capacity(levels.len());
+    for l in &levels {
+        first_level.push(sizes.len());
+        sizes.extend(l.iter().map(|t| (t.width, t.height)));
+    }
     let AtlasLayout { page, pages, place } = atlas_layout(&sizes);
     let page_texels = page as usize * page as usize;
     let mut texels = vec![0u32; page_texels * pages as usize];
-    for (t, &(x, y, p)) in textures.iter().zip(&place) {
+    let every = textures.iter().copied().chain(levels.iter().flatten());
+    let mut mip_bytes = 0u64;
+    for (n, (t, &(x, y, p))) in every.zip(&place).enumerate() {
+        if n >= textures.len() {
+            mip_bytes += 4 * u64::from(t.width) * u64::from(t.height);
+        }
         for row in 0..t.height as usize {
             let src = &t.texels[row * t.width as usize..(row + 1) * t.width as usize];
             let at = p as usize * page_texels + (y as usize + row) * page as usize + x as usize;
@@ -571,25 +841,45 @@ pub fn pack_atlas(all: &[Texture]) -> TextureAtlas {
             }
         }
     }
-    let descriptors = all
+    let place_of = |image: usize, w: u32, h: u32, flags: u32| {
+        let (x, y, p) = place[image];
+        [x | (y << 16), p, w | (h << 16), flags]
+    };
+    let mut descriptors: Vec<GpuTexDesc> = all
         .iter()
         .zip(&image_of)
-        .map(|(t, &i)| {
-            let (x, y, p) = place[i];
-            GpuTexDesc {
-                place: [x | (y << 16), p, t.width | (t.height << 16), t.flags()],
-                m: t.transform.m,
-                offset: t.transform.offset,
-                uv_set: t.uv_set.min(1),
-                pad: 0,
-            }
+        .map(|(t, &i)| GpuTexDesc {
+            place: place_of(i, t.width, t.height, t.flags()),
+            m: t.transform.m,
+            offset: t.transform.offset,
+            uv_set: t.uv_set.min(1),
+            mips: 0,
         })
         .collect();
+    for (k, (t, &i)) in all.iter().zip(&image_of).enumerate() {
+        if t.nearest || levels[i].is_empty() {
+            continue;
+        }
+        let n = u32::try_from(levels[i].len())
+            .unwrap_or(u32::MAX)
+            .min(MAX_MIP_LEVELS - 1);
+        let first = u32::try_from(descriptors.len()).unwrap_or(u32::MAX);
+        for (j, l) in levels[i].iter().take(n as usize).enumerate() {
+            descriptors.push(GpuTexDesc {
+                place: place_of(first_level[i] + j, l.width, l.height, t.flags()),
+                ..GpuTexDesc::default()
+            });
+        }
+        descriptors[k].place[3] |= n << TEX_MIPS_SHIFT;
+        descriptors[k].mips = first;
+    }
     TextureAtlas {
         page_size: page,
         pages,
         descriptors,
         texels,
+        mip_bytes,
+        textures: all.len(),
     }
 }
 

@@ -66,6 +66,7 @@ fn sphere_grid_scene() -> Scene {
             max_bounces: 20,
             spp: 1,
             seed: 0,
+            texture_mips: true,
         },
         report: mesh.report,
         stats: lumagraph_scene::LoadStats::default(),

@@ -171,7 +171,7 @@ fn wgsl_layouts_match_rust() {
             "TriTexcoords",
             [t0, t1, t2, uv01, uv2, uv1_2, uv1_01, colors, pad0]
         ),
-        layout!(GpuTexDesc, "TexDesc", [place, m, offset, uv_set, pad]),
+        layout!(GpuTexDesc, "TexDesc", [place, m, offset, uv_set, mips]),
         layout!(
             GpuLight,
             "Light",

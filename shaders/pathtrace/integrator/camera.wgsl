@@ -25,3 +25,9 @@ fn camera_ray(pixel: vec2u, u: vec2f) -> Ray {
     }
     return ray;
 }
+
+// The spread angle of a pixel's ray cone (Akenine-Moller et al. 2021, eq. 30): the angle a
+// pixel subtends at the image's center, atan(2 tan(fov / 2) / height).
+fn pixel_spread() -> f32 {
+    return atan(2.0 * frame.camera.tan_half_fov / f32(frame.settings.height));
+}

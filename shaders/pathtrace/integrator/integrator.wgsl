@@ -28,6 +28,15 @@ struct PathState {
     bounce: u32,
     // The index-matched boundaries crossed so far.
     crossings: u32,
+    // The ray's cone (HAS_TEXTURES; Akenine-Moller et al. 2021): its width at the ray's
+    // origin (x) and its spread angle (y), which give texture lookups their footprint. A
+    // camera ray's starts at width 0 with the pixel's spread (`pixel_spread`); at each
+    // surface the width grows by spread x distance, and a BSDF sample adds to the spread the
+    // angular radius of the solid angle 1 / pdf around its direction (`lobe_spread`): a
+    // rough lobe scatters a ray's neighbours over about that; mirror, interface and glass
+    // samples (pdf 0) add nothing. Curvature is not counted (surfaces are taken as locally
+    // flat), nor is a scattering in a medium (the width stays that of the last surface).
+    cone: vec2f,
 }
 
 // With WAVES: the shadow ray of the step's next-event estimate, which the host or the
@@ -62,6 +71,7 @@ fn start_path(pixel: vec2u) {
     path.prev_p = path.ray.origin;
     path.bounce = 0u;
     path.crossings = 0u;
+    path.cone = vec2f(0.0, pixel_spread());
     // The triangle the current ray leaves (never hit again); camera rays leave none.
     leave_no_surface();
     // The medium the ray travels in: paths start in none.
@@ -123,7 +133,7 @@ fn bounce_path(p: ptr<function, PathState>, hit: Hit, may_miss: bool) -> u32 {
         add_escaped(p);
         return PATH_ENDS;
     }
-    let s = surface_at((*p).ray, hit);
+    let s = surface_at((*p).ray, hit, (*p).cone);
     // Rays leaving a surface start at the hit position itself and skip the primitive
     // left: a triangle ignores what is within the position's error (see `leave`), a
     // closed shape (a sphere) is met again only by a ray going into it, at its far side.
@@ -132,7 +142,9 @@ fn bounce_path(p: ptr<function, PathState>, hit: Hit, may_miss: bool) -> u32 {
     skip_inst = hit.inst;
     var mat = scene_material(s.material);
     if HAS_TEXTURES {
-        mat = textured_material(mat, s.uv, s.color);
+        mat = textured_material(mat, s.uv, s.lod, s.color);
+        // The cone's width at the surface, where the next ray leaves (see PathState).
+        (*p).cone.x += (*p).cone.y * hit.t;
     }
     if HAS_MEDIA && (mat.flags & MATERIAL_INDEX_MATCHED) != 0u {
         return cross_boundary(p, s, mat, on_shape);
@@ -322,11 +334,24 @@ fn scatter(
         medium_id = medium_after(s.material, mat, s.ng, wi, medium_id);
     }
     let side = select(-ng, ng, dot(ng, wi) > 0.0);
+    if HAS_TEXTURES {
+        (*p).cone.y += lobe_spread(bs.pdf);
+    }
     (*p).throughput *= bs.weight;
     (*p).bsdf_pdf = bs.pdf;
     (*p).prev_p = s.p;
     (*p).ray = Ray(leave(s, on_shape, side, wi), wi);
     return select(PATH_ENDS, BOUNCE_DONE, survives_roulette(p));
+}
+
+// What a BSDF sample of solid-angle pdf `pdf` adds to its ray cone's spread angle: the
+// half-angle of a cone of solid angle 1 / pdf (about sqrt(1 / (pi pdf)) radians), at most 1
+// radian (a diffuse sample's); 0 for a delta sample (pdf 0).
+fn lobe_spread(pdf: f32) -> f32 {
+    if !(pdf > 0.0) {
+        return 0.0;
+    }
+    return min(inverseSqrt(PI * pdf), 1.0);
 }
 
 // Russian roulette from bounce RR_START on: whether path `p` goes on, its throughput then

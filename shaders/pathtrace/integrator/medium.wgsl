@@ -75,7 +75,7 @@ fn shadow_transmittance(shadow: Ray, t_max: f32, medium: u32) -> vec3f {
         if hit.prim == NO_HIT {
             break;
         }
-        let s = surface_at(ray, hit);
+        let s = surface_at(ray, hit, vec2f(0.0));
         let m = scene_material(s.material);
         crossings += 1u;
         if (m.flags & MATERIAL_INDEX_MATCHED) == 0u || crossings > MAX_CROSSINGS {

@@ -319,11 +319,11 @@ fn first_hit_aovs(at: vec2u) {
         // never mixes emitters with the rest).
         var flag = 0.0;
         if hit.prim != NO_HIT {
-            let s = surface_at(ray, hit);
+            let s = surface_at(ray, hit, vec2f(0.0, pixel_spread()));
             var m = scene_material(s.material);
             flag = select(1.0, 2.0, any(m.emission > vec3f(0.0)));
             if HAS_TEXTURES {
-                m = textured_material(m, s.uv, s.color);
+                m = textured_material(m, s.uv, s.lod, s.color);
             }
             albedo = m.base_color;
             normal = s.ns;

@@ -27,6 +27,9 @@ struct Surface {
     uv: vec4f,
     // Vertex colour (HAS_TEXTURES; white on shapes).
     color: vec4f,
+    // The footprint of the ray's cone here, per UV set (HAS_TEXTURES; `tri_lod` in
+    // pathtrace/textures.wgsl; TEX_LOD_NONE on shapes).
+    lod: vec2f,
 }
 
 // Rounding error bounds of a point computed as v0 + u e1 + v e2 in f32: a float step of each
@@ -45,8 +48,11 @@ fn is_shape(prim: u32) -> bool {
     return HAS_SHAPES && (!HAS_TRIANGLES || (prim & PRIM_SHAPE) != 0u);
 }
 
-fn surface_at(ray: Ray, hit: Hit) -> Surface {
+// The surface `ray` meets at `hit`; `cone` is the ray's cone (its width at the ray's origin
+// and its spread angle, see PathState), which gives the footprint of texture lookups.
+fn surface_at(ray: Ray, hit: Hit, cone: vec2f) -> Surface {
     var s: Surface;
+    s.lod = vec2f(TEX_LOD_NONE);
     s.p = ray.origin + hit.t * ray.dir;
     s.err = vec3f(0.0);
     s.uv = vec4f(0.0);
@@ -89,15 +95,16 @@ fn surface_at(ray: Ray, hit: Hit) -> Surface {
             let tc = tri_texcoords[hit.prim];
             s.uv = tri_uv(tc, hit.u, hit.v);
             s.color = tri_color(tc, hit.u, hit.v);
+            s.lod = tri_lod(tc, w.e1, w.e2, cone.x + cone.y * hit.t, dot(s.ng, ray.dir));
             let m = scene_material(sh.material);
             var tangent = tri_tangent(tc, hit.u, hit.v);
             if placed {
                 tangent = vec4f(instance_apply(hit.inst, 0u, tangent.xyz, 0.0), turn * tangent.w);
             }
             let interpolated = s.ns;
-            s.ns = normal_mapped(m, interpolated, s.ng, s.uv, tangent);
+            s.ns = normal_mapped(m, interpolated, s.ng, s.uv, s.lod, tangent);
             if HAS_COAT && m.clearcoat > 0.0 {
-                s.coat_n = normal_mapped_by(tex_hi(m.tex_specular_color), m.clearcoat_normal_scale, interpolated, s.ng, s.uv, tangent);
+                s.coat_n = normal_mapped_by(tex_hi(m.tex_specular_color), m.clearcoat_normal_scale, interpolated, s.ng, s.uv, s.lod, tangent);
             } else {
                 s.coat_n = s.ns;
             }

@@ -85,7 +85,8 @@ struct WaveHit {
 // (no origin: host intersection hits only triangles, whose points come from the
 // barycentrics); [1] the shadow ray's contribution and the Sobol index, only while a shadow
 // ray is out or the first hit is next; [2] the pixel's sum and the Sobol seed, [3] the
-// sample index and the dropped samples, only when a path ends or starts. (llvmpipe loads
+// sample index and the dropped samples, only when a path ends or starts, then the ray
+// cone's width and spread (HAS_TEXTURES: `PathState::cone`), every step. (llvmpipe loads
 // and stores a buffer word lane by lane, and a step touches every slot's state: the fewer
 // words and cache lines a step moves, the faster it runs.)
 fn save_slot(b: u32, c: u32, flags: u32, moved: bool, i: u32, sum: vec3f, dropped: u32) {
@@ -102,6 +103,10 @@ fn save_slot(b: u32, c: u32, flags: u32, moved: bool, i: u32, sum: vec3f, droppe
         wave[c + 2u] = vec4u(bitcast<vec3u>(sum), sampler_seed);
         wave[c + 3u].x = i;
         wave[c + 3u].y = dropped;
+    }
+    if HAS_TEXTURES {
+        wave[c + 3u].z = bitcast<u32>(path.cone.x);
+        wave[c + 3u].w = bitcast<u32>(path.cone.y);
     }
 }
 
@@ -171,6 +176,9 @@ fn wave_load(slot: u32, j: u32, kind: u32) -> WaveSlot {
         let s3 = wave[s.c];
         path.prev_p = bitcast<vec3f>(s3.xyz);
         path.crossings = s3.w;
+    }
+    if HAS_TEXTURES {
+        path.cone = bitcast<vec2f>(wave[s.c + 3u].zw);
     }
     sampler_sobol = frame.sampler == SAMPLER_SOBOL;
     // The `WaveHit` of this slot's ray; the sign bit of its `t` answers the shadow ray.

@@ -375,6 +375,14 @@ fn render_settings(ui: &mut Ui, r: &mut RenderSettings) {
             row(ui, "seed", "random seed", |ui, _| {
                 ui.add(egui::DragValue::new(&mut r.seed));
             });
+            row(
+                ui,
+                "texture mips",
+                "mip levels for the textures, each lookup's level from a ray cone (off: every texture at full resolution)",
+                |ui, _| {
+                    ui.checkbox(&mut r.texture_mips, "");
+                },
+            );
         });
 }
 
