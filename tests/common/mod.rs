@@ -501,6 +501,13 @@ pub fn image_ray(g: &lumagraph::scene::GpuScene, p: glam::Vec2) -> lumagraph::sc
     }
 }
 
+/// What [`render_with`] and its kin return: the colour, albedo, normal and depth, and how
+/// the shader was specialized.
+pub type Rendered = (
+    Vec<lumagraph::render::cpu::Image>,
+    lumagraph::render::specialize::Features,
+);
+
 /// `scene` rendered at `size` and `spp` with `resources` (the scene set here): color,
 /// albedo, normal and depth, and how the shader was specialized.
 pub fn render_with(
@@ -508,10 +515,7 @@ pub fn render_with(
     size: (u32, u32),
     spp: u32,
     resources: lumagraph::render::Resources,
-) -> Option<(
-    Vec<lumagraph::render::cpu::Image>,
-    lumagraph::render::specialize::Features,
-)> {
+) -> Option<Rendered> {
     use lumagraph::scene::{GpuScene, Scene};
     gpu()?;
     let scene = GpuScene::build(&Scene::load(&repo(&format!("assets/{name}"))).unwrap()).unwrap();
@@ -525,10 +529,7 @@ pub fn render_scene(
     size: (u32, u32),
     spp: u32,
     resources: lumagraph::render::Resources,
-) -> Option<(
-    Vec<lumagraph::render::cpu::Image>,
-    lumagraph::render::specialize::Features,
-)> {
+) -> Option<Rendered> {
     (scene.settings.width, scene.settings.height) = size;
     let out = render_scene_with(&std::sync::Arc::new(scene), spp, resources);
     if let Some((_, features)) = &out {
@@ -542,10 +543,7 @@ pub fn render_scene_with(
     scene: &std::sync::Arc<lumagraph::scene::GpuScene>,
     spp: u32,
     resources: lumagraph::render::Resources,
-) -> Option<(
-    Vec<lumagraph::render::cpu::Image>,
-    lumagraph::render::specialize::Features,
-)> {
+) -> Option<Rendered> {
     use lumagraph::graph::ParamValue;
     use lumagraph::render::{Executor, compile};
     let ctx = gpu()?;

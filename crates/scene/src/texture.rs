@@ -157,24 +157,12 @@ impl Texture {
     #[must_use]
     pub fn halved(&self) -> Self {
         let (w, h) = (self.width.div_ceil(2), self.height.div_ceil(2));
-        let at = |x: u32, y: u32| {
-            self.texels[(y.min(self.height - 1) * self.width + x.min(self.width - 1)) as usize]
-        };
-        let mut texels = Vec::with_capacity(w as usize * h as usize);
-        for y in 0..h {
-            for x in 0..w {
-                let q = [
-                    at(2 * x, 2 * y),
-                    at(2 * x + 1, 2 * y),
-                    at(2 * x, 2 * y + 1),
-                    at(2 * x + 1, 2 * y + 1),
-                ];
-                texels.push(std::array::from_fn(|c| {
-                    let sum: u32 = q.iter().map(|p| u32::from(p[c])).sum();
-                    u8::try_from((sum + 2) / 4).unwrap_or(u8::MAX)
-                }));
-            }
-        }
+        let texels: Vec<[u8; 4]> = halve(&self.texels, self.width, self.height, |q| {
+            std::array::from_fn(|c| {
+                let sum: u32 = q.iter().map(|p| u32::from(p[c])).sum();
+                u8::try_from((sum + 2) / 4).unwrap_or(u8::MAX)
+            })
+        });
         Self {
             width: w,
             height: h,
@@ -216,23 +204,10 @@ impl Texture {
             .collect();
         let mut out = Vec::new();
         while (w, h) != (1, 1) {
-            let (nw, nh) = (w.div_ceil(2), h.div_ceil(2));
-            let at = |x: u32, y: u32| level[(y.min(h - 1) * w + x.min(w - 1)) as usize];
-            let mut next = Vec::with_capacity(nw as usize * nh as usize);
-            for y in 0..nh {
-                for x in 0..nw {
-                    let q = [
-                        at(2 * x, 2 * y),
-                        at(2 * x + 1, 2 * y),
-                        at(2 * x, 2 * y + 1),
-                        at(2 * x + 1, 2 * y + 1),
-                    ];
-                    next.push(std::array::from_fn(|c| {
-                        0.25 * (q[0][c] + q[1][c] + q[2][c] + q[3][c])
-                    }));
-                }
-            }
-            (level, w, h) = (next, nw, nh);
+            let next = halve(&level, w, h, |q| {
+                std::array::from_fn(|c| 0.25 * (q[0][c] + q[1][c] + q[2][c] + q[3][c]))
+            });
+            (level, w, h) = (next, w.div_ceil(2), h.div_ceil(2));
             let texels: Vec<[u8; 4]> = level
                 .iter()
                 .map(|t| std::array::from_fn(|c| encode(c, t[c])))
@@ -270,6 +245,26 @@ pub const TEX_NEAREST: u32 = 16;
 pub const TEX_MIPS_SHIFT: u32 = 8;
 /// The most levels a mip chain has, level 0 included: a 16 384-texel side down to 1.
 pub const MAX_MIP_LEVELS: u32 = 15;
+
+/// A `w`×`h` grid of texels halved: each texel of the result (`w`/2 × `h`/2, odd sides
+/// rounded up, the last row or column then taken with itself) made by `mean` from the 2×2
+/// texels it covers.
+fn halve<T: Copy, U>(texels: &[T], w: u32, h: u32, mean: impl Fn([T; 4]) -> U) -> Vec<U> {
+    let at = |x: u32, y: u32| texels[(y.min(h - 1) * w + x.min(w - 1)) as usize];
+    let (nw, nh) = (w.div_ceil(2), h.div_ceil(2));
+    let mut out = Vec::with_capacity(nw as usize * nh as usize);
+    for y in 0..nh {
+        for x in 0..nw {
+            out.push(mean([
+                at(2 * x, 2 * y),
+                at(2 * x + 1, 2 * y),
+                at(2 * x, 2 * y + 1),
+                at(2 * x + 1, 2 * y + 1),
+            ]));
+        }
+    }
+    out
+}
 
 /// The 256 sRGB bytes decoded to linear light.
 fn srgb_table() -> [f32; 256] {
