@@ -489,16 +489,7 @@ impl TextureAtlas {
         {
             return self.sample(id, uvs, srgb);
         }
-        let uv = if d.uv_set == 0 {
-            uvs.truncate().truncate()
-        } else {
-            Vec2::new(uvs.z, uvs.w)
-        };
-        let uv = UvTransform {
-            m: d.m,
-            offset: d.offset,
-        }
-        .apply(uv);
+        let uv = self.uv(id, uvs);
         let lambda = lambda.min(levels as f32);
         let k = lambda.floor();
         let f = lambda - k;
@@ -520,18 +511,23 @@ impl TextureAtlas {
     /// xy, set 1 in zw): `tex_sample` in `pathtrace/textures.wgsl`, and
     /// [`Texture::sample`] at [`Texture::uv`] of the texture placed there.
     pub fn sample(&self, id: u32, uvs: Vec4, srgb: bool) -> Vec4 {
+        self.filter(id, self.uv(id, uvs), srgb)
+    }
+
+    /// Texture `id`'s coordinates at a point whose coordinates are `uvs` (set 0 in xy, set 1
+    /// in zw): its UV set, through its transform (`tex_uv` in `pathtrace/textures.wgsl`).
+    fn uv(&self, id: u32, uvs: Vec4) -> Vec2 {
         let d = &self.descriptors[id as usize];
         let uv = if d.uv_set == 0 {
             uvs.truncate().truncate()
         } else {
             Vec2::new(uvs.z, uvs.w)
         };
-        let uv = UvTransform {
+        UvTransform {
             m: d.m,
             offset: d.offset,
         }
-        .apply(uv);
-        self.filter(id, uv, srgb)
+        .apply(uv)
     }
 
     /// The filtered value of texture `id` at `uv` in its own coordinates (after its
