@@ -6,8 +6,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 use lumagraph::graph::{Edge, Graph, Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
 use lumagraph::render::cpu::Image;
-use lumagraph::render::{Executor, GpuContext, Resources, compile, image_io, metrics};
+use lumagraph::render::{GpuContext, Resources, image_io, metrics};
 use lumagraph::scene::{GpuScene, Scene};
 
 fn cornell(seed: Option<u32>) -> anyhow::Result<Arc<GpuScene>> {
@@ -58,7 +59,7 @@ fn render(
         scene: Some(Arc::clone(scene)),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources)?;
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources)?;
     exec.run_frames(spp, true)?;
     Ok((exec.read_port("acc.color")?, exec.read_port("dn.color")?))
 }

@@ -6,8 +6,8 @@
 //! use lumagraph::render::NodeLibrary;
 //!
 //! fn main() -> std::process::ExitCode {
-//!     // NodeLibrary::with_builtins().with_kind(…) for kinds of its own.
-//!     lumagraph::cli::main_with(NodeLibrary::with_builtins())
+//!     // crate::pathtrace::library::with_builtins().with_kind(…) for kinds of its own.
+//!     lumagraph::cli::main_with(crate::pathtrace::library::with_builtins())
 //! }
 //! ```
 

@@ -6,7 +6,10 @@
 //! - [`color`]: OpenColorIO colour management (configs, processors, their WGSL);
 //! - [`footage`]: EXR files as compositors read them (parts, layers, windows, colour),
 //!   and frame sequences (no GPU);
-//! - [`render`]: the wgpu executor, node implementations and image files;
+//! - [`render`]: the frame graph on wgpu: the executor, the post-processing nodes and
+//!   image files;
+//! - [`pathtrace`]: the path tracer and the kinds that render the scene, and the library of
+//!   every built-in kind ([`pathtrace::library`]);
 //! - [`editor`]: the node editor.
 //!
 //! [`session::Session`] renders a graph and its scene from a program: progressively, read
@@ -27,6 +30,7 @@ pub use lumagraph_color as color;
 pub use lumagraph_editor as editor;
 pub use lumagraph_footage as footage;
 pub use lumagraph_graph as graph;
+pub use lumagraph_pathtrace as pathtrace;
 pub use lumagraph_render as render;
 pub use lumagraph_scene as scene;
 pub use lumagraph_session as session;

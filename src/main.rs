@@ -3,5 +3,5 @@
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    lumagraph::cli::main_with(lumagraph::render::NodeLibrary::with_builtins())
+    lumagraph::cli::main_with(lumagraph::pathtrace::library::with_builtins())
 }

@@ -32,12 +32,12 @@ fn apply_from(var: impl Fn(&str) -> Option<String>) -> Vec<String> {
     let mut warnings = Vec::new();
     if let Some(v) = var("LUMAGRAPH_EMBREE").map(|v| v.trim().to_owned()) {
         let library = match v.as_str() {
-            "" => lumagraph_render::embree::Library::System,
-            off if off.eq_ignore_ascii_case("off") => lumagraph_render::embree::Library::Off,
-            path => lumagraph_render::embree::Library::Path(path.to_owned()),
+            "" => lumagraph_pathtrace::embree::Library::System,
+            off if off.eq_ignore_ascii_case("off") => lumagraph_pathtrace::embree::Library::Off,
+            path => lumagraph_pathtrace::embree::Library::Path(path.to_owned()),
         };
         // Already configured: by the program embedding lumagraph, which wins.
-        let _ = lumagraph_render::embree::configure(library);
+        let _ = lumagraph_pathtrace::embree::configure(library);
     }
     if var("LUMAGRAPH_RAY_QUERY").is_some_and(|v| v == "off" || v == "0") {
         lumagraph_render::turn_off_ray_queries();

@@ -925,16 +925,14 @@ fn render_to_file_in_the_editor_equals_the_cli_render() {
     assert!(ok, "{out}\n{err}");
     let graph = lumagraph::graph::Graph::load(&common::repo("graphs/pathtrace.ron")).unwrap();
     let request = RenderRequest {
-        registry: lumagraph::render::NodeLibrary::builtins()
-            .registry()
-            .clone(),
+        registry: lumagraph::pathtrace::library::builtins().registry().clone(),
         base: graph.base_dir(),
         graph,
         scene: Some(common::gpu_scene("assets/cornell.ron", None)),
         spp: 8,
         target: Target::Outputs(editor_dir.clone()),
     };
-    let library = std::sync::Arc::new(lumagraph::render::NodeLibrary::builtins().clone());
+    let library = std::sync::Arc::new(lumagraph::pathtrace::library::builtins().clone());
     let job = RenderJob::start(gpu.clone(), library, request);
     assert!(
         job.wait(std::time::Duration::from_secs(300)),

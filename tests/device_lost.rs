@@ -5,7 +5,8 @@ mod common;
 
 use std::sync::Arc;
 
-use lumagraph::render::{Executor, GpuContext, RenderError, Resources, compile};
+use lumagraph::pathtrace::library::compile;
+use lumagraph::render::{Executor, GpuContext, RenderError, Resources};
 
 fn executor(ctx: &GpuContext, scene: &Arc<lumagraph::scene::GpuScene>) -> Executor {
     let graph = common::progressive_graph(&[]);
@@ -14,7 +15,7 @@ fn executor(ctx: &GpuContext, scene: &Arc<lumagraph::scene::GpuScene>) -> Execut
         scene: Some(Arc::clone(scene)),
         ..Resources::default()
     };
-    Executor::new(ctx, plan, &resources).unwrap()
+    lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap()
 }
 
 #[test]

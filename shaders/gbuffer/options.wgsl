@@ -1,5 +1,5 @@
 // Compile-time options of the G-buffer. The renderer replaces this file for the scene at hand
-// (crates/render/src/nodes/gbuffer.rs); this is the default the shader validation test
+// (crates/pathtrace/src/nodes/gbuffer.rs); this is the default the shader validation test
 // compiles.
 
 // Some material has a texture: textured albedo and normal maps compiled in.

@@ -1,5 +1,5 @@
 // Compile-time options of the path tracer. The renderer replaces this file with values for
-// the scene and graph at hand (crates/render/src/specialize/features.rs); these are the
+// the scene and graph at hand (crates/pathtrace/src/specialize/features.rs); these are the
 // defaults the shader validation test compiles.
 
 // Write first-hit albedo, normal and depth (through the pixel center) to the AOV outputs.

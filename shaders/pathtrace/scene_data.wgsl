@@ -3,7 +3,7 @@
 // buffers the includer declares. For small scenes the renderer replaces this file with
 // generated code that returns them from `switch` statements with the values written into the
 // shader, so no bounce loads them from memory (see
-// crates/render/src/specialize/codegen.rs).
+// crates/pathtrace/src/specialize/codegen.rs).
 // requires: var materials, var lights, var light_alias (integrator/pathtrace.wgsl)
 // requires: var tri_positions, var tri_shading, var shapes (integrator/pathtrace.wgsl)
 #import "pathtrace/scene_types.wgsl"

@@ -7,8 +7,9 @@ use std::time::Instant;
 
 use super::progressive::counter;
 use crate::graph::{Edge, Graph, Node, ParamValue};
-use crate::render::specialize::{Feature, Features, Intersector};
-use crate::render::{Executor, GpuContext, Resources, compile};
+use crate::pathtrace::library::compile;
+use crate::pathtrace::specialize::{Feature, Features, Intersector, Tracer as _};
+use crate::render::{GpuContext, Resources};
 use crate::scene::GpuScene;
 use anyhow::Result;
 
@@ -37,7 +38,7 @@ struct Figures {
     /// Host intersection's figures over all runs, where it was used.
     host: Option<HostFigures>,
     /// The shader's features (what the variants to compare with are chosen by).
-    features: Option<crate::render::specialize::Features>,
+    features: Option<crate::pathtrace::specialize::Features>,
     /// Rays traced per path (camera, bounce and shadow rays; the node's `rays` counter over
     /// the timed runs), where counted.
     rays_per_path: Option<f64>,
@@ -78,8 +79,8 @@ fn measure(
         scene: Some(Arc::clone(scene)),
         ..variant
     };
-    let mut exec = Executor::new(ctx, plan, &resources)?;
-    let features = exec.shader_features("pathtrace").cloned();
+    let mut exec = crate::pathtrace::library::executor(ctx, plan, &resources)?;
+    let features = crate::pathtrace::nodes::pathtrace::features(&exec, "pathtrace").cloned();
     let how = exec
         .notes()
         .into_iter()
@@ -142,7 +143,7 @@ impl Figures {
     }
 
     /// The intersector the shader traced with, where it has features.
-    fn intersector(&self) -> Option<&'static dyn crate::render::intersect::IntersectorKind> {
+    fn intersector(&self) -> Option<&'static dyn crate::pathtrace::intersect::IntersectorKind> {
         self.features.as_ref().map(Features::kind)
     }
 }
@@ -225,7 +226,7 @@ pub fn run(
     // the specialized shader is one), where the scene allows it: the specialized shader as
     // `--schedule wavefront` or `megakernel` runs it.
     if !special.host_steps() {
-        use crate::render::specialize::Schedule;
+        use crate::pathtrace::specialize::Schedule;
         let front = special.on(Feature::Wavefront);
         let other = asked.clone().tracing(|t| {
             t.schedule = if front {
@@ -303,7 +304,7 @@ pub fn run(
 
 /// A ray of `raycast` through the centre of pixel (x, y), as the path tracer's pinhole
 /// camera makes it.
-fn pixel_ray(scene: &GpuScene, x: u32, y: u32) -> crate::render::raycast::RayQuery {
+fn pixel_ray(scene: &GpuScene, x: u32, y: u32) -> crate::pathtrace::raycast::RayQuery {
     use glam::Vec3;
     let c = &scene.camera;
     #[expect(clippy::cast_precision_loss, reason = "pixel coordinates")]
@@ -314,7 +315,7 @@ fn pixel_ray(scene: &GpuScene, x: u32, y: u32) -> crate::render::raycast::RayQue
     let dir = Vec3::from(c.forward)
         + (2.0 * u - 1.0) * c.tan_half_fov * c.aspect * Vec3::from(c.right)
         - (2.0 * v - 1.0) * c.tan_half_fov * Vec3::from(c.up);
-    crate::render::raycast::RayQuery {
+    crate::pathtrace::raycast::RayQuery {
         origin: c.position,
         t_max: f32::MAX,
         dir: dir.normalize().to_array(),
@@ -327,10 +328,10 @@ fn pixel_ray(scene: &GpuScene, x: u32, y: u32) -> crate::render::raycast::RayQue
 /// coordinates' magnitude; `None` on a miss.
 fn diffuse_ray(
     scene: &GpuScene,
-    ray: &crate::render::raycast::RayQuery,
+    ray: &crate::pathtrace::raycast::RayQuery,
     hit: &crate::scene::Hit,
     i: u32,
-) -> Option<crate::render::raycast::RayQuery> {
+) -> Option<crate::pathtrace::raycast::RayQuery> {
     use glam::Vec3;
     if hit.prim == crate::scene::NO_HIT {
         return None;
@@ -363,7 +364,7 @@ fn diffuse_ray(
     let (b1, b2) = n.any_orthonormal_pair();
     let dir = b1 * (r * phi.cos()) + b2 * (r * phi.sin()) + n * (1.0 - r * r).max(0.0).sqrt();
     let origin = p + n * (1e-4 * p.abs().max_element().max(1.0));
-    Some(crate::render::raycast::RayQuery {
+    Some(crate::pathtrace::raycast::RayQuery {
         origin: origin.to_array(),
         t_max: f32::MAX,
         dir: dir.to_array(),
@@ -376,11 +377,11 @@ fn diffuse_ray(
 /// primary hit. Each set is cast in one submission of several dispatches (enough for about
 /// a quarter of a second), best of `runs`; prints M rays/s and the rays that hit.
 pub fn traversal(scene: &Arc<GpuScene>, runs: u32) -> Result<()> {
-    use crate::render::intersect::wide_bvh::{WideBvh, upload};
-    use crate::render::raycast::Raycaster;
+    use crate::pathtrace::intersect::wide_bvh::{WideBvh, upload};
+    use crate::pathtrace::raycast::Raycaster;
     let ctx = GpuContext::headless()?;
     println!("adapter: {}", ctx.describe());
-    let buffers = crate::render::SceneBuffers::upload(&ctx, scene)?;
+    let buffers = crate::pathtrace::SceneBuffers::upload(&ctx, scene)?;
     let start = Instant::now();
     let wide = WideBvh::build(scene).map_err(anyhow::Error::msg)?;
     println!(

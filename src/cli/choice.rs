@@ -5,8 +5,8 @@
 //! library itself reads neither. A `PathTrace` node's `intersector` or `schedule` param,
 //! when not `auto`, wins over both.
 
+use crate::pathtrace::specialize::{Intersector, Schedule, Tracer as _, Tracing};
 use crate::render::Resources;
-use crate::render::specialize::{Intersector, Schedule, Tracing};
 
 /// The path tracer's choices on the command line.
 #[derive(clap::Args, Clone, Copy, Debug, Default)]
@@ -37,14 +37,10 @@ impl Choice {
 
     /// `resources` with the intersector and schedule asked for.
     pub(crate) fn apply(self, resources: Resources) -> Resources {
-        Resources {
-            tracer: Tracing {
-                intersector: self.intersector(),
-                schedule: self.schedule(),
-                ..resources.tracer
-            },
-            ..resources
-        }
+        resources.tracing(|t: &mut Tracing| {
+            t.intersector = self.intersector();
+            t.schedule = self.schedule();
+        })
     }
 }
 
@@ -112,7 +108,7 @@ pub(crate) fn print_features(
         }
         Err(e) => {
             println!("adapter: none found ({e}); shader choices shown for a CPU one");
-            crate::render::specialize::AdapterTraits {
+            crate::render::AdapterTraits {
                 cpu: true,
                 ray_query_limit: None,
             }
@@ -121,30 +117,12 @@ pub(crate) fn print_features(
     let resources = choice.apply(Resources::default());
     let mut refusals = Vec::new();
     for (pass, features) in specialized {
-        let (features, refusal) = features(pass, scene, &resources, traits);
+        let choices = features(pass, scene, &resources, traits);
         println!("shader features of {} for this scene:", pass.node);
-        println!(
-            "  intersector: {} ({})",
-            features.intersector().name(),
-            features.intersector_reason()
-        );
-        for (other, why) in features.intersectors() {
-            if other != features.intersector() {
-                println!("    not {}: {why}", other.name());
-            }
+        for line in &choices.lines {
+            println!("{line}");
         }
-        println!(
-            "  schedule: {} ({})",
-            features.schedule().name(),
-            features.reason(crate::render::specialize::Feature::Wavefront)
-        );
-        for included in [true, false] {
-            println!("  {}:", if included { "compiled in" } else { "left out" });
-            for (f, d) in features.iter().filter(|(_, d)| d.included == included) {
-                println!("    {:<28} {}", f.label(), d.reason);
-            }
-        }
-        if let Some(why) = refusal {
+        if let Some(why) = choices.refusal {
             refusals.push(format!("{}: {why}", pass.node));
         }
     }

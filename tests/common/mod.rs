@@ -6,7 +6,7 @@
 
 #![allow(dead_code, reason = "each test binary uses a different subset")]
 
-use lumagraph::render::specialize::Tracing;
+use lumagraph::pathtrace::specialize::Tracing;
 use std::path::{Path, PathBuf};
 
 #[path = "bench_mesh.rs"]
@@ -102,26 +102,27 @@ pub fn executor(
     keep: &[&str],
     scene: &std::sync::Arc<lumagraph::scene::GpuScene>,
 ) -> Option<lumagraph::render::Executor> {
-    use lumagraph::render::{Executor, Resources, compile};
+    use lumagraph::pathtrace::library::compile;
+    use lumagraph::render::Resources;
     let ctx = gpu()?;
     let keep: Vec<String> = keep.iter().map(|&k| k.to_owned()).collect();
     let plan = compile(graph, &keep, Some(scene)).unwrap();
     // `LUMAGRAPH_RAY_QUERY=on` runs these renders through ray queries, as
     // `lumagraph render --intersector rays` does (docs/pathtracer.md: the reference suite).
     let intersector = if std::env::var("LUMAGRAPH_RAY_QUERY").is_ok_and(|v| v == "on") {
-        lumagraph::render::specialize::Intersector::RAY_QUERIES
+        lumagraph::pathtrace::specialize::Intersector::RAY_QUERIES
     } else {
-        lumagraph::render::specialize::Intersector::AUTO
+        lumagraph::pathtrace::specialize::Intersector::AUTO
     };
     let resources = Resources {
         scene: Some(std::sync::Arc::clone(scene)),
-        tracer: Tracing {
-            intersector,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
-    Some(Executor::new(ctx, plan, &resources).unwrap())
+    }
+    .with(Tracing {
+        intersector,
+        ..Tracing::default()
+    });
+    Some(lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap())
 }
 
 /// A progressive render of `scene` ([`progressive_graph`]) keeping `acc.color`.
@@ -261,7 +262,8 @@ pub fn run_graph(
     keep: &[&str],
     out_dir: &Path,
 ) -> Option<Vec<lumagraph::render::cpu::Image>> {
-    use lumagraph::render::{Executor, Resources, compile};
+    use lumagraph::pathtrace::library::compile;
+    use lumagraph::render::Resources;
     let ctx = gpu()?;
     let keep: Vec<String> = keep.iter().map(|s| (*s).to_owned()).collect();
     let plan = compile(graph, &keep, None).unwrap_or_else(|e| panic!("{e}"));
@@ -270,7 +272,7 @@ pub fn run_graph(
         out_dir: out_dir.to_owned(),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &paths).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &paths).unwrap();
     exec.run_frame().unwrap();
     Some(keep.iter().map(|k| exec.read_port(k).unwrap()).collect())
 }
@@ -448,7 +450,8 @@ pub fn accumulate(
     frames: u32,
     resources: lumagraph::render::Resources,
 ) -> lumagraph::render::cpu::Image {
-    use lumagraph::render::{Executor, Resources, compile};
+    use lumagraph::pathtrace::library::compile;
+    use lumagraph::render::Resources;
     let plan = compile(
         &progressive_graph(&[(
             "samples_per_frame",
@@ -462,7 +465,7 @@ pub fn accumulate(
         scene: Some(std::sync::Arc::clone(scene)),
         ..resources
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frames(frames, true).unwrap();
     exec.read_port("acc.color").unwrap()
 }
@@ -505,7 +508,7 @@ pub fn image_ray(g: &lumagraph::scene::GpuScene, p: glam::Vec2) -> lumagraph::sc
 /// the shader was specialized.
 pub type Rendered = (
     Vec<lumagraph::render::cpu::Image>,
-    lumagraph::render::specialize::Features,
+    lumagraph::pathtrace::specialize::Features,
 );
 
 /// `scene` rendered at `size` and `spp` with `resources` (the scene set here): color,
@@ -545,7 +548,8 @@ pub fn render_scene_with(
     resources: lumagraph::render::Resources,
 ) -> Option<Rendered> {
     use lumagraph::graph::ParamValue;
-    use lumagraph::render::{Executor, compile};
+    use lumagraph::pathtrace::library::compile;
+
     let ctx = gpu()?;
     let ports = ["acc.color", "pt.albedo", "pt.normal", "pt.depth"];
     let outputs: Vec<String> = ports.iter().map(|p| (*p).to_owned()).collect();
@@ -555,8 +559,10 @@ pub fn render_scene_with(
         scene: Some(std::sync::Arc::clone(scene)),
         ..resources
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
-    let features = exec.shader_features("pt").unwrap().clone();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
+    let features = lumagraph::pathtrace::nodes::pathtrace::features(&exec, "pt")
+        .unwrap()
+        .clone();
     exec.run_frames(spp.div_ceil(4), true).unwrap();
     let images = ports.iter().map(|p| exec.read_port(p).unwrap()).collect();
     Some((images, features))
@@ -597,7 +603,10 @@ pub fn same_hits(
     name: &str,
     a: lumagraph::render::Resources,
     b: lumagraph::render::Resources,
-    check: impl Fn(&lumagraph::render::specialize::Features, &lumagraph::render::specialize::Features),
+    check: impl Fn(
+        &lumagraph::pathtrace::specialize::Features,
+        &lumagraph::pathtrace::specialize::Features,
+    ),
 ) -> Option<(usize, f64)> {
     let (a, how_a) = render_with(name, (64, 64), 16, a)?;
     let (b, how_b) = render_with(name, (64, 64), 16, b)?;

@@ -11,8 +11,9 @@ use crate::common;
 use std::sync::Arc;
 
 use lumagraph::graph::{Graph, Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
 use lumagraph::render::cpu::Image;
-use lumagraph::render::{Executor, Resources, compile, image_io, metrics};
+use lumagraph::render::{Resources, image_io, metrics};
 use lumagraph::scene::{GpuScene, Scene};
 
 fn cornell(seed: Option<u32>) -> Arc<GpuScene> {
@@ -47,7 +48,7 @@ fn render(
         scene: Some(Arc::clone(scene)),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frames(spp, true).unwrap();
     Some((
         exec.read_port("acc.color").unwrap(),
@@ -107,7 +108,7 @@ fn gpu_filter_matches_cpu_mirror() {
             scene: Some(Arc::clone(&scene)),
             ..Resources::default()
         };
-        let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+        let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
         exec.run_frames(4, true).unwrap();
         let read = |p: &str| exec.read_port(p).unwrap();
         let cpu = denoise(

@@ -15,8 +15,9 @@ use crate::common;
 use std::sync::Arc;
 
 use lumagraph::graph::{Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
 use lumagraph::render::cpu::Image;
-use lumagraph::render::{Executor, Resources, compile, image_io};
+use lumagraph::render::{Resources, image_io};
 use lumagraph::scene::{GpuScene, Scene};
 
 const SIZE: u32 = 256;
@@ -67,7 +68,7 @@ fn denoise(
         scene: Some(scene),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frames(frames, true).unwrap();
     Some((
         exec.read_port("dn.color").unwrap(),

@@ -10,8 +10,9 @@ use crate::common;
 use std::sync::Arc;
 
 use lumagraph::graph::{Edge, Graph, Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
 use lumagraph::render::oidn::Oidn;
-use lumagraph::render::{Executor, Resources, compile, image_io, metrics};
+use lumagraph::render::{Resources, image_io, metrics};
 
 /// Whether OIDN loads here; panics saying how to get it unless `LUMAGRAPH_ALLOW_NO_OIDN=1`.
 pub(crate) fn oidn_here() -> bool {
@@ -81,7 +82,7 @@ fn oidn_at_16_spp_is_10x_better_than_raw_and_keeps_its_result() {
         scene: Some(Arc::clone(&scene)),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frames(16, true).unwrap();
     let reference = image_io::load(&common::repo("tests/reference/cornell_ref.exr")).unwrap();
     let raw = exec.read_port("acc.color").unwrap();

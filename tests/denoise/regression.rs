@@ -8,8 +8,9 @@ use crate::common;
 use std::sync::Arc;
 
 use lumagraph::graph::{Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
 use lumagraph::render::cpu::{Image, RegressionParams, regression};
-use lumagraph::render::{Executor, Resources, compile, image_io, metrics};
+use lumagraph::render::{Resources, image_io, metrics};
 use lumagraph::scene::GpuScene;
 
 const KIND: &str = "RegressionDenoise";
@@ -34,7 +35,7 @@ fn run(
         scene: Some(Arc::clone(scene)),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frames(frames, true).unwrap();
     Some(ports.iter().map(|p| exec.read_port(p).unwrap()).collect())
 }

@@ -29,8 +29,9 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use lumagraph::graph::Graph;
+use lumagraph::pathtrace::library::compile;
 use lumagraph::render::cpu::Image;
-use lumagraph::render::{Executor, NodeLibrary, Resources, compile, image_io, metrics};
+use lumagraph::render::{Resources, image_io, metrics};
 
 /// Relative slack on the recorded relMSE figures (see the module docs).
 const TOLERANCE: f64 = 0.02;
@@ -122,7 +123,11 @@ struct Outputs {
 fn render(scene: &str, spp: u32, with_oidn: bool) -> Option<Outputs> {
     let ctx = common::gpu()?;
     let mut graph = Graph::load(&common::repo("graphs/denoise_inputs.ron")).unwrap();
-    graph.remove_sinks(&NodeLibrary::builtins().registry_for(&graph).unwrap());
+    graph.remove_sinks(
+        &lumagraph::pathtrace::library::builtins()
+            .registry_for(&graph)
+            .unwrap(),
+    );
     assert!(graph.node(OIDN_NODE).is_some_and(|n| n.kind == "OIDN"));
     if !with_oidn {
         graph.nodes.retain(|n| n.id != OIDN_NODE);
@@ -151,7 +156,7 @@ fn render(scene: &str, spp: u32, with_oidn: bool) -> Option<Outputs> {
         scene: Some(Arc::clone(&scene)),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frames(spp, true).unwrap();
     let read = |p: &str| exec.read_port(p).unwrap();
     Some(Outputs {

@@ -24,7 +24,8 @@ use std::path::{Path, PathBuf};
 
 use lumagraph::footage::exr::{self, Layer, Selection, Want};
 use lumagraph::graph::{Edge, Graph, Node, ParamValue};
-use lumagraph::render::{Executor, Resources, compile};
+use lumagraph::pathtrace::library::compile;
+use lumagraph::render::Resources;
 use serde_json::{Value, json};
 
 use checks::{Kind, check_part, expect, selection_of};
@@ -41,7 +42,8 @@ fn run(graph: &Graph, out: &Path) -> Result<(), String> {
         out_dir: out.to_owned(),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).map_err(|e| e.to_string())?;
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources)
+        .map_err(|e| e.to_string())?;
     exec.run_frame().map(|_| ()).map_err(|e| e.to_string())
 }
 

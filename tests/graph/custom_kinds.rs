@@ -26,7 +26,8 @@ fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
 
 /// Loads, compiles and runs one frame of the graph at `path`, returning the `keep` ports.
 fn run(path: &Path, keep: &[&str]) -> Option<Vec<lumagraph::render::cpu::Image>> {
-    use lumagraph::render::{Executor, Resources, compile};
+    use lumagraph::pathtrace::library::compile;
+    use lumagraph::render::Resources;
     let ctx = common::gpu()?;
     let graph = Graph::load(path).unwrap();
     let keep: Vec<String> = keep.iter().map(|&k| k.to_owned()).collect();
@@ -36,7 +37,7 @@ fn run(path: &Path, keep: &[&str]) -> Option<Vec<lumagraph::render::cpu::Image>>
         out_dir: graph.base_dir(),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frame().unwrap();
     Some(keep.iter().map(|k| exec.read_port(k).unwrap()).collect())
 }

@@ -27,7 +27,7 @@ use std::sync::{Arc, LazyLock};
 use std::time::{Duration, Instant};
 
 use lumagraph::graph::Graph;
-use lumagraph::render::{NodeLibrary, image_io};
+use lumagraph::render::image_io;
 use lumagraph::scene::{GpuScene, Scene};
 use proptest::prelude::*;
 use proptest::sample::Index;
@@ -749,7 +749,7 @@ static SCENE: LazyLock<GpuScene> = LazyLock::new(|| {
 /// compile it (with and without a scene).
 fn validate_graph(path: &Path) -> Result<(), String> {
     let graph = Graph::load(path).map_err(|e| e.to_string())?;
-    let library = NodeLibrary::builtins();
+    let library = lumagraph::pathtrace::library::builtins();
     let registry = library.registry_for(&graph).map_err(|e| e.to_string())?;
     let has_sink = graph
         .nodes

@@ -9,7 +9,8 @@ use crate::common;
 use std::path::{Path, PathBuf};
 
 use lumagraph::graph::{Graph, Registry};
-use lumagraph::render::{Executor, Resources, compile};
+use lumagraph::pathtrace::library::compile;
+use lumagraph::render::Resources;
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let path = dir.join(name);
@@ -93,7 +94,7 @@ fn a_grouped_graph_renders_what_its_flattened_copy_renders() {
             out_dir: tempfile::tempdir().unwrap().keep(),
             ..Resources::default()
         };
-        let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+        let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
         exec.run_frame().unwrap();
         exec.read_port(port).unwrap()
     };
@@ -177,7 +178,7 @@ fn groups_nest_pass_params_through_and_read_files_beside_themselves() {
         out_dir: dir.path().to_owned(),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frame().unwrap();
     let a = exec.read_port("a.image").unwrap();
     let source = lumagraph::render::image_io::load(&chart).unwrap();

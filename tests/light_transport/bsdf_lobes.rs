@@ -1,5 +1,5 @@
 //! Statistical tests of every lobe of the path tracer's BSDF (`shaders/pathtrace/bsdf/bsdf.wgsl`),
-//! run on the GPU through `render::bsdf_check`, as Mitsuba's and pbrt's test suites do.
+//! run on the GPU through `pathtrace::bsdf_check`, as Mitsuba's and pbrt's test suites do.
 //!
 //! - **Chi-square**: the directions `sample_bsdf` draws follow the pdf `eval_bsdf` reports
 //!   (for glass, which the path tracer only samples, the density derived in [`glass_pdf`]
@@ -24,7 +24,7 @@
 use crate::common;
 
 use glam::{DVec3, Vec3};
-use lumagraph::render::bsdf_check::{BsdfCheck, BsdfSample};
+use lumagraph::pathtrace::bsdf_check::{BsdfCheck, BsdfSample};
 use lumagraph::scene::conductor;
 use lumagraph::scene::{GpuMaterial, Material};
 

@@ -29,7 +29,7 @@
 use std::f64::consts::PI;
 
 use glam::{DVec3, Vec3};
-use lumagraph::render::bsdf_check::BsdfCheck;
+use lumagraph::pathtrace::bsdf_check::BsdfCheck;
 use lumagraph::scene::{GpuMaterial, Material};
 
 use super::bsdf_lobes::{

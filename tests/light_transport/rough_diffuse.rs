@@ -27,7 +27,7 @@ use crate::common;
 use std::f64::consts::PI;
 
 use glam::{DVec3, Vec3};
-use lumagraph::render::bsdf_check::BsdfCheck;
+use lumagraph::pathtrace::bsdf_check::BsdfCheck;
 use lumagraph::scene::{GpuMaterial, GpuScene, Material, Scene};
 
 const C1: f64 = 0.5 - 2.0 / (3.0 * PI);

@@ -16,8 +16,8 @@ use crate::common;
 use std::sync::Arc;
 
 use lumagraph::graph::ParamValue;
+use lumagraph::pathtrace::sampler::{SamplerCheck, SamplerQuery};
 use lumagraph::render::cpu::Image;
-use lumagraph::render::sampler::{SamplerCheck, SamplerQuery};
 use lumagraph::render::{Executor, metrics};
 use lumagraph::scene::{GpuScene, Scene};
 

@@ -18,7 +18,7 @@
 //!   at cosine 0.2 would lose F90 · 0.8⁵ = 33 %.
 
 use glam::{DVec3, Vec3};
-use lumagraph::render::bsdf_check::BsdfCheck;
+use lumagraph::pathtrace::bsdf_check::BsdfCheck;
 use lumagraph::scene::{GpuMaterial, Material};
 
 use super::bsdf_lobes::{at_four_angles, chi_square_against_eval, material, weights_against_eval};

@@ -29,8 +29,9 @@ use crate::common;
 use std::sync::Arc;
 
 use lumagraph::graph::{Edge, Graph, Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
 use lumagraph::render::cpu::Image;
-use lumagraph::render::{Executor, Resources, compile, metrics};
+use lumagraph::render::{Resources, metrics};
 use lumagraph::scene::{GpuScene, Scene};
 
 /// Renders `scene` at `spp`; returns the accumulated image, the first-hit depth (0 where
@@ -51,7 +52,7 @@ fn render(scene: &Scene, spp: u32) -> Option<(Image, Image, u64)> {
         scene: Some(Arc::clone(&gpu)),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frames(spp.div_ceil(16), true).unwrap();
     let dropped = exec
         .counters()
@@ -452,7 +453,7 @@ fn render_with(scene: &Scene, spp: u32, params: &[(&str, ParamValue)]) -> Option
         scene: Some(Arc::clone(&gpu)),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frames(spp.div_ceil(16), true).unwrap();
     Some(exec.read_port("acc.color").unwrap())
 }

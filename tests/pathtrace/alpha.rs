@@ -4,15 +4,16 @@
 //! camera rays, bounces and shadow rays alike.
 
 use crate::common;
-use lumagraph::render::specialize::Tracing;
+use lumagraph::pathtrace::specialize::Tracing;
 
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 use lumagraph::graph::{Edge, Graph, Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
+use lumagraph::pathtrace::specialize::{Feature, Intersector};
+use lumagraph::render::Resources;
 use lumagraph::render::cpu::Image;
-use lumagraph::render::specialize::{Feature, Intersector};
-use lumagraph::render::{Executor, Resources, compile};
 use lumagraph::scene::traverse::{Ray, intersect};
 use lumagraph::scene::{AlphaMode, GpuScene, Scene, Texture, Wrap};
 
@@ -93,7 +94,12 @@ fn pixel_ray(g: &GpuScene, x: u32, y: u32) -> Ray {
 pub(super) fn albedos(
     scene: &Arc<GpuScene>,
     resources: Resources,
-) -> Option<(Image, Image, Image, lumagraph::render::specialize::Features)> {
+) -> Option<(
+    Image,
+    Image,
+    Image,
+    lumagraph::pathtrace::specialize::Features,
+)> {
     let ctx = common::gpu()?;
     let graph = Graph {
         nodes: vec![
@@ -110,8 +116,10 @@ pub(super) fn albedos(
         scene: Some(Arc::clone(scene)),
         ..resources
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
-    let features = exec.shader_features("pt").unwrap().clone();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
+    let features = lumagraph::pathtrace::nodes::pathtrace::features(&exec, "pt")
+        .unwrap()
+        .clone();
     exec.run_frame().unwrap();
     Some((
         exec.read_port("pt.albedo").unwrap(),
@@ -132,27 +140,27 @@ pub(super) fn albedos(
 #[test]
 fn masked_checkerboard_shows_the_wall_through_its_holes() {
     let inline_or_bvh = Resources {
-        tracer: Tracing {
-            as_gpu_adapter: true,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
+    }
+    .with(Tracing {
+        as_gpu_adapter: true,
+        ..Tracing::default()
+    });
     let wgsl = Resources {
-        tracer: Tracing {
-            intersector: Intersector::BINARY_BVH,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
+    }
+    .with(Tracing {
+        intersector: Intersector::BINARY_BVH,
+        ..Tracing::default()
+    });
     let wide = Resources {
-        tracer: Tracing {
-            as_gpu_adapter: true,
-            intersector: Intersector::WIDE_BVH,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
+    }
+    .with(Tracing {
+        as_gpu_adapter: true,
+        intersector: Intersector::WIDE_BVH,
+        ..Tracing::default()
+    });
     check_checkerboard(
         1,
         &[
@@ -180,12 +188,12 @@ fn masked_checkerboard_shows_the_wall_through_ray_queries() {
         return;
     }
     let ray_queries = Resources {
-        tracer: Tracing {
-            intersector: Intersector::RAY_QUERIES,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
+    }
+    .with(Tracing {
+        intersector: Intersector::RAY_QUERIES,
+        ..Tracing::default()
+    });
     check_checkerboard(1, &[("ray queries", ray_queries.clone())]);
     check_checkerboard(8, &[("ray queries", ray_queries)]);
 }
@@ -292,13 +300,13 @@ fn blended_quad_passes_one_minus_its_opacity() {
         .unwrap();
         let resources = Resources {
             scene: Some(Arc::clone(&gpu)),
-            tracer: Tracing {
-                as_gpu_adapter: bvh,
-                ..Tracing::default()
-            },
             ..Resources::default()
-        };
-        let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+        }
+        .with(Tracing {
+            as_gpu_adapter: bvh,
+            ..Tracing::default()
+        });
+        let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
         exec.run_frames(4, true).unwrap();
         let image = exec.read_port("acc.color").unwrap();
         let mut sum = 0.0;
@@ -363,7 +371,7 @@ fn a_fully_cut_out_quad_is_invisible_and_a_full_one_solid() {
 /// every ray agrees; asserted: at most 0.5 % differ.
 #[test]
 fn embree_applies_the_same_any_hit_test_as_the_mirror() {
-    use lumagraph::render::embree::{Embree, HostHit, HostRay, HostScene};
+    use lumagraph::pathtrace::embree::{Embree, HostHit, HostRay, HostScene};
     let embree = match Embree::load() {
         Ok(e) => e,
         Err(e) => {

@@ -8,8 +8,8 @@
 
 use crate::common;
 
-use lumagraph::render::SceneBuffers;
-use lumagraph::render::raycast::{RayQuery, Raycaster};
+use lumagraph::pathtrace::SceneBuffers;
+use lumagraph::pathtrace::raycast::{RayQuery, Raycaster};
 use lumagraph::scene::{GpuScene, NO_HIT, Ray, Scene, intersect_within};
 
 const SCENE: &str = r#"(
@@ -127,8 +127,8 @@ fn the_wide_bvh_finds_the_binary_bvhs_hits() {
     let scene = Scene::from_ron(SCENE, &common::repo("assets")).unwrap();
     let gpu_scene = GpuScene::build(&scene).unwrap();
     let buffers = SceneBuffers::upload(ctx, &gpu_scene).unwrap();
-    let wide = lumagraph::render::intersect::wide_bvh::WideBvh::build(&gpu_scene).unwrap();
-    let wide_nodes = lumagraph::render::intersect::wide_bvh::upload(ctx, &wide).unwrap();
+    let wide = lumagraph::pathtrace::intersect::wide_bvh::WideBvh::build(&gpu_scene).unwrap();
+    let wide_nodes = lumagraph::pathtrace::intersect::wide_bvh::upload(ctx, &wide).unwrap();
     let rays = random_rays(100_000);
     let binary = Raycaster::new(ctx)
         .unwrap()

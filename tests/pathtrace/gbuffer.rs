@@ -18,8 +18,9 @@ use crate::common;
 use std::sync::Arc;
 
 use lumagraph::graph::{Graph, Node};
+use lumagraph::pathtrace::library::compile;
 use lumagraph::render::cpu::Image;
-use lumagraph::render::{Executor, Resources, compile, image_io};
+use lumagraph::render::{Resources, image_io};
 use lumagraph::scene::{GpuScene, Scene};
 
 fn scene(name: &str) -> Arc<GpuScene> {
@@ -48,7 +49,7 @@ fn render(scene: &Arc<GpuScene>) -> Option<([Image; 3], [Image; 3])> {
         scene: Some(Arc::clone(scene)),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frame().unwrap();
     let read = |n: &str| {
         ["albedo", "normal", "depth"].map(|p| exec.read_port(&format!("{n}.{p}")).unwrap())

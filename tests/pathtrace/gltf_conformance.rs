@@ -6,7 +6,7 @@
 //! from one that ignores the feature.
 
 use crate::common;
-use lumagraph::render::specialize::Tracing;
+use lumagraph::pathtrace::specialize::Tracing;
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -14,8 +14,9 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 use lumagraph::graph::{Graph, Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
+use lumagraph::render::Resources;
 use lumagraph::render::cpu::Image;
-use lumagraph::render::{Executor, Resources, compile};
 use lumagraph::scene::{GpuScene, Scene, UvTransform, intersect};
 
 /// A scene around the model `rel` (under `assets/gltf-conformance/`), looked at from +z,
@@ -163,13 +164,13 @@ impl Render {
         .unwrap();
         let resources = Resources {
             scene: Some(Arc::clone(&gpu)),
-            tracer: Tracing {
-                as_gpu_adapter: true,
-                ..Tracing::default()
-            },
             ..Resources::default()
-        };
-        let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+        }
+        .with(Tracing {
+            as_gpu_adapter: true,
+            ..Tracing::default()
+        });
+        let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
         exec.run_frame().unwrap();
         let albedo = exec.read_port("pt.albedo").unwrap();
         let normal = exec.read_port("pt.normal").unwrap();

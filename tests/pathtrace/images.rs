@@ -11,14 +11,15 @@
 //!   under an environment; Cornell with 28 spheres of 28 materials), 64×64 at 8 spp.
 
 use crate::common;
-use lumagraph::render::specialize::Tracing;
+use lumagraph::pathtrace::specialize::Tracing;
 
 use std::sync::Arc;
 
 use lumagraph::graph::{Graph, Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
+use lumagraph::pathtrace::specialize::{Feature, Features, Intersector};
 use lumagraph::render::cpu::Image;
-use lumagraph::render::specialize::{Feature, Features, Intersector};
-use lumagraph::render::{Executor, Resources, compile, image_io, metrics};
+use lumagraph::render::{Executor, Resources, image_io, metrics};
 use lumagraph::scene::{GpuScene, Scene};
 
 fn scene(name: &str) -> Arc<GpuScene> {
@@ -185,17 +186,17 @@ fn a_frame_of_many_samples_traces_every_path() {
         let plan = compile(&graph, &["acc.color".to_owned()], Some(&grid)).unwrap();
         let resources = Resources {
             scene: Some(Arc::clone(&grid)),
-            tracer: Tracing {
-                intersector: if wgsl {
-                    Intersector::WIDE_BVH
-                } else {
-                    Intersector::AUTO
-                },
-                ..Tracing::default()
-            },
             ..Resources::default()
-        };
-        let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+        }
+        .with(Tracing {
+            intersector: if wgsl {
+                Intersector::WIDE_BVH
+            } else {
+                Intersector::AUTO
+            },
+            ..Tracing::default()
+        });
+        let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
         exec.run_frames(frames, true).unwrap();
         let rays = common::counter(&mut exec, "rays");
         Some((rays, exec.read_port("acc.color").unwrap()))
@@ -250,10 +251,10 @@ fn first_hit_aovs_see_the_back_wall() {
         scene: Some(Arc::clone(&cornell)),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frame().unwrap();
     assert!(
-        exec.shader_features("pt")
+        lumagraph::pathtrace::nodes::pathtrace::features(&exec, "pt")
             .unwrap()
             .on(Feature::FirstHitAovs),
         "{:?}",
@@ -302,13 +303,13 @@ fn render_small(
         (64, 64),
         spp,
         Resources {
-            tracer: Tracing {
-                scene_data_in_buffers: in_buffers,
-                as_gpu_adapter: bvh,
-                ..Tracing::default()
-            },
             ..Resources::default()
-        },
+        }
+        .with(Tracing {
+            scene_data_in_buffers: in_buffers,
+            as_gpu_adapter: bvh,
+            ..Tracing::default()
+        }),
     )
 }
 
@@ -376,12 +377,12 @@ fn spreading_workgroups_over_the_image_renders_bit_identical_images() {
                 size,
                 8,
                 Resources {
-                    tracer: Tracing {
-                        workgroups_in_image_order: in_order,
-                        ..Tracing::default()
-                    },
                     ..Resources::default()
-                },
+                }
+                .with(Tracing {
+                    workgroups_in_image_order: in_order,
+                    ..Tracing::default()
+                }),
             )
         };
         let Some((spread, how_spread)) = run(false) else {
@@ -420,14 +421,14 @@ fn leaving_out_a_missing_primitive_kind_renders_bit_identical_images() {
                 (48, 40),
                 8,
                 Resources {
-                    tracer: Tracing {
-                        general_shaders: general,
-                        as_gpu_adapter: true,
-                        scene_data_in_buffers: true,
-                        ..Tracing::default()
-                    },
                     ..Resources::default()
-                },
+                }
+                .with(Tracing {
+                    general_shaders: general,
+                    as_gpu_adapter: true,
+                    scene_data_in_buffers: true,
+                    ..Tracing::default()
+                }),
             )
         };
         let Some((specialized, how)) = run(false) else {
@@ -516,12 +517,12 @@ fn host_against_wgsl(name: &str, size: (u32, u32), spp: u32) -> Option<HostAgain
         return None;
     }
     let wgsl_only = Resources {
-        tracer: Tracing {
-            intersector: Intersector::WIDE_BVH,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
+    }
+    .with(Tracing {
+        intersector: Intersector::WIDE_BVH,
+        ..Tracing::default()
+    });
     let (wgsl, how_wgsl) = common::render_with(name, size, spp, wgsl_only).unwrap();
     assert_ne!(how_wgsl.intersector(), Intersector::HOST);
     assert_bit_identical(&format!("{name} AOVs"), &host[1..], &wgsl[1..]);
@@ -659,12 +660,12 @@ fn inlined_materials_of_a_large_scene_render_what_the_buffers_render() {
         return;
     };
     let buffers = Resources {
-        tracer: Tracing {
-            scene_data_in_buffers: true,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
+    }
+    .with(Tracing {
+        scene_data_in_buffers: true,
+        ..Tracing::default()
+    });
     let (buffers, how_buffers) =
         common::render_with("spheregrid.ron", (64, 64), 8, buffers).unwrap();
     if !common::gpu().is_some_and(lumagraph::render::GpuContext::is_cpu) {

@@ -4,15 +4,16 @@
 //! mesh, whose copies (100 M triangles) no intersector could hold.
 
 use crate::common;
-use lumagraph::render::specialize::Tracing;
+use lumagraph::pathtrace::specialize::Tracing;
 
 use std::sync::Arc;
 
 use glam::Vec3;
 use lumagraph::graph::ParamValue;
-use lumagraph::render::raycast::{RayQuery, Raycaster};
-use lumagraph::render::specialize::{Feature, Intersector};
-use lumagraph::render::{Executor, Resources, SceneBuffers, compile};
+use lumagraph::pathtrace::raycast::{RayQuery, Raycaster};
+use lumagraph::pathtrace::specialize::{Feature, Intersector};
+use lumagraph::pathtrace::{SceneBuffers, library::compile};
+use lumagraph::render::Resources;
 use lumagraph::scene::{GpuScene, NO_HIT, Ray, Scene, intersect_within};
 
 /// The sphere grid (55 200 triangles, 25 metal-rough materials) placed 6 times (moved,
@@ -168,15 +169,17 @@ fn render(
     let plan = compile(&graph, &outputs, Some(&scene)).unwrap();
     let resources = Resources {
         scene: Some(scene),
-        tracer: Tracing {
-            as_gpu_adapter: true,
-            intersector: Intersector::BINARY_BVH,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
-    let features = exec.shader_features("pt").unwrap().clone();
+    }
+    .with(Tracing {
+        as_gpu_adapter: true,
+        intersector: Intersector::BINARY_BVH,
+        ..Tracing::default()
+    });
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
+    let features = lumagraph::pathtrace::nodes::pathtrace::features(&exec, "pt")
+        .unwrap()
+        .clone();
     println!("{}", features.summary());
     exec.run_frames(spp.div_ceil(4), true).unwrap();
     let images = ports.iter().map(|p| exec.read_port(p).unwrap()).collect();
@@ -337,8 +340,10 @@ fn a_thousand_instances_of_a_100k_triangle_mesh() {
         scene: Some(scene.clone()),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
-    let features = exec.shader_features("pt").unwrap().clone();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
+    let features = lumagraph::pathtrace::nodes::pathtrace::features(&exec, "pt")
+        .unwrap()
+        .clone();
     println!("{}", features.summary());
     assert!(features.on(Feature::Instances));
     // The instances walked as such: by the host where it intersects, else the binary BVH.
@@ -387,14 +392,14 @@ fn a_thousand_instances_of_a_100k_triangle_mesh() {
 /// adapter with Embree gives it to the host, asked or not.
 #[test]
 fn flat_only_intersectors_refuse_instances_and_the_choice_says_why() {
-    use lumagraph::render::specialize::{Features, PathTraceOptions, Schedule};
+    use lumagraph::pathtrace::specialize::{Features, PathTraceOptions, Schedule};
     let scene = gpu_scene("On");
-    let e = lumagraph::render::intersect::wide_bvh::WideBvh::build(&scene).unwrap_err();
+    let e = lumagraph::pathtrace::intersect::wide_bvh::WideBvh::build(&scene).unwrap_err();
     assert!(
         e.contains("the 8-wide BVH takes flat scenes only, and this one has 6 instances"),
         "{e}"
     );
-    let e = lumagraph::render::accel::unsupported(&scene, u32::MAX).unwrap();
+    let e = lumagraph::pathtrace::accel::unsupported(&scene, u32::MAX).unwrap();
     assert!(e.contains("ray queries takes flat scenes only"), "{e}");
     for (cpu_adapter, intersector) in [
         (true, Intersector::AUTO),
@@ -442,7 +447,7 @@ fn flat_only_intersectors_refuse_instances_and_the_choice_says_why() {
             f.summary()
         );
         assert!(
-            lumagraph::render::specialize::support::refusal(&triangles, options, &f).is_none(),
+            lumagraph::pathtrace::specialize::support::refusal(&triangles, options, &f).is_none(),
             "{intersector:?}"
         );
     }
@@ -460,7 +465,7 @@ fn flat_only_intersectors_refuse_instances_and_the_choice_says_why() {
 /// 1 occlusion). Fails without Embree unless `LUMAGRAPH_ALLOW_NO_EMBREE=1`.
 #[test]
 fn embree_hits_instances_as_the_mirror_does() {
-    use lumagraph::render::embree::{Embree, HostHit, HostRay, HostScene};
+    use lumagraph::pathtrace::embree::{Embree, HostHit, HostRay, HostScene};
     use lumagraph::scene::NO_INSTANCE;
     let embree = match Embree::load() {
         Ok(e) => e,
@@ -590,10 +595,7 @@ fn host_intersection_renders_instances_as_the_binary_bvh_and_the_copies_do() {
                 triangles_scene(instancing, veil),
                 (64, 64),
                 16,
-                Resources {
-                    tracer,
-                    ..Resources::default()
-                },
+                Resources::default().with(tracer),
             )
             .unwrap()
         };

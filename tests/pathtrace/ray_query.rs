@@ -8,12 +8,12 @@
 //! `LUMAGRAPH_ALLOW_NO_RAY_QUERY=1`.
 
 use crate::common;
-use lumagraph::render::specialize::Tracing;
+use lumagraph::pathtrace::specialize::Tracing;
 
-use lumagraph::render::Resources;
-use lumagraph::render::specialize::{
+use lumagraph::pathtrace::specialize::{
     AdapterTraits, Features, Intersector, PathTraceOptions, Specialization,
 };
+use lumagraph::render::Resources;
 use lumagraph::scene::{GpuScene, Scene};
 
 fn scene(rel: &str) -> GpuScene {
@@ -149,21 +149,21 @@ fn ray_queries_are_chosen_where_the_device_has_them() {
 fn against_wgsl_bvh(name: &str) -> Option<(usize, f64)> {
     // Both as a GPU adapter runs (the same dispatches, materials read from buffers).
     let rq = Resources {
-        tracer: Tracing {
-            intersector: Intersector::RAY_QUERIES,
-            as_gpu_adapter: true,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
+    }
+    .with(Tracing {
+        intersector: Intersector::RAY_QUERIES,
+        as_gpu_adapter: true,
+        ..Tracing::default()
+    });
     let bvh = Resources {
-        tracer: Tracing {
-            as_gpu_adapter: true,
-            intersector: Intersector::BINARY_BVH,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
+    }
+    .with(Tracing {
+        as_gpu_adapter: true,
+        intersector: Intersector::BINARY_BVH,
+        ..Tracing::default()
+    });
     common::same_hits(name, rq, bvh, |a, b| {
         assert_eq!(intersector(a), "ray queries", "{}", a.summary());
         assert_eq!(intersector(b), "WGSL BVH", "{}", b.summary());

@@ -36,7 +36,7 @@ fn entry_shaders() -> Vec<&'static str> {
 /// Fragments only the path tracer's specialization imports (in place of
 /// `pathtrace/intersect.wgsl`), with the whole shader it assembles around each.
 fn specialized_sources() -> Vec<(&'static str, String)> {
-    use lumagraph::render::specialize::{Intersector, PathTraceOptions, Specialization};
+    use lumagraph::pathtrace::specialize::{Intersector, PathTraceOptions, Specialization};
     use lumagraph::scene::{GpuScene, Scene};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell_spheres.ron");
     let scene = GpuScene::build(&Scene::load(&path).unwrap()).unwrap();

@@ -14,15 +14,16 @@
 //! what the specialized one leaves out.
 
 use crate::common;
-use lumagraph::render::specialize::Tracing;
+use lumagraph::pathtrace::specialize::Tracing;
 
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 use lumagraph::graph::{Graph, Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
+use lumagraph::pathtrace::specialize::{Feature, Features};
+use lumagraph::render::Resources;
 use lumagraph::render::cpu::Image;
-use lumagraph::render::specialize::{Feature, Features};
-use lumagraph::render::{Executor, Resources, compile};
 use lumagraph::scene::{AlphaMode, GpuScene, NO_TEXTURE, Scene, Texture, Wrap};
 
 /// A small deterministic generator (`SplitMix64`), so a failing case can be rerun by its seed.
@@ -213,16 +214,18 @@ fn frames(scene: &GpuScene, general: bool, seed: u32) -> Option<(Vec<Image>, Fea
     let plan = compile(&graph, &["pt.color".to_owned()], Some(&scene)).unwrap();
     let resources = Resources {
         scene: Some(Arc::clone(&scene)),
-        tracer: Tracing {
-            general_shaders: general,
-            as_gpu_adapter: true,
-            scene_data_in_buffers: true,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
-    let features = exec.shader_features("pt").unwrap().clone();
+    }
+    .with(Tracing {
+        general_shaders: general,
+        as_gpu_adapter: true,
+        scene_data_in_buffers: true,
+        ..Tracing::default()
+    });
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
+    let features = lumagraph::pathtrace::nodes::pathtrace::features(&exec, "pt")
+        .unwrap()
+        .clone();
     let images = (0..FRAMES)
         .map(|_| {
             exec.run_frames(1, true).unwrap();
@@ -344,7 +347,7 @@ fn specialized_shaders_render_what_the_general_shader_renders() {
 fn each_feature_sets_its_own_wgsl_constant() {
     let scene =
         GpuScene::build(&Scene::load(&common::repo("assets/cornell.ron")).unwrap()).unwrap();
-    let options = lumagraph::render::specialize::PathTraceOptions::default();
+    let options = lumagraph::pathtrace::specialize::PathTraceOptions::default();
     let all = Features::decide(&scene, options);
     let mut labels = std::collections::HashSet::new();
     for f in Feature::ALL {

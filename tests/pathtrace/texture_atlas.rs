@@ -9,7 +9,8 @@ use std::sync::Arc;
 
 use glam::Vec2;
 use lumagraph::graph::{Graph, Node};
-use lumagraph::render::{Executor, Resources, check_scene_limits, compile};
+use lumagraph::pathtrace::{check_scene_limits, library::compile};
+use lumagraph::render::Resources;
 use lumagraph::scene::texture::srgb_decode;
 use lumagraph::scene::{GpuScene, Scene, Texture, Wrap};
 
@@ -97,7 +98,7 @@ fn check_each_texture_where_it_belongs(n: usize, side: u32) {
         scene: Some(Arc::clone(&gpu)),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frame().unwrap();
     let albedo = exec.read_port("pt.albedo").unwrap();
     let width = gpu.settings.width as usize;

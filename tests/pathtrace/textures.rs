@@ -7,15 +7,16 @@
 //! flattened scene; the tolerances and what was measured are stated at each test.
 
 use crate::common;
-use lumagraph::render::specialize::Tracing;
+use lumagraph::pathtrace::specialize::Tracing;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3, Vec4};
 use lumagraph::graph::{Graph, Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
+use lumagraph::render::Resources;
 use lumagraph::render::cpu::Image;
-use lumagraph::render::{Executor, Resources, compile};
 use lumagraph::scene::texture::{Texture, srgb_decode, triangle_tangents};
 use lumagraph::scene::{GpuScene, NO_TEXTURE, Ray, Scene, UvTransform, Wrap};
 
@@ -324,13 +325,13 @@ fn render(scene: &Arc<GpuScene>, spp: i64) -> Option<[Image; 5]> {
     // scene, x = y = 0.667 on a quad from (0, 0) to (1, 1), is such a crack).
     let resources = Resources {
         scene: Some(Arc::clone(scene)),
-        tracer: Tracing {
-            as_gpu_adapter: true,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    }
+    .with(Tracing {
+        as_gpu_adapter: true,
+        ..Tracing::default()
+    });
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frame().unwrap();
     Some(ports.map(|p| exec.read_port(p).unwrap()))
 }
@@ -629,7 +630,7 @@ fn missing_or_broken_images_name_the_material_and_image() {
 
 #[test]
 fn plan_lists_textures_for_textured_scenes_only() {
-    use lumagraph::render::specialize::{Feature, Features, PathTraceOptions};
+    use lumagraph::pathtrace::specialize::{Feature, Features, PathTraceOptions};
     let opts = PathTraceOptions {
         specialize: true,
         cpu_adapter: true,
@@ -1643,7 +1644,7 @@ fn textured_emitter_selection_follows_the_texture() {
 /// which and why.
 #[test]
 fn small_scenes_are_inlined_on_cpu_adapters_only() {
-    use lumagraph::render::specialize::{Feature, Features, Intersector, PathTraceOptions};
+    use lumagraph::pathtrace::specialize::{Feature, Features, Intersector, PathTraceOptions};
     let scene = GpuScene::build(&Scene::load(&common::repo("assets/cornell_spheres.ron")).unwrap())
         .unwrap();
     for cpu_adapter in [true, false] {

@@ -8,20 +8,20 @@ use crate::common;
 
 use std::sync::Arc;
 
+use lumagraph::pathtrace::specialize::{Feature, Intersector, Schedule, Tracing};
 use lumagraph::render::Resources;
-use lumagraph::render::specialize::{Feature, Intersector, Schedule, Tracing};
 use lumagraph::scene::GpuScene;
 
 fn as_gpu(intersector: Intersector, schedule: Schedule) -> Resources {
     Resources {
-        tracer: Tracing {
-            as_gpu_adapter: true,
-            intersector,
-            schedule,
-            ..Tracing::default()
-        },
         ..Resources::default()
     }
+    .with(Tracing {
+        as_gpu_adapter: true,
+        intersector,
+        schedule,
+        ..Tracing::default()
+    })
 }
 
 /// The wavefront against the megakernel, both as a GPU adapter runs them, at 64×64 and
@@ -117,7 +117,7 @@ fn the_wavefront_carries_the_ray_cone_as_the_megakernel_does() {
 /// the plan says why.
 #[test]
 fn the_wavefront_is_used_where_asked_for_or_measured_faster() {
-    use lumagraph::render::specialize::{Features, PathTraceOptions, WAVEFRONT_MIN_TRIANGLES};
+    use lumagraph::pathtrace::specialize::{Features, PathTraceOptions, WAVEFRONT_MIN_TRIANGLES};
     use lumagraph::scene::Scene;
     let decide = |scene: &GpuScene, schedule, cpu_adapter| {
         Features::decide(

@@ -5,11 +5,11 @@
 //! one. Its hits are the binary BVH's: the same exact tests on the same primitives.
 
 use crate::common;
-use lumagraph::render::specialize::Tracing;
+use lumagraph::pathtrace::specialize::Tracing;
 
+use lumagraph::pathtrace::intersect::wide_bvh::{WIDE_BVH_STACK, WideBvh};
+use lumagraph::pathtrace::specialize::{Features, Intersector, PathTraceOptions, Specialization};
 use lumagraph::render::Resources;
-use lumagraph::render::intersect::wide_bvh::{WIDE_BVH_STACK, WideBvh};
-use lumagraph::render::specialize::{Features, Intersector, PathTraceOptions, Specialization};
 use lumagraph::scene::{GpuScene, PRIM_SHAPE, Scene};
 
 fn scene(rel: &str) -> GpuScene {
@@ -308,21 +308,21 @@ fn records_nodes(bvh: &WideBvh) -> usize {
 #[test]
 fn the_wide_bvh_renders_what_the_binary_bvh_renders() {
     let wide = Resources {
-        tracer: Tracing {
-            as_gpu_adapter: true,
-            intersector: Intersector::WIDE_BVH,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
+    }
+    .with(Tracing {
+        as_gpu_adapter: true,
+        intersector: Intersector::WIDE_BVH,
+        ..Tracing::default()
+    });
     let binary = Resources {
-        tracer: Tracing {
-            as_gpu_adapter: true,
-            intersector: Intersector::BINARY_BVH,
-            ..Tracing::default()
-        },
         ..Resources::default()
-    };
+    }
+    .with(Tracing {
+        as_gpu_adapter: true,
+        intersector: Intersector::BINARY_BVH,
+        ..Tracing::default()
+    });
     for name in [
         "cornell.ron",
         "cornell_spheres.ron",

@@ -13,9 +13,10 @@ use crate::common;
 
 use common::{assert_within, map_pixels, repo};
 use lumagraph::graph::{Edge, Graph, Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
 use lumagraph::render::cpu::{self, Image};
 use lumagraph::render::nodes::difference::heat;
-use lumagraph::render::{Executor, Resources, compile, image_io, metrics};
+use lumagraph::render::{Executor, Resources, image_io, metrics};
 
 const CHART: &str = "assets/test_chart.exr";
 
@@ -52,7 +53,7 @@ fn run(
         base_dir: common::root(),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frame().unwrap();
     let image = exec.read_port(&keep[0]).unwrap();
     Some((exec, image))
@@ -165,7 +166,7 @@ fn difference_refuses_a_reference_of_another_size() {
         ],
         ..Graph::default()
     };
-    let e = lumagraph::render::compile_with(
+    let e = lumagraph::pathtrace::library::compile_with(
         &graph,
         &lumagraph::graph::Registry::with_builtins(),
         &common::root(),
@@ -248,8 +249,12 @@ fn auto_exposure_adapts_over_frames_and_restarts_at_the_target() {
         base_dir: common::root(),
         ..Resources::default()
     };
-    let mut exec =
-        Executor::new(ctx, compile(&graph(0.18), &keep, None).unwrap(), &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(
+        ctx,
+        compile(&graph(0.18), &keep, None).unwrap(),
+        &resources,
+    )
+    .unwrap();
     exec.run_frame().unwrap();
     let ev1 = measured(&mut exec, "exposure_ev");
     // Twice the key: the target is one stop up; each frame takes a quarter of what is left.

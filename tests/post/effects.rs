@@ -252,7 +252,7 @@ fn crop_copies_the_rectangle() {
         lumagraph::graph::Edge::new("c.color", "out.color"),
     ];
     g.origin = None;
-    let e = lumagraph::render::compile(&g, &[], None)
+    let e = lumagraph::pathtrace::library::compile(&g, &[], None)
         .unwrap_err()
         .to_string();
     assert!(

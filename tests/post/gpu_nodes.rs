@@ -8,8 +8,9 @@
 use crate::common;
 
 use lumagraph::graph::{Edge, Graph, Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
 use lumagraph::render::cpu::{self, Image};
-use lumagraph::render::{Executor, Resources, compile, image_io};
+use lumagraph::render::{Resources, image_io};
 
 /// Runs `graph` once with `keep` ports kept alive and returns them.
 fn run(graph: &Graph, keep: &[&str], out_dir: &std::path::Path) -> Option<Vec<Image>> {
@@ -202,7 +203,7 @@ fn dead_branch_never_executes() {
         out_dir: dir.path().to_owned(),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &paths).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &paths).unwrap();
     let report = exec.run_frame().unwrap();
     assert_eq!(report.executed, ["input", "exposure", "tonemap", "out"]);
     if let Some(times) = &report.pass_ms {

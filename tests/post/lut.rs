@@ -156,12 +156,12 @@ fn bad_cube_files_name_their_line() {
             .with("path", ParamValue::Str(bad.to_str().unwrap().into())),
     ];
     g.edges = vec![lumagraph::graph::Edge::new("in.color", "look.color")];
-    let plan = lumagraph::render::compile(&g, &["look.color".into()], None).unwrap();
+    let plan = lumagraph::pathtrace::library::compile(&g, &["look.color".into()], None).unwrap();
     let resources = lumagraph::render::Resources {
         base_dir: common::root(),
         ..Default::default()
     };
-    let e = lumagraph::render::Executor::new(ctx, plan, &resources)
+    let e = lumagraph::pathtrace::library::executor(ctx, plan, &resources)
         .unwrap_err()
         .to_string();
     assert!(

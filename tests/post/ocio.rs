@@ -242,7 +242,8 @@ fn check(reference: &Value, by_input: bool) -> usize {
 /// fails under CI and is skipped elsewhere.
 #[test]
 fn view_agx_matches_blenders_agx_view_through_pyopencolorio() {
-    use lumagraph::render::{Executor, Resources, compile};
+    use lumagraph::pathtrace::library::compile;
+    use lumagraph::render::Resources;
     if let Err(e) = lumagraph::color::blender_config() {
         assert!(std::env::var_os("CI").is_none(), "{e}");
         eprintln!("skipped: {e}");
@@ -259,7 +260,7 @@ fn view_agx_matches_blenders_agx_view_through_pyopencolorio() {
         out_dir: out.path().to_owned(),
         ..Resources::default()
     };
-    let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+    let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
     exec.run_frame().unwrap();
     let got = exec.read_port("agx.color").unwrap();
     let want = image::open(common::repo("tests/color/blender_agx_cornell.png"))
@@ -289,7 +290,8 @@ fn view_agx_matches_blenders_agx_view_through_pyopencolorio() {
 /// is one error naming the node's file and the config's spaces.
 #[test]
 fn image_input_reads_a_named_colour_space_or_the_config_file_rules() {
-    use lumagraph::render::{Executor, Resources, compile};
+    use lumagraph::pathtrace::library::compile;
+    use lumagraph::render::Resources;
     let Some(ctx) = common::gpu() else {
         return;
     };
@@ -349,7 +351,7 @@ fn image_input_reads_a_named_colour_space_or_the_config_file_rules() {
         out_dir: dir.path().to_owned(),
         ..Resources::default()
     };
-    let err = Executor::new(ctx, plan, &resources)
+    let err = lumagraph::pathtrace::library::executor(ctx, plan, &resources)
         .err()
         .unwrap()
         .to_string();

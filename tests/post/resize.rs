@@ -200,7 +200,7 @@ fn resize_matches_cpu() {
 /// limit is an error naming the node, not a GPU failure.
 #[test]
 fn resize_sizes_its_output_in_the_plan() {
-    use lumagraph::render::compile;
+    use lumagraph::pathtrace::library::compile;
     let mut g = graph(&[("width", ParamValue::Int(40))]);
     g.nodes.push(Node::new("t", "Tonemap"));
     g.nodes.push(Node::new("out", "Output"));

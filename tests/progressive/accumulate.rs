@@ -4,8 +4,9 @@
 use crate::common;
 
 use lumagraph::graph::{Edge, Graph, Node, ParamValue};
+use lumagraph::pathtrace::library::compile;
 use lumagraph::render::cpu::{Image, KahanMean};
-use lumagraph::render::{Executor, Resources, compile, image_io};
+use lumagraph::render::{Resources, image_io};
 
 fn acc_graph(input: &std::path::Path) -> Graph {
     Graph {
@@ -58,7 +59,8 @@ fn gpu_keeps_1e5_frames_of_a_constant_within_1e6() {
     let image = Image::filled(8, 8, [VALUES[0], VALUES[1], VALUES[2], 1.0]);
     std::fs::write(&input, image_io::encode_exr(&image, false).unwrap()).unwrap();
     let plan = compile(&acc_graph(&input), &["acc.color".into()], None).unwrap();
-    let mut exec = Executor::new(ctx, plan, &Resources::default()).unwrap();
+    let mut exec =
+        lumagraph::pathtrace::library::executor(ctx, plan, &Resources::default()).unwrap();
     let start = std::time::Instant::now();
     for _ in 0..10 {
         exec.run_frames(10_000, true).unwrap();
@@ -86,7 +88,8 @@ fn gpu_matches_cpu_mirror_bit_for_bit_and_resets() {
     }
     std::fs::write(&input, image_io::encode_exr(&image, false).unwrap()).unwrap();
     let plan = compile(&acc_graph(&input), &["acc.color".into()], None).unwrap();
-    let mut exec = Executor::new(ctx, plan, &Resources::default()).unwrap();
+    let mut exec =
+        lumagraph::pathtrace::library::executor(ctx, plan, &Resources::default()).unwrap();
     exec.run_frames(777, true).unwrap();
     let gpu = exec.read_port("acc.color").unwrap();
     for (g, p) in gpu.pixels.iter().zip(&image.pixels) {
@@ -137,7 +140,7 @@ fn variance_of_the_mean_matches_cpu(estimate: &str) {
     let run = |keep: &[&str]| {
         let keep: Vec<String> = keep.iter().map(|s| (*s).to_owned()).collect();
         let plan = compile(&graph, &keep, Some(&scene)).unwrap();
-        let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+        let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
         let mut frames = Vec::new();
         for _ in 0..4 {
             exec.run_frames(1, true).unwrap();
@@ -213,7 +216,7 @@ fn rerun_after_a_post_edit_runs_only_downstream_passes() {
     ]
     .map(str::to_owned)
     .into();
-    let mut exec = Executor::new(
+    let mut exec = lumagraph::pathtrace::library::executor(
         ctx,
         compile(&graph(0.0), &keep, None).unwrap(),
         &Resources::default(),
@@ -228,7 +231,7 @@ fn rerun_after_a_post_edit_runs_only_downstream_passes() {
     assert_eq!(report.executed, ["exposure", "tonemap"]);
     assert_eq!(exec.frames(), 3, "a rerun adds no frame");
     let edited = exec.read_port("tonemap.color").unwrap();
-    let mut fresh = Executor::new(
+    let mut fresh = lumagraph::pathtrace::library::executor(
         ctx,
         compile(&graph(1.5), &keep, None).unwrap(),
         &Resources::default(),
@@ -297,7 +300,7 @@ fn variance_estimate_matches_the_spread_over_seeds() {
                 scene: Some(std::sync::Arc::clone(&gpu)),
                 ..Resources::default()
             };
-            let mut exec = Executor::new(ctx, plan, &resources).unwrap();
+            let mut exec = lumagraph::pathtrace::library::executor(ctx, plan, &resources).unwrap();
             exec.run_frames(spp, true).unwrap();
             let mean = exec.read_port("halves.color").unwrap();
             for (i, m) in mean.pixels.iter().enumerate() {

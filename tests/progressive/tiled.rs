@@ -191,7 +191,7 @@ fn a_node_that_needs_the_whole_image_refuses_tiles() {
 /// Denoise passes' 2 × (1 + 2 + 4 + 8 + 16) in the default graph.
 #[test]
 fn the_default_graph_needs_a_63_pixel_apron() {
-    let library = lumagraph::render::NodeLibrary::builtins();
+    let library = lumagraph::pathtrace::library::builtins();
     let graph =
         lumagraph::graph::Graph::load(&common::repo("graphs/pathtrace_denoise.ron")).unwrap();
     let scene = common::gpu_scene("assets/cornell.ron", Some(64));

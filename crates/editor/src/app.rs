@@ -61,7 +61,7 @@ impl Default for EditorConfig {
             recent_store: None,
             scene: None,
             preview_max: DEFAULT_PREVIEW_MAX,
-            library: Arc::new(NodeLibrary::builtins().clone()),
+            library: Arc::new(lumagraph_pathtrace::library::builtins().clone()),
             thumbnails: None,
         }
     }

@@ -43,7 +43,11 @@ impl Document {
     /// those the graph declares (when they all compile; else the built-in ones, and the
     /// editor shows why).
     pub fn new(graph: Graph, path: Option<PathBuf>) -> Self {
-        Self::with_library(graph, path, Arc::new(NodeLibrary::builtins().clone()))
+        Self::with_library(
+            graph,
+            path,
+            Arc::new(lumagraph_pathtrace::library::builtins().clone()),
+        )
     }
 
     /// A document for `graph`, as if just opened from `path`, with the kinds of `library`

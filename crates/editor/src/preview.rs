@@ -275,7 +275,10 @@ pub fn encode_rgba8(image: &lumagraph_render::cpu::Image, ty: PortType) -> Vec<u
 impl Preview {
     /// A preview rendering on `gpu` (the editor's device) with the built-in node kinds.
     pub fn new(gpu: GpuContext) -> Self {
-        Self::with_library(gpu, Arc::new(NodeLibrary::builtins().clone()))
+        Self::with_library(
+            gpu,
+            Arc::new(lumagraph_pathtrace::library::builtins().clone()),
+        )
     }
 
     /// A preview rendering on `gpu`, running nodes with the implementations of `library`.

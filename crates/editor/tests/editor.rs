@@ -7,7 +7,8 @@ mod common;
 use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable as _;
 use lumagraph_graph::{Graph, ParamValue};
-use lumagraph_render::{Executor, Resources, compile};
+use lumagraph_pathtrace::library::compile;
+use lumagraph_render::Resources;
 
 use common::{click_at, editor, harness, repo, snapshot_options, with_config};
 use lumagraph_editor::{EditorConfig, Pick};
@@ -341,7 +342,8 @@ fn a_chain_built_in_the_editor_renders_headless_like_its_preview() {
         out_dir: dir.path().join("out"),
         ..Resources::default()
     };
-    let mut exec = Executor::new(h.state().preview.gpu(), plan, &paths).unwrap();
+    let mut exec =
+        lumagraph_pathtrace::library::executor(h.state().preview.gpu(), plan, &paths).unwrap();
     let report = exec.run_frame().unwrap();
     assert_eq!(report.written, vec![dir.path().join("out/chain.png")]);
     let png = image::open(&report.written[0]).unwrap().to_rgba8();

@@ -497,7 +497,7 @@ impl Session {
         intersector: &str,
         schedule: &str,
     ) -> PyResult<Self> {
-        use lumagraph::render::specialize::{Intersector, Schedule};
+        use lumagraph::pathtrace::specialize::{Intersector, Schedule};
         let options = SessionOptions {
             out: PathBuf::from(out),
             write_outputs,
@@ -752,7 +752,7 @@ fn converge<'py>(
     );
     let ctx = lumagraph::render::GpuContext::headless()
         .map_err(|e| LumagraphError::new_err(e.to_string()))?;
-    let library = lumagraph::render::NodeLibrary::with_builtins();
+    let library = lumagraph::pathtrace::library::with_builtins();
     let measured = lumagraph::converge::measure(
         &ctx,
         graph,

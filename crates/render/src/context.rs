@@ -12,6 +12,17 @@ use crate::error::{RenderError, Result};
 /// How long to wait for the GPU before giving up. lavapipe is slow, so this is generous.
 pub const GPU_TIMEOUT: Duration = Duration::from_secs(600);
 
+/// What the path tracer's choices depend on in an adapter (found without opening a device:
+/// [`GpuContext::default_adapter_traits`]; of an open one: [`GpuContext::traits`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AdapterTraits {
+    /// A CPU implementation (lavapipe).
+    pub cpu: bool,
+    /// Where the device has ray queries: the most primitives one of its acceleration
+    /// structures holds.
+    pub ray_query_limit: Option<u32>,
+}
+
 /// Instance, adapter, device and queue, plus what the device can do.
 #[derive(Clone, Debug)]
 pub struct GpuContext {
@@ -71,12 +82,11 @@ impl GpuContext {
     ///
     /// # Errors
     /// When no adapter matches.
-    pub fn default_adapter_traits() -> Result<(wgpu::AdapterInfo, crate::specialize::AdapterTraits)>
-    {
+    pub fn default_adapter_traits() -> Result<(wgpu::AdapterInfo, AdapterTraits)> {
         let adapter = pollster::block_on(Self::select_adapter(false))?;
         let info = adapter.get_info();
         let rq = adapter.features() & Self::optional_features();
-        let traits = crate::specialize::AdapterTraits {
+        let traits = AdapterTraits {
             cpu: info.device_type == wgpu::DeviceType::Cpu,
             ray_query_limit: rq
                 .contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY)
@@ -306,8 +316,8 @@ impl GpuContext {
     }
 
     /// What the path tracer's choices depend on in this device.
-    pub fn traits(&self) -> crate::specialize::AdapterTraits {
-        crate::specialize::AdapterTraits {
+    pub fn traits(&self) -> AdapterTraits {
+        AdapterTraits {
             cpu: self.is_cpu(),
             ray_query_limit: self
                 .ray_queries()

@@ -405,7 +405,7 @@ fn generate(kind: &NodeKind, code: &Code) -> Result<GeneratedShader, (String, Op
 /// # Errors
 /// As [`registry_for`].
 pub fn registry(graph: &Graph) -> Result<Registry, GraphErrors> {
-    crate::NodeLibrary::builtins().registry_for(graph)
+    registry_for(graph, &Registry::with_builtins())
 }
 
 /// Checks a graph file meant as a node group on its own (it has an `interface` and no

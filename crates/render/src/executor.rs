@@ -102,16 +102,6 @@ impl std::fmt::Debug for Executor {
 }
 
 impl Executor {
-    /// Creates every pass's GPU resources and the plan's textures, with the built-in
-    /// implementations ([`Executor::with_library`] takes a library).
-    ///
-    /// # Errors
-    /// When a node cannot be set up (missing input file, unwritable output, shader error,
-    /// a kind that is not built in); the error names the node.
-    pub fn new(ctx: &GpuContext, plan: Plan, paths: &Resources) -> Result<Self> {
-        Self::with_library(ctx, plan, paths, NodeLibrary::builtins())
-    }
-
     /// Creates every pass's GPU resources, each node by its kind's implementation in
     /// `library`, and the plan's textures.
     ///
@@ -716,14 +706,15 @@ impl Executor {
             .collect()
     }
 
-    /// The shader features of node `id`, where its kind is specialized to the scene.
-    pub fn shader_features(&self, id: &str) -> Option<&crate::specialize::Features> {
+    /// The GPU side of node `id` (the crate that defines its kind reaches its state through
+    /// [`AsAny`](crate::AsAny)).
+    pub fn node(&self, id: &str) -> Option<&dyn NodeExec> {
         self.plan
             .passes
             .iter()
             .zip(&self.nodes)
             .find(|(pass, _)| pass.node == id)
-            .and_then(|(_, node)| node.shader_features())
+            .map(|(_, node)| node.as_ref())
     }
 
     /// Every node's counters since its last reset, as `(node id, counter)`.

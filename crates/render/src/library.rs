@@ -1,7 +1,8 @@
 //! The node kinds a program knows and how each one runs: a [`NodeLibrary`] holds a
 //! [`Registry`] (ports, params, docs) and one [`NodeImpl`] per kind that has GPU code of
-//! its own. The built-in library is [`NodeLibrary::with_builtins`]; a program built on
-//! lumagraph adds its own kinds with [`NodeLibrary::with_kind`] and hands the library to
+//! its own. This crate's built-in kinds are [`NodeLibrary::frame_graph`]'s; the path
+//! tracer's crate adds the kinds that render the scene (`lumagraph_pathtrace::library`,
+//! the library programs start from), and a program built on lumagraph adds its own kinds with [`NodeLibrary::with_kind`] and hands the library to
 //! the compiler, the [`Executor`](crate::Executor), the CLI and the editor.
 //!
 //! Kinds that name a shader ([`NodeKind::shader`]: the built-in generic post filters and
@@ -9,7 +10,6 @@
 //! need no entry of their own.
 
 use std::path::Path;
-use std::sync::LazyLock;
 
 use lumagraph_graph::{
     CompileOptions, Extent, Graph, GraphErrors, NodeKind, Params, Pass, Plan, Registry,
@@ -28,7 +28,7 @@ use crate::nodes::{IMPLEMENTATIONS, NodeExec, NodeImpl, Resources, post_filter};
 /// #     lumagraph_render::nodes::NodeImpl::new("Mine", |_, _, _| unimplemented!());
 /// use lumagraph_render::NodeLibrary;
 ///
-/// let library = NodeLibrary::with_builtins().with_kind(kind(), IMPL)?;
+/// let library = NodeLibrary::frame_graph().with_kind(kind(), IMPL)?;
 /// # Ok::<(), lumagraph_render::RenderError>(())
 /// ```
 #[derive(Clone, Debug)]
@@ -37,22 +37,41 @@ pub struct NodeLibrary {
     implementations: Vec<NodeImpl>,
 }
 
-/// The built-in library, made once, for the functions that take no library.
-static BUILTINS: LazyLock<NodeLibrary> = LazyLock::new(NodeLibrary::with_builtins);
-
 impl NodeLibrary {
-    /// The kinds built into lumagraph and their implementations.
-    pub fn with_builtins() -> Self {
+    /// Every built-in kind, with this crate's implementations: the post-processing, image
+    /// file and colour nodes. The kinds that render the scene (`PathTrace`, `GBuffer`) are
+    /// in the registry but run only once their crate adds them
+    /// ([`NodeLibrary::with_implementations`]; `lumagraph_pathtrace::library` does);
+    /// until then a graph using one is refused when its node is created, naming the kind.
+    pub fn frame_graph() -> Self {
         Self {
             registry: Registry::with_builtins(),
             implementations: IMPLEMENTATIONS.to_vec(),
         }
     }
 
-    /// The built-in library, shared (what [`crate::compile`] and
-    /// [`Executor::new`](crate::Executor::new) use).
-    pub fn builtins() -> &'static Self {
-        &BUILTINS
+    /// The library with implementations of built-in kinds it has none of (the kinds that
+    /// render the scene, from the crate that defines them).
+    ///
+    /// # Errors
+    /// [`RenderError::Library`], naming the kind, when the registry has no such kind, it
+    /// already has an implementation, or the kind names a shader or does not fit.
+    pub fn with_implementations(mut self, implementations: &[NodeImpl]) -> Result<Self> {
+        for implementation in implementations {
+            let err = |m: &str| {
+                RenderError::Library(format!("node kind \"{}\": {m}", implementation.kind))
+            };
+            let kind = self
+                .registry
+                .get(implementation.kind)
+                .ok_or_else(|| err("the registry has no kind of that name"))?;
+            if kind.shader.is_some() || self.implementation(kind).is_some() {
+                return Err(err("it already has an implementation"));
+            }
+            check(kind, implementation).map_err(|m| err(&m))?;
+            self.implementations.push(*implementation);
+        }
+        Ok(self)
     }
 
     /// The library with `kind` added, run by `implementation` (see [`NodeLibrary::add`]).
@@ -275,46 +294,21 @@ fn check(kind: &NodeKind, implementation: &NodeImpl) -> std::result::Result<(), 
     }
 }
 
-/// [`NodeLibrary::compile`] with the built-in kinds.
-///
-/// # Errors
-/// Every problem found in the graph (first in its declared kinds).
-pub fn compile(
-    graph: &Graph,
-    keep: &[String],
-    scene: Option<&GpuScene>,
-) -> std::result::Result<Plan, GraphErrors> {
-    NodeLibrary::builtins().compile(graph, keep, scene)
-}
-
-/// [`NodeLibrary::compile_with`] with the built-in implementations.
-///
-/// # Errors
-/// Every problem found in the graph.
-pub fn compile_with(
-    graph: &Graph,
-    registry: &Registry,
-    base_dir: &Path,
-    keep: &[String],
-    scene: Option<&GpuScene>,
-) -> std::result::Result<Plan, GraphErrors> {
-    NodeLibrary::builtins().compile_with(graph, registry, base_dir, keep, scene)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// The registry's kinds are the implementation table's and the generic post filters,
-    /// each once, and each implementation fits its kind.
+    /// The registry's kinds that do not render the scene are the implementation table's
+    /// and the generic post filters, each once, and each implementation fits its kind (the
+    /// path tracer's crate checks the whole library).
     #[test]
     fn every_builtin_kind_has_one_implementation() {
-        let library = NodeLibrary::with_builtins();
+        let library = NodeLibrary::frame_graph();
         let mut kinds: Vec<&str> = library
             .registry()
             .kinds()
             .iter()
-            .filter(|k| k.shader.is_none())
+            .filter(|k| k.shader.is_none() && !k.renders_scene)
             .map(|k| k.name)
             .collect();
         let mut implemented: Vec<&str> = library.implementations().iter().map(|i| i.kind).collect();
@@ -327,7 +321,10 @@ mod tests {
                 "{}: a post filter with an implementation of its own",
                 k.name
             );
-            let i = library.implementation(k).unwrap();
+            let Some(i) = library.implementation(k) else {
+                assert!(k.renders_scene, "{}", k.name);
+                continue;
+            };
             if k.shader.is_none() {
                 check(k, i).unwrap_or_else(|e| panic!("{}: {e}", k.name));
             }
@@ -336,7 +333,7 @@ mod tests {
 
     fn source(name: &'static str) -> NodeKind {
         let mut kind = NodeKind::clone(
-            NodeLibrary::builtins()
+            NodeLibrary::frame_graph()
                 .registry()
                 .get("ImageInput")
                 .unwrap(),
@@ -352,12 +349,12 @@ mod tests {
 
     #[test]
     fn a_kind_is_added_and_found() {
-        let library = NodeLibrary::with_builtins()
+        let library = NodeLibrary::frame_graph()
             .with_kind(source("Mine"), sized("Mine"))
             .unwrap();
         let kind = library.registry().get("Mine").unwrap();
         assert_eq!(library.implementation(kind).unwrap().kind, "Mine");
-        assert!(NodeLibrary::builtins().implementation(kind).is_none());
+        assert!(NodeLibrary::frame_graph().implementation(kind).is_none());
     }
 
     #[test]
@@ -372,16 +369,20 @@ mod tests {
             ),
         ];
         for (kind, implementation, expected) in cases {
-            let e = NodeLibrary::with_builtins()
+            let e = NodeLibrary::frame_graph()
                 .with_kind(kind, implementation)
                 .unwrap_err()
                 .to_string();
             assert!(e.contains(expected) && e.contains("node kind \""), "{e}");
         }
-        let mut exposure =
-            NodeKind::clone(NodeLibrary::builtins().registry().get("Exposure").unwrap());
+        let mut exposure = NodeKind::clone(
+            NodeLibrary::frame_graph()
+                .registry()
+                .get("Exposure")
+                .unwrap(),
+        );
         exposure.name = "MyExposure";
-        let e = NodeLibrary::with_builtins()
+        let e = NodeLibrary::frame_graph()
             .with_kind(
                 exposure,
                 NodeImpl::new("MyExposure", |_, _, _| {

@@ -68,22 +68,20 @@ macro_rules! param_block {
     };
 }
 
-/// Every param block of the nodes, for the layout test.
+/// Every param block of this crate's nodes and of [`crate::shared`], for the layout test
+/// (the path tracer's crate checks its own).
 pub const BLOCKS: &[BlockLayout] = &[
     <crate::nodes::tonemap::TonemapParams as ParamBlock>::LAYOUT,
     <crate::nodes::accumulate::AccumulateParams as ParamBlock>::LAYOUT,
     <crate::nodes::temporal::TemporalParams as ParamBlock>::LAYOUT,
     <crate::nodes::denoise::DenoiseParams as ParamBlock>::LAYOUT,
     <crate::nodes::regression::RegressionParams as ParamBlock>::LAYOUT,
-    <crate::nodes::pathtrace::Frame as ParamBlock>::LAYOUT,
-    <crate::nodes::gbuffer::RasterCamera as ParamBlock>::LAYOUT,
     <crate::nodes::blur::BlurParams as ParamBlock>::LAYOUT,
     <crate::nodes::bloom::BloomParams as ParamBlock>::LAYOUT,
     <crate::nodes::lut::LutParams as ParamBlock>::LAYOUT,
     <crate::nodes::difference::DifferenceParams as ParamBlock>::LAYOUT,
     <crate::nodes::auto_exposure::AutoExposureParams as ParamBlock>::LAYOUT,
     <crate::shared::WaveRays as ParamBlock>::LAYOUT,
-    <crate::embree::HostHit as ParamBlock>::LAYOUT,
 ];
 
 /// Whether `layout` matches naga's layout of its WGSL twin in its shader file under

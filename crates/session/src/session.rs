@@ -15,7 +15,7 @@
 //! # anyhow::Ok(())
 //! ```
 
-use lumagraph_render::specialize::Tracing;
+use lumagraph_pathtrace::{Tracer as _, Tracing};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -47,11 +47,11 @@ pub struct SessionOptions {
     pub frame: Option<i64>,
     /// Let `Output` paths be absolute or climb out of `out` (by default they are refused).
     pub outputs_anywhere: bool,
-    /// The path tracer's intersector ([`Resources::tracer`]'s; `AUTO`: the scene and
+    /// The path tracer's intersector ([`Tracing`]'s; `AUTO`: the scene and
     /// the adapter decide).
-    pub intersector: lumagraph_render::specialize::Intersector,
-    /// The path tracer's schedule ([`Resources::tracer`]'s).
-    pub schedule: lumagraph_render::specialize::Schedule,
+    pub intersector: lumagraph_pathtrace::specialize::Intersector,
+    /// The path tracer's schedule ([`Tracing`]'s).
+    pub schedule: lumagraph_pathtrace::specialize::Schedule,
 }
 
 impl Default for SessionOptions {
@@ -63,8 +63,8 @@ impl Default for SessionOptions {
             library: None,
             frame: None,
             outputs_anywhere: false,
-            intersector: lumagraph_render::specialize::Intersector::AUTO,
-            schedule: lumagraph_render::specialize::Schedule::Auto,
+            intersector: lumagraph_pathtrace::specialize::Intersector::AUTO,
+            schedule: lumagraph_pathtrace::specialize::Schedule::Auto,
         }
     }
 }
@@ -155,7 +155,7 @@ impl Session {
     ) -> Result<Self> {
         let library = options
             .library
-            .unwrap_or_else(|| Arc::new(NodeLibrary::with_builtins()));
+            .unwrap_or_else(|| Arc::new(lumagraph_pathtrace::library::with_builtins()));
         let params = FrameParams::of(&graph, &library.registry_for(&graph)?);
         let (graph, sequence) = if params.is_empty() {
             (graph, None)
@@ -184,13 +184,12 @@ impl Session {
             out_dir: options.out,
             outputs_anywhere: options.outputs_anywhere,
             scene: scene.clone(),
-            tracer: Tracing {
-                intersector: options.intersector,
-                schedule: options.schedule,
-                ..Tracing::default()
-            },
             ..Resources::default()
-        };
+        }
+        .tracing(|t: &mut Tracing| {
+            t.intersector = options.intersector;
+            t.schedule = options.schedule;
+        });
         let mut exec = Executor::with_library(&ctx, plan, &resources, &library)?;
         exec.hold_sinks(!options.write_outputs);
         let mut session = Self::from_executor(exec, graph, scene, resources, library);

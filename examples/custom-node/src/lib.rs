@@ -89,7 +89,7 @@ fn extent(_base_dir: &Path, params: &Params) -> std::result::Result<Extent, Stri
 /// # Errors
 /// When the library refuses the kind (it would, were a kind of that name built in).
 pub fn library() -> Result<NodeLibrary> {
-    NodeLibrary::with_builtins().with_kind(kind(), IMPL)
+    lumagraph::pathtrace::library::with_builtins().with_kind(kind(), IMPL)
 }
 
 /// `ZonePlate`'s GPU side: the shader's pipeline and its param block.

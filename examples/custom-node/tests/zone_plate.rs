@@ -11,7 +11,7 @@ use std::sync::{Arc, LazyLock};
 
 use lumagraph::graph::{Graph, Node, ParamValue};
 use lumagraph::render::cpu::Image;
-use lumagraph::render::{Executor, GpuContext, NodeLibrary, Resources};
+use lumagraph::render::{Executor, GpuContext, Resources};
 use lumagraph_example_custom_node::{SHADER, ZonePlateParams, library, reference};
 
 /// The shared GPU context, or `None` when there is no GPU and that is allowed.
@@ -129,7 +129,7 @@ fn the_example_graph_renders() {
 #[test]
 fn only_the_extended_library_knows_the_kind() {
     let graph = Graph::load(&graph_file()).unwrap();
-    let e = NodeLibrary::builtins()
+    let e = lumagraph::pathtrace::library::builtins()
         .compile(&graph, &[], None)
         .unwrap_err()
         .to_string();
@@ -142,7 +142,7 @@ fn only_the_extended_library_knows_the_kind() {
     assert_eq!(plan.passes.len(), 6);
     assert!(library.registry().get("ZonePlate").is_some());
     let Some(ctx) = gpu() else { return };
-    let e = Executor::new(ctx, plan, &Resources::default())
+    let e = lumagraph::pathtrace::library::executor(ctx, plan, &Resources::default())
         .unwrap_err()
         .to_string();
     assert!(

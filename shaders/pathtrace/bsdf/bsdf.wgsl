@@ -16,7 +16,7 @@
 // Kulla-Conty term; rough glass's reflections into the surface, sent back out, and its
 // missing shadowing of the outgoing direction), as Mitsuba's roughconductor and
 // roughdielectric do.
-// The GGX albedo tables (`ggx_table`, computed by crates/render/src/bsdf_tables.rs and
+// The GGX albedo tables (`ggx_table`, computed by crates/pathtrace/src/bsdf_tables.rs and
 // declared by the includer) make the white furnace white at every roughness.
 // Vectors are in the shading frame (normal = +z); wo points to the viewer.
 // Uses nothing its includer must define; what its imports need they declare (`ggx_table`,

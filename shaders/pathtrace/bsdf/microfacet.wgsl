@@ -1,9 +1,9 @@
 // GGX microfacet lobes with Schlick's Fresnel, shared by the material's lobes (bsdf.wgsl)
 // and the clear coat (coat.wgsl): the distribution, height-correlated Smith shadowing,
 // visible-normal sampling, and the albedo tables that make layers over them conserve energy
-// (`ggx_table`, computed by crates/render/src/bsdf_tables.rs).
+// (`ggx_table`, computed by crates/pathtrace/src/bsdf_tables.rs).
 // Vectors are in the shading frame (normal = +z); wo points to the viewer.
-// requires: var ggx_table (the GGX albedo tables of crates/render/src/bsdf_tables.rs:
+// requires: var ggx_table (the GGX albedo tables of crates/pathtrace/src/bsdf_tables.rs:
 //   integrator/pathtrace.wgsl, bsdf/bsdf_check.wgsl)
 #import "common/sampling.wgsl"
 

@@ -5,7 +5,7 @@
 // with the visibility of Estevez and Kulla (2017), V = 1 / ((1 + L(mu_o) + L(mu_i)) 4 mu_o mu_i)
 // clamped to [0, 1], L their fit of the shadowing; f = sheen_color D V. The layers below are
 // scaled by 1 - max(sheen_color) E_s(mu_o) (E_s the lobe's directional albedo at colour 1,
-// from the table crates/render/src/bsdf_tables.rs appends to the GGX tables), as glTF's
+// from the table crates/pathtrace/src/bsdf_tables.rs appends to the GGX tables), as glTF's
 // albedo scaling does. Sampled by the cosine.
 // Uses nothing its includer must define; bsdf/microfacet.wgsl declares the `ggx_table` it
 // reads (the sheen table follows the GGX tables).

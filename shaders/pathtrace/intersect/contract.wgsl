@@ -10,7 +10,7 @@
 // ray leaves skipped and each candidate tested as candidates.wgsl tests it), and this file
 // gives the path tracer the three calls it makes. The binary BVH (bvh.wgsl), the 8-wide BVH
 // (wide_bvh.wgsl) and ray queries (ray_query.wgsl) keep it so; the intersection generated
-// inline for small scenes (crates/render/src/specialize/codegen.rs) writes the three calls
+// inline for small scenes (crates/pathtrace/src/specialize/codegen.rs) writes the three calls
 // itself, each with its own loop over the primitives.
 
 // The closest hit with 0 < t < t_max; hit.prim == NO_HIT on a miss.

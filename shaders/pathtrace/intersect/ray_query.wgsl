@@ -5,7 +5,7 @@
 
 // Scene intersection through the device's ray queries (`enable wgpu_ray_query`, which the
 // renderer puts at the top of the shader): the device's acceleration structure
-// (crates/render/src/accel.rs) finds the candidates, and each is tested here exactly as the
+// (crates/pathtrace/src/accel.rs) finds the candidates, and each is tested here exactly as the
 // BVH traversal of bvh.wgsl tests a leaf's primitives: the same ray/primitive tests, the
 // same rules for rays leaving a surface (`skip_prim`, the origin's error) and the same
 // any-hit test (alpha.wgsl). So the device only replaces the BVH: on GPUs with ray-tracing

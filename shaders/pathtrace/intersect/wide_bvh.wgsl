@@ -6,7 +6,7 @@
 #import "pathtrace/intersect/contract.wgsl"
 
 // Scene intersection through the 8-wide compressed BVH (CWBVH, Ylitie, Karras and Laine,
-// HPG 2017) that crates/render/src/intersect/wide_bvh.rs builds and packs: what the plan calls
+// HPG 2017) that crates/pathtrace/src/intersect/wide_bvh.rs builds and packs: what the plan calls
 // "8-wide BVH". One node holds the boxes of up to eight children on a 256-step grid (a byte
 // a bound); one node read tests them all, and the children hit are visited nearest first by
 // the ray's octant, the rest kept on a short stack as (first child node, hit bits) pairs.

@@ -1,7 +1,7 @@
 // Environment lighting from an equirectangular map. Radiance is Mitsuba's `envmap` lookup:
 // bilinear between texel values placed at u = (x + 1/2) / W (wrapping around) and
 // v = y / (H - 1), so renders compare with Mitsuba's pixel for pixel. Sampling follows the
-// same interpolant (crates/render/src/env_map.rs): a cell between four texel points is drawn
+// same interpolant (crates/pathtrace/src/env_map.rs): a cell between four texel points is drawn
 // with an alias table by its weights (luminance x sin theta), then a point in it from their
 // bilinear interpolant; `a` of each texel is that interpolant's value over its integral, the
 // pdf in (u, v). The includer declares `env_texels: array<vec4f>`, `env_alias:

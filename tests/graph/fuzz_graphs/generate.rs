@@ -8,7 +8,8 @@ use lumagraph::graph::{NodeKind, ParamType, PortType};
 use lumagraph::render::NodeLibrary;
 
 /// The built-in kinds, and their implementations for the runner.
-pub static LIBRARY: LazyLock<NodeLibrary> = LazyLock::new(NodeLibrary::with_builtins);
+pub static LIBRARY: LazyLock<NodeLibrary> =
+    LazyLock::new(lumagraph::pathtrace::library::with_builtins);
 /// Cases in a hundred that have a scene (each compiles the path tracer: slower).
 const SCENE_PERCENT: usize = 4;
 

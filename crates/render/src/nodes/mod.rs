@@ -6,19 +6,18 @@ pub(crate) mod bloom;
 pub(crate) mod blur;
 pub(crate) mod denoise;
 pub mod difference;
-pub(crate) mod gbuffer;
 mod image_input;
 pub mod lut;
 pub(crate) mod multi_layer_output;
 pub mod ocio;
 pub(crate) mod oidn;
 pub mod output;
-pub(crate) mod pathtrace;
 pub mod post_filter;
 pub(crate) mod regression;
 pub(crate) mod temporal;
 pub(crate) mod tonemap;
 
+use std::any::{Any, TypeId};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -45,13 +44,46 @@ pub struct Resources {
     pub working_space: lumagraph_graph::WorkingSpace,
     /// The scene, flattened, for nodes that render one.
     pub scene: Option<Arc<lumagraph_scene::GpuScene>>,
-    /// What the path tracer is asked for beyond its node's params (the command line's
-    /// `--intersector` and `--schedule`, and the knobs tests and benchmarks turn); only
-    /// `PathTrace` reads it.
-    pub tracer: crate::specialize::Tracing,
+    /// What kinds are asked for beyond their nodes' params, a value per type: the path
+    /// tracer's `Tracing` (the command line's `--intersector` and `--schedule`, and the
+    /// knobs tests and benchmarks turn), read only by the kind that defines the type.
+    pub settings: Settings,
     /// What the graph's image-file sources read, per output port, for the sinks that
     /// write it back (filled as they load; see [`crate::image_io::Sources`]).
     pub sources: crate::image_io::Sources,
+}
+
+/// Settings of node kinds beyond their nodes' params, one value per type, each read by the
+/// kind that defines the type (the frame graph names none of them).
+#[derive(Clone, Default)]
+pub struct Settings(Vec<(TypeId, &'static str, Arc<dyn Any + Send + Sync>)>);
+
+impl Settings {
+    /// The value of type `T`, if one was set.
+    pub fn get<T: Any + Send + Sync>(&self) -> Option<&T> {
+        self.0
+            .iter()
+            .find(|(id, _, _)| *id == TypeId::of::<T>())
+            .and_then(|(_, _, v)| v.downcast_ref::<T>())
+    }
+
+    /// Sets the value of type `T`, replacing the one set before.
+    pub fn set<T: Any + Send + Sync>(&mut self, value: T) {
+        self.0.retain(|(id, _, _)| *id != TypeId::of::<T>());
+        self.0.push((
+            TypeId::of::<T>(),
+            std::any::type_name::<T>(),
+            Arc::new(value),
+        ));
+    }
+}
+
+impl std::fmt::Debug for Settings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list()
+            .entries(self.0.iter().map(|(_, name, _)| name))
+            .finish()
+    }
 }
 
 /// An image a sink would write: its pixels and what they are.
@@ -158,10 +190,28 @@ impl Resources {
         )?)
     }
 
-    /// These resources with what the path tracer is asked for changed by `change`.
+    /// These resources with `value` as the setting of its type ([`Settings`]).
     #[must_use]
-    pub fn tracing(mut self, change: impl FnOnce(&mut crate::specialize::Tracing)) -> Self {
-        change(&mut self.tracer);
+    pub fn with<T: Any + Send + Sync>(mut self, value: T) -> Self {
+        self.settings.set(value);
+        self
+    }
+
+    /// The setting of type `T` ([`Settings`]; its default where none was set).
+    pub fn setting<T: Any + Send + Sync + Clone + Default>(&self) -> T {
+        self.settings.get::<T>().cloned().unwrap_or_default()
+    }
+
+    /// These resources with the setting of type `T` changed by `change` (from its default
+    /// where none was set).
+    #[must_use]
+    pub fn with_setting<T: Any + Send + Sync + Clone + Default>(
+        mut self,
+        change: impl FnOnce(&mut T),
+    ) -> Self {
+        let mut value = self.setting::<T>();
+        change(&mut value);
+        self.settings.set(value);
         self
     }
 }
@@ -221,8 +271,22 @@ impl<'r> Recording<'r> {
     }
 }
 
+/// A node's GPU side as [`Any`], so the crate that defines a kind can reach its own node's
+/// state through the [`Executor`](crate::Executor) (`Executor::node`); every `'static` type
+/// has it.
+pub trait AsAny {
+    /// This node as [`Any`].
+    fn as_any(&self) -> &dyn Any;
+}
+
+impl<T: Any> AsAny for T {
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
+
 /// A node's GPU side.
-pub trait NodeExec {
+pub trait NodeExec: AsAny {
     /// Takes new param values (the kind and ports are unchanged).
     ///
     /// # Errors
@@ -260,12 +324,6 @@ pub trait NodeExec {
     /// Lines describing how the node was set up (shader specialization and such).
     fn notes(&self) -> Vec<String> {
         Vec::new()
-    }
-
-    /// What the node's shader compiles in and leaves out, for kinds specialized to the
-    /// scene (tests and tools read the choices here, never from the notes' words).
-    fn shader_features(&self) -> Option<&crate::specialize::Features> {
-        None
     }
 
     /// The node's counters since its last reset (may read back from the GPU).
@@ -382,12 +440,20 @@ pub trait History {
 /// resources (the intersector and schedule asked for) on an adapter with these traits (a CPU
 /// one or a GPU, with or without ray queries); and why the pass would refuse to render, if
 /// it would (an intersector or schedule asked for that cannot trace the scene there).
-pub type ShaderFeatures = fn(
-    &Pass,
-    &lumagraph_scene::GpuScene,
-    &Resources,
-    crate::specialize::AdapterTraits,
-) -> (crate::specialize::Features, Option<String>);
+pub type ShaderFeatures =
+    fn(&Pass, &lumagraph_scene::GpuScene, &Resources, crate::AdapterTraits) -> ShaderChoices;
+
+/// A pass's shader choices for the scene, as [`ShaderFeatures`] finds them: lines that say
+/// what is chosen, compiled in and left out, and why (`lumagraph plan` prints them), and why
+/// the pass would refuse to render, if it would.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ShaderChoices {
+    /// What is chosen, compiled in and left out, with why, a line each.
+    pub lines: Vec<String>,
+    /// Why the pass would refuse to render (an intersector or schedule asked for that
+    /// cannot trace the scene on this adapter), if it would.
+    pub refusal: Option<String>,
+}
 
 /// The size of the image a source produces from its params (paths relative to the folder
 /// given), or why it cannot tell.
@@ -478,16 +544,14 @@ pub fn boxed<N: NodeExec + 'static>(node: Result<N>) -> Result<Box<dyn NodeExec>
 
 /// Every built-in kind with an implementation of its own; with the generic post filters
 /// ([`post_filter`]) they are exactly the built-in registry's kinds (a test checks it).
-/// [`NodeLibrary::with_builtins`](crate::NodeLibrary::with_builtins) starts from them.
+/// [`NodeLibrary::frame_graph`](crate::NodeLibrary::frame_graph) holds them.
 pub static IMPLEMENTATIONS: &[NodeImpl] = &[
     image_input::IMPL,
     multi_layer_output::IMPL,
     ocio::COLOR_SPACE,
     ocio::DISPLAY_VIEW,
-    pathtrace::IMPL,
     accumulate::IMPL,
     temporal::IMPL,
-    gbuffer::IMPL,
     denoise::IMPL,
     regression::IMPL,
     oidn::IMPL,
