@@ -319,7 +319,7 @@ impl Editor {
         if let Err(errs) = result {
             for e in errs.0 {
                 // Inside a group: errors of its nodes, by their ids in the group.
-                let node = e.node.as_deref().map(|n| n.strip_prefix(prefix).ok_or(n));
+                let node = e.about.as_deref().map(|n| n.strip_prefix(prefix).ok_or(n));
                 match node {
                     Some(Ok(n)) => self
                         .errors

@@ -248,7 +248,7 @@ pub fn compile_preview(
 ) -> Result<Plan, String> {
     let messages = |e: lumagraph_graph::GraphErrors| {
         e.0.iter()
-            .map(|e| match &e.node {
+            .map(|e| match e.about.as_deref() {
                 Some(n) => format!("{n}: {}", e.kind),
                 None => e.kind.to_string(),
             })

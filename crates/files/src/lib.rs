@@ -1,14 +1,15 @@
 //! Files as the graph and the scene crates both handle them: [`write_atomic`], the one
 //! writer every lumagraph crate saves through (graphs, scenes, images, checkpoints, lists),
-//! so that readers never see half of a file; and where in a file an error is ([`Pos`],
-//! [`write_location`]), said the same way for graphs and scenes.
+//! so that readers never see half of a file; and errors located in a file ([`Located`]:
+//! the file, the line and column, what it concerns), the one type graph and scene errors
+//! both are, said the same way.
 //!
 //! A leaf crate with no lumagraph dependency, so that crates which do not depend on each
 //! other (the graph and the scene) can share it.
 
 use std::fmt;
 use std::io::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// A line and column in a text file, both starting at 1.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -17,6 +18,84 @@ pub struct Pos {
     pub line: usize,
     /// Column, from 1.
     pub col: usize,
+}
+
+/// An error of kind `K` with where it is: the file, the line and column, and what it
+/// concerns (`S`: a graph's node, a scene's shape or material), each where known. Displayed
+/// as compilers do: `FILE:LINE:COL: WHAT: KIND`.
+#[derive(Debug)]
+pub struct Located<K, S = String> {
+    /// The file, when the error came from one.
+    pub file: Option<PathBuf>,
+    /// Line and column in the file, when known.
+    pub pos: Option<Pos>,
+    /// What the error concerns, when there is one.
+    pub about: Option<S>,
+    /// What went wrong.
+    pub kind: Box<K>,
+}
+
+impl<K, S> Located<K, S> {
+    /// An error with no location yet.
+    pub fn new(kind: K) -> Self {
+        Self {
+            file: None,
+            pos: None,
+            about: None,
+            kind: Box::new(kind),
+        }
+    }
+
+    /// The same error, in `file`, unless it already names one.
+    #[must_use]
+    pub fn in_file(mut self, file: impl Into<PathBuf>) -> Self {
+        if self.file.is_none() {
+            self.file = Some(file.into());
+        }
+        self
+    }
+
+    /// The same error, at `pos`, unless it already has a position.
+    #[must_use]
+    pub fn at(mut self, pos: Option<Pos>) -> Self {
+        if self.pos.is_none() {
+            self.pos = pos;
+        }
+        self
+    }
+
+    /// The same error, about `about`, unless it already names what it concerns.
+    #[must_use]
+    pub fn about(mut self, about: impl Into<S>) -> Self {
+        if self.about.is_none() {
+            self.about = Some(about.into());
+        }
+        self
+    }
+
+    /// The same error, about `about` in place of what it named (an error inside a group
+    /// of nodes is about the group's node in the graph using it).
+    #[must_use]
+    pub fn now_about(mut self, about: impl Into<S>) -> Self {
+        self.about = Some(about.into());
+        self
+    }
+}
+
+impl<K: fmt::Display, S: fmt::Display> fmt::Display for Located<K, S> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let about = self.about.as_ref().map(ToString::to_string);
+        write_location(f, self.file.as_deref(), self.pos, about.as_deref())?;
+        write!(f, "{}", self.kind)
+    }
+}
+
+impl<K: std::error::Error + 'static, S: fmt::Debug + fmt::Display> std::error::Error
+    for Located<K, S>
+{
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.kind.source()
+    }
 }
 
 /// Writes where an error is, as compilers do: `FILE:LINE:COL: ` (the position only with a

@@ -15,7 +15,7 @@ use std::sync::Arc;
 use petgraph::algo::{tarjan_scc, toposort};
 use petgraph::graph::{DiGraph, NodeIndex};
 
-use crate::error::{ErrorKind, GraphError, GraphErrors};
+use crate::error::{ErrorKind, GraphError, GraphErrors, NodeId};
 use crate::graph::{Graph, Node, split_port_ref};
 use crate::plan::{LeftOut, Pass, Plan, Slot, TextureDesc, TextureId};
 use crate::registry::{NodeKind, Registry};
@@ -205,7 +205,7 @@ pub fn compile(
                     .map(|&i| format!("\"{}\"", graph.nodes[i].id))
                     .collect();
                 let e = GraphError::new(ErrorKind::Cycle(names.join(", ")))
-                    .at_node(&graph.nodes[ids[0]].id);
+                    .now_about(&graph.nodes[ids[0]].id);
                 errors.push(graph.locate(e, None, None));
             }
         }
@@ -259,7 +259,7 @@ pub fn compile(
                 let e = GraphError::new(ErrorKind::UnconnectedInput {
                     port: input.name.to_owned(),
                 })
-                .at_node(&node.id);
+                .now_about(&node.id);
                 errors.push(graph.locate(e, None, None));
             }
         }
@@ -303,7 +303,7 @@ fn check_nodes<'g>(
     let mut params = Vec::with_capacity(graph.nodes.len());
     for node in &graph.nodes {
         let err = |kind: ErrorKind, param: Option<&str>| {
-            graph.locate(GraphError::new(kind).at_node(&node.id), None, param)
+            graph.locate(GraphError::new(kind).now_about(&node.id), None, param)
         };
         if node.id.is_empty()
             || !node
@@ -360,7 +360,7 @@ fn check_edges<'g>(
     for (e_i, edge) in graph.edges.iter().enumerate() {
         let mut fail = |kind: ErrorKind, node: Option<&str>| {
             let mut e = GraphError::new(kind);
-            e.node = node.map(str::to_owned);
+            e.about = node.map(NodeId::from);
             errors.push(graph.locate(e, Some(e_i), None));
         };
         let (Some((from_node, from_port)), Some((to_node, to_port))) =
@@ -481,7 +481,7 @@ fn build_plan(
         let params = checked.params[i].clone();
         let located = |m: String, param: Option<&str>| {
             graph.locate(
-                GraphError::new(ErrorKind::Source(m)).at_node(&node.id),
+                GraphError::new(ErrorKind::Source(m)).now_about(&node.id),
                 None,
                 param,
             )

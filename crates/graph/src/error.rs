@@ -2,7 +2,6 @@
 //! node it concerns.
 
 use std::fmt;
-use std::path::PathBuf;
 
 pub use lumagraph_files::Pos;
 
@@ -137,49 +136,29 @@ pub enum ErrorKind {
     OutsideOutput(crate::outputs::OutsideOutput),
 }
 
-/// One error with its location.
-#[derive(Debug)]
-pub struct GraphError {
-    /// The graph file, when the graph came from one.
-    pub file: Option<PathBuf>,
-    /// Line and column in the file, when known.
-    pub pos: Option<Pos>,
-    /// The node concerned, when there is one.
-    pub node: Option<String>,
-    /// What went wrong.
-    pub kind: Box<ErrorKind>,
-}
+/// One error with its location: the graph file, the line and column, the node.
+pub type GraphError = lumagraph_files::Located<ErrorKind, NodeId>;
 
-impl GraphError {
-    /// An error with no location yet.
-    pub fn new(kind: ErrorKind) -> Self {
-        Self {
-            file: None,
-            pos: None,
-            node: None,
-            kind: Box::new(kind),
-        }
-    }
+/// The node a graph error concerns, by id (displayed as `node "ID"`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct NodeId(pub String);
 
-    /// The same error, about `node`.
-    #[must_use]
-    pub fn at_node(mut self, node: &str) -> Self {
-        self.node = Some(node.to_owned());
-        self
+impl std::ops::Deref for NodeId {
+    type Target = str;
+    fn deref(&self) -> &str {
+        &self.0
     }
 }
 
-impl fmt::Display for GraphError {
+impl<T: AsRef<str> + ?Sized> From<&T> for NodeId {
+    fn from(id: &T) -> Self {
+        Self(id.as_ref().to_owned())
+    }
+}
+
+impl fmt::Display for NodeId {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let node = self.node.as_ref().map(|n| format!("node \"{n}\""));
-        lumagraph_files::write_location(f, self.file.as_deref(), self.pos, node.as_deref())?;
-        write!(f, "{}", self.kind)
-    }
-}
-
-impl std::error::Error for GraphError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        std::error::Error::source(&*self.kind)
+        write!(f, "node \"{}\"", self.0)
     }
 }
 
@@ -192,7 +171,7 @@ impl GraphErrors {
     pub fn for_node<'a>(&'a self, node: &'a str) -> impl Iterator<Item = &'a GraphError> + 'a {
         self.0
             .iter()
-            .filter(move |e| e.node.as_deref() == Some(node))
+            .filter(move |e| e.about.as_deref() == Some(node))
     }
 }
 

@@ -441,7 +441,7 @@ impl Graph {
     ) -> GraphError {
         if let Some(origin) = &self.origin {
             e.file = Some(origin.path.clone());
-            e.pos = match (edge, &e.node, param) {
+            e.pos = match (edge, e.about.as_deref(), param) {
                 (Some(i), _, _) => origin.edge_pos(i),
                 (None, Some(node), Some(p)) => origin.param_pos(node, p),
                 (None, Some(node), None) => origin.node_pos(node),

@@ -417,7 +417,7 @@ fn expand(
                 let e = GraphError::new(ErrorKind::Source(format!(
                     "groups nest deeper than {MAX_DEPTH}"
                 )));
-                errors.push(graph.locate(e.at_node(&node.id), None, None));
+                errors.push(graph.locate(e.now_about(&node.id), None, None));
             } else {
                 expand_group(graph, node, group, depth, &mut out, errors);
             }
@@ -503,7 +503,7 @@ fn expand_group(
                     known.join(", ")
                 },
             });
-            errors.push(graph.locate(e.at_node(&node.id), None, Some(name)));
+            errors.push(graph.locate(e.now_about(&node.id), None, Some(name)));
             continue;
         };
         for (id, param) in targets.iter().filter_map(|t| split_port_ref(t)) {
@@ -541,7 +541,7 @@ fn rewire(graph: &Graph, registry: &Registry, out: &mut Expanded, errors: &mut V
                 "edge {} -> {}: the group node \"{node}\" has no {what} \"{port}\"",
                 e.from, e.to
             )));
-            graph.locate(e.at_node(node), Some(i), None)
+            graph.locate(e.now_about(node), Some(i), None)
         };
         let from = match group_port(&e.from, false) {
             Some(true) => out.outputs[&e.from].clone(),

@@ -25,7 +25,7 @@ mod types;
 pub mod working_space;
 
 pub use compile::{CompileOptions, Params, compile, resolve_params};
-pub use error::{ErrorKind, GraphError, GraphErrors, Pos};
+pub use error::{ErrorKind, GraphError, GraphErrors, NodeId, Pos};
 pub use graph::{
     Edge, FrameDecl, Graph, Node, Origin, Rgb, VERSION, read_text, split_port_ref, write_atomic,
 };

@@ -131,7 +131,7 @@ pub fn output_files(
                     path,
                 }),
                 Err(e) => {
-                    let e = GraphError::new(ErrorKind::OutsideOutput(e)).at_node(&pass.node);
+                    let e = GraphError::new(ErrorKind::OutsideOutput(e)).now_about(&pass.node);
                     errors.push(graph.locate(e, None, Some(def.name)));
                 }
             }

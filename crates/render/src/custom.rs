@@ -424,7 +424,7 @@ pub fn check_group(graph: &Graph, registry: Registry) -> Result<NodeKind, GraphE
                 "unknown node kind \"{}\"",
                 node.kind
             )))
-            .at_node(&node.id);
+            .now_about(&node.id);
             errors.push(graph.locate(e, None, None));
             continue;
         };
@@ -433,7 +433,7 @@ pub fn check_group(graph: &Graph, registry: Registry) -> Result<NodeKind, GraphE
         }
         if let Err(found) = lumagraph_graph::resolve_params(node, kind) {
             for (param, kind) in found {
-                let e = GraphError::new(kind).at_node(&node.id);
+                let e = GraphError::new(kind).now_about(&node.id);
                 errors.push(graph.locate(e, None, Some(&param)));
             }
         }

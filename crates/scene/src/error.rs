@@ -1,9 +1,6 @@
 //! Scene errors: each names the file, the line and column when known, and the shape or
 //! material it concerns.
 
-use std::fmt;
-use std::path::PathBuf;
-
 pub use lumagraph_files::Pos;
 
 /// What went wrong.
@@ -119,76 +116,10 @@ impl From<gltf::Error> for ErrorKind {
     }
 }
 
-/// One scene error with its location.
-#[derive(Debug)]
-pub struct SceneError {
-    /// The file concerned (the scene file, or the mesh file it references).
-    pub file: Option<PathBuf>,
-    /// Line and column in the file, when known.
-    pub pos: Option<Pos>,
-    /// The shape or material concerned, e.g. `shape "floor"` or `material "white"`.
-    pub item: Option<String>,
-    /// What went wrong.
-    pub kind: ErrorKind,
-}
-
-impl SceneError {
-    /// An error with no location yet.
-    pub fn new(kind: ErrorKind) -> Self {
-        Self {
-            file: None,
-            pos: None,
-            item: None,
-            kind,
-        }
-    }
-
-    /// The same error, in `file`, unless it already names one.
-    #[must_use]
-    pub fn in_file(mut self, file: impl Into<PathBuf>) -> Self {
-        if self.file.is_none() {
-            self.file = Some(file.into());
-        }
-        self
-    }
-
-    /// The same error, at `pos`, unless it already has a position.
-    #[must_use]
-    pub fn at(mut self, pos: Option<Pos>) -> Self {
-        if self.pos.is_none() {
-            self.pos = pos;
-        }
-        self
-    }
-
-    /// The same error, about `item` (e.g. `shape "floor"`), unless it already names one.
-    #[must_use]
-    pub fn about(mut self, item: impl Into<String>) -> Self {
-        if self.item.is_none() {
-            self.item = Some(item.into());
-        }
-        self
-    }
-}
-
-impl<E: Into<ErrorKind>> From<E> for SceneError {
-    fn from(e: E) -> Self {
-        Self::new(e.into())
-    }
-}
-
-impl fmt::Display for SceneError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        lumagraph_files::write_location(f, self.file.as_deref(), self.pos, self.item.as_deref())?;
-        write!(f, "{}", self.kind)
-    }
-}
-
-impl std::error::Error for SceneError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        std::error::Error::source(&self.kind)
-    }
-}
+/// One scene error with its location: the file (the scene file, or the mesh file it
+/// references), the line and column, and the shape or material concerned (e.g.
+/// `shape "floor"`, `material "white"`).
+pub type SceneError = lumagraph_files::Located<ErrorKind>;
 
 /// What [`ErrorKind::TooManyInstancedTriangles`] names.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -203,4 +134,10 @@ pub struct InstancedCopies {
     pub total: u64,
     /// The limit.
     pub max: u64,
+}
+
+impl From<ErrorKind> for SceneError {
+    fn from(kind: ErrorKind) -> Self {
+        Self::new(kind)
+    }
 }

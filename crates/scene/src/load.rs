@@ -629,7 +629,7 @@ impl<'a> Builder<'a> {
     fn build(mut self, file: &SceneFile) -> Result<Scene, SceneError> {
         for (name, desc) in &file.materials {
             let m = material_from_desc(name, desc).map_err(|e| {
-                let field = match &e.kind {
+                let field = match &*e.kind {
                     ErrorKind::BadValue { field, .. } => Some(*field),
                     _ => None,
                 };
@@ -649,7 +649,7 @@ impl<'a> Builder<'a> {
             self.shape(shape)
                 .and_then(|()| self.check_medium(&label, first_tri, first_shape))
                 .map_err(|e| {
-                    let needle = match &e.kind {
+                    let needle = match &*e.kind {
                         ErrorKind::UnknownMaterial { material, .. } => format!("\"{material}\""),
                         ErrorKind::BadValue { field, .. } => (*field).to_owned(),
                         _ => String::new(),
@@ -663,7 +663,7 @@ impl<'a> Builder<'a> {
                     Some(n) => format!("light \"{n}\""),
                     None => format!("light {i} ({})", light.kind()),
                 };
-                let needle = match &e.kind {
+                let needle = match &*e.kind {
                     ErrorKind::BadValue { field, .. } => *field,
                     _ => "",
                 };

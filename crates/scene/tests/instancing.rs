@@ -179,7 +179,7 @@ fn copies_over_the_limit_are_refused_and_emitters_are_copied() {
     );
     let err = Scene::from_ron(&text, &common::assets()).unwrap_err();
     assert!(
-        matches!(&err.kind, ErrorKind::TooManyInstancedTriangles(c) if c.instances == 1007),
+        matches!(&*err.kind, ErrorKind::TooManyInstancedTriangles(c) if c.instances == 1007),
         "{err}"
     );
     assert!(err.to_string().contains("instancing: On"), "{err}");

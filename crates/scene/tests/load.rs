@@ -45,7 +45,7 @@ fn minimal_scene_and_defaults() {
 fn syntax_error_names_line_and_column() {
     let text = MINIMAL.replace("radius: 1,", "radius: 1,,");
     let e = parse(&text).unwrap_err();
-    assert!(matches!(e.kind, ErrorKind::Syntax(_)), "{e}");
+    assert!(matches!(*e.kind, ErrorKind::Syntax(_)), "{e}");
     let pos = e.pos.unwrap();
     assert_eq!(pos.line, 6, "{e}");
     assert!(pos.col > 50, "{e}");
@@ -69,7 +69,7 @@ fn file_errors_name_the_file() {
     let msg = e.to_string();
     assert!(msg.starts_with(&format!("{}:3:", path.display())), "{msg}");
     let e = Scene::load(Path::new("/nonexistent/scene.ron")).unwrap_err();
-    assert!(matches!(e.kind, ErrorKind::Io { .. }), "{e}");
+    assert!(matches!(*e.kind, ErrorKind::Io { .. }), "{e}");
 }
 
 #[test]
@@ -77,7 +77,10 @@ fn unknown_material_names_shape_and_position() {
     let text = MINIMAL.replace("material: \"white\"", "material: \"whte\"");
     let e = parse(&text).unwrap_err();
     let msg = e.to_string();
-    assert!(matches!(e.kind, ErrorKind::UnknownMaterial { .. }), "{msg}");
+    assert!(
+        matches!(*e.kind, ErrorKind::UnknownMaterial { .. }),
+        "{msg}"
+    );
     assert!(msg.contains("shape \"ball\""), "{msg}");
     assert!(msg.contains("\"whte\"") && msg.contains("white"), "{msg}");
     let pos = e.pos.unwrap();
@@ -99,7 +102,10 @@ fn semantic_errors_name_item() {
     );
     assert_eq!(e.pos.unwrap().line, 4);
     let e = parse(&MINIMAL.replace("version: 1", "version: 7")).unwrap_err();
-    assert!(matches!(e.kind, ErrorKind::Version { found: 7, .. }), "{e}");
+    assert!(
+        matches!(*e.kind, ErrorKind::Version { found: 7, .. }),
+        "{e}"
+    );
     let e = parse(&MINIMAL.replace("fov_y: 40", "fov_y: 190")).unwrap_err();
     assert!(e.to_string().contains("camera: fov_y"), "{e}");
 }

@@ -345,7 +345,7 @@ fn materials_are_added_and_removed() {
 fn shapes_lights_and_version_are_not_edited() {
     let text = asset("cornell.ron");
     let not_editable = |edited: &SceneFile| match save::write(&text, edited) {
-        Err(e) => match e.kind {
+        Err(e) => match *e.kind {
             ErrorKind::NotEditable(what) => what,
             other => panic!("{other}"),
         },
@@ -611,7 +611,7 @@ fn save_writes_atomically_and_names_the_file() {
     // A folder that does not exist: an error naming the file.
     let missing = dir.join("missing/scene.ron");
     let err = save::save(&missing, &text, &parse(&text)).unwrap_err();
-    assert!(matches!(err.kind, ErrorKind::Write { .. }), "{err}");
+    assert!(matches!(*err.kind, ErrorKind::Write { .. }), "{err}");
     assert_eq!(err.file.as_deref(), Some(missing.as_path()));
 }
 

@@ -50,7 +50,8 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
     let (file, unread) = open(path)?;
     check_images(&file.document)?;
     check_uris(&file.document, path.parent())?;
-    let buffers = ::gltf::import_buffers(&file.document, path.parent(), file.blob.clone())?;
+    let buffers = ::gltf::import_buffers(&file.document, path.parent(), file.blob.clone())
+        .map_err(ErrorKind::from)?;
     let doc = &file.document;
     check_views(doc, &buffers)?;
     check_tree(doc)?;
@@ -224,7 +225,9 @@ fn read_mesh(
 /// accessor) and what lumagraph does not read ([`super::gltf_extensions::check`]: an error
 /// for a required extension, the warnings returned for the rest).
 fn open(path: &Path) -> Result<(::gltf::Gltf, Vec<String>), SceneError> {
-    let bytes = std::fs::read(path).map_err(::gltf::Error::Io)?;
+    let bytes = std::fs::read(path)
+        .map_err(::gltf::Error::Io)
+        .map_err(ErrorKind::from)?;
     let file = path
         .file_name()
         .map_or_else(String::new, |f| f.to_string_lossy().into_owned());
@@ -241,7 +244,7 @@ fn open(path: &Path) -> Result<(::gltf::Gltf, Vec<String>), SceneError> {
             ))));
         }
     }
-    let unchecked = ::gltf::Gltf::from_slice_without_validation(&bytes)?;
+    let unchecked = ::gltf::Gltf::from_slice_without_validation(&bytes).map_err(ErrorKind::from)?;
     let json = unchecked.document.as_json();
     for (m, mesh) in json.meshes.iter().enumerate() {
         for (p, prim) in mesh.primitives.iter().enumerate() {
@@ -262,7 +265,7 @@ fn open(path: &Path) -> Result<(::gltf::Gltf, Vec<String>), SceneError> {
     // them from the raw JSON where the gltf crate does not know them: its validation would
     // refuse those.
     root.extensions_required.clear();
-    let document = ::gltf::Document::from_json(root)?;
+    let document = ::gltf::Document::from_json(root).map_err(ErrorKind::from)?;
     Ok((
         ::gltf::Gltf {
             document,

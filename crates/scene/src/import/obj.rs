@@ -29,7 +29,9 @@ pub fn import_obj(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneErr
         single_index: true,
         ..tobj::LoadOptions::default()
     };
-    let text = std::fs::read(path).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+    let text = std::fs::read(path)
+        .map_err(|_| tobj::LoadError::OpenFileFailed)
+        .map_err(ErrorKind::from)?;
     if let Some(problem) = check_obj(&String::from_utf8_lossy(&text)) {
         return Err(SceneError::new(ErrorKind::ObjData(problem)));
     }
@@ -50,7 +52,8 @@ pub fn import_obj(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneErr
             return Err(tobj::LoadError::MaterialParseError);
         }
         tobj::load_mtl_buf(&mut text.as_slice())
-    })?;
+    })
+    .map_err(ErrorKind::from)?;
     let mut out = ImportedMesh::default();
     match materials {
         Ok(mats) => {
