@@ -166,15 +166,16 @@ fn difference_refuses_a_reference_of_another_size() {
         ],
         ..Graph::default()
     };
-    let e = lumagraph::pathtrace::library::compile_with(
-        &graph,
-        &lumagraph::graph::Registry::with_builtins(),
-        &common::root(),
-        &["diff.heat".to_owned()],
-        None,
-    )
-    .unwrap_err()
-    .to_string();
+    let e = lumagraph::pathtrace::library::builtins()
+        .compile_with(
+            &graph,
+            &lumagraph::graph::Registry::with_builtins(),
+            &common::root(),
+            &["diff.heat".to_owned()],
+            None,
+        )
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("diff") && e.contains("7x5"), "{e}");
 }
 
