@@ -929,6 +929,8 @@ fn test_chart(out: &Path) -> Result<()> {
 /// Call it at the start of `main`, before the program starts threads: it may set one
 /// environment variable for the Vulkan loader (see [`GpuContext::quiet_device_select`]).
 pub fn main_with(library: NodeLibrary) -> ExitCode {
+    #[cfg(unix)]
+    end_quietly_on_a_closed_pipe();
     GpuContext::quiet_device_select();
     crate::overrides::apply();
     let cli = Cli::parse();
@@ -950,6 +952,19 @@ pub fn main_with(library: NodeLibrary) -> ExitCode {
             }
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Output piped into a program that stops reading (`lumagraph nodes | head`) ends the
+/// process quietly at that write, as other command-line tools do. Rust starts programs with
+/// SIGPIPE ignored, so the write fails instead and `println!` panics.
+#[cfg(unix)]
+#[allow(unsafe_code)]
+fn end_quietly_on_a_closed_pipe() {
+    // SAFETY: restores SIGPIPE's default action at start-up; no handler of ours is
+    // installed and no memory is shared with one.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 

@@ -158,6 +158,26 @@ fn validate_and_nodes() {
     assert!(help.contains("Examples:"), "{help}");
 }
 
+/// Output piped into a reader that stops (`lumagraph nodes --markdown | head`) ends the
+/// process quietly: no panic message on stderr. The reader's end is closed before the
+/// program writes its first line.
+#[cfg(unix)]
+#[test]
+fn a_closed_pipe_ends_the_output_without_a_panic() {
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lumagraph"))
+        .args(["nodes", "--markdown"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(stderr.is_empty(), "{stderr}");
+}
+
 #[test]
 fn docs_node_reference_is_up_to_date() {
     let generated = lumagraph::graph::docs::markdown(&lumagraph::graph::Registry::with_builtins());
