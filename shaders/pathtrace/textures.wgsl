@@ -181,7 +181,7 @@ fn textured_emission(m: Material, uv: vec4f) -> vec3f {
 }
 
 // `m` with its textures and the vertex colour `color` applied at `uv` (footprint `lod`, see
-// `tex_sample_lod`): base color x texture
+// `tex_sample_lod`; emission at level 0): base color x texture
 // (sRGB; alpha is the any-hit test's) x vertex colour, roughness x G and metallic x B of the
 // metallic-roughness texture, emission x texture (sRGB), transmission x R of the
 // transmission texture, specular x A of the specular texture, specular colour x the specular
@@ -199,7 +199,10 @@ fn textured_material(m_in: Material, uv: vec4f, lod: vec2f, color: vec4f) -> Mat
         if id == NO_TEX {
             continue;
         }
-        let t = tex_sample_lod(id, uv, lod, tex_slot_srgb(k));
+        // Emission at level 0, as light sampling reads it (`textured_emission`): the two
+        // strategies MIS weighs must see one emitter, or the mix is neither.
+        let footprint = select(lod, vec2f(TEX_LOD_NONE), k == 2u);
+        let t = tex_sample_lod(id, uv, footprint, tex_slot_srgb(k));
         switch k {
             case 0u: { m.base_color *= t.rgb; }
             case 1u: {
