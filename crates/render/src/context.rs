@@ -287,7 +287,7 @@ impl GpuContext {
         let experimental_features = if features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
             // SAFETY: wgpu marks ray queries experimental (its API may change, and bugs in
             // it may be undefined behaviour). lumagraph uses them only through
-            // `crate::accel` and `pathtrace/intersect/ray_query.wgsl`, whose images the tests compare
+            // `lumagraph_pathtrace::accel` and `pathtrace/intersect/ray_query.wgsl`, whose images the tests compare
             // with the WGSL BVH's; `turn_off_ray_queries` leaves them out.
             unsafe { wgpu::ExperimentalFeatures::enabled() }
         } else {
@@ -308,7 +308,7 @@ impl GpuContext {
         // nodes): every desktop GPU and lavapipe have it; a shader that samples needs it.
         let mut f = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::FLOAT32_FILTERABLE;
         // Ray queries: the path tracer's intersector where the device has them
-        // (`crate::accel`), unless LUMAGRAPH_RAY_QUERY=off.
+        // (`lumagraph_pathtrace::accel`), unless LUMAGRAPH_RAY_QUERY=off.
         if !ray_queries_turned_off() {
             f |= wgpu::Features::EXPERIMENTAL_RAY_QUERY;
         }

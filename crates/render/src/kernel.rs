@@ -53,7 +53,7 @@ pub enum Binding {
         /// Whether the shader only reads it.
         read_only: bool,
     },
-    /// `acceleration_structure` (ray queries, [`crate::accel`]).
+    /// `acceleration_structure` (ray queries, `lumagraph_pathtrace::accel`).
     AccelerationStructure,
 }
 

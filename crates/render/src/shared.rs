@@ -17,7 +17,7 @@ pub const WAVE_HOT_VEC4S: u32 = 3;
 /// ... the path state it moves now and then ...
 pub const WAVE_COLD_VEC4S: u32 = 4;
 /// ... then, section after section over all the slots: the rays of a step
-/// ([`WaveRays`], from [`WAVE_RAYS_AT`]), the hit of the next ray ([`crate::embree::HostHit`],
+/// ([`WaveRays`], from [`WAVE_RAYS_AT`]), the hit of the next ray (`lumagraph_pathtrace::embree::HostHit`,
 /// from [`WAVE_HITS_AT`]), and the list of the slots to step (from [`WAVE_LIST_AT`]: their
 /// count, then each slot's index).
 pub const WAVE_RAYS_VEC4S: u32 = 3;
@@ -31,7 +31,7 @@ pub const WAVE_LIST_AT: u32 = WAVE_HITS_AT + 1;
 /// per slot fit in a vec4 per slot), the instance of each listed position's hit (a word
 /// per slot: its node slot, or `NO_INSTANCE`). The wavefront keeps its own sections there.
 pub const WAVE_INSTS_AT: u32 = WAVE_LIST_AT + 1;
-/// The wavefront ([`crate::wavefront`]) keeps, in the host's list's place, how each step's
+/// The wavefront (`lumagraph_pathtrace`'s `wavefront`) keeps, in the host's list's place, how each step's
 /// rays leave their surface (`WAVE_LEAVE_VEC4S` vec4 per listed position, from
 /// [`WAVE_LIST_AT`]) ...
 pub const WAVE_LEAVE_VEC4S: u32 = 2;
@@ -63,7 +63,7 @@ pub const WAVE_FINISH: u32 = 2;
 pub const LIGHT_UNIFORM_SHARE: f32 = lumagraph_scene::LIGHT_UNIFORM_SHARE;
 
 /// The custom data of the ray queries' instance of the triangles' boxes
-/// ([`crate::accel`], `pathtrace/intersect/ray_query.wgsl`).
+/// (`lumagraph_pathtrace::accel`, `pathtrace/intersect/ray_query.wgsl`).
 pub const ACCEL_TRIANGLES: u32 = 0;
 /// The custom data of the ray queries' instance of the analytic shapes' boxes.
 pub const ACCEL_SHAPES: u32 = 1;

@@ -35,7 +35,7 @@
 //! direction's sign on the node's `axis` gives (the second child first when negative), so
 //! the depth-first order in which a ray visits the nodes depends only on its direction's
 //! octant (the signs of its three components). For each node and each of the 8 octants,
-//! [`FlatBvh::skips`] holds the node that comes after the node's subtree in that order,
+//! `FlatBvh::skips` holds the node that comes after the node's subtree in that order,
 //! or [`BVH_END`]: where a ray goes after a leaf, or after an inner node whose box it
 //! misses. After an inner node whose box it meets, it goes to the near child. This visits
 //! the nodes in the order a stack traversal would (push the far child, pop after a leaf or

@@ -37,7 +37,7 @@ pub struct GpuScene {
     /// Triangle intersection data in BVH order (buffer `tri_positions`).
     pub tri_positions: Vec<GpuTriangle>,
     /// Each GPU triangle's corners in BVH order, as the scene gave them (CPU side only: the
-    /// host intersector, `lumagraph_render::embree`).
+    /// host intersector, `lumagraph_pathtrace::embree`).
     pub tri_corners: Vec<[[f32; 3]; 3]>,
     /// Triangle shading data, same order (buffer `tri_shading`).
     pub tri_shading: Vec<GpuTriShading>,

@@ -1,6 +1,6 @@
 //! lumagraph scenes, with no GPU in sight.
 //!
-//! - [`file`]: the RON scene format (`version: 2`): camera, named materials, shapes
+//! - [`file`](mod@file): the RON scene format (`version: 2`): camera, named materials, shapes
 //!   (meshes, spheres, Mitsuba-style rectangles and boxes, quads), point, spot and
 //!   directional lights, environment, render settings. [`Scene::load`] reads it into a [`Scene`] with world-space triangles.
 //! - [`import`]: glTF 2.0 and OBJ + MTL meshes, cameras, materials and

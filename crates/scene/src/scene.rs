@@ -458,7 +458,7 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// World-space triangles.
     pub triangles: Vec<Triangle>,
-    /// Meshes placed several times, stored once each ([`Scene::instancing`] decides which
+    /// Meshes placed several times, stored once each (the render settings' `instancing` decides which
     /// stay so and which become copies in `triangles`).
     pub instanced: Vec<InstancedMesh>,
     /// Analytic shapes (spheres, disks, …).
