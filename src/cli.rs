@@ -3,11 +3,11 @@
 //! of its own is the whole `lumagraph` command with its kinds in it:
 //!
 //! ```no_run
-//! use lumagraph::render::NodeLibrary;
+//! use lumagraph::pathtrace::library;
 //!
 //! fn main() -> std::process::ExitCode {
-//!     // crate::pathtrace::library::with_builtins().with_kind(…) for kinds of its own.
-//!     lumagraph::cli::main_with(crate::pathtrace::library::with_builtins())
+//!     // library::with_builtins().with_kind(…) for kinds of its own.
+//!     lumagraph::cli::main_with(library::with_builtins())
 //! }
 //! ```
 
