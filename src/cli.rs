@@ -589,7 +589,9 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
             .or(scene.as_ref().map(|s| s.scene.settings.spp))
             .unwrap_or(1);
         let mut checkpoints = args.checkpoints.clone();
-        checkpoints.key = crate::session::render_key(&graph, scene.as_ref().map(|s| &*s.gpu));
+        let (g, s) = (graph.clone(), scene.as_ref().map(|s| Arc::clone(&s.gpu)));
+        checkpoints.key =
+            progressive::Key::new(move || crate::session::render_key(&g, s.as_deref()));
         let mut session = Session::from_executor(
             exec,
             graph,
@@ -929,6 +931,7 @@ fn test_chart(out: &Path) -> Result<()> {
 /// Call it at the start of `main`, before the program starts threads: it may set one
 /// environment variable for the Vulkan loader (see [`GpuContext::quiet_device_select`]).
 pub fn main_with(library: NodeLibrary) -> ExitCode {
+    progressive::started();
     GpuContext::quiet_device_select();
     crate::overrides::apply();
     let cli = Cli::parse();
