@@ -279,8 +279,8 @@ fn obj_textures_are_read() {
 /// reduced afterwards.
 #[test]
 fn a_diffuse_gltf_decodes_only_its_base_colours() {
-    use lumagraph_scene::import::import_mesh_with;
     use lumagraph_scene::NO_TEXTURE;
+    use lumagraph_scene::import::import_mesh_with;
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     png(&d.join("rough.png"), 2, 2, |x, y| {
