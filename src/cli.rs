@@ -537,6 +537,8 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
         return frames::render(args, frames, *skip_missing);
     }
     let graph = load(args.graph, args.overrides)?;
+    // The adapter and device are made on a thread of their own while the scene loads.
+    let device = std::thread::spawn(GpuContext::headless);
     let mut scene = load_scene(args.scene)?;
     let plan = args
         .library
@@ -546,7 +548,9 @@ fn render(args: &RenderArgs<'_>) -> Result<()> {
     if scene.is_some() && !progressive {
         println!("scene not used: no node of this graph renders a scene");
     }
-    let ctx = GpuContext::headless()?;
+    let ctx = device
+        .join()
+        .unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
     println!("adapter: {}", ctx.describe());
     if let (Some(s), true) = (scene.as_mut(), progressive) {
         fit_textures(s, &ctx, args.textures)?;
