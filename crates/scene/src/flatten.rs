@@ -415,53 +415,30 @@ impl GpuScene {
                 Aabb::new(lo.into(), hi.into())
             })
             .collect();
-        let textured = surface_attributes(scene);
-        check_textures(scene)?;
-        // The texture atlas (its mip chains included) is packed on a thread of its own
-        // while the BVHs are built: neither reads the other.
-        let (built, atlas) = std::thread::scope(|s| {
-            let atlas = textured.then(|| {
-                s.spawn(|| {
-                    let packing = std::time::Instant::now();
-                    let srgb = scene.settings.texture_mips.then(|| texture_srgb(scene));
-                    let atlas = crate::texture::pack_atlas_with(&scene.textures, srgb.as_deref());
-                    (srgb, atlas, packing.elapsed())
-                })
+        let bvh_started = std::time::Instant::now();
+        // One BVH per mesh, in its own space; its root's box is the mesh's.
+        let meshes: Vec<bvh::FlatBvh> = scene
+            .instanced
+            .iter()
+            .map(|m| {
+                let boxes: Vec<Aabb> = m.triangles.iter().map(triangle_box).collect();
+                bvh::build(&boxes, &[], &[], options)
+            })
+            .collect::<Result<_, _>>()?;
+        // Each instance's box: its mesh's box, transformed.
+        let mut placed = Vec::new();
+        let mut instance_boxes = Vec::new();
+        for (mesh, (m, flat)) in scene.instanced.iter().zip(&meshes).enumerate() {
+            let root = flat.nodes.first().map_or_else(Aabb::empty, |n| {
+                Aabb::new(Vec3A::from(n.aabb_min), Vec3A::from(n.aabb_max))
             });
-            let built = (|| {
-                let bvh_started = std::time::Instant::now();
-                // One BVH per mesh, in its own space; its root's box is the mesh's.
-                let meshes: Vec<bvh::FlatBvh> = scene
-                    .instanced
-                    .iter()
-                    .map(|m| {
-                        let boxes: Vec<Aabb> = m.triangles.iter().map(triangle_box).collect();
-                        bvh::build(&boxes, &[], &[], options)
-                    })
-                    .collect::<Result<_, _>>()?;
-                // Each instance's box: its mesh's box, transformed.
-                let mut placed = Vec::new();
-                let mut instance_boxes = Vec::new();
-                for (mesh, (m, flat)) in scene.instanced.iter().zip(&meshes).enumerate() {
-                    let root = flat.nodes.first().map_or_else(Aabb::empty, |n| {
-                        Aabb::new(Vec3A::from(n.aabb_min), Vec3A::from(n.aabb_max))
-                    });
-                    for t in &m.transforms {
-                        placed.push((mesh as u32, *t));
-                        instance_boxes.push(transformed_box(&root, t));
-                    }
-                }
-                let flat = bvh::build(&tri_boxes, &shape_boxes, &instance_boxes, options)?;
-                *bvh_time = bvh_started.elapsed();
-                Ok::<_, SceneError>((meshes, placed, flat))
-            })();
-            let atlas = atlas.map(|t| {
-                t.join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
-            });
-            (built, atlas)
-        });
-        let (meshes, placed, flat) = built?;
+            for t in &m.transforms {
+                placed.push((mesh as u32, *t));
+                instance_boxes.push(transformed_box(&root, t));
+            }
+        }
+        let flat = bvh::build(&tri_boxes, &shape_boxes, &instance_boxes, options)?;
+        *bvh_time = bvh_started.elapsed();
 
         let mut out = Self {
             materials: scene.materials.iter().map(GpuMaterial::from).collect(),
@@ -475,10 +452,14 @@ impl GpuScene {
             },
             ..Self::default()
         };
-        if let Some((srgb, atlas, took)) = atlas {
-            out.texture_srgb = srgb;
-            out.atlas = atlas;
-            out.atlas_time = took;
+        let textured = surface_attributes(scene);
+        check_textures(scene)?;
+        if textured {
+            let packing = std::time::Instant::now();
+            out.texture_srgb = scene.settings.texture_mips.then(|| texture_srgb(scene));
+            out.atlas =
+                crate::texture::pack_atlas_with(&scene.textures, out.texture_srgb.as_deref());
+            out.atlas_time = packing.elapsed();
             out.texture_ranges = scene
                 .textures
                 .iter()
