@@ -595,6 +595,7 @@ fn test_chart(out: &Path) -> Result<()> {
 /// Call it at the start of `main`, before the program starts threads: it may set one
 /// environment variable for the Vulkan loader (see [`GpuContext::quiet_device_select`]).
 pub fn main_with(library: NodeLibrary) -> ExitCode {
+    progressive::started();
     #[cfg(unix)]
     end_quietly_on_a_closed_pipe();
     GpuContext::quiet_device_select();

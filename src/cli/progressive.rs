@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow, bail};
@@ -23,8 +24,59 @@ pub(super) struct Checkpoints {
     pub every: Option<Duration>,
     /// Go on from this checkpoint.
     pub resume: Option<PathBuf>,
-    /// What is rendered ([`key`]).
-    pub key: u64,
+    /// What is rendered ([`crate::session::render_key`]).
+    pub key: Key,
+}
+
+/// A render's key ([`crate::session::render_key`]), worked out when a checkpoint is first
+/// written: it hashes every number of the scene (about 0.1 s for the Crytek Sponza), which
+/// a render writing no checkpoint would otherwise spend before its first frame.
+#[derive(Clone, Default)]
+pub(super) struct Key {
+    make: Option<Arc<dyn Fn() -> u64 + Send + Sync>>,
+    made: Arc<OnceLock<u64>>,
+}
+
+impl Key {
+    pub(super) fn new(make: impl Fn() -> u64 + Send + Sync + 'static) -> Self {
+        Self {
+            make: Some(Arc::new(make)),
+            made: Arc::default(),
+        }
+    }
+
+    /// The key (0 where none was given).
+    pub(super) fn get(&self) -> u64 {
+        *self
+            .made
+            .get_or_init(|| self.make.as_ref().map_or(0, |make| make()))
+    }
+}
+
+impl std::fmt::Debug for Key {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_tuple("Key").field(&self.made.get()).finish()
+    }
+}
+
+/// When the process started (as near as `main` knows it: [`started`]).
+static START: OnceLock<Instant> = OnceLock::new();
+
+/// Notes the process's start, from which `render` times its first sample.
+pub(super) fn started() {
+    START.get_or_init(Instant::now);
+}
+
+/// Prints how long after the start the first frame the image keeps was finished (the
+/// first `samples_per_frame` samples of every pixel): the time to the first sample,
+/// loading, the GPU layout, pipelines, uploads and the warm-up included.
+fn print_first_sample(spp: u32) {
+    if let Some(start) = START.get() {
+        println!(
+            "first sample: {:.0} ms after the start (the first frame kept, {spp} spp)",
+            start.elapsed().as_secs_f64() * 1e3
+        );
+    }
 }
 
 impl Checkpoints {
@@ -40,7 +92,7 @@ impl Checkpoints {
             path: path.unwrap_or_else(|| out.join("render.checkpoint")),
             every: every.map(Duration::from_secs_f64),
             resume,
-            key: 0,
+            key: Key::default(),
         }
     }
 }
@@ -156,14 +208,20 @@ pub(super) fn render(session: &mut Session, spp: u32, ck: &Checkpoints) -> Resul
     let start = Instant::now();
     let mut last = Instant::now();
     let mut failed = None;
+    // A resumed render's first frames were made by an earlier process.
+    let mut first = ck.resume.is_none();
     let report = session.render_with(spp, |exec, done, _| {
+        if first && done > 0 {
+            first = false;
+            print_first_sample(exec.samples_per_frame());
+        }
         if bar.is_hidden() && start.elapsed() > Duration::from_secs(1) {
             bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
         }
         bar.set_position(u64::from(done));
         if ck.every.is_some_and(|every| last.elapsed() >= every) && done < frames {
             last = Instant::now();
-            if let Err(e) = exec.checkpoint(ck.key).and_then(|c| c.save(&ck.path)) {
+            if let Err(e) = exec.checkpoint(ck.key.get()).and_then(|c| c.save(&ck.path)) {
                 failed = Some(e);
                 return false;
             }
@@ -179,7 +237,7 @@ pub(super) fn render(session: &mut Session, spp: u32, ck: &Checkpoints) -> Resul
         Some(report) => {
             report_speed(exec, start.elapsed(), before)?;
             if ck.every.is_some() {
-                exec.checkpoint(ck.key)?.save(&ck.path)?;
+                exec.checkpoint(ck.key.get())?.save(&ck.path)?;
             }
             Ok(report)
         }
@@ -193,7 +251,7 @@ fn stopped(exec: &mut Executor, spp: u32, frames: u32, ck: &Checkpoints) -> anyh
     if done == 0 {
         return anyhow!("interrupted before the first frame: nothing written");
     }
-    if let Err(e) = exec.checkpoint(ck.key).and_then(|c| c.save(&ck.path)) {
+    if let Err(e) = exec.checkpoint(ck.key.get()).and_then(|c| c.save(&ck.path)) {
         return anyhow!("interrupted at frame {done} of {frames}, and the checkpoint failed: {e}");
     }
     let written = match exec.run_tail() {

@@ -16,6 +16,8 @@ pub(super) fn render(args: &RenderArgs<'_>) -> Result<()> {
         return frames::render(args, frames, *skip_missing);
     }
     let graph = load(args.graph, args.overrides)?;
+    // The adapter and device are made on a thread of their own while the scene loads.
+    let device = std::thread::spawn(GpuContext::headless);
     let mut scene = load_scene(args.scene)?;
     let plan = args
         .library
@@ -25,7 +27,9 @@ pub(super) fn render(args: &RenderArgs<'_>) -> Result<()> {
     if scene.is_some() && !progressive {
         println!("scene not used: no node of this graph renders a scene");
     }
-    let ctx = GpuContext::headless()?;
+    let ctx = device
+        .join()
+        .unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
     println!("adapter: {}", ctx.describe());
     if let (Some(s), true) = (scene.as_mut(), progressive) {
         fit_textures(s, &ctx, args.textures)?;
@@ -68,7 +72,9 @@ pub(super) fn render(args: &RenderArgs<'_>) -> Result<()> {
             .or(scene.as_ref().map(|s| s.scene.settings.spp))
             .unwrap_or(1);
         let mut checkpoints = args.checkpoints.clone();
-        checkpoints.key = crate::session::render_key(&graph, scene.as_ref().map(|s| &*s.gpu));
+        let (g, s) = (graph.clone(), scene.as_ref().map(|s| Arc::clone(&s.gpu)));
+        checkpoints.key =
+            progressive::Key::new(move || crate::session::render_key(&g, s.as_deref()));
         let mut session = Session::from_executor(
             exec,
             graph,

@@ -4,7 +4,8 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use lumagraph_graph::{Plan, TextureId};
+use lumagraph_graph::registry::SAMPLES_PER_FRAME;
+use lumagraph_graph::{ParamValue, Plan, TextureId};
 
 use crate::context::GpuContext;
 use crate::cpu::Image;
@@ -579,7 +580,22 @@ impl Executor {
     /// # Errors
     /// When a node fails; the error names the node.
     pub fn warm_up(&mut self) -> Result<()> {
-        self.run(1, Mode::WarmUp)?;
+        // One sample per pixel: the frame dispatches every pipeline as a whole frame does,
+        // and is thrown away, so its other samples would only delay the first frame kept
+        // (on a CPU adapter most of the warm-up was tracing them).
+        let full = self.plan.clone();
+        let mut one = full.clone();
+        for p in &mut one.passes {
+            if p.params.has(SAMPLES_PER_FRAME) {
+                p.params
+                    .0
+                    .insert(SAMPLES_PER_FRAME.to_owned(), ParamValue::Int(1));
+            }
+        }
+        self.update_params(one)?;
+        let run = self.run(1, Mode::WarmUp);
+        self.update_params(full)?;
+        run?;
         self.reset_history();
         self.counters()?;
         self.reset_history();

@@ -15,7 +15,7 @@ use crate::file::{
     CameraDesc, Environment, LightDesc, MaterialDesc, SceneFile, ShapeDesc, TransformDesc, V3,
     VERSION,
 };
-use crate::import::import_mesh;
+use crate::import::import_mesh_with;
 use crate::scene::{
     Camera, LoadReport, Material, Medium, PunctualLight, Scene, Shape, cube_quads, push_triangle,
     quad_triangles, rectangle_quad, transform_triangle,
@@ -865,7 +865,7 @@ impl<'a> Builder<'a> {
             .collect::<Result<Vec<_>, _>>()?;
         let over = material.map(|m| self.lookup(m)).transpose()?;
         let full = self.base_dir.join(path);
-        let mut mesh = import_mesh(&full, t)?;
+        let mut mesh = import_mesh_with(&full, t, diffuse)?;
         if diffuse {
             reduce_to_diffuse(&mut mesh);
         }

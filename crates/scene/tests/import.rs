@@ -272,3 +272,69 @@ fn obj_textures_are_read() {
         "{e}"
     );
 }
+
+/// A `Mesh`'s `diffuse: true` reduces a glTF file's materials before its images are decoded:
+/// only the base colour is decoded (the roughness map is not, and a normal map that cannot
+/// be decoded is no error), and the textures and materials are those of the whole import
+/// reduced afterwards.
+#[test]
+fn a_diffuse_gltf_decodes_only_its_base_colours() {
+    use lumagraph_scene::NO_TEXTURE;
+    use lumagraph_scene::import::import_mesh_with;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    png(&d.join("rough.png"), 2, 2, |x, y| {
+        [0, (x * 100) as u8, (y * 100) as u8]
+    });
+    png(&d.join("base.png"), 4, 2, |x, y| {
+        [x as u8 * 60, y as u8 * 90, 200]
+    });
+    png(&d.join("normal.png"), 2, 2, |_, _| [128, 128, 255]);
+    // Positions, then texture coordinates: one triangle.
+    let floats: [f32; 15] = [
+        0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0,
+    ];
+    let bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
+    std::fs::write(d.join("m.bin"), &bytes).unwrap();
+    let gltf = r#"{
+  "asset": {"version": "2.0"},
+  "scene": 0,
+  "scenes": [{"nodes": [0]}],
+  "nodes": [{"mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 0}]}],
+  "materials": [{"name": "stone", "normalTexture": {"index": 2},
+    "pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": 0}, "baseColorTexture": {"index": 1}}}],
+  "textures": [{"source": 0}, {"source": 1}, {"source": 2}],
+  "images": [{"uri": "rough.png"}, {"uri": "base.png"}, {"uri": "normal.png"}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+    {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}],
+  "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
+  "buffers": [{"byteLength": 60, "uri": "m.bin"}]
+}"#;
+    std::fs::write(d.join("m.gltf"), gltf).unwrap();
+    let path = d.join("m.gltf");
+    let whole = import_mesh(&path, Mat4::IDENTITY).unwrap();
+    assert_eq!(whole.decode.images, 3);
+    let diffuse = import_mesh_with(&path, Mat4::IDENTITY, true).unwrap();
+    assert_eq!(diffuse.decode.images, 1);
+    assert_eq!(diffuse.textures.len(), 1);
+    let (m, full) = (&diffuse.materials[0], &whole.materials[0]);
+    let mut expected = full.as_diffuse();
+    expected.textures.base_color = 0;
+    assert_eq!(m, &expected);
+    let (t, base) = (
+        &diffuse.textures[0],
+        &whole.textures[full.textures.base_color as usize],
+    );
+    assert_eq!(
+        (t.width, t.height, &t.texels, &t.name),
+        (base.width, base.height, &base.texels, &base.name)
+    );
+    assert_eq!(m.textures.normal, NO_TEXTURE);
+    // The normal map unreadable: the whole import fails, the diffuse one does not read it.
+    std::fs::write(d.join("normal.png"), b"not a PNG").unwrap();
+    assert!(import_mesh(&path, Mat4::IDENTITY).is_err());
+    let again = import_mesh_with(&path, Mat4::IDENTITY, true).unwrap();
+    assert_eq!(again.textures[0].texels, t.texels);
+}

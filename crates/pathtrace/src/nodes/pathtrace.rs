@@ -278,27 +278,42 @@ impl PathTrace {
         } else {
             CPU_SAMPLES_PER_DISPATCH[0]
         };
-        let backend = features.kind().build(ctx, &scene)?;
-        let wavefront = features
-            .on(Feature::Wavefront)
-            .then(|| crate::wavefront::Wavefront::new(ctx));
         let (main, entries) = entry_points(&features);
-        let kernel = Kernel::with_entries(
-            ctx,
-            "pathtrace/integrator/pathtrace.wgsl",
-            &source,
-            main,
-            entries,
-        )?;
-        let env = match &scene.environment_map {
-            Some(path) => crate::env_map::EnvMap::load(
-                ctx,
-                path,
-                pass.params.str("env_sampling") == "uniform",
-            )?,
-            None => crate::env_map::EnvMap::empty(ctx),
-        };
-        let ggx_table = crate::bsdf_tables::upload(ctx, features.on(Feature::Sheen));
+        // The pipelines compile on a thread of their own (a CPU adapter's driver takes most
+        // of a second over the path tracer's) while this one builds the intersector (Embree's
+        // BVH, for host intersection), loads the environment map and uploads the tables.
+        let (kernel, backend, wavefront, env, ggx_table) = std::thread::scope(|s| {
+            let kernel = s.spawn(|| {
+                Kernel::with_entries(
+                    ctx,
+                    "pathtrace/integrator/pathtrace.wgsl",
+                    &source,
+                    main,
+                    entries,
+                )
+            });
+            let rest = (|| {
+                let backend = features.kind().build(ctx, &scene)?;
+                let wavefront = features
+                    .on(Feature::Wavefront)
+                    .then(|| crate::wavefront::Wavefront::new(ctx));
+                let env = match &scene.environment_map {
+                    Some(path) => crate::env_map::EnvMap::load(
+                        ctx,
+                        path,
+                        pass.params.str("env_sampling") == "uniform",
+                    )?,
+                    None => crate::env_map::EnvMap::empty(ctx),
+                };
+                let ggx_table = crate::bsdf_tables::upload(ctx, features.on(Feature::Sheen));
+                Ok::<_, RenderError>((backend, wavefront, env, ggx_table))
+            })();
+            let kernel = kernel
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            let (backend, wavefront, env, ggx_table) = rest?;
+            Ok::<_, RenderError>((kernel?, backend, wavefront, env, ggx_table))
+        })?;
         // Outputs nothing reads are bound to 1x1 stand-ins (stores outside them are dropped).
         let one = lumagraph_graph::Extent::new(1, 1);
         let unused = [

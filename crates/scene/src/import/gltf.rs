@@ -47,6 +47,19 @@ use crate::texture::{Texture, UvTransform, Wrap};
 /// # Errors
 /// When the file or its buffers cannot be read or are not valid glTF.
 pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneError> {
+    import_gltf_with(path, transform, false)
+}
+
+/// [`import_gltf`], with the materials reduced to [`Material::as_diffuse`] before the
+/// images are decoded where `diffuse`, so that only the images they still read are.
+///
+/// # Errors
+/// As [`import_gltf`].
+pub fn import_gltf_with(
+    path: &Path,
+    transform: Mat4,
+    diffuse: bool,
+) -> Result<ImportedMesh, SceneError> {
     let (file, unread) = open(path)?;
     check_images(&file.document)?;
     check_uris(&file.document, path.parent())?;
@@ -74,6 +87,12 @@ pub fn import_gltf(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneEr
         let mat = material(doc, &m, &mut decoder, &mut out.report.warnings)
             .map_err(|e| e.about(format!("material \"{}\"", material_name(&m))))?;
         out.materials.push(mat);
+    }
+    if diffuse {
+        for m in &mut out.materials {
+            *m = m.as_diffuse();
+        }
+        decoder.keep_only(&mut out.materials);
     }
     let started = std::time::Instant::now();
     let threads = decoder.threads();
@@ -832,6 +851,23 @@ fn rgba8(data: &::gltf::image::Data) -> Option<Vec<[u8; 4]>> {
     if p.len() < n * channels * bytes {
         return None;
     }
+    // 8-bit channels, the usual case, a pixel at a time (the same texels as below, without
+    // the per-channel indexing).
+    if bytes == 1 {
+        let p = &p[..n * channels];
+        return Some(match channels {
+            4 => p
+                .chunks_exact(4)
+                .map(|c| [c[0], c[1], c[2], c[3]])
+                .collect(),
+            3 => p.chunks_exact(3).map(|c| [c[0], c[1], c[2], 255]).collect(),
+            2 => p
+                .chunks_exact(2)
+                .map(|c| [c[0], c[0], c[0], c[1]])
+                .collect(),
+            _ => p.iter().map(|&v| [v, v, v, 255]).collect(),
+        });
+    }
     let channel = |px: usize, c: usize| -> u8 {
         let i = (px * channels + c) * bytes;
         match bytes {
@@ -920,6 +956,46 @@ impl<'a> Decoder<'a> {
         ));
         self.used.insert(key, index);
         Ok(index)
+    }
+
+    /// Leaves out the textures none of `materials` reads, and the images only they read,
+    /// before anything is decoded; the materials' indices move along (the textures kept
+    /// stay in their order).
+    fn keep_only(&mut self, materials: &mut [Material]) {
+        let mut index = vec![NO_TEXTURE; self.textures.len()];
+        for m in materials.iter() {
+            for t in m.textures.all() {
+                if t != NO_TEXTURE {
+                    index[t as usize] = 0;
+                }
+            }
+        }
+        let mut image_index = vec![usize::MAX; self.users.len()];
+        let mut users = Vec::new();
+        let mut kept = Vec::new();
+        for (i, (t, image)) in std::mem::take(&mut self.textures).into_iter().enumerate() {
+            if index[i] == NO_TEXTURE {
+                continue;
+            }
+            if image_index[image] == usize::MAX {
+                image_index[image] = users.len();
+                users.push(self.users[image].clone());
+            }
+            index[i] = kept.len() as u32;
+            kept.push((t, image_index[image]));
+        }
+        self.textures = kept;
+        self.users = users;
+        // The maps from glTF textures are for reading materials, which is done.
+        self.used.clear();
+        self.decoded.clear();
+        for m in materials {
+            for t in m.textures.all_mut() {
+                if *t != NO_TEXTURE {
+                    *t = index[*t as usize];
+                }
+            }
+        }
     }
 
     /// Threads [`Decoder::decode_all`] uses: what [`set_decode_threads`] gave, else the

@@ -70,13 +70,28 @@ impl DecodeStats {
 /// When the file cannot be read or parsed, or its extension is not one of these; the
 /// error names the file.
 pub fn import_mesh(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneError> {
+    import_mesh_with(path, transform, false)
+}
+
+/// [`import_mesh`], with every material reduced to [`crate::scene::Material::as_diffuse`]
+/// where `diffuse` (a `Mesh`'s `diffuse: true`): a glTF file then decodes only the images
+/// the reduced materials read (the Crytek Sponza's base colours, not its normal and
+/// roughness maps), which takes half its loading off.
+///
+/// # Errors
+/// As [`import_mesh`].
+pub fn import_mesh_with(
+    path: &Path,
+    transform: Mat4,
+    diffuse: bool,
+) -> Result<ImportedMesh, SceneError> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
     let result = match ext.as_str() {
-        "gltf" | "glb" => gltf::import_gltf(path, transform),
+        "gltf" | "glb" => gltf::import_gltf_with(path, transform, diffuse),
         "obj" => obj::import_obj(path, transform),
         "ply" => ply::import_ply(path, transform),
         _ => Err(SceneError::new(ErrorKind::MeshType(ext))),

@@ -149,12 +149,17 @@ pub fn import_obj(path: &Path, transform: Mat4) -> Result<ImportedMesh, SceneErr
 fn check_obj(text: &str) -> Option<String> {
     const KEYS: [&str; 3] = ["v", "vt", "vn"];
     const WHAT: [&str; 3] = ["vertex", "texture coordinate", "normal"];
-    let count = |key: &str| {
-        text.lines()
-            .filter(|l| l.split_whitespace().next() == Some(key))
-            .count()
-    };
-    let totals = KEYS.map(count);
+    // The elements of each kind, in one pass over the lines.
+    let mut totals = [0usize; 3];
+    for line in text.lines() {
+        if let Some(k) = line
+            .split_whitespace()
+            .next()
+            .and_then(|key| KEYS.iter().position(|&x| x == key))
+        {
+            totals[k] += 1;
+        }
+    }
     let mut seen = [0usize; 3];
     for (i, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
