@@ -229,33 +229,11 @@ fn place_instances(mesh: &mut crate::import::ImportedMesh, places: &[Mat4], name
 /// the textures none of them reads any more left out (they were decoded with the file, but
 /// take no place in the atlas).
 fn reduce_to_diffuse(mesh: &mut crate::import::ImportedMesh) {
-    use crate::scene::NO_TEXTURE;
     for m in &mut mesh.materials {
         *m = m.as_diffuse();
     }
-    let mut index = vec![NO_TEXTURE; mesh.textures.len()];
-    for m in &mesh.materials {
-        for t in m.textures.all() {
-            if t != NO_TEXTURE {
-                index[t as usize] = 0;
-            }
-        }
-    }
-    let mut kept = Vec::new();
-    for (i, t) in std::mem::take(&mut mesh.textures).into_iter().enumerate() {
-        if index[i] != NO_TEXTURE {
-            index[i] = kept.len() as u32;
-            kept.push(t);
-        }
-    }
-    mesh.textures = kept;
-    for m in &mut mesh.materials {
-        for t in m.textures.all_mut() {
-            if *t != NO_TEXTURE {
-                *t = index[*t as usize];
-            }
-        }
-    }
+    let textures = std::mem::take(&mut mesh.textures);
+    mesh.textures = crate::scene::keep_read_textures(&mut mesh.materials, textures);
 }
 
 /// The conductor a material description names or gives, if any.

@@ -119,6 +119,35 @@ impl MaterialTextures {
     }
 }
 
+/// Leaves out of `textures` (a mesh's, by index) those none of `materials` reads, keeping
+/// the others in their order, and moves the materials' indices along (`diffuse: true`
+/// reduces materials and then drops what they no longer read).
+pub(crate) fn keep_read_textures<T>(materials: &mut [Material], textures: Vec<T>) -> Vec<T> {
+    let mut index = vec![NO_TEXTURE; textures.len()];
+    for m in materials.iter() {
+        for t in m.textures.all() {
+            if t != NO_TEXTURE {
+                index[t as usize] = 0;
+            }
+        }
+    }
+    let mut kept = Vec::new();
+    for (i, t) in textures.into_iter().enumerate() {
+        if index[i] != NO_TEXTURE {
+            index[i] = kept.len() as u32;
+            kept.push(t);
+        }
+    }
+    for m in materials {
+        for t in m.textures.all_mut() {
+            if *t != NO_TEXTURE {
+                *t = index[*t as usize];
+            }
+        }
+    }
+    kept
+}
+
 /// The scene's material, its lobe parameters' fields from `lobe_params!`
 /// ([`crate::lobes`]), and [`Material::named`], which gives every field the file format's
 /// default.

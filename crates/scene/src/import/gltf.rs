@@ -962,40 +962,24 @@ impl<'a> Decoder<'a> {
     /// before anything is decoded; the materials' indices move along (the textures kept
     /// stay in their order).
     fn keep_only(&mut self, materials: &mut [Material]) {
-        let mut index = vec![NO_TEXTURE; self.textures.len()];
-        for m in materials.iter() {
-            for t in m.textures.all() {
-                if t != NO_TEXTURE {
-                    index[t as usize] = 0;
-                }
-            }
-        }
+        let textures = std::mem::take(&mut self.textures);
+        let kept = crate::scene::keep_read_textures(materials, textures);
         let mut image_index = vec![usize::MAX; self.users.len()];
         let mut users = Vec::new();
-        let mut kept = Vec::new();
-        for (i, (t, image)) in std::mem::take(&mut self.textures).into_iter().enumerate() {
-            if index[i] == NO_TEXTURE {
-                continue;
-            }
-            if image_index[image] == usize::MAX {
-                image_index[image] = users.len();
-                users.push(self.users[image].clone());
-            }
-            index[i] = kept.len() as u32;
-            kept.push((t, image_index[image]));
-        }
-        self.textures = kept;
+        self.textures = kept
+            .into_iter()
+            .map(|(t, image)| {
+                if image_index[image] == usize::MAX {
+                    image_index[image] = users.len();
+                    users.push(self.users[image].clone());
+                }
+                (t, image_index[image])
+            })
+            .collect();
         self.users = users;
         // The maps from glTF textures are for reading materials, which is done.
         self.used.clear();
         self.decoded.clear();
-        for m in materials {
-            for t in m.textures.all_mut() {
-                if *t != NO_TEXTURE {
-                    *t = index[*t as usize];
-                }
-            }
-        }
     }
 
     /// Threads [`Decoder::decode_all`] uses: what [`set_decode_threads`] gave, else the
