@@ -413,10 +413,11 @@ fn multi_uv_test_reads_the_second_set() {
             spp: 4,
         },
     );
-    // Full-resolution lookups, as the CPU mirror's expectation (`atlas.sample`) makes them:
-    // with mip levels (the default) the render is the texture filtered over each pixel's
-    // cone, 5.9 % from that expectation (measured), not a wrong UV set.
-    s.settings.texture_mips = false;
+    // With mip levels (the default): emission is read at level 0 at every hit, as light
+    // sampling reads it, so the render is the full-resolution lookups the CPU mirror's
+    // expectation (`atlas.sample`) makes. When a hit read emission at its cone's level, it
+    // was the texture filtered over each pixel's cone, 5.9 % from that expectation.
+    assert!(s.settings.texture_mips);
     no_warnings(&s);
     let m = &s.materials[0];
     let emissive = m.textures.emissive as usize;
